@@ -1,0 +1,99 @@
+"""What the full and reduced models share: scene constants, loads and the observation map."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..loads import LoadSet
+from ..scene import Scene
+from .base import OdeModel, OdeSystem
+from .paper_matrices import (VARIANTS, angle_differences, assemble_mass, chain_constants, damping_matrix,
+                             generalized_forces, node_positions, stiffness_matrix)
+
+
+class PaperSystem(OdeSystem):
+    """Base of the paper's ODE systems. Subclasses provide ``rhs`` and ``bending`` (alpha,
+    beta, alpha', beta' at output times)."""
+
+    def __init__(self, scene: Scene, coefficients: str = "printed"):
+        chain = scene.chain
+        self.scene = scene
+        self.n = chain.n
+        self.l = chain.l
+        self.cc = chain_constants(chain, coefficients)
+        self.K = stiffness_matrix(chain)
+        self.C = damping_matrix(chain)
+        self.damped = bool(np.any(chain.nu > 0))
+        self.loads = LoadSet(scene.loads, chain.n)
+        self.initial = scene.initial.resolve(chain.n)
+
+    def generalized_force(self, t: float, phi: np.ndarray) -> np.ndarray | None:
+        """Q(phi, t) (N m) on the phi coordinates, or None when no load acts at t."""
+        sums = self.loads.suffix_sums(t)
+        return None if sums is None else generalized_forces(self.l, phi, *sums)
+
+    def rigid(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """phi, phi' from a state history Y (nt, N)."""
+        raise NotImplementedError
+
+    def bending(self, times: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, ...]:
+        """alpha, beta, alpha', beta' (each (nt, n)) from a state history."""
+        raise NotImplementedError
+
+    def observe(self, times, Y):
+        scene, n = self.scene, self.n
+        rods = np.arange(1, n + 1)
+        phi, dphi = self.rigid(Y)
+        out = {}
+        if scene.wants("phi"):
+            out["phi"] = (phi, rods)
+        if scene.wants("dphi"):
+            out["dphi"] = (dphi, rods)
+        if scene.wants("alpha", "beta", "energy"):
+            alpha, beta, dalpha, dbeta = self.bending(times, Y)
+            if scene.wants("alpha"):
+                out["alpha"] = (alpha, rods)
+            if scene.wants("beta"):
+                out["beta"] = (beta, rods)
+        if scene.wants("x", "y"):
+            x, y = node_positions(self.l, phi)
+            nodes = np.arange(0, n + 1)
+            if scene.wants("x"):
+                out["x"] = (x, nodes)
+            if scene.wants("y"):
+                out["y"] = (y, nodes)
+        if scene.wants("energy"):
+            kin, pot = self.energies(phi, dphi, alpha, beta, dalpha, dbeta)
+            zero = np.zeros(1, dtype=int)
+            out["kinetic"] = (kin[:, None], zero)
+            out["potential"] = (pot[:, None], zero)
+            out["energy"] = ((kin + pot)[:, None], zero)
+        return out
+
+    def energies(self, phi, dphi, alpha, beta, dalpha, dbeta) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic T = 1/2 q'^T M(phi) q' with the kinematic (printed) mass matrix, and
+        Pi = 1/2 q^T K q (J), per output time."""
+        cc = self.cc if self.cc.variant == "printed" else chain_constants(self.scene.chain)
+        q = np.concatenate([phi, alpha, beta], axis=1)
+        v = np.concatenate([dphi, dalpha, dbeta], axis=1)
+        kin = np.array([0.5 * vi @ assemble_mass(cc, angle_differences(p)[0]) @ vi
+                        for p, vi in zip(phi, v)])
+        pot = 0.5 * np.einsum("ti,ij,tj->t", q, self.K, q)
+        return kin, pot
+
+
+class PaperModel(OdeModel):
+    """A model of the paper. ``coefficients``: "printed" (default, from the kinematics) or
+    "published" (the erratum that reproduces the paper's alpha/beta; see paper_matrices)."""
+
+    system_class: type[PaperSystem]
+
+    def __init__(self, coefficients: str = "printed"):
+        if coefficients not in VARIANTS:
+            raise ValueError(f"coefficients must be one of {VARIANTS}, got {coefficients!r}")
+        self.coefficients = coefficients
+
+    def options(self):
+        return {"coefficients": self.coefficients}
+
+    def system(self, scene: Scene) -> PaperSystem:
+        return self.system_class(scene, self.coefficients)

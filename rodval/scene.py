@@ -1,0 +1,246 @@
+"""What to simulate: the chain, its loads, its initial state, the horizon and the outputs.
+
+Conventions (used throughout rodval)
+-----------------------------------
+* Rods k = 1..n join node k-1 to node k; node 0 is pinned at the origin. Arrays indexed by rod
+  are 0-based numpy arrays of length n (entry i is rod i+1).
+* ``phi_k`` (rad) is the angle of the chord node k-1 -> node k from the global x axis,
+  counter-clockwise positive. ``alpha_k``, ``beta_k`` (rad) are the angles from that chord to
+  the bent rod's tangent at its left (node k-1) and right (node k) end, counter-clockwise
+  positive. ``dphi`` is d(phi)/dt in rad/s.
+* Hinge k (k = 0..n-1) sits at node k, between rod k and rod k+1 (hinge 0: ground and rod 1).
+  ``kappa[i]``, ``nu[i]`` belong to hinge i. The tip node n has no hinge.
+* ``mu[i]`` (kg) is the point mass at node i+1.
+* Units: m, kg, s, N, rad. ``m`` is mass per length (kg/m), ``EI`` in N m^2, ``kappa`` in
+  N m/rad, ``nu`` in N m s/rad.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Iterable, Mapping
+
+import numpy as np
+
+from .loads import NodalForce
+
+#: Quantities a scene may ask for. "x"/"y" are node positions (k = 0..n); "energy" yields
+#: kinetic, potential and total energy (k = 0).
+QUANTITIES = ("phi", "dphi", "alpha", "beta", "x", "y", "energy")
+ENERGY_QUANTITIES = ("kinetic", "potential", "energy")
+
+
+def _as_rod_array(name: str, value, n: int, *, positive: bool) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or have length n = {n}, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    if positive and np.any(arr <= 0):
+        raise ValueError(f"{name} must be > 0 (allowed range (0, inf)), got {arr.tolist()}")
+    if not positive and np.any(arr < 0):
+        raise ValueError(f"{name} must be >= 0 (allowed range [0, inf)), got {arr.tolist()}")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class Chain:
+    """Physical data of a plane chain of n rods (see module docstring for conventions).
+
+    Scalars are broadcast to all rods/nodes/hinges.
+    """
+
+    l: np.ndarray
+    m: np.ndarray
+    EI: np.ndarray
+    mu: np.ndarray
+    kappa: np.ndarray
+    nu: np.ndarray
+
+    @classmethod
+    def uniform(cls, n: int, *, l=2.0, m=3.0, EI=1e5, mu=3.0, kappa=100.0, nu=0.01) -> "Chain":
+        """Chain of n rods; each argument is a scalar or a length-n sequence."""
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+            raise ValueError(f"n (number of rods) must be an integer >= 1, got {n!r}")
+        return cls(l=l, m=m, EI=EI, mu=mu, kappa=kappa, nu=nu, _n=int(n))  # type: ignore[call-arg]
+
+    def __init__(self, l, m, EI, mu, kappa, nu, _n: int | None = None):
+        n = _n
+        if n is None:
+            sizes = [np.size(v) for v in (l, m, EI, mu, kappa, nu) if np.ndim(v) > 0]
+            n = sizes[0] if sizes else 1
+        if n < 1:
+            raise ValueError(f"n (number of rods) must be >= 1, got {n}")
+        set_ = object.__setattr__
+        set_(self, "l", _as_rod_array("l (rod length)", l, n, positive=True))
+        set_(self, "m", _as_rod_array("m (mass per length)", m, n, positive=True))
+        set_(self, "EI", _as_rod_array("EI (bending stiffness)", EI, n, positive=True))
+        set_(self, "mu", _as_rod_array("mu (node mass)", mu, n, positive=False))
+        set_(self, "kappa", _as_rod_array("kappa (hinge stiffness)", kappa, n, positive=False))
+        set_(self, "nu", _as_rod_array("nu (hinge damping)", nu, n, positive=False))
+
+    @property
+    def n(self) -> int:
+        return self.l.shape[0]
+
+    def as_dict(self) -> dict[str, list[float]]:
+        return {k: getattr(self, k).tolist() for k in ("l", "m", "EI", "mu", "kappa", "nu")}
+
+    def with_(self, **changes) -> "Chain":
+        """A copy with some fields replaced (scalars broadcast)."""
+        d = {k: getattr(self, k) for k in ("l", "m", "EI", "mu", "kappa", "nu")}
+        d.update(changes)
+        return Chain(**d, _n=self.n)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Chain) and all(
+            np.array_equal(getattr(self, k), getattr(other, k))
+            for k in ("l", "m", "EI", "mu", "kappa", "nu"))
+
+    def __hash__(self):  # pragma: no cover - frozen dataclass with arrays
+        return hash(tuple(getattr(self, k).tobytes() for k in ("l", "m", "EI", "mu", "kappa", "nu")))
+
+
+@dataclass(frozen=True, eq=False)
+class InitialState:
+    """Initial generalized coordinates and rates; ``None`` means zeros (straight, at rest).
+
+    A model that has no bending coordinates (the reduced model) ignores alpha/beta entries.
+    """
+
+    phi: np.ndarray | None = None
+    dphi: np.ndarray | None = None
+    alpha: np.ndarray | None = None
+    beta: np.ndarray | None = None
+    dalpha: np.ndarray | None = None
+    dbeta: np.ndarray | None = None
+
+    def resolve(self, n: int) -> dict[str, np.ndarray]:
+        out = {}
+        for key in ("phi", "dphi", "alpha", "beta", "dalpha", "dbeta"):
+            v = getattr(self, key)
+            if v is None:
+                out[key] = np.zeros(n)
+                continue
+            arr = np.asarray(v, dtype=float)
+            if arr.ndim == 0:
+                arr = np.full(n, float(arr))
+            if arr.shape != (n,):
+                raise ValueError(f"initial {key} must be a scalar or have length n = {n}, "
+                                 f"got shape {arr.shape}")
+            if not np.all(np.isfinite(arr)):
+                raise ValueError(f"initial {key} must be finite, got {arr.tolist()}")
+            out[key] = arr
+        return out
+
+
+def default_times(t_end: float, num: int = 201) -> np.ndarray:
+    return np.linspace(0.0, t_end, num)
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A complete simulation request: the *what*, independent of any model or integrator.
+
+    Parameters
+    ----------
+    chain : Chain
+    loads : sequence of NodalForce
+    t_end : float
+        Horizon (s), > 0. Integration runs over [0, t_end].
+    times : array_like, optional
+        Output times (s), sorted ascending, within [0, t_end]. Default: 201 equally spaced.
+    outputs : iterable of str
+        Quantities to compute, from ``QUANTITIES``. Nothing else is computed.
+    initial : InitialState
+    name : str
+    """
+
+    chain: Chain
+    loads: tuple[NodalForce, ...] = ()
+    t_end: float = 2.0
+    times: np.ndarray | None = None
+    outputs: tuple[str, ...] = ("phi", "dphi", "alpha", "beta")
+    initial: InitialState = field(default_factory=InitialState)
+    name: str = "scene"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.chain, Chain):
+            raise ValueError(f"chain must be a rodval.Chain, got {type(self.chain).__name__}")
+        n = self.chain.n
+        try:
+            t_end = float(self.t_end)
+        except (TypeError, ValueError):
+            raise ValueError(f"t_end (horizon) must be a number > 0 s, got {self.t_end!r}") from None
+        if not (math.isfinite(t_end) and t_end > 0):
+            raise ValueError(f"t_end (horizon) must be finite and > 0 s, got {self.t_end!r}")
+        object.__setattr__(self, "t_end", t_end)
+        loads = tuple(self.loads)
+        for f in loads:
+            if not isinstance(f, NodalForce):
+                raise ValueError(f"loads must be NodalForce objects, got {type(f).__name__}")
+            if f.node > n:
+                raise ValueError(f"load node must be in 1..n = 1..{n}, got {f.node}")
+        object.__setattr__(self, "loads", loads)
+        times = default_times(t_end) if self.times is None else np.asarray(self.times, float)
+        if times.ndim != 1 or times.size == 0:
+            raise ValueError("times (output times) must be a non-empty 1-D sequence of seconds")
+        if not np.all(np.isfinite(times)):
+            raise ValueError(f"times (output times) must be finite, got {times.tolist()}")
+        if np.any(np.diff(times) <= 0):
+            raise ValueError("times (output times) must be strictly increasing")
+        if times[0] < 0 or times[-1] > t_end * (1 + 1e-12):
+            raise ValueError(f"times (output times) must lie in [0, t_end] = [0, {t_end}], "
+                             f"got [{times[0]}, {times[-1]}]")
+        times = times.copy()
+        times.setflags(write=False)
+        object.__setattr__(self, "times", times)
+        outputs = (self.outputs,) if isinstance(self.outputs, str) else tuple(self.outputs)
+        bad = [q for q in outputs if q not in QUANTITIES]
+        if bad or not outputs:
+            raise ValueError(f"outputs must be a non-empty subset of {QUANTITIES}, got {list(outputs)}")
+        object.__setattr__(self, "outputs", tuple(dict.fromkeys(outputs)))
+        if not isinstance(self.initial, InitialState):
+            raise ValueError("initial must be a rodval.InitialState")
+        self.initial.resolve(n)  # validate now, before any work
+
+    @property
+    def n(self) -> int:
+        return self.chain.n
+
+    @property
+    def breakpoints(self) -> np.ndarray:
+        """Sorted load kinks strictly inside (0, t_end), where integration restarts."""
+        bps = {b for f in self.loads for b in f.breakpoints if 0 < b < self.t_end}
+        return np.array(sorted(bps))
+
+    def with_(self, **changes) -> "Scene":
+        """A copy with fields replaced (validated again)."""
+        return replace(self, **changes)
+
+    def wants(self, *quantities: str) -> bool:
+        return any(q in self.outputs for q in quantities)
+
+
+def paper_scene(n: int = 8, *, t_end: float = 2.0, times: Iterable[float] | None = None,
+                outputs: Iterable[str] = ("phi", "dphi", "alpha", "beta"),
+                load_node: int | None = None, **chain_overrides: Mapping) -> Scene:
+    """The example of the paper (section 3): n uniform rods, the pulse at the last node.
+
+    l = 2 m, m = 3 kg/m, mu = 3 kg, EI = 1e5 N m^2, kappa = 100 N m/rad, nu = 0.01 N m s/rad,
+    Xbar = -150 N, Ybar = 1200 N, T = 1 s; straight along x at rest; 0 <= t <= 2 T.
+    """
+    from .loads import pulse
+
+    chain = Chain.uniform(n, **chain_overrides)
+    node = n if load_node is None else load_node
+    return Scene(chain=chain, loads=(pulse(node),), t_end=t_end,
+                 times=None if times is None else np.asarray(list(times), float),
+                 outputs=tuple(outputs), name=f"paper-n{n}")
+
+
+#: Output times of the paper's Table 1 and Fig. 3 (s).
+TABLE1_TIMES = (0.5, 1.0, 1.5, 2.0)
