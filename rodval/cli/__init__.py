@@ -1,0 +1,41 @@
+"""The ``rodval`` command. Each subcommand lives in its own module exposing
+``register(subparsers)``; bad options exit with status 2 and a one-line message."""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+#: Subcommand modules, in the order ``rodval --help`` lists them.
+COMMANDS = ("simulate",)
+
+
+class CliError(Exception):
+    """A user error: printed as one line, exit status 2."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="rodval",
+        description="Cross-validate plane rod-chain models: the paper's full and reduced "
+                    "models against each other and an independent exudyn beam model.")
+    from .. import __version__
+    parser.add_argument("--version", action="version", version=f"rodval {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in COMMANDS:
+        importlib.import_module(f"{__name__}.{name}").register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (CliError, ValueError, FileNotFoundError) as exc:
+        print(f"rodval {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

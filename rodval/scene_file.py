@@ -1,0 +1,139 @@
+"""Scenes from TOML files or plain dicts (the format studies reuse for their base scene).
+
+Format (every key optional except where noted)::
+
+    base = "paper"            # start from the paper example; omitted: "paper" as well
+    name = "my-chain"
+    n = 8                     # number of rods (the paper's per-rod data are repeated)
+    t_end = 2.0               # horizon, s
+    times = [0.5, 1.0, 1.5, 2.0]          # or {start = 0.0, stop = 2.0, num = 201}
+    outputs = ["phi", "dphi", "alpha", "beta"]   # from rodval.scene.QUANTITIES
+
+    [chain]                   # scalars or lists of length n
+    l = 2.0
+    m = 3.0
+    EI = 1e5
+    mu = 3.0
+    kappa = 100.0
+    nu = 0.01
+
+    [[loads]]                 # replaces the base scene's loads; `loads = []` for none
+    type = "pulse"            # pulse: node, Xbar, Ybar, T;  constant: node, X, Y, t_on, t_off
+    node = 8
+
+    [initial]                 # scalars or lists of length n (rad, rad/s)
+    phi = 0.0
+"""
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .loads import LOAD_FACTORIES
+from .scene import QUANTITIES, Chain, InitialState, Scene, paper_scene
+
+BASES = ("paper",)
+TOP_KEYS = {"base", "name", "n", "t_end", "times", "outputs", "chain", "loads", "initial"}
+CHAIN_KEYS = {"l", "m", "EI", "mu", "kappa", "nu"}
+INITIAL_KEYS = {"phi", "dphi", "alpha", "beta", "dalpha", "dbeta"}
+TIMES_KEYS = {"start", "stop", "num"}
+
+
+def _check_keys(d: dict, allowed: set[str], where: str) -> None:
+    if not isinstance(d, dict):
+        raise ValueError(f"{where}: expected a table, got {type(d).__name__}")
+    unknown = sorted(set(d) - allowed)
+    if unknown:
+        raise ValueError(f"{where}: unknown key {unknown[0]!r} (allowed: {', '.join(sorted(allowed))})")
+
+
+def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
+    if value is None:
+        return None
+    if isinstance(value, dict):
+        _check_keys(value, TIMES_KEYS, f"{where} key 'times'")
+        try:
+            num = int(value.get("num", 201))
+            start = float(value.get("start", 0.0))
+            stop = float(value.get("stop", t_end))
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{where} key 'times': {exc}") from None
+        if num < 1:
+            raise ValueError(f"{where} key 'times': num must be >= 1, got {num}")
+        return np.linspace(start, stop, num)
+    if isinstance(value, (list, tuple)):
+        try:
+            return np.array([float(v) for v in value])
+        except (TypeError, ValueError):
+            raise ValueError(f"{where} key 'times': must be a list of numbers (s)") from None
+    raise ValueError(f"{where} key 'times': must be a list of seconds or a table {{start, stop, num}}")
+
+
+def _load(spec: dict, where: str):
+    if not isinstance(spec, dict) or "type" not in spec:
+        raise ValueError(f"{where}: each load needs a 'type' (one of {', '.join(LOAD_FACTORIES)})")
+    kind = spec["type"]
+    if kind not in LOAD_FACTORIES:
+        raise ValueError(f"{where}: load type must be one of {', '.join(LOAD_FACTORIES)}, got {kind!r}")
+    args = {k: v for k, v in spec.items() if k != "type"}
+    try:
+        return LOAD_FACTORIES[kind](**args)
+    except TypeError as exc:
+        raise ValueError(f"{where}: load {kind!r}: {exc}") from None
+
+
+def scene_from_dict(d: dict, where: str = "scene") -> Scene:
+    """Build and validate a Scene from the dict form (see module docstring).
+
+    Every error is a ValueError that names ``where`` (a file name) and the offending key.
+    """
+    _check_keys(d, TOP_KEYS, where)
+    base = d.get("base", "paper")
+    if base not in BASES:
+        raise ValueError(f"{where} key 'base': must be one of {BASES}, got {base!r}")
+    try:
+        n = d.get("n", 8)
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise ValueError(f"key 'n' (number of rods) must be an integer >= 1, got {n!r}")
+        t_end = d.get("t_end", 2.0)
+        if isinstance(t_end, bool) or not isinstance(t_end, (int, float)):
+            raise ValueError(f"key 't_end' (horizon) must be a number > 0 s, got {t_end!r}")
+        scene = paper_scene(n, t_end=float(t_end))
+        chain_spec = d.get("chain", {})
+        _check_keys(chain_spec, CHAIN_KEYS, f"{where} [chain]")
+        chain = Chain(**{**scene.chain.as_dict(), **chain_spec}, _n=n) if chain_spec else scene.chain
+        loads = scene.loads
+        if "loads" in d:
+            if not isinstance(d["loads"], list):
+                raise ValueError("key 'loads' must be an array of tables [[loads]]")
+            loads = tuple(_load(s, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"]))
+        init_spec = d.get("initial", {})
+        _check_keys(init_spec, INITIAL_KEYS, f"{where} [initial]")
+        outputs = d.get("outputs", scene.outputs)
+        if isinstance(outputs, str) or not isinstance(outputs, (list, tuple)):
+            raise ValueError(f"key 'outputs' must be a list from {QUANTITIES}, got {outputs!r}")
+        return Scene(chain=chain, loads=loads, t_end=float(t_end),
+                     times=_times(d.get("times"), float(t_end), where),
+                     outputs=tuple(outputs), initial=InitialState(**init_spec),
+                     name=str(d.get("name", scene.name)))
+    except ValueError as exc:
+        msg = str(exc)
+        raise ValueError(msg if msg.startswith(where) else f"{where}: {msg}") from None
+
+
+def load_scene(source: str | Path) -> Scene:
+    """``"paper"`` (the paper's example) or the path of a TOML scene file."""
+    if str(source) in BASES:
+        return scene_from_dict({"base": str(source)}, where=str(source))
+    path = Path(source)
+    if not path.is_file():
+        raise ValueError(f"SCENE must be 'paper' or an existing TOML file, got {str(source)!r}")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{path}: malformed TOML: {exc}") from None
+    data.setdefault("name", path.stem)
+    return scene_from_dict(data, where=str(path))
