@@ -30,6 +30,12 @@ def _segments(scene: Scene) -> list[tuple[float, float]]:
     return list(zip(edges[:-1], edges[1:]))
 
 
+def _add_counts(stats: SolverStats, solver) -> None:
+    stats.nfev += solver.nfev
+    stats.njev += solver.njev
+    stats.nlu += solver.nlu
+
+
 def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
               model: str, options: dict | None = None) -> Trajectory:
     """Integrate ``system`` over [0, scene.t_end] and observe it at ``scene.times``."""
@@ -56,6 +62,7 @@ def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
         Y[n_out] = y
         n_out += 1
     t_now = 0.0
+    solver = None
     try:
         for a, b in _segments(scene):
             solver = solver_cls(fun, a, y, b, rtol=settings.rtol, atol=settings.atol,
@@ -76,14 +83,15 @@ def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
                     while n_out < times.size and times[n_out] <= solver.t:
                         Y[n_out] = dense(times[n_out])
                         n_out += 1
-            stats.nfev += solver.nfev
-            stats.njev += solver.njev
-            stats.nlu += solver.nlu
             if stats.status != 0:
                 break
             y = solver.y.copy()
+            _add_counts(stats, solver)
+            solver = None
     except _ModelError as exc:
         stats.status, stats.message = STATUS_ERROR, str(exc)
+    if solver is not None:
+        _add_counts(stats, solver)
     stats.t_reached = float(t_now)
     if stats.status == 0:
         stats.message = "reached t_end"
