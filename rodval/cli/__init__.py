@@ -7,7 +7,7 @@ import importlib
 import sys
 
 #: Subcommand modules, in the order ``rodval --help`` lists them.
-COMMANDS = ("simulate",)
+COMMANDS = ("simulate", "bench")
 
 
 class CliError(Exception):
