@@ -37,11 +37,17 @@ REFERENCE_DOP = ("LSODA", 1e-12, 1e-14)
 REFERENCE_OTHER = ("DOP853-numba", 1e-13, 1e-15)
 
 
+#: Runs whose warm-up takes longer than this (s) are timed once (their noise is relatively small).
+SLOW_RUN_S = 2.0
+
+
 def timed(scene: Scene, model: str, settings: IntegratorSettings, repeats: int = 3,
           **options) -> tuple[Trajectory, float]:
     """(trajectory, min wall time over ``repeats`` runs after a warm-up run) in s."""
-    runs = [simulate(scene, model, settings=settings, **options) for _ in range(repeats + 1)]
-    return runs[-1], min(r.stats.wall_s for r in runs[1:])
+    warm = simulate(scene, model, settings=settings, **options)
+    count = 1 if warm.stats.wall_s > SLOW_RUN_S else repeats
+    runs = [simulate(scene, model, settings=settings, **options) for _ in range(count)]
+    return runs[-1], min(r.stats.wall_s for r in runs)
 
 
 def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str, float]:

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from .. import bench
 from ..provenance import provenance
@@ -149,7 +150,6 @@ def run_cost_n(args) -> int:
                      "exponent (all n)": bench.fitted_exponent(n, c)})
         print(f"{model} {kernel}: fitted exponent {fits[-1]['exponent (n >= 32)']:.2f} (n >= 32), "
               f"{fits[-1]['exponent (all n)']:.2f} (all n)")
-    import pandas as pd
     wide = frame.pivot_table(index="n", columns=["model", "kernel"], values="s_per_eval")
     wide.columns = [f"{m}/{k} (us)" for m, k in wide.columns]
     body = ["Seconds per right-hand-side evaluation, paper chain, load active, random state.", "",
