@@ -11,6 +11,7 @@ import time
 import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
+from .integrators import compiled_form, run_compiled
 from .models.base import OdeSystem
 from .scene import Scene
 from .settings import IntegratorSettings
@@ -44,7 +45,8 @@ def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
     n_out = 0
     stats = SolverStats()
     y = system.y0.astype(float).copy()
-    solver_cls = _SOLVERS[settings.method]
+    form = compiled_form(system, settings.method) if settings.compiled else None
+    solver_cls = _SOLVERS.get(settings.method)
     extra = {}
     if settings.implicit and system.jac is not None:
         extra["jac"] = system.jac
@@ -64,7 +66,10 @@ def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
     t_now = 0.0
     solver = None
     try:
-        for a, b in _segments(scene):
+        if form is not None:   # the whole run in one compiled loop (rodval.integrators)
+            n_out = run_compiled(form, y, scene, settings, Y, stats)
+            t_now = stats.t_reached
+        for a, b in (_segments(scene) if form is None else ()):
             solver = solver_cls(fun, a, y, b, rtol=settings.rtol, atol=settings.atol,
                                 max_step=settings.max_step, **extra)
             while solver.status == "running":

@@ -7,7 +7,7 @@ import importlib
 import sys
 
 #: Subcommand modules, in the order ``rodval --help`` lists them.
-COMMANDS = ("reproduce", "simulate")
+COMMANDS = ("reproduce", "simulate", "bench")
 
 
 class CliError(Exception):

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ..settings import SCIPY_METHODS
+from ..settings import METHODS
 
 
 def positive_float(name: str):
@@ -50,8 +50,9 @@ def key_value(text: str) -> tuple[str, object]:
 
 
 def add_integrator_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--method", default="DOP853", choices=SCIPY_METHODS,
-                   help="scipy solve_ivp method for native models (default DOP853)")
+    p.add_argument("--method", default="DOP853", choices=METHODS,
+                   help="scipy solve_ivp method, or DOP853-numba (compiled loop), for native "
+                        "models (default DOP853)")
     p.add_argument("--rtol", type=positive_float("--rtol"), default=1e-10,
                    help="relative tolerance > 0 (default 1e-10)")
     p.add_argument("--atol", type=positive_float("--atol"), default=1e-12,

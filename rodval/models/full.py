@@ -1,38 +1,89 @@
 """The paper's full model: 3n second-order ODEs in q = [phi; alpha; beta] (equations (9)-(10)).
 
 State y = [q; q'] (6n). M(phi) q'' = [Q; 0; 0] - h - C q' - K q, see ``paper_matrices``.
+``numpy_rhs`` is the straightforward dense form; the default compiled kernel
+(``kernels.full_accel``) computes the same in O(n).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..scene import Scene
-from .paper_matrices import angle_differences, assemble_mass, convective_terms
+from . import kernels
+from .paper_matrices import angle_differences, angle_jacobian, assemble_mass, convective_terms
 from .paper_system import PaperModel, PaperSystem
 
 
 class FullSystem(PaperSystem):
-    def __init__(self, scene: Scene, coefficients: str = "printed"):
-        super().__init__(scene, coefficients)
+    kernel_kind = kernels.KIND_FULL
+
+    def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
+        super().__init__(scene, coefficients, kernel)
         i = self.initial
         self.y0 = np.concatenate([i["phi"], i["alpha"], i["beta"],
                                   i["dphi"], i["dalpha"], i["dbeta"]])
+        self.use_kernel()
 
-    def rhs(self, t, y):
+    def kernel_constants(self):
+        return kernels.full_constants(self.cc, self.scene.chain), np.zeros((0, self.n, self.n))
+
+    def forces(self, t: float, q: np.ndarray, v: np.ndarray, skj: np.ndarray) -> np.ndarray:
+        """Right-hand side f = [Q; 0; 0] - h - C q' - K q of M q'' = f (3n)."""
         n = self.n
-        q, v = y[:3 * n], y[3 * n:]
-        phi = q[:n]
-        ckj, skj = angle_differences(phi)
         h_phi, h_gamma = convective_terms(self.cc, skj, v[:n], v[n:2 * n], v[2 * n:])
         f = -(self.K @ q)
         if self.damped:
             f -= self.C @ v
         f[:n] -= h_phi
         f[n:] -= h_gamma
-        Q = self.generalized_force(t, phi)
+        Q = self.generalized_force(t, q[:n])
         if Q is not None:
             f[:n] += Q
+        return f
+
+    def numpy_rhs(self, t, y):
+        n = self.n
+        q, v = y[:3 * n], y[3 * n:]
+        ckj, skj = angle_differences(q[:n])
+        f = self.forces(t, q, v, skj)
         return np.concatenate([v, np.linalg.solve(assemble_mass(self.cc, ckj), f)])
+
+    def jac(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Analytic Jacobian df/dy (6n, 6n): [[0, I], [M^-1 (df/dq - dM/dphi q''), M^-1 df/dq']]."""
+        n, cc = self.n, self.cc
+        q, v = y[:3 * n], y[3 * n:]
+        phi, dphi, dgam = q[:n], v[:n], v[n:2 * n] - v[2 * n:]
+        ckj, skj = angle_differences(phi)
+        M = assemble_mass(cc, ckj)
+        a = np.linalg.solve(M, self.forces(t, q, v, skj))
+        Wt = cc.w_upper.T
+        w2, u = dphi * dphi, dphi * dgam
+        # d(M q'')/dphi at fixed q'' (only the angle-dependent blocks; d cos = -sin)
+        dM_a = np.vstack([angle_jacobian(cc.pp_scale, -skj, a[:n])
+                          + angle_jacobian(cc.w_upper, -skj, a[n:2 * n] - a[2 * n:]),
+                          angle_jacobian(Wt, -skj, a[:n]), -angle_jacobian(Wt, -skj, a[:n])])
+        # dh/dphi at fixed rates (d sin = cos); h_alpha = -G_pa^T w2 = (W^T o s_jk) w2
+        dh_alpha = angle_jacobian(Wt, ckj, w2)
+        dh = np.vstack([angle_jacobian(cc.pp_scale, ckj, w2) + 2 * angle_jacobian(cc.w_upper, ckj, u),
+                        dh_alpha, -dh_alpha])
+        dfdq = -self.K.copy()
+        dfdq[:, :n] -= dh + dM_a
+        sums = self.loads.suffix_sums(t)
+        if sums is not None:
+            SX, SY = sums
+            dfdq[np.arange(n), np.arange(n)] -= self.l * (np.sin(phi) * SY + np.cos(phi) * SX)
+        G_pp, G_pa = cc.pp_scale * skj, cc.w_upper * skj
+        dhdv = np.zeros((3 * n, 3 * n))
+        dhdv[:n, :n] = 2 * G_pp * dphi + 2 * G_pa * dgam
+        dhdv[:n, n:2 * n] = 2 * G_pa * dphi
+        dhdv[:n, 2 * n:] = -2 * G_pa * dphi
+        dhdv[n:2 * n, :n] = -2 * G_pa.T * dphi
+        dhdv[2 * n:, :n] = 2 * G_pa.T * dphi
+        dfdv = -dhdv - self.C if self.damped else -dhdv
+        J = np.zeros((6 * n, 6 * n))
+        J[:3 * n, 3 * n:] = np.eye(3 * n)
+        J[3 * n:] = np.linalg.solve(M, np.hstack([dfdq, dfdv]))
+        return J
 
     def rigid(self, Y):
         n = self.n
@@ -44,7 +95,8 @@ class FullSystem(PaperSystem):
 
 
 class FullModel(PaperModel):
-    """Full model (3n ODEs). ``coefficients``: "printed" (default) or "published" (erratum)."""
+    """Full model (3n ODEs). ``coefficients``: "printed" (default) or "published" (erratum);
+    ``kernel``: "numba" (default) or "numpy"."""
 
     name = "full"
     system_class = FullSystem

@@ -137,6 +137,14 @@ def convective_terms(cc: ChainConstants, skj: np.ndarray, dphi: np.ndarray,
     return h_phi, np.concatenate([h_alpha, -h_alpha])
 
 
+def angle_jacobian(scale: np.ndarray, dtrig: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """d(X u)/dphi for X[k,j] = scale[k,j] trig(phi_k - phi_j) and a fixed vector u, given
+    dtrig[k,j] = trig'(phi_k - phi_j) (cos -> -s_kj, sin -> c_kj):
+    d(X u)_k/dphi_i = delta_ki (X' u)_k - X'_ki u_i with X' = scale * dtrig, (n, n)."""
+    Xp = scale * dtrig
+    return np.diag(Xp @ u) - Xp * u
+
+
 def hinge_matrix(n: int) -> np.ndarray:
     """A with hinge angles D = A q: D_i = (phi_i + alpha_i) - (phi_{i-1} + beta_{i-1}), (n, 3n).
 

@@ -5,16 +5,28 @@ import numpy as np
 
 from ..loads import LoadSet
 from ..scene import Scene
+from . import kernels
 from .base import OdeModel, OdeSystem
 from .paper_matrices import (VARIANTS, angle_differences, assemble_mass, chain_constants, damping_matrix,
                              generalized_forces, node_positions, stiffness_matrix)
 
 
-class PaperSystem(OdeSystem):
-    """Base of the paper's ODE systems. Subclasses provide ``rhs`` and ``bending`` (alpha,
-    beta, alpha', beta' at output times)."""
+#: Right-hand-side implementations: "numba" (compiled, structured; default) or "numpy"
+#: (the straightforward dense reference).
+KERNELS = ("numba", "numpy")
 
-    def __init__(self, scene: Scene, coefficients: str = "printed"):
+
+class PaperSystem(OdeSystem):
+    """Base of the paper's ODE systems. Subclasses provide ``numpy_rhs``, the compiled
+    kernel's constants (``kernel_kind``, ``kernel_constants``), ``jac`` and ``bending``
+    (alpha, beta, alpha', beta' at output times)."""
+
+    kernel_kind: int
+
+    def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
+        if kernel not in KERNELS:
+            raise ValueError(f"kernel must be one of {KERNELS}, got {kernel!r}")
+        self.kernel = kernel
         chain = scene.chain
         self.scene = scene
         self.n = chain.n
@@ -25,6 +37,43 @@ class PaperSystem(OdeSystem):
         self.damped = bool(np.any(chain.nu > 0))
         self.loads = LoadSet(scene.loads, chain.n)
         self.initial = scene.initial.resolve(chain.n)
+
+    def use_kernel(self) -> None:
+        """Set up the compiled kernel (subclasses call this last in __init__) and evaluate it
+        once, so that loading or compiling it is not part of the integration's wall time."""
+        if self.kernel == "numba":
+            self.V, self.Mt = self.kernel_constants()
+            self._no_load = np.zeros(self.n)
+            self.rhs(0.0, self.y0)
+
+    def kernel_constants(self) -> tuple[np.ndarray, np.ndarray]:
+        """(V, Mt) of ``rodval.models.kernels`` for this system."""
+        raise NotImplementedError
+
+    def numpy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def rhs(self, t, y):
+        if self.kernel == "numpy":
+            return self.numpy_rhs(t, y)
+        sums = self.loads.suffix_sums(t)
+        SX, SY = (self._no_load, self._no_load) if sums is None else sums
+        half = y.size // 2
+        out = np.empty_like(y)
+        out[:half] = y[half:]
+        kernels.accel(self.kernel_kind, self.V, self.Mt, y, sums is not None, SX, SY,
+                      self.damped, out[half:])
+        return out
+
+    def compiled(self) -> tuple | None:
+        """(kind, V, Mt, load table, damped) for the compiled integrator, or None when this
+        system has no compiled form (numpy kernel, or a load law without a table form)."""
+        if self.kernel != "numba":
+            return None
+        table = kernels.load_table(self.loads)
+        if table is None:
+            return None
+        return self.kernel_kind, self.V, self.Mt, table, self.damped
 
     def generalized_force(self, t: float, phi: np.ndarray) -> np.ndarray | None:
         """Q(phi, t) (N m) on the phi coordinates, or None when no load acts at t."""
@@ -83,17 +132,22 @@ class PaperSystem(OdeSystem):
 
 class PaperModel(OdeModel):
     """A model of the paper. ``coefficients``: "printed" (default, from the kinematics) or
-    "published" (the erratum that reproduces the paper's alpha/beta; see paper_matrices)."""
+    "published" (the erratum that reproduces the paper's alpha/beta; see paper_matrices).
+    ``kernel``: "numba" (default, compiled O(n) kernels) or "numpy" (the straightforward
+    dense right-hand side, kept as the reference and benchmark baseline)."""
 
     system_class: type[PaperSystem]
 
-    def __init__(self, coefficients: str = "printed"):
+    def __init__(self, coefficients: str = "printed", kernel: str = "numba"):
         if coefficients not in VARIANTS:
             raise ValueError(f"coefficients must be one of {VARIANTS}, got {coefficients!r}")
+        if kernel not in KERNELS:
+            raise ValueError(f"kernel must be one of {KERNELS}, got {kernel!r}")
         self.coefficients = coefficients
+        self.kernel = kernel
 
     def options(self):
-        return {"coefficients": self.coefficients}
+        return {"coefficients": self.coefficients, "kernel": self.kernel}
 
     def system(self, scene: Scene) -> PaperSystem:
-        return self.system_class(scene, self.coefficients)
+        return self.system_class(scene, self.coefficients, self.kernel)

@@ -16,13 +16,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..scene import Scene
-from .paper_matrices import angle_differences
+from . import kernels
+from .paper_matrices import angle_differences, angle_jacobian
 from .paper_system import PaperModel, PaperSystem
 
 
 class ReducedSystem(PaperSystem):
-    def __init__(self, scene: Scene, coefficients: str = "printed"):
-        super().__init__(scene, coefficients)
+    kernel_kind = kernels.KIND_REDUCED
+
+    def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
+        super().__init__(scene, coefficients, kernel)
         n = self.n
         p, g = slice(0, n), slice(n, 3 * n)
         K, C = self.K, self.C
@@ -36,6 +39,12 @@ class ReducedSystem(PaperSystem):
         self.K_gp, self.C_gp = K[g, p], C[g, p]
         i = self.initial
         self.y0 = np.concatenate([i["phi"], i["dphi"]])
+        self.use_kernel()
+
+    def kernel_constants(self):
+        P_diag = self.P_a * self.cc.ap_diag + self.P_b * self.cc.bp_diag
+        return kernels.reduced_constants(self.cc, self.scene.chain, self.P_diff, P_diag,
+                                         self.K_r, self.C_r)
 
     def reduced_matrices(self, phi: np.ndarray):
         """M_r(phi), G_r(phi) and the bending-row blocks M_gp, G_gp (for recovery)."""
@@ -49,17 +58,44 @@ class ReducedSystem(PaperSystem):
         G_r = cc.pp_scale * skj + self.P_diff @ G_pa.T
         return M_r, G_r, U, G_pa
 
-    def rhs(self, t, y):
-        n = self.n
-        phi, dphi = y[:n], y[n:]
-        M_r, G_r, _, _ = self.reduced_matrices(phi)
+    def forces(self, t: float, phi: np.ndarray, dphi: np.ndarray, G_r: np.ndarray) -> np.ndarray:
+        """f_r = Q - G_r phi'^2 - C_r phi' - K_r phi of M_r phi'' = f_r (n)."""
         f = -(self.K_r @ phi) - G_r @ (dphi * dphi)
         if self.damped:
             f -= self.C_r @ dphi
         Q = self.generalized_force(t, phi)
         if Q is not None:
             f += Q
-        return np.concatenate([dphi, np.linalg.solve(M_r, f)])
+        return f
+
+    def numpy_rhs(self, t, y):
+        n = self.n
+        phi, dphi = y[:n], y[n:]
+        M_r, G_r, _, _ = self.reduced_matrices(phi)
+        return np.concatenate([dphi, np.linalg.solve(M_r, self.forces(t, phi, dphi, G_r))])
+
+    def jac(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Analytic Jacobian df/dy (2n, 2n): [[0, I], [M_r^-1 (df_r/dphi - dM_r/dphi phi''),
+        M_r^-1 df_r/dphi']]."""
+        n, cc = self.n, self.cc
+        phi, dphi = y[:n], y[n:]
+        ckj, skj = angle_differences(phi)
+        M_r, G_r, _, G_pa = self.reduced_matrices(phi)
+        a = np.linalg.solve(M_r, self.forces(t, phi, dphi, G_r))
+        Wt, w2 = cc.w_upper.T, dphi * dphi
+        # M_r a = M_pp a - P_diff (W^T o c_jk) a - const;  G_pa^T w2 = -(W^T o s_jk) w2
+        dM_a = angle_jacobian(cc.pp_scale, -skj, a) - self.P_diff @ angle_jacobian(Wt, -skj, a)
+        dG_w2 = angle_jacobian(cc.pp_scale, ckj, w2) - self.P_diff @ angle_jacobian(Wt, ckj, w2)
+        dfdphi = -self.K_r - dG_w2 - dM_a
+        sums = self.loads.suffix_sums(t)
+        if sums is not None:
+            SX, SY = sums
+            dfdphi[np.arange(n), np.arange(n)] -= self.l * (np.sin(phi) * SY + np.cos(phi) * SX)
+        dfdv = -2.0 * G_r * dphi - (self.C_r if self.damped else 0.0)
+        J = np.zeros((2 * n, 2 * n))
+        J[:n, n:] = np.eye(n)
+        J[n:] = np.linalg.solve(M_r, np.hstack([dfdphi, dfdv]))
+        return J
 
     def recover_bending(self, t: float, y: np.ndarray) -> np.ndarray:
         """gamma = [alpha; beta] (rad) at one time from the algebraic bending rows."""

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# All performance benchmarks (not part of the test suite). Usage: benchmarks/run_all.sh OUT_DIR
+# One BLAS thread: the machine is shared, and multi-threaded BLAS on small matrices only adds
+# contention to the numpy baseline.
+set -euo pipefail
+OUT=${1:-out/bench}
+export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
+PY=${PYTHON:-python}
+$PY -m rodval bench work-precision --out "$OUT/work_precision"
+$PY -m rodval bench cost-n --out "$OUT/cost_n"
+$PY -m rodval bench skips --out "$OUT/skips"
+$PY -m rodval bench speedup --out "$OUT/speedup"

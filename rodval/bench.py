@@ -1,0 +1,370 @@
+"""Performance measurements: work-precision, cost per evaluation against n, the cost of what a
+scene may skip, and reduced-vs-full speed-up at equal accuracy.
+
+Conventions
+-----------
+* Wall time is the integration's own ``stats.wall_s`` (no model set-up, no compilation), the
+  minimum over ``repeats`` runs after one warm-up run. Runs that are compared are measured in
+  the same process, one after the other, so that their ratio is meaningful on a shared machine.
+* Errors are against a reference computed with a *different* method: LSODA at rtol 1e-12 for
+  the DOP853 family, the compiled DOP853 at rtol 1e-13 for every other method (their mutual
+  difference is reported as the reference uncertainty). Per quantity q (phi, dphi, alpha,
+  beta), with d = q - q_ref over all output times and rods and s = max |q_ref|:
+  ``final_q`` = max_k |d(t_end)| / s, ``rms_q`` = RMS(d) / s, ``max_q`` = max |d| / s;
+  ``scd`` = -log10 of the largest ``max_q``.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .integrate import integrate
+from .models import get_model
+from .provenance import machine, package_versions
+from .scene import Scene, paper_scene
+from .settings import IntegratorSettings
+from .simulate import simulate
+from .trajectory import Trajectory
+
+QUANTITIES = ("phi", "dphi", "alpha", "beta")
+DOP853_FAMILY = ("DOP853", "DOP853-numba")
+#: The two references: (method, rtol, atol).
+REFERENCE_DOP = ("LSODA", 1e-12, 1e-14)
+REFERENCE_OTHER = ("DOP853-numba", 1e-13, 1e-15)
+
+
+#: Runs whose warm-up takes longer than this (s) are timed once (their noise is relatively small).
+SLOW_RUN_S = 2.0
+
+
+def timed(scene: Scene, model: str, settings: IntegratorSettings, repeats: int = 3,
+          **options) -> tuple[Trajectory, float]:
+    """(trajectory, min wall time over ``repeats`` runs after a warm-up run) in s."""
+    warm = simulate(scene, model, settings=settings, **options)
+    count = 1 if warm.stats.wall_s > SLOW_RUN_S else repeats
+    runs = [simulate(scene, model, settings=settings, **options) for _ in range(count)]
+    return runs[-1], min(r.stats.wall_s for r in runs)
+
+
+def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str, float]:
+    """Relative errors of ``traj`` against ``ref`` (see module docstring); NaN for a run that
+    did not reach every output time."""
+    out: dict[str, float] = {}
+    worst = 0.0
+    for q in quantities:
+        if q not in ref.values:
+            continue
+        if q not in traj.values or len(traj.times) != len(ref.times):
+            out.update({f"final_{q}": math.nan, f"rms_{q}": math.nan, f"max_{q}": math.nan})
+            worst = math.inf
+            continue
+        d, s = traj[q] - ref[q], np.max(np.abs(ref[q]))
+        out[f"final_{q}"] = float(np.max(np.abs(d[-1])) / s)
+        out[f"rms_{q}"] = float(np.sqrt(np.mean(d * d)) / s)
+        out[f"max_{q}"] = float(np.max(np.abs(d)) / s)
+        worst = max(worst, out[f"max_{q}"])
+    out["scd"] = -math.log10(worst) if 0 < worst < math.inf else (math.inf if worst == 0 else math.nan)
+    return out
+
+
+@dataclass
+class References:
+    """The two references of one (scene, model) and their mutual difference."""
+
+    dop: Trajectory      # for the DOP853 family
+    other: Trajectory    # for every other method
+    uncertainty: float   # max relative difference over phi, dphi
+
+    def for_method(self, method: str) -> Trajectory:
+        return self.dop if method in DOP853_FAMILY else self.other
+
+
+def references(scene: Scene, model: str, **options) -> References:
+    runs = [simulate(scene, model, method=m, rtol=r, atol=a, **options)
+            for m, r, a in (REFERENCE_DOP, REFERENCE_OTHER)]
+    for run in runs:
+        if not run.success:
+            raise RuntimeError(f"reference run of {model} failed: {run.stats.message}")
+    e = errors(runs[0], runs[1], ("phi", "dphi"))
+    return References(runs[0], runs[1], max(e["max_phi"], e["max_dphi"]))
+
+
+def work_precision(scene: Scene, models: list[str], methods: list[str], rtols: list[float], *,
+                   repeats: int = 3, budget_s: float = 20.0, baseline: bool = True,
+                   progress=print) -> tuple[pd.DataFrame, dict[str, float], list[str]]:
+    """One row per (model, method, kernel, rtol): cost and errors. For each model and method
+    the ladder (loosest first) stops after a run slower than ``budget_s``. ``baseline`` adds
+    scipy DOP853 with the numpy right-hand side (``kernel="numpy"``) for native models.
+
+    Returns (rows, reference uncertainty per model, notes)."""
+    rows, uncertainty, notes = [], {}, []
+    for model in models:
+        try:
+            get_model(model)
+        except ValueError as exc:
+            notes.append(f"model {model} skipped: {exc}")
+            continue
+        native = model in ("full", "reduced")
+        refs = references(scene, model) if native else None
+        if refs is not None:
+            uncertainty[model] = refs.uncertainty
+        else:   # a reference model: its own tightest run is the reference
+            own_ref = simulate(scene, model, rtol=1e-10, atol=1e-12)
+            notes.append(f"model {model}: reference = its own run at rtol 1e-10")
+        variants = [(m, "numba" if native else None) for m in methods]
+        if native and baseline:
+            variants.append(("DOP853", "numpy"))
+        for method, kernel in variants:
+            if not native and method not in ("DOP853",):
+                continue
+            for rtol in sorted(rtols, reverse=True):
+                settings = IntegratorSettings(method=method, rtol=rtol, atol=rtol * 1e-2)
+                opts = {"kernel": kernel} if kernel else {}
+                traj, wall = timed(scene, model, settings, repeats, **opts)
+                ref = refs.for_method(method) if refs else own_ref
+                row = {"model": model, "method": method, "kernel": kernel or "", "rtol": rtol,
+                       "atol": settings.atol, "wall_s": wall, **traj.stats.as_dict(),
+                       "reference": f"{ref.settings['method']} rtol {ref.settings['rtol']:g}"}
+                row["wall_s"] = wall   # the minimum, not the last run's
+                row.update(errors(traj, ref))
+                rows.append(row)
+                progress(f"{model:8s} {method:13s} {kernel or '':6s} rtol {rtol:7.0e}  "
+                         f"wall {wall * 1e3:9.2f} ms  nfev {traj.stats.nfev:7d}  "
+                         f"phi err {row.get('max_phi', math.nan):.2e}")
+                if wall > budget_s:
+                    notes.append(f"{model} {method} {kernel or ''}: ladder stopped after rtol "
+                                 f"{rtol:g} ({wall:.1f} s > budget {budget_s:g} s)")
+                    break
+    frame = pd.DataFrame(rows)
+    return with_provenance(frame), uncertainty, notes
+
+
+def with_provenance(frame: pd.DataFrame) -> pd.DataFrame:
+    """Machine and package versions as constant columns (so a CSV carries its own context)."""
+    info = {**{k: str(v) for k, v in machine().items()},
+            **{f"version_{k}": str(v) for k, v in package_versions().items()}}
+    return frame.assign(**info)
+
+
+def cheapest(frame: pd.DataFrame, quantity: str = "phi", tol: float = 1e-6) -> pd.DataFrame:
+    """Per (model, method, kernel): the fastest run whose ``max_<quantity>`` <= tol."""
+    ok = frame[frame[f"max_{quantity}"] <= tol]
+    idx = ok.groupby(["model", "method", "kernel"])["wall_s"].idxmin()
+    return ok.loc[idx].sort_values(["model", "wall_s"])
+
+
+def pareto_front(cost: np.ndarray, err: np.ndarray) -> np.ndarray:
+    """Indices of the points not dominated in (cost, error), by increasing cost: along the
+    front the error decreases strictly as the cost grows (a monotone front)."""
+    order = np.argsort(cost, kind="stable")
+    front, best = [], math.inf
+    for i in order:
+        if np.isfinite(err[i]) and err[i] < best:
+            front.append(i)
+            best = err[i]
+    return np.array(front, dtype=int)
+
+
+def plot_work_precision(frame: pd.DataFrame, out_dir, quantities=QUANTITIES) -> list:
+    """One figure per model and x axis (wall, nfev): error against cost per quantity, one
+    line per method/kernel, and the monotone front over all of them. Returns the paths."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    paths = []
+    for model, part in frame.groupby("model"):
+        for xcol, xlabel in (("wall_s", "wall time (s)"), ("nfev", "RHS evaluations")):
+            qs = [q for q in quantities if f"max_{q}" in part and part[f"max_{q}"].notna().any()]
+            fig, axes = plt.subplots(1, len(qs), figsize=(4.2 * len(qs), 3.8), squeeze=False)
+            for ax, q in zip(axes[0], qs):
+                for (method, kernel), line in part.groupby(["method", "kernel"]):
+                    line = line.sort_values("rtol", ascending=False)
+                    label = method + (f" ({kernel})" if kernel == "numpy" else "")
+                    ax.loglog(line[xcol], line[f"max_{q}"], "o-", ms=3, label=label)
+                x, y = part[xcol].to_numpy(float), part[f"max_{q}"].to_numpy(float)
+                f = pareto_front(x, y)
+                ax.loglog(x[f], y[f], "k--", lw=1.2, label="front")
+                ax.set_xlabel(xlabel)
+                ax.set_ylabel(f"max rel. error {q}")
+                ax.set_title(f"{model}: {q}")
+                ax.grid(True, which="both", alpha=0.3)
+            axes[0][0].legend(fontsize=7)
+            fig.tight_layout()
+            path = out_dir / f"wp_{model}_{'wall' if xcol == 'wall_s' else 'nfev'}.png"
+            fig.savefig(path, dpi=110)
+            plt.close(fig)
+            paths.append(path)
+    return paths
+
+
+def baseline_ratios(scene: Scene, tol: float = 1e-6, rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
+                    repeats: int = 3, progress=print) -> pd.DataFrame:
+    """Per native model: the loosest rtol at which the compiled DOP853 reaches phi error <= tol,
+    then, side by side at that same tolerance, scipy DOP853 with the numba kernel and with
+    the straightforward numpy kernel; speed-up = baseline wall / compiled wall."""
+    rows = []
+    for model in ("reduced", "full"):
+        refs = references(scene, model)
+        for rtol in sorted(rtols, reverse=True):
+            settings = IntegratorSettings("DOP853-numba", rtol=rtol, atol=rtol * 1e-2)
+            fast, wall = timed(scene, model, settings, repeats)
+            err = errors(fast, refs.dop)["max_phi"]
+            if err <= tol:
+                break
+        runs = {"DOP853-numba/numba": (fast, wall)}
+        for kernel in ("numba", "numpy"):
+            s = IntegratorSettings("DOP853", rtol=rtol, atol=rtol * 1e-2)
+            runs[f"DOP853/{kernel}"] = timed(scene, model, s, repeats, kernel=kernel)
+        for name, (traj, w) in runs.items():
+            method, kernel = name.split("/")
+            rows.append({"model": model, "method": method, "kernel": kernel, "rtol": rtol,
+                         "wall_s": w, "nfev": traj.stats.nfev,
+                         "max_phi": errors(traj, refs.dop)["max_phi"],
+                         "speedup_vs_numpy_DOP853": runs["DOP853/numpy"][1] / w})
+            progress(f"{model:8s} {name:20s} rtol {rtol:g}: {w * 1e3:9.2f} ms")
+    return with_provenance(pd.DataFrame(rows))
+
+
+def per_eval_cost(n_values=(2, 4, 8, 16, 32, 64, 128, 256, 512), kernels=("numba", "numpy"),
+                  models=("full",), min_time: float = 0.05, repeats: int = 3,
+                  progress=print) -> pd.DataFrame:
+    """Seconds per right-hand-side evaluation (min over repeats of a timed loop) against n at
+    a random state with the load active."""
+    rows = []
+    rng = np.random.default_rng(0)
+    for model in models:
+        for kernel in kernels:
+            for n in n_values:
+                system = get_model(model, kernel=kernel).system(paper_scene(n))
+                y = rng.normal(scale=0.5, size=system.y0.size)
+                system.rhs(0.3, y)
+                reps = max(1, int(min_time / _once(system, y)))
+                best = min(_loop(system, y, reps) for _ in range(repeats)) / reps
+                rows.append({"model": model, "kernel": kernel, "n": n, "s_per_eval": best})
+                progress(f"{model} {kernel:5s} n = {n:4d}: {best * 1e6:10.2f} us/eval")
+    return with_provenance(pd.DataFrame(rows))
+
+
+def _once(system, y) -> float:
+    t = time.perf_counter()
+    system.rhs(0.3, y)
+    return max(time.perf_counter() - t, 1e-7)
+
+
+def _loop(system, y, reps: int) -> float:
+    t = time.perf_counter()
+    for _ in range(reps):
+        system.rhs(0.3, y)
+    return time.perf_counter() - t
+
+
+def fitted_exponent(n: np.ndarray, cost: np.ndarray, n_min: int = 1) -> float:
+    """Least-squares slope of log(cost) against log(n) over n >= n_min."""
+    keep = np.asarray(n) >= n_min
+    return float(np.polyfit(np.log(np.asarray(n)[keep]), np.log(np.asarray(cost)[keep]), 1)[0])
+
+
+def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
+    """Cost with and without each skip, paper example n = 8, compiled DOP853 at rtol 1e-8
+    (outputs and dense output: scipy DOP853, where they run in Python):
+
+    * damping: nu = 0 chain, damping terms skipped vs forced on (C = 0, same result);
+    * load: RHS evaluation past the load's support (no load term) vs inside it;
+    * gamma recovery: reduced model with outputs phi, dphi vs phi, dphi, alpha, beta;
+    * dense output: 4 output times vs 2001 (dense output formed only on steps containing one).
+    """
+    rows = []
+    settings = IntegratorSettings("DOP853-numba", rtol=1e-8, atol=1e-10)
+    undamped = paper_scene(8, times=(0.5, 1.0, 1.5, 2.0), nu=0.0)
+    for model in ("reduced", "full"):
+        walls = {}
+        for forced in (False, True):
+            system = get_model(model).system(undamped)
+            system.damped = forced
+            runs = [integrate(system, undamped, settings, model=model) for _ in range(repeats + 1)]
+            walls[forced] = (min(r.stats.wall_s for r in runs[1:]), runs[-1])
+        same = np.max(np.abs(walls[True][1]["phi"] - walls[False][1]["phi"]))
+        rows.append(_skip_row("damping terms (all nu = 0)", model, walls[False][0], walls[True][0],
+                              f"max |phi difference| = {same:.1e}"))
+    for model in ("reduced", "full"):
+        for kernel in ("numba", "numpy"):
+            system = get_model(model, kernel=kernel).system(paper_scene(8))
+            y = np.random.default_rng(1).normal(scale=0.5, size=system.y0.size)
+            cost = {t: min(_timeit(system, y, t) for _ in range(repeats)) for t in (1.5, 0.3)}
+            rows.append(_skip_row(f"load term past its support ({kernel} RHS, per eval)", model,
+                                  cost[1.5], cost[0.3], "t = 1.5 s (skipped) vs 0.3 s (evaluated)"))
+    scipy_dop = IntegratorSettings("DOP853", rtol=1e-8, atol=1e-10)
+    times = np.linspace(0, 2, 201)
+    lean = paper_scene(8, times=times, outputs=("phi", "dphi"))
+    full_out = paper_scene(8, times=times)
+    w_lean = timed(lean, "reduced", scipy_dop, repeats)[1]
+    w_full = timed(full_out, "reduced", scipy_dop, repeats)[1]
+    rows.append(_skip_row("gamma recovery (outputs phi, dphi only; 201 times)", "reduced",
+                          w_lean, w_full, "vs outputs phi, dphi, alpha, beta"))
+    few, fe = timed(paper_scene(8, times=(0.5, 1.0, 1.5, 2.0)), "reduced", scipy_dop, repeats)
+    many, ma = timed(paper_scene(8, times=np.linspace(0, 2, 2001)), "reduced", scipy_dop, repeats)
+    rows.append(_skip_row("dense output only on steps with output times", "reduced", fe, ma,
+                          f"4 vs 2001 output times; nfev {few.stats.nfev} vs {many.stats.nfev}"))
+    for r in rows:
+        progress(f"{r['skip']:60s} {r['model']:8s} {r['with_skip_s'] * 1e3:9.3f} ms vs "
+                 f"{r['without_skip_s'] * 1e3:9.3f} ms")
+    return with_provenance(pd.DataFrame(rows))
+
+
+def _timeit(system, y, t, reps: int = 2000) -> float:
+    start = time.perf_counter()
+    for _ in range(reps):
+        system.rhs(t, y)
+    return (time.perf_counter() - start) / reps
+
+
+def _skip_row(skip: str, model: str, with_skip: float, without: float, note: str) -> dict:
+    return {"skip": skip, "model": model, "with_skip_s": with_skip, "without_skip_s": without,
+            "saving": 1 - with_skip / without, "note": note}
+
+
+def speedup_vs_n(n_values=(2, 4, 8, 16, 32), tol: float = 1e-6,
+                 rtols=(1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10), repeats: int = 3,
+                 models=("full", "reduced", "exudyn"), progress=print) -> tuple[pd.DataFrame, list[str]]:
+    """For each n and model: the fastest compiled-DOP853 run (scipy DOP853 for a model without
+    a compiled form) with phi error <= tol against that model's own reference; then the
+    full/reduced (and exudyn/native) wall-time ratios at that equal accuracy."""
+    rows, notes = [], []
+    available = []
+    for model in models:
+        try:
+            get_model(model)
+            available.append(model)
+        except ValueError as exc:
+            notes.append(f"model {model} skipped: {exc}")
+    for n in n_values:
+        scene = paper_scene(n, times=np.linspace(0, 2, 21), outputs=("phi", "dphi"))
+        for model in available:
+            native = model in ("full", "reduced")
+            ref = references(scene, model).dop if native else simulate(scene, model, rtol=1e-10, atol=1e-12)
+            method = "DOP853-numba" if native else "DOP853"
+            best = None
+            for rtol in sorted(rtols, reverse=True):
+                traj, wall = timed(scene, model, IntegratorSettings(method, rtol=rtol,
+                                                                     atol=rtol * 1e-2), repeats)
+                if errors(traj, ref, ("phi",))["max_phi"] <= tol:
+                    best = (rtol, wall, traj.stats.nfev)
+                    break
+            rows.append({"n": n, "model": model, "method": method,
+                         "rtol": best[0] if best else math.nan,
+                         "wall_s": best[1] if best else math.nan,
+                         "nfev": best[2] if best else math.nan})
+            progress(f"n = {n:3d} {model:8s}: {rows[-1]['wall_s'] * 1e3:9.2f} ms at rtol {rows[-1]['rtol']:g}")
+    frame = pd.DataFrame(rows)
+    wide = frame.pivot(index="n", columns="model", values="wall_s")
+    if {"full", "reduced"} <= set(wide):
+        wide["full/reduced"] = wide["full"] / wide["reduced"]
+    if "exudyn" in wide:
+        for m in ("full", "reduced"):
+            wide[f"exudyn/{m}"] = wide["exudyn"] / wide[m]
+    return with_provenance(wide.reset_index()), notes

@@ -1,0 +1,178 @@
+"""rodval bench {work-precision, cost-n, skips, speedup} --out DIR: performance measurements
+(see ``rodval.bench``). Each writes a CSV (with machine and package versions), a markdown
+summary and, where it applies, plots into DIR."""
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import bench
+from ..provenance import provenance
+from ..scene import paper_scene
+from ..settings import METHODS
+from .options import positive_float
+
+DEFAULT_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "DOP853-numba")
+DEFAULT_RTOLS = "1e-4,1e-6,1e-8,1e-10"
+
+
+def _float_list(name: str):
+    def parse(text: str) -> list[float]:
+        values = []
+        for part in text.split(","):
+            try:
+                v = float(part)
+            except ValueError:
+                raise argparse.ArgumentTypeError(f"{name} must be comma-separated numbers, got {text!r}") from None
+            if not (0 < v < 1):
+                raise argparse.ArgumentTypeError(f"{name} values must be in (0, 1), got {v}")
+            values.append(v)
+        return values
+    return parse
+
+
+def _choice_list(name: str, allowed: tuple[str, ...]):
+    def parse(text: str) -> list[str]:
+        values = [v.strip() for v in text.split(",") if v.strip()]
+        bad = [v for v in values if v not in allowed]
+        if bad or not values:
+            raise argparse.ArgumentTypeError(f"{name} must be a comma-separated subset of {allowed}, got {text!r}")
+        return values
+    return parse
+
+
+def _int_list(text: str) -> list[int]:
+    try:
+        values = [int(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--n-values must be comma-separated integers >= 1, got {text!r}") from None
+    if any(v < 1 for v in values):
+        raise argparse.ArgumentTypeError(f"--n-values must be integers >= 1, got {text!r}")
+    return values
+
+
+def _repeats(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        v = 0
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"--repeats must be an integer >= 1, got {text!r}")
+    return v
+
+
+def register(sub) -> None:
+    p = sub.add_parser("bench", help="performance benchmarks (work-precision, cost vs n, ...)",
+                       description="Performance measurements on the paper example; see "
+                                   "docs/performance.md.")
+    bsub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
+    wp = bsub.add_parser("work-precision", help="error against cost for every model and integrator")
+    wp.add_argument("--n", type=int, default=8, help="number of rods (default 8)")
+    wp.add_argument("--models", type=_choice_list("--models", ("full", "reduced", "exudyn")),
+                    default=["reduced", "full", "exudyn"])
+    wp.add_argument("--methods", type=_choice_list("--methods", METHODS), default=list(DEFAULT_METHODS))
+    wp.add_argument("--rtols", type=_float_list("--rtols"), default=_float_list("--rtols")(DEFAULT_RTOLS),
+                    help=f"tolerance ladder (default {DEFAULT_RTOLS}; atol = rtol/100)")
+    wp.add_argument("--budget", type=positive_float("--budget"), default=20.0,
+                    help="stop a method's ladder after a run slower than this, s (default 20)")
+    wp.set_defaults(func=run_work_precision)
+    cn = bsub.add_parser("cost-n", help="seconds per RHS evaluation against n, fitted exponent")
+    cn.add_argument("--n-values", type=_int_list, default=[2, 4, 8, 16, 32, 64, 128, 256, 512])
+    cn.set_defaults(func=run_cost_n)
+    sk = bsub.add_parser("skips", help="cost with and without each skipped piece of work")
+    sk.set_defaults(func=run_skips)
+    sp = bsub.add_parser("speedup", help="reduced vs full (and exudyn) at equal phi accuracy against n")
+    sp.add_argument("--n-values", type=_int_list, default=[2, 4, 8, 16, 32])
+    sp.set_defaults(func=run_speedup)
+    for q in (wp, cn, sk, sp):
+        q.add_argument("--repeats", type=_repeats, default=3, help="timed runs after a warm-up (min is kept)")
+        q.add_argument("--out", required=True, type=Path, help="output folder")
+
+
+def _write(out: Path, stem: str, frame, title: str, body: list[str]) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(out / f"{stem}.csv", index=False)
+    (out / "provenance.json").write_text(json.dumps(provenance(), indent=2, default=str))
+    command = "rodval " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    text = [f"# {title}", "", f"Command: `{command}`", "", *body, ""]
+    (out / f"{stem}.md").write_text("\n".join(text))
+    print(f"-> {out / (stem + '.md')}")
+
+
+def _table(frame, columns, floatfmt=".3g") -> str:
+    return frame[columns].to_markdown(index=False, floatfmt=floatfmt)
+
+
+def run_work_precision(args) -> int:
+    if args.n < 1:
+        raise ValueError(f"--n must be an integer >= 1, got {args.n}")
+    scene = paper_scene(args.n, times=np.linspace(0, 2, 41))
+    frame, unc, notes = bench.work_precision(scene, args.models, args.methods, args.rtols,
+                                             repeats=args.repeats, budget_s=args.budget)
+    args.out.mkdir(parents=True, exist_ok=True)
+    plots = bench.plot_work_precision(frame, args.out)
+    ratios = bench.baseline_ratios(paper_scene(args.n, times=np.linspace(0, 2, 41)),
+                                   repeats=args.repeats)
+    ratios.to_csv(args.out / "baseline_ratios.csv", index=False)
+    best = bench.cheapest(frame)
+    cols = ["model", "method", "kernel", "rtol", "wall_s", "nfev", "njev", "nlu", "nsteps",
+            "max_phi", "rms_phi", "final_phi", "max_dphi", "max_alpha", "max_beta", "scd"]
+    body = ["Paper example, n = %d, 0..2 s, 41 output times. Errors: max relative over output "
+            "times (see rodval.bench)." % args.n, "",
+            "Reference uncertainty (max relative difference of the two references, phi/dphi): "
+            + ", ".join(f"{m}: {u:.1e}" for m, u in unc.items()), "",
+            "## Fastest run per integrator with phi error <= 1e-6", "",
+            _table(best, cols), "",
+            "## Side by side at equal tolerance: compiled DOP853 vs scipy DOP853 (numba and "
+            "numpy right-hand sides)", "",
+            _table(ratios, ["model", "method", "kernel", "rtol", "wall_s", "nfev", "max_phi",
+                            "speedup_vs_numpy_DOP853"]), "",
+            "## All runs", "", _table(frame, [c for c in cols if c in frame]), "",
+            "## Notes", "", *[f"- {n}" for n in notes or ["none"]], "",
+            "Plots: " + ", ".join(p.name for p in plots)]
+    _write(args.out, "work_precision", frame, "Work-precision", body)
+    return 0
+
+
+def run_cost_n(args) -> int:
+    frame = bench.per_eval_cost(args.n_values, models=("full", "reduced"), repeats=args.repeats)
+    fits = []
+    for (model, kernel), part in frame.groupby(["model", "kernel"]):
+        n, c = part.n.to_numpy(), part.s_per_eval.to_numpy()
+        fits.append({"model": model, "kernel": kernel,
+                     "exponent (n >= 32)": bench.fitted_exponent(n, c, 32),
+                     "exponent (all n)": bench.fitted_exponent(n, c)})
+        print(f"{model} {kernel}: fitted exponent {fits[-1]['exponent (n >= 32)']:.2f} (n >= 32), "
+              f"{fits[-1]['exponent (all n)']:.2f} (all n)")
+    wide = frame.pivot_table(index="n", columns=["model", "kernel"], values="s_per_eval")
+    wide.columns = [f"{m}/{k} (us)" for m, k in wide.columns]
+    body = ["Seconds per right-hand-side evaluation, paper chain, load active, random state.", "",
+            (wide * 1e6).reset_index().to_markdown(index=False, floatfmt=".3g"), "",
+            "Fitted exponent of cost ~ n^p:", "",
+            pd.DataFrame(fits).to_markdown(index=False, floatfmt=".2f")]
+    _write(args.out, "cost_n", frame, "Cost per evaluation against n", body)
+    return 0
+
+
+def run_skips(args) -> int:
+    frame = bench.skip_rows(repeats=args.repeats)
+    body = [_table(frame, ["skip", "model", "with_skip_s", "without_skip_s", "saving", "note"])]
+    _write(args.out, "skips", frame, "What a scene does not need: cost with and without", body)
+    return 0
+
+
+def run_speedup(args) -> int:
+    frame, notes = bench.speedup_vs_n(args.n_values, repeats=args.repeats)
+    body = ["Fastest run with phi error <= 1e-6 against each model's own reference; wall "
+            "times in s.", "", frame[[c for c in frame if not c.startswith(("version_", "python",
+                                                                         "platform", "processor",
+                                                                         "cpu_count"))]]
+            .to_markdown(index=False, floatfmt=".3g"), "", *[f"- {n}" for n in notes]]
+    _write(args.out, "speedup", frame, "Speed-up at equal phi accuracy against n", body)
+    return 0

@@ -1,0 +1,180 @@
+"""DOP853 (Dormand-Prince 8(5,3), Hairer's step control) as one compiled (numba) loop.
+
+The same method, coefficients (scipy's ``dop853_coefficients``), error norm, step-size control,
+initial-step selection and 7th-order dense output as ``scipy.integrate.DOP853``, but the whole
+integration (all steps, across the scene's load breakpoints, dense output at output times)
+runs without returning to Python, so the per-step overhead of the Python loop (~50-100 us)
+disappears. The right-hand side is one of the compiled model kernels
+(``rodval.models.kernels.rhs``), loads from a load table.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from scipy.integrate._ivp import dop853_coefficients as dc
+
+from ..models.kernels import rhs
+
+N_STAGES = dc.N_STAGES
+_A = np.ascontiguousarray(dc.A)
+_B = np.ascontiguousarray(dc.B)
+_C = np.ascontiguousarray(dc.C)
+_E3 = np.ascontiguousarray(dc.E3)
+_E5 = np.ascontiguousarray(dc.E5)
+_D = np.ascontiguousarray(dc.D)
+
+#: Return codes of ``run``.
+OK, STEP_TOO_SMALL, NON_FINITE = 0, 1, 2
+
+SAFETY, MIN_FACTOR, MAX_FACTOR, ERROR_EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
+
+
+@njit(cache=True)
+def _rms(x):
+    return np.sqrt(np.mean(x * x))
+
+
+@njit(cache=True)
+def _initial_step(kind, V, Mt, L, damped, t0, y0, f0, t_bound, rtol, atol, max_step, tmp, f1):
+    """scipy's select_initial_step (Hairer, Sec. II.4) for order 7; uses one evaluation."""
+    scale = atol + np.abs(y0) * rtol
+    d0 = _rms(y0 / scale)
+    d1 = _rms(f0 / scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, t_bound - t0)
+    tmp[:] = y0 + h0 * f0
+    rhs(kind, t0 + h0, tmp, V, Mt, L, damped, f1)
+    d2 = _rms((f1 - f0) / scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, t_bound - t0, max_step)
+
+
+@njit(cache=True)
+def run(kind, V, Mt, L, damped, y0, edges, times, rtol, atol, max_step, first_step,
+        A, B, C, E3, E5, D, Y):
+    """Integrate from edges[0] to edges[-1], restarting at each interior edge (breakpoint),
+    writing the state at ``times`` into Y. ``first_step`` <= 0 selects it automatically.
+
+    Returns (number of output times written, nfev, accepted steps, code, t reached).
+    """
+    N = y0.shape[0]
+    y = y0.copy()
+    K = np.empty((16, N))
+    y_new = np.empty(N)
+    tmp = np.empty(N)
+    f1 = np.empty(N)
+    F = np.empty((7, N))
+    nt = times.shape[0]
+    n_out = 0
+    nfev = 0
+    nsteps = 0
+    t = edges[0]
+    while n_out < nt and times[n_out] <= t:
+        Y[n_out] = y
+        n_out += 1
+    for seg in range(edges.shape[0] - 1):
+        t = edges[seg]
+        t_bound = edges[seg + 1]
+        rhs(kind, t, y, V, Mt, L, damped, K[0])
+        nfev += 1
+        if first_step > 0:
+            h_abs = min(first_step, t_bound - t)
+        else:
+            h_abs = _initial_step(kind, V, Mt, L, damped, t, y, K[0], t_bound, rtol, atol,
+                                  max_step, tmp, f1)
+            nfev += 1
+        while t < t_bound:
+            min_step = 10.0 * (np.nextafter(t, np.inf) - t)
+            h_abs = min(max(h_abs, min_step), max_step)
+            rejected = False
+            while True:
+                if h_abs < min_step:
+                    return n_out, nfev, nsteps, STEP_TOO_SMALL, t
+                t_new = t + h_abs
+                if t_new > t_bound:
+                    t_new = t_bound
+                h = t_new - t
+                h_abs = h
+                for s in range(1, N_STAGES):
+                    tmp[:] = y
+                    for j in range(s):
+                        if A[s, j] != 0.0:
+                            tmp += (h * A[s, j]) * K[j]
+                    rhs(kind, t + C[s] * h, tmp, V, Mt, L, damped, K[s])
+                y_new[:] = y
+                for j in range(N_STAGES):
+                    y_new += (h * B[j]) * K[j]
+                rhs(kind, t_new, y_new, V, Mt, L, damped, K[N_STAGES])
+                nfev += N_STAGES
+                err5 = 0.0
+                err3 = 0.0
+                for i in range(N):
+                    sc = atol + max(abs(y[i]), abs(y_new[i])) * rtol
+                    e5 = 0.0
+                    e3 = 0.0
+                    for j in range(N_STAGES + 1):
+                        e5 += K[j, i] * E5[j]
+                        e3 += K[j, i] * E3[j]
+                    err5 += (e5 / sc) ** 2
+                    err3 += (e3 / sc) ** 2
+                if err5 == 0.0 and err3 == 0.0:
+                    err = 0.0
+                else:
+                    err = h * err5 / np.sqrt((err5 + 0.01 * err3) * N)
+                if not np.isfinite(err):
+                    return n_out, nfev, nsteps, NON_FINITE, t
+                if err < 1.0:
+                    factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** ERROR_EXPONENT)
+                    if rejected:
+                        factor = min(1.0, factor)
+                    h_abs *= factor
+                    break
+                h_abs *= max(MIN_FACTOR, SAFETY * err ** ERROR_EXPONENT)
+                rejected = True
+            nsteps += 1
+            if not np.all(np.isfinite(y_new)):
+                return n_out, nfev, nsteps, NON_FINITE, t
+            if n_out < nt and times[n_out] <= t_new:
+                # dense output: three extra stages, then the 7th-order interpolant
+                for s in range(N_STAGES + 1, 16):
+                    tmp[:] = y
+                    for j in range(s):
+                        if A[s, j] != 0.0:
+                            tmp += (h * A[s, j]) * K[j]
+                    rhs(kind, t + C[s] * h, tmp, V, Mt, L, damped, K[s])
+                nfev += 3
+                F[0] = y_new - y
+                F[1] = h * K[0] - F[0]
+                F[2] = 2.0 * F[0] - h * (K[N_STAGES] + K[0])
+                for p in range(4):
+                    F[3 + p] = 0.0
+                    for j in range(16):
+                        if D[p, j] != 0.0:
+                            F[3 + p] += (h * D[p, j]) * K[j]
+                while n_out < nt and times[n_out] <= t_new:
+                    x = (times[n_out] - t) / h
+                    acc = np.zeros(N)
+                    for i in range(7):
+                        acc += F[6 - i]
+                        acc *= x if i % 2 == 0 else 1.0 - x
+                    Y[n_out] = acc + y
+                    n_out += 1
+            t = t_new
+            y[:] = y_new
+            K[0] = K[N_STAGES]
+    return n_out, nfev, nsteps, OK, t
+
+
+def integrate_compiled(kind: int, V: np.ndarray, Mt: np.ndarray, L: np.ndarray, damped: bool,
+                       y0: np.ndarray, edges: np.ndarray, times: np.ndarray, rtol: float,
+                       atol: float, max_step: float, first_step: float | None, Y: np.ndarray
+                       ) -> tuple[int, int, int, int, float]:
+    """Run ``run`` with scipy's DOP853 coefficients (see ``run`` for the result)."""
+    n_out, nfev, nsteps, code, t = run(
+        kind, V, Mt, L, damped, np.array(y0, float), np.array(edges, float),
+        np.array(times, float), rtol, atol, max_step, -1.0 if first_step is None else first_step,
+        _A, _B, _C, _E3, _E5, _D, Y)
+    return int(n_out), int(nfev), int(nsteps), int(code), float(t)

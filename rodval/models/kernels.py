@@ -1,0 +1,378 @@
+"""Compiled (numba) right-hand sides of the paper's full and reduced models.
+
+The numpy right-hand sides in ``full.py``/``reduced.py`` are the straightforward reference
+(``kernel="numpy"``); the kernels here compute the same accelerations with the chain
+structure exploited (``kernel="numba"``, the default):
+
+* every product with an angle-dependent block (M_pp, G_pp, U = M_pa off-diagonal, G_pa and
+  their transposes) is O(n): with c_kj = c_k c_j + s_k s_j and s_kj = s_k c_j - c_k s_j the
+  sums over j < k or j > k are running (prefix/suffix) sums;
+* K q and C q' go through the hinge angles D = A q (A bidiagonal), O(n);
+* the full model's 3n x 3n solve eliminates the bending coordinates (M_gg is constant and
+  2 x 2 block diagonal per rod); the n x n Schur complement S = M_pp - M_pg M_gg^-1 M_gp is
+  "diagonal + rank-2 semiseparable": S[k,j] = a_k . b_j (k > j), b_k . e_j (k < j), so its
+  LU factors have the same form and the solve is O(n) (a generator-form LU, the recursion used
+  by Foreman-Mackey et al. 2017, "celerite", generalised to a non-symmetric matrix for the
+  ``published`` coefficients).
+
+The reduced model's M_r = M_pp - P M_gp has the dense constant factor P = K_pg B^-1, so it
+is assembled in O(n^2) and solved densely (O(n^3), n is small for that model).
+
+Parameters are packed into plain arrays so that one compiled integrator
+(``rodval.integrators.dop853``) can call either model through ``accel``:
+``V`` (rows of length-n vectors, layout ``V_*`` below), ``Mt`` (stack of n x n matrices of the
+reduced model, layout ``M_*``), and the load table ``L`` (see ``load_table``).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..loads import LoadSet
+
+#: Model kinds understood by ``accel``.
+KIND_FULL, KIND_REDUCED = 0, 1
+
+# Rows of V (per-rod vectors). Shared by both models.
+V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB = range(7)
+# Full model only: Schur-complement constants per rod (see full_constants).
+V_PA, V_PB, V_AP, V_BP, V_AA, V_AB, V_EPS, V_PI, V_RHO, V_TAU = range(7, 17)
+N_V_FULL = 17
+# Stack Mt of the reduced model: P_a - P_b, P_a ap + P_b bp, K_r, C_r.
+M_PDIFF, M_PDIAG, M_KR, M_CR = range(4)
+
+# Load table columns: node (0-based), component (0 = X, 1 = Y), law (0 = constant,
+# 1 = raised cosine amp (1/2 - 1/2 cos(omega t))), amp (N), omega (rad/s), t0, t1 (s).
+LAW_CONSTANT, LAW_RAISED_COSINE = 0, 1
+
+
+def _rows(cc, chain) -> list[np.ndarray]:
+    return [cc.l, cc.outer_mass, cc.pp_diag, chain.m * chain.l**2 / 12.0, chain.kappa,
+            chain.nu, 4.0 * chain.EI / chain.l]
+
+
+def full_constants(cc, chain) -> np.ndarray:
+    """V for the full model: chain vectors plus the per-rod constants of the bending
+    elimination. With M_gg,j = [[aa, ab], [ab, aa]], e = (1, -1), p = (pa, pb), a = (ap, bp):
+    eps = e^T M_gg^-1 e, pi = p^T M_gg^-1 e, rho = e^T M_gg^-1 a, tau = p^T M_gg^-1 a."""
+    aa, ab = cc.aa_diag, cc.ab_diag
+    det = aa * aa - ab * ab
+    eps = 2.0 / (aa - ab)
+    pi = (cc.pa_diag - cc.pb_diag) / (aa - ab)
+    rho = (cc.ap_diag - cc.bp_diag) / (aa - ab)
+    tau = (cc.pa_diag * (aa * cc.ap_diag - ab * cc.bp_diag)
+           + cc.pb_diag * (aa * cc.bp_diag - ab * cc.ap_diag)) / det
+    rows = _rows(cc, chain) + [cc.pa_diag, cc.pb_diag, cc.ap_diag, cc.bp_diag, aa, ab,
+                               np.broadcast_to(eps, aa.shape), pi, rho, tau]
+    return np.ascontiguousarray(np.vstack(rows), dtype=np.float64)
+
+
+def reduced_constants(cc, chain, P_diff, P_diag, K_r, C_r) -> tuple[np.ndarray, np.ndarray]:
+    """(V, Mt) for the reduced model."""
+    V = np.ascontiguousarray(np.vstack(_rows(cc, chain)), dtype=np.float64)
+    Mt = np.ascontiguousarray(np.stack([P_diff, P_diag, K_r, C_r]), dtype=np.float64)
+    return V, Mt
+
+
+def load_table(loads: LoadSet) -> np.ndarray | None:
+    """The scene's loads as a table the compiled kernels evaluate, or None when a load is an
+    arbitrary callable (only ``pulse`` and ``constant`` laws have a compiled form)."""
+    rows = []
+    for f in loads.loads:
+        p = f.params
+        if f.name == "pulse":
+            T = p["T"]
+            rows.append((f.node - 1, 0, LAW_RAISED_COSINE, p["Xbar"], 4 * math.pi / T, 0.0, 0.5 * T))
+            rows.append((f.node - 1, 1, LAW_RAISED_COSINE, p["Ybar"], 2 * math.pi / T, 0.0, T))
+        elif f.name == "constant":
+            for comp, key in ((0, "X"), (1, "Y")):
+                if p[key]:
+                    rows.append((f.node - 1, comp, LAW_CONSTANT, p[key], 0.0, p["t_on"], p["t_off"]))
+        else:
+            return None
+    return np.array(rows, dtype=np.float64).reshape(-1, 7)
+
+
+@njit(cache=True)
+def load_sums(L, t, SX, SY):
+    """Suffix sums SX_k = sum_{j>=k} X_j, SY_k (N) at t from the load table ``L``; returns
+    False (and leaves SX, SY untouched) when no load acts at t. A law is evaluated only
+    inside its support [t0, t1]."""
+    n = SX.shape[0]
+    active = False
+    for r in range(L.shape[0]):
+        if L[r, 5] <= t <= L[r, 6]:
+            if not active:
+                SX[:] = 0.0
+                SY[:] = 0.0
+                active = True
+            if L[r, 2] == LAW_RAISED_COSINE:
+                value = L[r, 3] * (0.5 - 0.5 * math.cos(L[r, 4] * t))
+            else:
+                value = L[r, 3]
+            if L[r, 1] == 0:
+                SX[int(L[r, 0])] += value
+            else:
+                SY[int(L[r, 0])] += value
+    if active:
+        for k in range(n - 2, -1, -1):
+            SX[k] += SX[k + 1]
+            SY[k] += SY[k + 1]
+    return active
+
+
+@njit(cache=True)
+def _hinge_forces(V, phi, alpha, beta, row, out_p, out_a, out_b):
+    """out += A^T diag(V[row]) A [phi; alpha; beta] (hinge springs or dampers), O(n)."""
+    n = phi.shape[0]
+    for i in range(n):
+        D = phi[i] + alpha[i]
+        if i > 0:
+            D -= phi[i - 1] + beta[i - 1]
+        T = V[row, i] * D
+        out_p[i] += T
+        out_a[i] += T
+        if i > 0:
+            out_p[i - 1] -= T
+            out_b[i - 1] -= T
+
+
+@njit(cache=True)
+def _gpp_times(V, c, s, x, out):
+    """out -= G_pp x, G_pp[k,j] = l_k l_j M_max(k,j) s_kj, O(n)."""
+    n = c.shape[0]
+    l, outer = V[V_L], V[V_OUTER]
+    pc = 0.0
+    ps = 0.0
+    for k in range(n):                       # j < k: weight M_k
+        out[k] -= l[k] * outer[k] * (s[k] * pc - c[k] * ps)
+        pc += l[k] * c[k] * x[k]
+        ps += l[k] * s[k] * x[k]
+    sc = 0.0
+    ss = 0.0
+    for k in range(n - 1, -1, -1):           # j > k: weight M_j
+        out[k] -= l[k] * (s[k] * sc - c[k] * ss)
+        sc += outer[k] * l[k] * c[k] * x[k]
+        ss += outer[k] * l[k] * s[k] * x[k]
+
+
+@njit(cache=True)
+def _upper_times(V, c, s, x, cos_part, out, sign):
+    """out += sign * X x with X[k,j] = l_k w_j (c_kj if cos_part else s_kj) for k < j, O(n)."""
+    n = c.shape[0]
+    l, w = V[V_L], V[V_W]
+    wc = 0.0
+    ws = 0.0
+    for k in range(n - 1, -1, -1):
+        if cos_part:
+            out[k] += sign * l[k] * (c[k] * wc + s[k] * ws)
+        else:
+            out[k] += sign * l[k] * (s[k] * wc - c[k] * ws)
+        wc += w[k] * c[k] * x[k]
+        ws += w[k] * s[k] * x[k]
+
+
+@njit(cache=True)
+def _upper_t_times(V, c, s, x, cos_part, out, sign):
+    """out += sign * X^T x for the X of ``_upper_times``, O(n)."""
+    n = c.shape[0]
+    l, w = V[V_L], V[V_W]
+    lc = 0.0
+    ls = 0.0
+    for j in range(n):
+        if cos_part:
+            out[j] += sign * w[j] * (c[j] * lc + s[j] * ls)
+        else:
+            out[j] += sign * w[j] * (c[j] * ls - s[j] * lc)
+        lc += l[j] * c[j] * x[j]
+        ls += l[j] * s[j] * x[j]
+
+
+@njit(cache=True)
+def _schur_solve(V, c, s, r, x):
+    """Solve S x = r for the full model's Schur complement S = M_pp - M_pg M_gg^-1 M_gp in
+    O(n): S = diag(d) + tril(a b^T) + triu(b e^T) with 2-vectors a_k, b_k, e_k per rod."""
+    n = c.shape[0]
+    l, outer, w = V[V_L], V[V_OUTER], V[V_W]
+    eps, pi, rho, tau = V[V_EPS], V[V_PI], V[V_RHO], V[V_TAU]
+    a = np.empty((n, 2))
+    b = np.empty((n, 2))
+    e = np.empty((n, 2))
+    d = np.empty(n)
+    scc = 0.0
+    scs = 0.0
+    sss = 0.0                               # sum_{j>k} w_j^2 eps_j (c c, c s, s s)_j
+    for k in range(n - 1, -1, -1):
+        g0 = c[k] * scc + s[k] * scs
+        g1 = c[k] * scs + s[k] * sss
+        base0 = l[k] * (outer[k] * c[k] - g0)
+        base1 = l[k] * (outer[k] * s[k] - g1)
+        a[k, 0] = base0 - w[k] * pi[k] * c[k]
+        a[k, 1] = base1 - w[k] * pi[k] * s[k]
+        e[k, 0] = base0 - w[k] * rho[k] * c[k]
+        e[k, 1] = base1 - w[k] * rho[k] * s[k]
+        b[k, 0] = l[k] * c[k]
+        b[k, 1] = l[k] * s[k]
+        d[k] = V[V_PPDIAG, k] - l[k] * l[k] * (c[k] * g0 + s[k] * g1) - tau[k]
+        we = w[k] * w[k] * eps[k]
+        scc += we * c[k] * c[k]
+        scs += we * c[k] * s[k]
+        sss += we * s[k] * s[k]
+    # LU with L[k,j] = a_k . W_j, R[j,k] = Z_j . e_k (unit triangular), pivots D_k.
+    S00 = 0.0
+    S01 = 0.0
+    S10 = 0.0
+    S11 = 0.0
+    f0 = 0.0
+    f1 = 0.0
+    Z = np.empty((n, 2))
+    for k in range(n):
+        Se0 = S00 * e[k, 0] + S01 * e[k, 1]
+        Se1 = S10 * e[k, 0] + S11 * e[k, 1]
+        Sta0 = S00 * a[k, 0] + S10 * a[k, 1]
+        Sta1 = S01 * a[k, 0] + S11 * a[k, 1]
+        Dk = d[k] - (a[k, 0] * Se0 + a[k, 1] * Se1)
+        W0 = (b[k, 0] - Se0) / Dk
+        W1 = (b[k, 1] - Se1) / Dk
+        Z[k, 0] = (b[k, 0] - Sta0) / Dk
+        Z[k, 1] = (b[k, 1] - Sta1) / Dk
+        S00 += Dk * W0 * Z[k, 0]
+        S01 += Dk * W0 * Z[k, 1]
+        S10 += Dk * W1 * Z[k, 0]
+        S11 += Dk * W1 * Z[k, 1]
+        yk = r[k] - (a[k, 0] * f0 + a[k, 1] * f1)
+        f0 += W0 * yk
+        f1 += W1 * yk
+        x[k] = yk / Dk
+    g0 = 0.0
+    g1 = 0.0
+    for k in range(n - 1, -1, -1):
+        x[k] -= Z[k, 0] * g0 + Z[k, 1] * g1
+        g0 += e[k, 0] * x[k]
+        g1 += e[k, 1] * x[k]
+
+
+@njit(cache=True)
+def full_accel(V, q, v, has_load, SX, SY, damped, out):
+    """Accelerations q'' (3n) of the full model into ``out``: M(phi) q'' = [Q; 0; 0] - h
+    - C q' - K q. SX, SY are the load suffix sums (N), used when ``has_load``."""
+    n = V.shape[1]
+    phi, alpha, beta = q[:n], q[n:2 * n], q[2 * n:]
+    dphi, dalpha, dbeta = v[:n], v[n:2 * n], v[2 * n:]
+    c = np.cos(phi)
+    s = np.sin(phi)
+    fp = np.zeros(n)
+    fa = np.zeros(n)
+    fb = np.zeros(n)
+    _hinge_forces(V, phi, alpha, beta, V_KAPPA, fp, fa, fb)
+    if damped:
+        _hinge_forces(V, dphi, dalpha, dbeta, V_NU, fp, fa, fb)
+    kb = V[V_KB]
+    for k in range(n):
+        fa[k] += kb[k] * (alpha[k] + 0.5 * beta[k])
+        fb[k] += kb[k] * (0.5 * alpha[k] + beta[k])
+        fp[k] = -fp[k]
+        fa[k] = -fa[k]
+        fb[k] = -fb[k]
+    w2 = dphi * dphi
+    _gpp_times(V, c, s, w2, fp)                                  # - G_pp phi'^2
+    _upper_times(V, c, s, dphi * (dalpha - dbeta), False, fp, -2.0)  # - 2 G_pa (...)
+    _upper_t_times(V, c, s, w2, False, fa, 1.0)                  # - h_alpha = + G_pa^T w2
+    _upper_t_times(V, c, s, w2, False, fb, -1.0)
+    if has_load:
+        l = V[V_L]
+        for k in range(n):
+            fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
+    # g = M_gg^-1 f_g per rod; r = f_p - M_pg g; S x_p = r; x_g = M_gg^-1 (f_g - M_gp x_p)
+    aa, ab = V[V_AA], V[V_AB]
+    ga = np.empty(n)
+    gb = np.empty(n)
+    for k in range(n):
+        det = aa[k] * aa[k] - ab[k] * ab[k]
+        ga[k] = (aa[k] * fa[k] - ab[k] * fb[k]) / det
+        gb[k] = (aa[k] * fb[k] - ab[k] * fa[k]) / det
+    r = fp - V[V_PA] * ga - V[V_PB] * gb
+    _upper_times(V, c, s, ga - gb, True, r, -1.0)
+    xp = out[:n]
+    _schur_solve(V, c, s, r, xp)
+    ut = np.zeros(n)
+    _upper_t_times(V, c, s, xp, True, ut, 1.0)
+    for k in range(n):
+        ra = fa[k] - ut[k] - V[V_AP, k] * xp[k]
+        rb = fb[k] + ut[k] - V[V_BP, k] * xp[k]
+        det = aa[k] * aa[k] - ab[k] * ab[k]
+        out[n + k] = (aa[k] * ra - ab[k] * rb) / det
+        out[2 * n + k] = (aa[k] * rb - ab[k] * ra) / det
+
+
+@njit(cache=True)
+def reduced_matrix(V, Mt, c, s):
+    """M_r(phi) = M_pp - (P_a - P_b) U^T - (P_a ap + P_b bp), O(n^2) (U^T by running sums)."""
+    n = c.shape[0]
+    l, outer = V[V_L], V[V_OUTER]
+    w = V[V_W]
+    Pd = Mt[M_PDIFF]
+    M = -Mt[M_PDIAG].copy()
+    for k in range(n):
+        M[k, k] += V[V_PPDIAG, k]
+        for j in range(k):
+            v = l[k] * l[j] * outer[k] * (c[k] * c[j] + s[k] * s[j])
+            M[k, j] += v
+            M[j, k] += v
+    # (Pd U^T)[i, k] = l_k sum_{j>k} Pd[i, j] w_j c_kj: suffix sums over j per row i.
+    for i in range(n):
+        acc_c = 0.0
+        acc_s = 0.0
+        for k in range(n - 1, -1, -1):
+            M[i, k] -= l[k] * (c[k] * acc_c + s[k] * acc_s)
+            acc_c += Pd[i, k] * w[k] * c[k]
+            acc_s += Pd[i, k] * w[k] * s[k]
+    return M
+
+
+@njit(cache=True)
+def reduced_accel(V, Mt, phi, dphi, has_load, SX, SY, damped, out):
+    """phi'' of the reduced model into ``out``: M_r phi'' = Q - G_r phi'^2 - C_r phi' - K_r phi,
+    G_r phi'^2 = G_pp phi'^2 + (P_a - P_b) G_pa^T phi'^2."""
+    n = phi.shape[0]
+    c = np.cos(phi)
+    s = np.sin(phi)
+    w2 = dphi * dphi
+    f = -(Mt[M_KR] @ phi)
+    if damped:
+        f -= Mt[M_CR] @ dphi
+    _gpp_times(V, c, s, w2, f)
+    gt = np.zeros(n)
+    _upper_t_times(V, c, s, w2, False, gt, 1.0)
+    f -= Mt[M_PDIFF] @ gt
+    if has_load:
+        l = V[V_L]
+        for k in range(n):
+            f[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
+    out[:] = np.linalg.solve(reduced_matrix(V, Mt, c, s), f)
+
+
+@njit(cache=True)
+def accel(kind, V, Mt, y, has_load, SX, SY, damped, out):
+    """Second derivatives (the lower half of y') of model ``kind`` (KIND_FULL or
+    KIND_REDUCED) at state y = [q; q'] into ``out``."""
+    half = y.shape[0] // 2
+    if kind == KIND_FULL:
+        full_accel(V, y[:half], y[half:], has_load, SX, SY, damped, out)
+    else:
+        reduced_accel(V, Mt, y[:half], y[half:], has_load, SX, SY, damped, out)
+
+
+@njit(cache=True)
+def rhs(kind, t, y, V, Mt, L, damped, out):
+    """y' = f(t, y) of model ``kind`` into ``out``, loads from table ``L`` (the compiled
+    integrator's right-hand side)."""
+    half = y.shape[0] // 2
+    out[:half] = y[half:]
+    n = V.shape[1]
+    SX = np.empty(n)
+    SY = np.empty(n)
+    has_load = load_sums(L, t, SX, SY)
+    accel(kind, V, Mt, y, has_load, SX, SY, damped, out[half:])
