@@ -10,8 +10,12 @@ import pandas as pd
 STATUS_SUCCESS = 0
 STATUS_FAILED = -1          # the integrator gave up (step size too small, singular matrix, ...)
 STATUS_ERROR = -2           # the model raised an exception
-STATUS_DIVERGED = -3        # NaN/inf or blow-up detected in the state
-STATUS_MESSAGES = {0: "success", -1: "integration failed", -2: "model error", -3: "diverged"}
+STATUS_DIVERGED = -3        # NaN/inf in the state
+STATUS_BLOWUP = -4          # energy grew beyond settings.blowup_factor x its physical budget
+STATUS_STALLED = -5         # step size collapsed below settings.min_step_fraction x t_end
+STATUS_MESSAGES = {0: "success", -1: "integration failed", -2: "model error",
+                   -3: "diverged (non-finite state)", -4: "diverged (energy blow-up)",
+                   -5: "stalled (step size collapse)"}
 
 
 @dataclass
@@ -27,6 +31,9 @@ class SolverStats:
     nlu: int = 0
     nsteps: int = 0
     wall_s: float = 0.0
+    #: max |E - E(0) - W_ext + D| / max(max E, max |W_ext|) over the output times, when the
+    #: scene asks for "energy" (see rodval.energy); None otherwise.
+    energy_residual: float | None = None
 
     @property
     def success(self) -> bool:
@@ -35,7 +42,8 @@ class SolverStats:
     def as_dict(self) -> dict:
         return {"status": self.status, "success": self.success, "message": self.message,
                 "t_reached": self.t_reached, "nfev": self.nfev, "njev": self.njev,
-                "nlu": self.nlu, "nsteps": self.nsteps, "wall_s": self.wall_s}
+                "nlu": self.nlu, "nsteps": self.nsteps, "wall_s": self.wall_s,
+                "energy_residual": self.energy_residual}
 
 
 @dataclass

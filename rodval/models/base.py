@@ -31,6 +31,13 @@ class OdeSystem(ABC):
     y0: np.ndarray
     #: Analytic Jacobian df/dy (t, y) -> (N, N), or None to let the integrator difference.
     jac: Callable[[float, np.ndarray], np.ndarray] | None = None
+    #: Mechanical energy E = T + Pi (J) at one state, (t, y) -> float, or None. Used by the
+    #: energy blow-up check (rodval.divergence).
+    energy: Callable[[float, np.ndarray], float] | None = None
+    #: (P_ext, P_diss) (W) at one state, (t, y) -> (float, float), or None: the power of the
+    #: applied loads and the power dissipated by the dampers. Integrated along the trajectory
+    #: by the energy audit (rodval.energy) and the blow-up check.
+    power: Callable[[float, np.ndarray], tuple[float, float]] | None = None
 
     @abstractmethod
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:

@@ -34,6 +34,9 @@ class FullSystem(PaperSystem):
             f[:n] += Q
         return np.concatenate([v, np.linalg.solve(assemble_mass(self.cc, ckj), f)])
 
+    def generalized_rates(self, y):
+        return y[3 * self.n:]
+
     def rigid(self, Y):
         n = self.n
         return Y[:, :n], Y[:, 3 * n:4 * n]

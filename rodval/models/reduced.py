@@ -77,6 +77,12 @@ class ReducedSystem(PaperSystem):
             r += self.C_gp @ dphi
         return -self.B_inv @ r
 
+    def generalized_rates(self, y):
+        """[phi'; 0; 0]: the reduced model drops the bending rates from its kinetic energy and
+        from its phi rows, so its dampers dissipate phi'^T C_pp phi' (see docs/stability.md)."""
+        n = self.n
+        return np.concatenate([y[n:], np.zeros(2 * n)])
+
     def rigid(self, Y):
         n = self.n
         return Y[:, :n], Y[:, n:]
