@@ -46,6 +46,8 @@ class IntegratorSettings:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v) or v <= 0:
                 raise ValueError(f"{name} must be a number > 0, got {v!r}")
+        if not math.isfinite(self.atol):
+            raise ValueError(f"atol must be a finite number > 0, got {self.atol!r}")
         if self.rtol >= 1:
             raise ValueError(f"rtol must be in (0, 1), got {self.rtol!r}")
         if self.first_step is not None and not (self.first_step > 0 and math.isfinite(self.first_step)):
