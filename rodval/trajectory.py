@@ -11,11 +11,12 @@ STATUS_SUCCESS = 0
 STATUS_FAILED = -1          # the integrator gave up (step size too small, singular matrix, ...)
 STATUS_ERROR = -2           # the model raised an exception
 STATUS_DIVERGED = -3        # NaN/inf in the state
-STATUS_BLOWUP = -4          # energy grew beyond settings.blowup_factor x its physical budget
-STATUS_STALLED = -5         # step size collapsed below settings.min_step_fraction x t_end
+# -4, -5: timeout and worker crash of the study runner (branch study)
+STATUS_BLOWUP = -6          # energy grew beyond settings.blowup_factor x its physical budget
+STATUS_STALLED = -7         # step size collapsed below settings.min_step_fraction x t_end
 STATUS_MESSAGES = {0: "success", -1: "integration failed", -2: "model error",
-                   -3: "diverged (non-finite state)", -4: "diverged (energy blow-up)",
-                   -5: "stalled (step size collapse)"}
+                   -3: "diverged (non-finite state)", -6: "diverged (energy blow-up)",
+                   -7: "stalled (step size collapse)"}
 
 
 @dataclass

@@ -1,0 +1,123 @@
+"""Stability map: which model/integrator completes each stress case, at what cost, with what
+energy residual (issue 6). The grid is the one of studies/stability.toml, run here with
+``rodval.simulate`` directly, each run in its own process with a wall-time limit.
+
+Run:  PYTHONPATH=. python benchmarks/stability_map.py [--out DIR] [--timeout S] [--workers N]
+Writes DIR/stability_map.csv and DIR/stability_map.md (default DIR: results/stability).
+
+Cases (paper chain data unless varied; the paper's pulse, T = 1 s, at the last node, scaled
+by ``load``; nu = 0.01 N m s/rad):
+  A. n in {8, 32, 128} x kappa in {0, 100, 1e6} N m/rad x load in {1, 10}; EI = 1e5; 10 T.
+  B. n = 8, kappa = 100, EI in {1e3, 1e4, 1e6, 1e7} N m^2 (1e5 is in A); 10 T.
+  C. n in {8, 32}, paper data, load in {1, 10}: 100 T.
+Each case runs with full and reduced, each with DOP853 (explicit) and Radau (implicit), rtol
+1e-6, atol 1e-8, outputs phi and energy at 101 times. A run still going after ``--timeout``
+seconds is stopped and recorded as "timeout".
+"""
+from __future__ import annotations
+
+import argparse
+import multiprocessing as mp
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from tabulate import tabulate
+
+from rodval import paper_scene, pulse, simulate
+from rodval.trajectory import STATUS_MESSAGES
+
+MODELS = (("full", "DOP853"), ("full", "Radau"), ("reduced", "DOP853"), ("reduced", "Radau"))
+RTOL, ATOL = 1e-6, 1e-8
+
+
+def cases() -> list[dict]:
+    out = []
+    for n in (8, 32, 128):
+        for kappa in (0.0, 100.0, 1e6):
+            for load in (1, 10):
+                out.append(dict(group="A", n=n, kappa=kappa, EI=1e5, load=load, horizon=10.0))
+    for EI in (1e3, 1e4, 1e6, 1e7):
+        out.append(dict(group="B", n=8, kappa=100.0, EI=EI, load=1, horizon=10.0))
+    for n in (8, 32):
+        for load in (1, 10):
+            out.append(dict(group="C", n=n, kappa=100.0, EI=1e5, load=load, horizon=100.0))
+    return out
+
+
+def scene_of(case: dict):
+    n, horizon = case["n"], case["horizon"]
+    scene = paper_scene(n, t_end=horizon, times=np.linspace(0.0, horizon, 101),
+                        outputs=("phi", "energy"), kappa=case["kappa"], EI=case["EI"])
+    return scene.with_(loads=(pulse(n, Xbar=-150.0 * case["load"], Ybar=1200.0 * case["load"]),))
+
+
+def _run(case: dict, model: str, method: str, conn) -> None:
+    tr = simulate(scene_of(case), model, method=method, rtol=RTOL, atol=ATOL)
+    st = tr.stats
+    E = tr["energy"][:, 0] if "energy" in tr.values else np.zeros(0)
+    conn.send({"status": STATUS_MESSAGES[st.status], "t_reached": st.t_reached,
+               "nsteps": st.nsteps, "nfev": st.nfev, "wall_s": st.wall_s,
+               "energy_residual": st.energy_residual,
+               "E_max": float(E.max()) if E.size else np.nan, "message": st.message})
+
+
+def run_all(jobs: list[tuple[dict, str, str]], timeout: float, workers: int) -> list[dict]:
+    ctx = mp.get_context("fork")
+    pending, active, rows = list(jobs), [], []
+    while pending or active:
+        while pending and len(active) < workers:
+            case, model, method = pending.pop(0)
+            recv, send = ctx.Pipe(duplex=False)
+            proc = ctx.Process(target=_run, args=(case, model, method, send), daemon=True)
+            proc.start()
+            active.append((proc, recv, time.perf_counter(), case, model, method))
+        time.sleep(0.05)
+        for item in list(active):
+            proc, recv, start, case, model, method = item
+            elapsed = time.perf_counter() - start
+            row = None
+            if recv.poll():
+                row = recv.recv()
+            elif not proc.is_alive():
+                row = {"status": "worker crashed", "message": f"exit code {proc.exitcode}"}
+            elif elapsed > timeout:
+                proc.kill()
+                row = {"status": "timeout", "message": f"stopped after {timeout:g} s"}
+            if row is None:
+                continue
+            proc.join()
+            active.remove(item)
+            rows.append({**case, "model": model, "method": method, "elapsed_s": elapsed, **row})
+            print(f"{case['group']} n={case['n']} kappa={case['kappa']:g} EI={case['EI']:g} "
+                  f"load={case['load']} T={case['horizon']:g} {model}/{method}: {row['status']} "
+                  f"R={row.get('energy_residual')} {elapsed:.1f} s", flush=True)
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=Path("results/stability"))
+    ap.add_argument("--timeout", type=float, default=20.0, help="wall-time limit per run, s")
+    ap.add_argument("--workers", type=int, default=2)
+    args = ap.parse_args()
+    jobs = [(c, m, meth) for c in cases() for m, meth in MODELS]
+    start = time.perf_counter()
+    rows = run_all(jobs, args.timeout, args.workers)
+    total = time.perf_counter() - start
+    df = pd.DataFrame(rows).sort_values(["group", "n", "kappa", "EI", "load", "horizon",
+                                         "model", "method"])
+    args.out.mkdir(parents=True, exist_ok=True)
+    df.to_csv(args.out / "stability_map.csv", index=False)
+    cols = ["group", "n", "kappa", "EI", "load", "horizon", "model", "method", "status",
+            "t_reached", "nsteps", "nfev", "wall_s", "energy_residual"]
+    table = tabulate(df[cols], headers=cols, tablefmt="pipe", showindex=False, floatfmt=".3g")
+    (args.out / "stability_map.md").write_text(
+        f"{table}\n\n{len(df)} runs, timeout {args.timeout:g} s per run, {args.workers} workers, "
+        f"total wall time {total:.0f} s\n")
+    print(f"{len(df)} runs in {total:.0f} s -> {args.out}")
+
+
+if __name__ == "__main__":
+    main()
