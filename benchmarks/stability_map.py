@@ -19,6 +19,7 @@ a run that exceeds it is recorded as "timeout". ``cpu_s`` is the run's CPU time.
 from __future__ import annotations
 
 import argparse
+import json
 import multiprocessing as mp
 import resource
 import signal
@@ -66,9 +67,19 @@ def _run(case: dict, model: str, method: str, conn, budget: float) -> None:
                "E_max": float(E.max()) if E.size else np.nan, "message": st.message})
 
 
-def run_all(jobs: list[tuple[dict, str, str]], timeout: float, workers: int) -> list[dict]:
+def _key(row: dict) -> tuple:
+    return tuple(row[k] for k in ("group", "n", "kappa", "EI", "load", "horizon", "model",
+                                  "method"))
+
+
+def run_all(jobs: list[tuple[dict, str, str]], timeout: float, workers: int,
+            log: Path) -> list[dict]:
+    """Run the jobs not yet in ``log`` (JSON lines, one finished run each: resumable)."""
     ctx = mp.get_context("fork")
-    pending, active, rows = list(jobs), [], []
+    rows = [json.loads(line) for line in log.read_text().splitlines()] if log.exists() else []
+    done = {_key(r) for r in rows}
+    pending = [j for j in jobs if _key({**j[0], "model": j[1], "method": j[2]}) not in done]
+    active = []
     while pending or active:
         while pending and len(active) < workers:
             case, model, method = pending.pop(0)
@@ -76,6 +87,7 @@ def run_all(jobs: list[tuple[dict, str, str]], timeout: float, workers: int) -> 
             proc = ctx.Process(target=_run, args=(case, model, method, send, timeout),
                                daemon=True)
             proc.start()
+            send.close()
             active.append((proc, recv, time.perf_counter(), case, model, method))
         time.sleep(0.05)
         for item in list(active):
@@ -83,16 +95,23 @@ def run_all(jobs: list[tuple[dict, str, str]], timeout: float, workers: int) -> 
             elapsed = time.perf_counter() - start
             row = None
             if recv.poll():
-                row = recv.recv()
-            elif not proc.is_alive() and proc.exitcode == -signal.SIGXCPU:
+                try:
+                    row = recv.recv()
+                except EOFError:        # the run died: its exit code says how
+                    proc.join()
+            if row is not None or proc.is_alive():
+                pass
+            elif proc.exitcode == -signal.SIGXCPU:
                 row = {"status": "timeout", "message": f"CPU budget of {timeout:g} s exceeded"}
-            elif not proc.is_alive():
+            else:
                 row = {"status": "worker crashed", "message": f"exit code {proc.exitcode}"}
             if row is None:
                 continue
             proc.join()
             active.remove(item)
             rows.append({**case, "model": model, "method": method, "elapsed_s": elapsed, **row})
+            with log.open("a") as fh:
+                fh.write(json.dumps(rows[-1]) + "\n")
             print(f"{case['group']} n={case['n']} kappa={case['kappa']:g} EI={case['EI']:g} "
                   f"load={case['load']} T={case['horizon']:g} {model}/{method}: {row['status']} "
                   f"R={row.get('energy_residual')} {elapsed:.1f} s", flush=True)
@@ -107,7 +126,8 @@ def main() -> None:
     args = ap.parse_args()
     jobs = [(c, m, meth) for c in cases() for m, meth in MODELS]
     start = time.perf_counter()
-    rows = run_all(jobs, args.timeout, args.workers)
+    args.out.mkdir(parents=True, exist_ok=True)
+    rows = run_all(jobs, args.timeout, args.workers, args.out / "runs.jsonl")
     total = time.perf_counter() - start
     df = pd.DataFrame(rows).sort_values(["group", "n", "kappa", "EI", "load", "horizon",
                                          "model", "method"])
