@@ -133,6 +133,10 @@ class LoadSet:
                     X[f.node - 1] += f.fx(t)
                 if f.fy is not None:
                     Y[f.node - 1] += f.fy(t)
+        if any_active and not (np.all(np.isfinite(X)) and np.all(np.isfinite(Y))):
+            bad = int(np.flatnonzero(~(np.isfinite(X) & np.isfinite(Y)))[0]) + 1
+            raise ValueError(f"load at node {bad} is not finite at t = {t:.6g} s "
+                             f"(X = {X[bad - 1]}, Y = {Y[bad - 1]})")
         return (X, Y) if any_active else None
 
     def suffix_sums(self, t: float) -> tuple[np.ndarray, np.ndarray] | None:

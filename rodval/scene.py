@@ -31,7 +31,10 @@ ENERGY_QUANTITIES = ("kinetic", "potential", "energy")
 
 
 def _as_rod_array(name: str, value, n: int, *, positive: bool) -> np.ndarray:
-    arr = np.asarray(value, dtype=float)
+    raw = np.asarray(value)
+    if raw.dtype.kind not in "iuf":          # strings, booleans, objects: refused, not converted
+        raise ValueError(f"{name} must be a number or a list of n = {n} numbers, got {value!r}")
+    arr = raw.astype(float)
     if arr.ndim == 0:
         arr = np.full(n, float(arr))
     if arr.shape != (n,):

@@ -10,8 +10,13 @@ import pandas as pd
 STATUS_SUCCESS = 0
 STATUS_FAILED = -1          # the integrator gave up (step size too small, singular matrix, ...)
 STATUS_ERROR = -2           # the model raised an exception
-STATUS_DIVERGED = -3        # NaN/inf or blow-up detected in the state
-STATUS_MESSAGES = {0: "success", -1: "integration failed", -2: "model error", -3: "diverged"}
+STATUS_DIVERGED = -3        # NaN/inf in the state
+# -4, -5: timeout and worker crash of the study runner (branch study)
+STATUS_BLOWUP = -6          # energy grew beyond settings.blowup_factor x its physical budget
+STATUS_STALLED = -7         # step size collapsed below settings.min_step_fraction x t_end
+STATUS_MESSAGES = {0: "success", -1: "integration failed", -2: "model error",
+                   -3: "diverged (non-finite state)", -6: "diverged (energy blow-up)",
+                   -7: "stalled (step size collapse)"}
 
 
 @dataclass
@@ -27,6 +32,9 @@ class SolverStats:
     nlu: int = 0
     nsteps: int = 0
     wall_s: float = 0.0
+    #: max |E - E(0) - W_ext + D| / max(max E, max |W_ext|) over the output times, when the
+    #: scene asks for "energy" (see rodval.energy); None otherwise.
+    energy_residual: float | None = None
 
     @property
     def success(self) -> bool:
@@ -35,7 +43,8 @@ class SolverStats:
     def as_dict(self) -> dict:
         return {"status": self.status, "success": self.success, "message": self.message,
                 "t_reached": self.t_reached, "nfev": self.nfev, "njev": self.njev,
-                "nlu": self.nlu, "nsteps": self.nsteps, "wall_s": self.wall_s}
+                "nlu": self.nlu, "nsteps": self.nsteps, "wall_s": self.wall_s,
+                "energy_residual": self.energy_residual}
 
 
 @dataclass

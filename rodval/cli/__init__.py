@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 
 #: Subcommand modules, in the order ``rodval --help`` lists them.
@@ -14,8 +15,21 @@ class CliError(Exception):
     """A user error: printed as one line, exit status 2."""
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line (no usage block), exit status 2, and which
+    reads any argument that starts with '-' and a digit or '.' as a value (``--times -1,2``,
+    ``--rtol -1e-3``) so that its parser can say what is allowed. Subparsers inherit it."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-[\d.]")
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="rodval",
         description="Cross-validate plane rod-chain models: the paper's full and reduced "
                     "models against each other and an independent exudyn beam model.")
@@ -32,7 +46,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
-    except (CliError, ValueError, FileNotFoundError) as exc:
+    except (CliError, ValueError, OSError) as exc:
         print(f"rodval {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

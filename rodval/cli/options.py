@@ -7,14 +7,20 @@ import math
 from ..settings import METHODS
 
 
-def positive_float(name: str):
+def positive_float(name: str, *, finite: bool = True, below: float = math.inf):
+    """Parser of a number > 0 (and < ``below``) for option ``name``; finite unless
+    ``finite=False``."""
+    allowed = "a finite number > 0" if finite else "a number > 0 (inf allowed)"
+    if below < math.inf:
+        allowed = f"a number in (0, {below:g})"
+
     def parse(text: str) -> float:
         try:
             v = float(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number > 0, got {text!r}") from None
-        if not (v > 0) or math.isnan(v):
-            raise argparse.ArgumentTypeError(f"{name} must be a number > 0, got {text!r}")
+            raise argparse.ArgumentTypeError(f"{name} must be {allowed}, got {text!r}") from None
+        if not (0 < v < below) or (finite and math.isinf(v)):
+            raise argparse.ArgumentTypeError(f"{name} must be {allowed}, got {text!r}")
         return v
     return parse
 
@@ -28,7 +34,7 @@ def time_list(text: str) -> list[float]:
     if not values:
         raise argparse.ArgumentTypeError("--times must list at least one time")
     if any(v < 0 or not math.isfinite(v) for v in values):
-        raise argparse.ArgumentTypeError(f"--times must be finite and >= 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"--times must be finite and >= 0 s, got {text!r}")
     if any(b <= a for a, b in zip(values, values[1:])):
         raise argparse.ArgumentTypeError(f"--times must be strictly increasing, got {text!r}")
     return values
@@ -53,9 +59,9 @@ def add_integrator_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--method", default="DOP853", choices=METHODS,
                    help="scipy solve_ivp method, or DOP853-numba (compiled loop), for native "
                         "models (default DOP853)")
-    p.add_argument("--rtol", type=positive_float("--rtol"), default=1e-10,
-                   help="relative tolerance > 0 (default 1e-10)")
+    p.add_argument("--rtol", type=positive_float("--rtol", below=1.0), default=1e-10,
+                   help="relative tolerance in (0, 1) (default 1e-10)")
     p.add_argument("--atol", type=positive_float("--atol"), default=1e-12,
                    help="absolute tolerance > 0 (default 1e-12)")
-    p.add_argument("--max-step", type=positive_float("--max-step"), default=math.inf,
+    p.add_argument("--max-step", type=positive_float("--max-step", finite=False), default=math.inf,
                    help="largest step, s (default unbounded)")

@@ -28,7 +28,10 @@ def get_model(name: str | Model, **options) -> Model:
         mod = importlib.import_module(module)
     except ImportError as exc:
         raise ValueError(f"model {name!r} is not available: {exc}") from exc
-    return getattr(mod, cls)(**options)
+    try:
+        return getattr(mod, cls)(**options)
+    except TypeError as exc:  # an unknown option name
+        raise ValueError(f"model {name!r} does not accept options {sorted(options)}: {exc}") from None
 
 
 __all__ = ["Model", "OdeModel", "OdeSystem", "FullModel", "ReducedModel", "REGISTRY", "get_model"]

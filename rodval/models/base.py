@@ -31,6 +31,19 @@ class OdeSystem(ABC):
     y0: np.ndarray
     #: Analytic Jacobian df/dy (t, y) -> (N, N), or None to let the integrator difference.
     jac: Callable[[float, np.ndarray], np.ndarray] | None = None
+    #: Mechanical energy E = T + Pi (J) at one state, (t, y) -> float, or None. Used by the
+    #: energy audit (rodval.energy).
+    energy: Callable[[float, np.ndarray], float] | None = None
+    #: Kinetic energy T (J) at one state, y -> float, or None. Cheap (no bending recovery);
+    #: used by the per-step blow-up check (rodval.divergence), valid because Pi >= 0.
+    kinetic_energy: Callable[[np.ndarray], float] | None = None
+    #: E = T + Pi (J) at one state without bending recovery, y -> float, or None (the
+    #: blow-up check's initial budget; for the reduced model exact at rest, see reduced.py).
+    stored_energy: Callable[[np.ndarray], float] | None = None
+    #: (P_ext, P_diss) (W) at one state, (t, y) -> (float, float), or None: the power of the
+    #: applied loads and the power dissipated by the dampers. Integrated along the trajectory
+    #: by the energy audit (rodval.energy) and the blow-up check.
+    power: Callable[[float, np.ndarray], tuple[float, float]] | None = None
 
     @abstractmethod
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:

@@ -85,6 +85,13 @@ class FullSystem(PaperSystem):
         J[3 * n:] = np.linalg.solve(M, np.hstack([dfdq, dfdv]))
         return J
 
+    def generalized_rates(self, y):
+        return y[3 * self.n:]
+
+    def stored_energy(self, y):
+        q = y[:3 * self.n]
+        return self.kinetic_energy(y) + 0.5 * float(q @ self.K @ q)
+
     def rigid(self, Y):
         n = self.n
         return Y[:, :n], Y[:, 3 * n:4 * n]

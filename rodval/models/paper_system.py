@@ -8,7 +8,7 @@ from ..scene import Scene
 from . import kernels
 from .base import OdeModel, OdeSystem
 from .paper_matrices import (VARIANTS, angle_differences, assemble_mass, chain_constants, damping_matrix,
-                             generalized_forces, node_positions, stiffness_matrix)
+                             generalized_forces, hinge_matrix, node_positions, stiffness_matrix)
 
 
 #: Right-hand-side implementations: "numba" (compiled, structured; default) or "numpy"
@@ -32,6 +32,10 @@ class PaperSystem(OdeSystem):
         self.n = chain.n
         self.l = chain.l
         self.cc = chain_constants(chain, coefficients)
+        # the kinetic energy always uses the kinematic (printed, symmetric) mass matrix
+        self.cc_kinetic = self.cc if coefficients == "printed" else chain_constants(chain)
+        self.A = hinge_matrix(chain.n)
+        self.nu = chain.nu
         self.K = stiffness_matrix(chain)
         self.C = damping_matrix(chain)
         self.damped = bool(np.any(chain.nu > 0))
@@ -88,6 +92,28 @@ class PaperSystem(OdeSystem):
         """alpha, beta, alpha', beta' (each (nt, n)) from a state history."""
         raise NotImplementedError
 
+    def generalized_rates(self, y: np.ndarray) -> np.ndarray:
+        """q' = [phi'; alpha'; beta'] (3n) as the model's equations see it at state y."""
+        raise NotImplementedError
+
+    def energy(self, t: float, y: np.ndarray) -> float:
+        """E = T + Pi (J) at one state (the same energy ``observe`` reports)."""
+        Y = y[None, :]
+        kin, pot = self.energies(*self.rigid(Y), *self.bending(np.array([t]), Y))
+        return float(kin[0] + pot[0])
+
+    def power(self, t: float, y: np.ndarray) -> tuple[float, float]:
+        """(P_ext, P_diss) (W): P_ext = Q(phi, t) . phi' (Q on the phi coordinates only, see
+        paper_matrices.generalized_forces); P_diss = q'^T C q' = sum_k nu_k (dD_k/dt)^2 >= 0,
+        the power taken out by the hinge dampers (D_k: hinge angles)."""
+        phi, dphi = (a[0] for a in self.rigid(y[None, :]))
+        Q = self.generalized_force(t, phi)
+        p_ext = 0.0 if Q is None else float(Q @ dphi)
+        if not self.damped:
+            return p_ext, 0.0
+        hinge_rates = self.A @ self.generalized_rates(y)
+        return p_ext, float(self.nu @ (hinge_rates * hinge_rates))
+
     def observe(self, times, Y):
         scene, n = self.scene, self.n
         rods = np.arange(1, n + 1)
@@ -118,14 +144,19 @@ class PaperSystem(OdeSystem):
             out["energy"] = ((kin + pot)[:, None], zero)
         return out
 
+    def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
+        return 0.5 * float(v @ assemble_mass(self.cc_kinetic, angle_differences(phi)[0]) @ v)
+
+    def kinetic_energy(self, y: np.ndarray) -> float:
+        """T = 1/2 q'^T M(phi) q' (J) at one state, without recovering bending angles."""
+        return self._kinetic(self.rigid(y[None, :])[0][0], self.generalized_rates(y))
+
     def energies(self, phi, dphi, alpha, beta, dalpha, dbeta) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic T = 1/2 q'^T M(phi) q' with the kinematic (printed) mass matrix, and
         Pi = 1/2 q^T K q (J), per output time."""
-        cc = self.cc if self.cc.variant == "printed" else chain_constants(self.scene.chain)
         q = np.concatenate([phi, alpha, beta], axis=1)
         v = np.concatenate([dphi, dalpha, dbeta], axis=1)
-        kin = np.array([0.5 * vi @ assemble_mass(cc, angle_differences(p)[0]) @ vi
-                        for p, vi in zip(phi, v)])
+        kin = np.array([self._kinetic(p, vi) for p, vi in zip(phi, v)])
         pot = 0.5 * np.einsum("ti,ij,tj->t", q, self.K, q)
         return kin, pot
 

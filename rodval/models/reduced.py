@@ -113,6 +113,18 @@ class ReducedSystem(PaperSystem):
             r += self.C_gp @ dphi
         return -self.B_inv @ r
 
+    def generalized_rates(self, y):
+        """[phi'; 0; 0]: the reduced model drops the bending rates from its kinetic energy and
+        from its phi rows, so its dampers dissipate phi'^T C_pp phi' (see docs/stability.md)."""
+        n = self.n
+        return np.concatenate([y[n:], np.zeros(2 * n)])
+
+    def stored_energy(self, y):
+        """T + 1/2 phi^T K_r phi: K_r is the Schur complement of B in K, so this is Pi at the
+        quasi-static bending gamma = -B^-1 K_gp phi (exact when phi'' = phi' = 0)."""
+        phi = y[:self.n]
+        return self.kinetic_energy(y) + 0.5 * float(phi @ self.K_r @ phi)
+
     def rigid(self, Y):
         n = self.n
         return Y[:, :n], Y[:, n:]
