@@ -25,8 +25,10 @@ def read_tables(out: Path) -> dict[str, pd.DataFrame]:
 
 
 def varying_params(cases: pd.DataFrame, params: list[str]) -> list[str]:
-    """Case parameters with more than one numeric value: the x axes of the figures."""
-    return [p for p in params if pd.api.types.is_numeric_dtype(cases[p]) and cases[p].nunique() > 1]
+    """Case parameters with more than one value, all numeric and finite: the x axes of the
+    figures (an axis such as max_step = [inf, 1e-7] has no place on a plot axis)."""
+    return [p for p in params if pd.api.types.is_numeric_dtype(cases[p]) and cases[p].nunique() > 1
+            and np.isfinite(cases[p].to_numpy(float)).all()]
 
 
 def _case_figures(out: Path, fig_dir: Path, meta: dict, tables: dict[str, pd.DataFrame]) -> list[str]:

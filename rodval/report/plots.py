@@ -18,8 +18,15 @@ def _label(model: str, others: Sequence[str], key: tuple) -> str:
     return ", ".join([model, *parts])
 
 
-def _lines(ax, df: pd.DataFrame, x: str, y: str, others: Sequence[str], styles: dict) -> None:
+def _lines(ax, df: pd.DataFrame, x: str, y: str, others: Sequence[str], styles: dict,
+           logx: bool, logy: bool = True) -> None:
+    """One line per model and combination of ``others``; log scales where the data allow."""
     markers = "os^dvP*X"
+    df = df[np.isfinite(df[y]) & (df[y] > 0 if logy else True)]
+    if logx and (df[x] > 0).all() and not df.empty:
+        ax.set_xscale("log")
+    if logy and not df.empty:
+        ax.set_yscale("log")
     for model, part in df.groupby("model", sort=False):
         groups = part.groupby(list(others), sort=True) if others else [((), part)]
         for i, (key, sub) in enumerate(groups):
@@ -52,11 +59,7 @@ def plot_discrepancy_vs(disc: pd.DataFrame, x: str, others: Sequence[str], model
         ax.set_visible(False)
     styles = model_styles(models)
     for ax, q in zip(axes, quantities):
-        sub = ok[(ok["quantity"] == q) & (ok[metric] > 0)]
-        _lines(ax, sub, x, metric, others, styles)
-        ax.set_yscale("log")
-        if logx:
-            ax.set_xscale("log")
+        _lines(ax, ok[ok["quantity"] == q], x, metric, others, styles, logx)
         ax.set_title(f"{q}, {QUANTITY_UNITS.get(q, '')}")
         ax.set_xlabel(x)
         ax.set_ylabel(metric)
@@ -67,12 +70,9 @@ def plot_discrepancy_vs(disc: pd.DataFrame, x: str, others: Sequence[str], model
 def plot_runtime_vs(runtime: pd.DataFrame, x: str, others: Sequence[str], models: Sequence[str],
                     path: Path, logx: bool = True) -> Path:
     """Integration wall time of successful runs against ``x`` (log-log)."""
-    ok = runtime[(runtime["status"] == "success") & (runtime["wall_s"] > 0)]
+    ok = runtime[runtime["status"] == "success"]
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    _lines(ax, ok, x, "wall_s", others, model_styles(models))
-    ax.set_yscale("log")
-    if logx:
-        ax.set_xscale("log")
+    _lines(ax, ok, x, "wall_s", others, model_styles(models), logx)
     ax.set_xlabel(x)
     ax.set_ylabel("integration wall time, s")
     ax.grid(alpha=0.3, which="both")
@@ -94,11 +94,8 @@ def speedups(runtime: pd.DataFrame, reference: str, params: Sequence[str]) -> pd
 def plot_speedup_vs(speed: pd.DataFrame, x: str, others: Sequence[str], models: Sequence[str],
                     reference: str, path: Path, logx: bool = True) -> Path:
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    _lines(ax, speed, x, "speedup", others, model_styles(models))
+    _lines(ax, speed, x, "speedup", others, model_styles(models), logx)
     ax.axhline(1.0, color="k", lw=0.8)
-    ax.set_yscale("log")
-    if logx:
-        ax.set_xscale("log")
     ax.set_xlabel(x)
     ax.set_ylabel(f"speed-up: wall time of {reference} / of model")
     ax.grid(alpha=0.3, which="both")

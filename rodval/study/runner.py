@@ -181,7 +181,9 @@ def run_study(spec: StudySpec, out: str | Path, *, workers: int | None = None,
     write_json_atomic(out / "provenance.json", provenance())
     (out / "study.toml").write_text(spec.text)
     reused = [c.id for c in spec.cases if resume and is_finished(out, c)]
-    todo = [c for c in spec.cases if c.id not in reused]
+    # Longest first (rods x horizon as the cost guess) so that no big case starts last.
+    todo = sorted((c for c in spec.cases if c.id not in reused),
+                  key=lambda c: -c.scene.n * c.scene.t_end)
     failed = 0
     bar = tqdm(total=len(todo), desc=spec.name, unit="case", disable=not progress or not todo)
 

@@ -24,7 +24,8 @@ from .runner import load_records
 
 TABLES = ("cases", "trajectories", "discrepancies", "runtime")
 FIXED = ("case", "n", "horizon", "model", "reference", "quantity", "method", "rtol", "atol",
-         "status", "message", "t", "k", "value", *METRICS)
+         "max_step", "wall_s", "setup_s", "nfev", "njev", "nlu", "nsteps", "t_reached",
+         "status", "message", "t", "k", "value", "l", "fingerprint", *METRICS)
 
 
 def axis_columns(meta: dict[str, Any]) -> dict[str, str]:
