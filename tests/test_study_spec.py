@@ -76,3 +76,21 @@ def test_cli_bad_study_exits_2_with_one_line(tmp_path):
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and str(path) in lines[0] and "t_end" in lines[0], res.stderr
     assert not (tmp_path / "out").exists()              # no work before validation
+
+
+def test_shipped_studies_and_the_readme_example_are_valid():
+    import re
+    import tomllib
+    from pathlib import Path
+
+    from rodval.study import study_from_dict
+
+    root = Path(__file__).parent.parent / "studies"
+    sizes = {p.stem: len(load_study(p).cases) for p in sorted(root.glob("*.toml"))}
+    assert sizes == {"n_sweep": 20, "paper": 1, "stiffness_sweep": 16}
+    n_sweep = load_study(root / "n_sweep.toml")
+    assert {(c.scene.n, c.scene.t_end) for c in n_sweep.cases} == {
+        (n, t) for n in (2, 4, 8, 16, 32) for t in (1.0, 2.0, 5.0, 10.0)}
+    assert all(c.scene.loads[0].node == c.scene.n for c in n_sweep.cases)   # load at the tip
+    block = re.search(r"```toml\n(.*?)```", (root / "README.md").read_text(), re.S).group(1)
+    assert len(study_from_dict(tomllib.loads(block), "README").cases) == 24
