@@ -8,6 +8,7 @@ from typing import Sequence
 
 import numpy as np
 import pandas as pd
+from matplotlib import ticker
 
 from ..figures import QUANTITY_UNITS, model_styles, plt
 
@@ -25,6 +26,9 @@ def _lines(ax, df: pd.DataFrame, x: str, y: str, others: Sequence[str], styles: 
     df = df[np.isfinite(df[y]) & (df[y] > 0 if logy else True)]
     if logx and (df[x] > 0).all() and not df.empty:
         ax.set_xscale("log")
+        ax.set_xticks(sorted(df[x].unique()))           # label the grid values themselves
+        ax.xaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_locator(ticker.NullLocator())
     if logy and not df.empty:
         ax.set_yscale("log")
     for model, part in df.groupby("model", sort=False):
