@@ -11,12 +11,13 @@ STATUS_SUCCESS = 0
 STATUS_FAILED = -1          # the integrator gave up (step size too small, singular matrix, ...)
 STATUS_ERROR = -2           # the model raised an exception
 STATUS_DIVERGED = -3        # NaN/inf in the state
-# -4, -5: timeout and worker crash of the study runner (branch study)
+STATUS_TIMEOUT = -4         # a study runner stopped the run at its time limit
+STATUS_CRASHED = -5         # the process running the model died (e.g. a segfault in a library)
 STATUS_BLOWUP = -6          # energy grew beyond settings.blowup_factor x its physical budget
 STATUS_STALLED = -7         # step size collapsed below settings.min_step_fraction x t_end
 STATUS_MESSAGES = {0: "success", -1: "integration failed", -2: "model error",
-                   -3: "diverged (non-finite state)", -6: "diverged (energy blow-up)",
-                   -7: "stalled (step size collapse)"}
+                   -3: "diverged (non-finite state)", -4: "timeout", -5: "worker crashed",
+                   -6: "diverged (energy blow-up)", -7: "stalled (step size collapse)"}
 
 
 @dataclass
@@ -81,6 +82,39 @@ class Trajectory:
         i = int(np.flatnonzero(np.isclose(self.times, t, rtol=0, atol=1e-12))[0])
         j = int(np.flatnonzero(self.k_index[quantity] == k)[0])
         return float(self.values[quantity][i, j])
+
+    def to_dict(self) -> dict:
+        """Plain JSON-ready form (lists and numbers); inverse of ``from_dict``."""
+        return {"model": self.model, "scene_name": self.scene_name, "times": self.times.tolist(),
+                "values": {q: v.tolist() for q, v in self.values.items()},
+                "k_index": {q: k.tolist() for q, k in self.k_index.items()},
+                "stats": self.stats.as_dict(), "settings": self.settings}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Trajectory":
+        times = np.asarray(d["times"], dtype=float)
+        stats = {k: v for k, v in d["stats"].items() if k != "success"}
+        k_index = {q: np.asarray(k, dtype=int) for q, k in d["k_index"].items()}
+        return cls(model=d["model"], scene_name=d["scene_name"], times=times,
+                   values={q: np.asarray(v, dtype=float).reshape(times.size, k_index[q].size)
+                           for q, v in d["values"].items()},
+                   k_index=k_index,
+                   stats=SolverStats(**stats), settings=dict(d.get("settings", {})))
+
+    @classmethod
+    def from_frame(cls, frame: pd.DataFrame, model: str, scene_name: str = "scene") -> "Trajectory":
+        """Inverse of ``to_frame`` (columns t, quantity, k, value; every (t, k) of a quantity
+        present). The stats are not in the frame: they are left at their defaults."""
+        times = np.unique(frame["t"].to_numpy(float))
+        values, k_index = {}, {}
+        for q, part in frame.groupby("quantity", sort=False):
+            wide = part.pivot(index="t", columns="k", values="value")
+            if wide.shape[0] != times.size or wide.isna().to_numpy().any():
+                raise ValueError(f"frame of quantity {q!r} does not cover every (t, k)")
+            values[q] = wide.to_numpy(float)
+            k_index[q] = wide.columns.to_numpy(int)
+        return cls(model=model, scene_name=scene_name, times=times, values=values,
+                   k_index=k_index, stats=SolverStats())
 
     def to_frame(self) -> pd.DataFrame:
         """Tidy table with columns t, quantity, k, value."""

@@ -8,7 +8,7 @@ import re
 import sys
 
 #: Subcommand modules, in the order ``rodval --help`` lists them.
-COMMANDS = ("reproduce", "simulate", "bench")
+COMMANDS = ("reproduce", "simulate", "study", "report", "bench")
 
 
 class CliError(Exception):
@@ -31,8 +31,14 @@ class OneLineParser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     parser = OneLineParser(
         prog="rodval",
-        description="Cross-validate plane rod-chain models: the paper's full and reduced "
-                    "models against each other and an independent exudyn beam model.")
+        description="Cross-validate plane rod-chain models: the paper's full and reduced\n"
+                    "models against each other and an independent exudyn beam model.",
+        epilog="examples:\n"
+               "  rodval simulate paper --model reduced --out out/paper-reduced\n"
+               "  rodval study studies/paper.toml --out out/paper\n"
+               "  rodval report out/paper\n"
+               "Run `rodval COMMAND --help` for the options of a command.",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     from .. import __version__
     parser.add_argument("--version", action="version", version=f"rodval {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)

@@ -25,6 +25,18 @@ def positive_float(name: str, *, finite: bool = True, below: float = math.inf):
     return parse
 
 
+def positive_int(name: str):
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1, got {text!r}") from None
+        if v < 1:
+            raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1, got {text!r}")
+        return v
+    return parse
+
+
 def time_list(text: str) -> list[float]:
     try:
         values = [float(t) for t in text.split(",") if t.strip()]

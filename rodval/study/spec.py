@@ -1,0 +1,315 @@
+"""Study files (TOML): a base scene, the models to compare, a grid of overrides, the report.
+
+A study file has the tables ``[study]``, ``[scene]``, ``[integrator]``, ``[models.LABEL]``,
+``[grid]`` and ``[report]`` (documented with an example in ``studies/README.md``). The
+rule for the grid is one: *each grid key is the dotted path of a key of this file, and each
+case is the file with those keys replaced* (e.g. ``scene.n``, ``scene.t_end``,
+``scene.chain.EI``, ``integrator.rtol``, ``models.full.method``, ``models.exudyn.elements``).
+The cartesian product of the axes gives the cases; a case id is built from the axis values
+(``n=8,t_end=2``), so it stays the same when other axes or values are added.
+
+Every error is a ValueError naming the file and the key, raised before any work.
+"""
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..models import REGISTRY, get_model
+from ..scene import QUANTITIES, Scene
+from ..scene_file import scene_from_dict
+from ..settings import IntegratorSettings
+
+TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report"}
+STUDY_KEYS = {"name", "description", "reference"}
+INTEGRATOR_KEYS = {"method", "rtol", "atol", "max_step", "first_step", "blowup_factor",
+                   "min_step_fraction", "stall_steps"}
+REPORT_KEYS = {"cases", "rods", "quantities", "times"}
+GRID_ROOTS = ("scene", "integrator", "models")
+DEFAULT_INTEGRATOR = {"method": "DOP853", "rtol": 1e-8, "atol": 1e-10}
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """One model of a study: its label (column in the tables), registry name, options
+    (passed to ``get_model``) and integrator settings."""
+
+    label: str
+    model: str
+    options: dict[str, Any]
+    settings: IntegratorSettings
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"label": self.label, "model": self.model, "options": self.options,
+                "settings": self.settings.as_dict()}
+
+
+@dataclass(frozen=True)
+class Case:
+    """One scene (the base scene after the grid's overrides) run by every model of the study."""
+
+    id: str
+    params: dict[str, Any]            # axis label -> value
+    scene_dict: dict[str, Any]        # the [scene] table of this case (scene_file format)
+    scene: Scene
+    models: tuple[ModelSpec, ...]
+    reference: str
+    where: str
+
+    @property
+    def fingerprint(self) -> str:
+        """Hash of everything that determines the case's results (scene, models, reference)."""
+        text = json.dumps({"scene": self.scene_dict, "reference": self.reference,
+                           "models": [m.as_dict() for m in self.models]},
+                          sort_keys=True, default=repr)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def payload(self) -> dict[str, Any]:
+        """What a worker needs to run the case (plain JSON)."""
+        return {"case": self.id, "where": self.where, "scene": self.scene_dict,
+                "models": [m.as_dict() for m in self.models]}
+
+
+@dataclass(frozen=True)
+class ReportSpec:
+    """What the report draws. ``rods``: rod numbers >= 1 or "last"; ``times``: configuration
+    times (s), None for quarters of each case's horizon."""
+
+    cases: tuple[str, ...]
+    rods: tuple[int | str, ...] = (1, "last")
+    quantities: tuple[str, ...] = ("phi", "dphi", "alpha", "beta")
+    times: tuple[float, ...] | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"cases": list(self.cases), "rods": list(self.rods),
+                "quantities": list(self.quantities),
+                "times": None if self.times is None else list(self.times)}
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    name: str
+    description: str
+    source: str                       # file name used in messages
+    text: str                         # the TOML text, copied beside the results
+    reference: str
+    models: tuple[ModelSpec, ...]
+    axes: dict[str, list[Any]]        # grid path -> values
+    labels: dict[str, str]            # grid path -> short label used in case ids and tables
+    cases: tuple[Case, ...]
+    report: ReportSpec
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def case(self, case_id: str) -> Case:
+        for c in self.cases:
+            if c.id == case_id:
+                return c
+        raise KeyError(case_id)
+
+
+def _err(where: str, key: str, msg: str) -> ValueError:
+    return ValueError(f"{where}: key '{key}': {msg}")
+
+
+def _check_keys(d: Any, allowed: set[str], where: str, table: str) -> None:
+    if not isinstance(d, dict):
+        raise ValueError(f"{where}: '{table}' must be a table, got {type(d).__name__}")
+    unknown = sorted(set(d) - allowed)
+    if unknown:
+        key = f"{table}.{unknown[0]}" if table else unknown[0]
+        raise _err(where, key, f"unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def _flatten(d: dict, prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        path = f"{prefix}.{k}" if prefix else str(k)
+        if isinstance(v, dict):
+            out.update(_flatten(v, path))
+        else:
+            out[path] = v
+    return out
+
+
+def _set_path(doc: dict, path: str, value: Any) -> None:
+    *parents, last = path.split(".")
+    node = doc
+    for p in parents:
+        node = node.setdefault(p, {})
+    node[last] = value
+
+
+def _format_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return str(v).lower()
+    if isinstance(v, float):
+        return "inf" if math.isinf(v) else f"{v:.12g}"
+    return re.sub(r"[^A-Za-z0-9._+-]", "-", str(v))
+
+
+def _axis_labels(paths: list[str]) -> dict[str, str]:
+    """Shortest unambiguous label of each path: its last segment(s); scene.t_end -> t_end."""
+    labels = {}
+    for p in paths:
+        parts = p.split(".")
+        for depth in range(1, len(parts) + 1):
+            cand = ".".join(parts[-depth:])
+            if sum(1 for q in paths if q == cand or q.endswith("." + cand)) == 1:
+                labels[p] = cand
+                break
+    return labels
+
+
+def _model_specs(doc: dict, where: str) -> tuple[ModelSpec, ...]:
+    integ = doc.get("integrator", {})
+    _check_keys(integ, INTEGRATOR_KEYS, where, "integrator")
+    models = doc.get("models")
+    if not isinstance(models, dict) or not models:
+        raise _err(where, "models", "at least one [models.LABEL] table is required "
+                                    f"(model names: {', '.join(REGISTRY)})")
+    specs = []
+    for label, table in models.items():
+        key = f"models.{label}"
+        if not isinstance(table, dict):
+            raise _err(where, key, "must be a table")
+        name = table.get("model", label)
+        if name not in REGISTRY:
+            raise _err(where, f"{key}.model" if "model" in table else key,
+                       f"model must be one of {', '.join(REGISTRY)}, got {name!r}")
+        settings_kw = {**DEFAULT_INTEGRATOR, **integ,
+                       **{k: v for k, v in table.items() if k in INTEGRATOR_KEYS}}
+        try:
+            settings = IntegratorSettings(**settings_kw)
+        except (TypeError, ValueError) as exc:
+            bad = next((k for k in INTEGRATOR_KEYS if k in str(exc)), "method")
+            src = f"{key}.{bad}" if bad in table else f"integrator.{bad}"
+            raise _err(where, src, str(exc)) from None
+        options = {k: v for k, v in table.items() if k not in INTEGRATOR_KEYS | {"model"}}
+        _check_model_options(name, options, where, key)
+        specs.append(ModelSpec(label=str(label), model=name, options=options, settings=settings))
+    return tuple(specs)
+
+
+def _check_model_options(name: str, options: dict, where: str, key: str) -> None:
+    """Reject bad options of an importable model now; a model that cannot be imported here
+    (e.g. exudyn not installed) is not an error of the file: its runs fail and say why."""
+    try:
+        get_model(name, **options)
+    except ValueError as exc:
+        if isinstance(exc.__cause__, ImportError):
+            return
+        raise _err(where, key, str(exc)) from None
+    except TypeError as exc:
+        raise _err(where, key, f"bad model option: {exc}") from None
+
+
+def _report_spec(table: Any, case_ids: list[str], where: str) -> ReportSpec:
+    table = {} if table is None else table
+    _check_keys(table, REPORT_KEYS, where, "report")
+    cases = table.get("cases", case_ids[:1])
+    if not isinstance(cases, list) or any(c not in case_ids for c in cases):
+        raise _err(where, "report.cases", f"must be a list of case ids from {case_ids}, got {cases!r}")
+    rods = table.get("rods", [1, "last"])
+    if not isinstance(rods, list) or not rods or any(
+            not (r == "last" or (isinstance(r, int) and not isinstance(r, bool) and r >= 1))
+            for r in rods):
+        raise _err(where, "report.rods", f"must be a list of rod numbers >= 1 or \"last\", got {rods!r}")
+    quantities = table.get("quantities", ["phi", "dphi", "alpha", "beta"])
+    if not isinstance(quantities, list) or not quantities or any(q not in QUANTITIES for q in quantities):
+        raise _err(where, "report.quantities", f"must be a list from {QUANTITIES}, got {quantities!r}")
+    times = table.get("times")
+    if times is not None and (not isinstance(times, list) or not times or any(
+            isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t < 0
+            for t in times)):
+        raise _err(where, "report.times", f"must be a list of times >= 0 s, got {times!r}")
+    return ReportSpec(cases=tuple(cases), rods=tuple(rods), quantities=tuple(quantities),
+                      times=None if times is None else tuple(float(t) for t in times))
+
+
+def _grid_axes(grid: Any, doc: dict, where: str) -> dict[str, list[Any]]:
+    if grid is None:
+        return {}
+    if not isinstance(grid, dict):
+        raise _err(where, "grid", "must be a table of dotted keys -> lists of values")
+    axes = _flatten(grid)
+    for path, values in axes.items():
+        key = f"grid.{path}"
+        root, *rest = path.split(".")
+        if root not in GRID_ROOTS or not rest:
+            raise _err(where, key, f"must be a path into {', '.join(GRID_ROOTS)} "
+                                   "(e.g. scene.n, scene.chain.EI, integrator.rtol, models.full.method)")
+        if root == "integrator" and (len(rest) != 1 or rest[0] not in INTEGRATOR_KEYS):
+            raise _err(where, key, f"integrator keys are {', '.join(sorted(INTEGRATOR_KEYS))}")
+        if root == "models" and (len(rest) != 2 or rest[0] not in doc.get("models", {})):
+            raise _err(where, key, f"must be models.LABEL.KEY with LABEL one of "
+                                   f"{', '.join(doc.get('models', {}))}")
+        if not isinstance(values, list) or not values:
+            raise _err(where, key, f"must be a non-empty list of values, got {values!r}")
+        if len({json.dumps(v, sort_keys=True) for v in values}) != len(values):
+            raise _err(where, key, f"values must be distinct, got {values!r}")
+    return axes
+
+
+def _build_case(doc: dict, combo: dict[str, Any], labels: dict[str, str], where: str) -> Case:
+    case_doc = copy.deepcopy(doc)
+    for path, value in combo.items():
+        _set_path(case_doc, path, value)
+    cid = ",".join(f"{labels[p]}={_format_value(v)}" for p, v in combo.items()) or "base"
+    case_where = where if not combo else f"{where} (case {cid})"
+    scene_dict = case_doc.get("scene", {})
+    scene_dict.setdefault("name", cid)
+    scene = scene_from_dict(scene_dict, where=f"{case_where} [scene]")
+    models = _model_specs(case_doc, case_where)
+    return Case(id=cid, params={labels[p]: v for p, v in combo.items()}, scene_dict=scene_dict,
+                scene=scene, models=models, reference=case_doc["study"]["reference"],
+                where=case_where)
+
+
+def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpec:
+    """Parse and validate a study document (the TOML as a dict); see the module docstring."""
+    _check_keys(doc, TOP_KEYS, where, "")
+    study = doc.setdefault("study", {})
+    _check_keys(study, STUDY_KEYS, where, "study")
+    models = _model_specs(doc, where)
+    labels_m = [m.label for m in models]
+    reference = study.get("reference", labels_m[0])
+    if reference not in labels_m:
+        raise _err(where, "study.reference", f"must be one of the model labels {labels_m}, "
+                                             f"got {reference!r}")
+    study["reference"] = reference
+    if "scene" in doc and not isinstance(doc["scene"], dict):
+        raise _err(where, "scene", "must be a table")
+    axes = _grid_axes(doc.get("grid"), doc, where)
+    labels = _axis_labels(list(axes))
+    cases = tuple(_build_case(doc, dict(zip(axes, combo)), labels, where)
+                  for combo in itertools.product(*axes.values()))
+    ids = [c.id for c in cases]
+    if len(set(ids)) != len(ids):
+        raise _err(where, "grid", "two cases format to the same id; use values that differ "
+                                  "in their first 12 significant digits")
+    report = _report_spec(doc.get("report"), ids, where)
+    return StudySpec(name=str(study.get("name", Path(where).stem)),
+                     description=str(study.get("description", "")), source=where, text=text,
+                     reference=reference, models=models, axes=axes, labels=labels,
+                     cases=cases, report=report)
+
+
+def load_study(path: str | Path) -> StudySpec:
+    """Read and validate a study file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"study file {str(path)!r} does not exist")
+    text = path.read_text()
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{path}: malformed TOML: {exc}") from None
+    return study_from_dict(doc, where=str(path), text=text)
