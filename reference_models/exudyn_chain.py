@@ -57,7 +57,7 @@ DEFAULTS: dict[str, Any] = {
     "solver": "generalized-alpha",
     "spectral_radius": 0.9,
     "newton_rtol": 1e-8,
-    "newton_atol_per_EA": 1e-14,
+    "newton_atol_per_EA": 1e-12,
 }
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(5)
@@ -293,7 +293,8 @@ class ExudynModel(Model):
         if self.solver == "trapezoidal":
             sim.timeIntegration.generalizedAlpha.useNewmark = True
             sim.timeIntegration.generalizedAlpha.useIndex2Constraints = True
-        exu.SetWriteToConsole(False)
+        console = exu.config.printToConsole
+        exu.config.printToConsole = False
         start = time.perf_counter()
         try:
             ok = solver.SolveSystem(built.mbs, sim)
@@ -305,7 +306,7 @@ class ExudynModel(Model):
             stats.message = f"{type(cause).__name__}: {cause}"
         finally:
             stats.wall_s = time.perf_counter() - start
-            exu.SetWriteToConsole(True)
+            exu.config.printToConsole = console
         stats.nsteps = int(solver.it.currentStepIndex)
         stats.njev = int(solver.it.newtonJacobiCount)
         stats.nfev = int(solver.it.newtonStepsCount)
@@ -323,7 +324,7 @@ class ExudynModel(Model):
         if stats.status == 0:
             stats.message = "reached t_end"
         times = np.asarray(scene.times)
-        times = times[times <= stats.t_reached + 1e-9 * max(1.0, scene.t_end)]
+        times = times[times <= stats.t_reached + 1e-9 * max(1.0, scene.t_end)] if t_rec.size else t_rec
         try:
             observed = _observe(scene, self.elements, self.EA, times, t_rec, records) if times.size else {}
         except Exception as exc:  # noqa: BLE001
@@ -338,6 +339,8 @@ class ExudynModel(Model):
         data = {key: tuple(mbs.GetSensorStoredData(s) for s in ids)
                 for key, ids in built.node_sensors.items()}
         first = next(iter(data.values()))[0]
+        if first.ndim != 2 or first.shape[0] == 0:
+            return np.empty(0), {}, False
         t = first[:, 0]
         # keep one record per time (the solver may write the last step twice)
         keep = np.concatenate([np.diff(t) > 0, [True]])
