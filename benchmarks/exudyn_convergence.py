@@ -58,6 +58,10 @@ def main(argv=None) -> None:
     rows = [{"run": "native published", "option": "coefficients", "value": "published",
              "status": published.stats.status, "wall_s": published.stats.wall_s,
              **errors(published, ref)}]
+    default = simulate(scene, "exudyn")
+    rows += [{"run": f"exudyn defaults vs native {name}", "option": "-", "value": "-",
+              "status": default.stats.status, "wall_s": default.stats.wall_s, **errors(default, other)}
+             for name, other in (("printed", ref), ("published", published))]
     for option, values in SWEEPS.items():
         for value in values[:2] if args.quick else values:
             tr = simulate(scene, "exudyn", **{option: value})

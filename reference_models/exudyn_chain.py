@@ -51,7 +51,7 @@ SOLVERS = ("generalized-alpha", "trapezoidal")
 #: Converged defaults, chosen by benchmarks/exudyn_convergence.py (docs/reference_model.md).
 DEFAULTS: dict[str, Any] = {
     "elements": 2,
-    "step": 1e-3,
+    "step": 2e-4,
     "EA": 1e10,
     "element": "cable2d",
     "solver": "generalized-alpha",

@@ -96,25 +96,49 @@ def test_failure_is_data_not_a_crash():
 
 def test_ci_comparison_native_vs_exudyn_n3():
     """n = 3 chain, paper per-rod data, pulse at node 3, 0..0.5 s: native full (printed) and
-    reduced (DOP853 rtol 1e-10, atol 1e-12) against exudyn at its defaults.
+    reduced (DOP853 rtol 1e-10, atol 1e-12) against exudyn at its defaults (2 elements/rod,
+    step 2e-4 s, EA 1e10 N).
 
-    Tolerances (see docs/reference_model.md, measured with benchmarks/exudyn_convergence.py on
-    the paper example n = 8): at the converged exudyn settings the remaining exudyn - full gap is
-    the model difference (first-order assumed-mode rods vs exact beams), phi 7e-4 rad, dphi 8e-3
-    of the column scale, alpha/beta 6e-5 rad over 0..2 s, and at 0.5 s below 1.3e-4 rad
-    (phi), 1e-4 (dphi), 6e-6 rad (alpha, beta). On this n = 3 run the measured gaps are
-    printed in the assertion messages; the bounds below are the issue's acceptance bounds for
-    phi and dphi (1.5e-3 rad, 2e-2) and 2e-4 rad for alpha/beta against the full model.
-    The reduced model has no bending dynamics: its alpha/beta are quasi-static, so they are
-    held to 2e-4 rad as well, which the 0.5 s run (before any load kink) meets.
+    Measured gaps on this run (max over t = 0.1..0.5 s, all rods): full: phi 1.4e-4 rad, dphi
+    1.5e-4 of the column scale, alpha/beta 6.5e-6 rad; reduced: phi 1.9e-4, dphi 2.1e-4,
+    alpha/beta 5.8e-6. The convergence study (benchmarks/exudyn_convergence.py, n = 8, 0..2 s,
+    docs/reference_model.md) shows the exudyn discretization moves phi by < 2e-5 rad, dphi by
+    < 3e-4 and alpha/beta by < 1e-6 rad between step 2e-4 and 5e-5 s, and EA 1e10 -> 1e11 by
+    ~7e-5 rad: what remains is the model difference (first-order assumed-mode rods vs exact
+    beams). The bounds below are ~3x the measured gaps: phi 5e-4 rad, dphi 1e-3, alpha/beta
+    2e-5 rad (the issue's acceptance bounds, 1.5e-3 / 2e-2 / 2e-4, are checked on n = 8 in the
+    slow study).
     """
     scene = paper_scene(3, t_end=0.5, times=np.linspace(0.1, 0.5, 5))
     ex = simulate(scene, "exudyn")
     assert ex.success, ex.stats.message
     for model in ("full", "reduced"):
         nat = simulate(scene, model, rtol=1e-10, atol=1e-12)
-        for q, bound in (("phi", 1.5e-3), ("dphi", 2e-2), ("alpha", 2e-4), ("beta", 2e-4)):
+        for q, bound in (("phi", 5e-4), ("dphi", 1e-3), ("alpha", 2e-5), ("beta", 2e-5)):
             d = np.abs(ex[q] - nat[q])
             if q == "dphi":
                 d = d / np.abs(nat[q]).max(axis=0)
             assert d.max() < bound, f"{model} {q}: max gap {d.max():.3g} >= {bound}"
+
+
+@pytest.mark.slow
+def test_paper_example_supports_printed_not_published():
+    """Paper example (n = 8, 0..2 s), rods 2, 4, 6, 8 at t = 0.5, 1, 1.5, 2 s: exudyn at its
+    converged defaults agrees with the native full model (printed coefficients) within phi
+    1.5e-3 rad, dphi 2e-2 of the column scale, alpha/beta 2e-4 rad; against the ``published``
+    variant the alpha/beta gap exceeds 2e-4 rad."""
+    from rodval import TABLE1_TIMES
+
+    scene = paper_scene(times=TABLE1_TIMES)
+    ex = simulate(scene, "exudyn")
+    assert ex.success, ex.stats.message
+    cols = [1, 3, 5, 7]
+    printed = simulate(scene, "full", rtol=1e-10, atol=1e-12)
+    published = simulate(scene, "full", rtol=1e-10, atol=1e-12, coefficients="published")
+    for q, bound in (("phi", 1.5e-3), ("dphi", 2e-2), ("alpha", 2e-4), ("beta", 2e-4)):
+        d = np.abs(ex[q] - printed[q])[:, cols]
+        if q == "dphi":
+            d = d / np.abs(printed[q][:, cols]).max(axis=0)
+        assert d.max() < bound, f"{q}: {d.max():.3g}"
+    for q in ("alpha", "beta"):
+        assert np.abs(ex[q] - published[q])[:, cols].max() > 2e-4
