@@ -87,7 +87,8 @@ def test_shipped_studies_and_the_readme_example_are_valid():
 
     root = Path(__file__).parent.parent / "studies"
     sizes = {p.stem: len(load_study(p).cases) for p in sorted(root.glob("*.toml"))}
-    assert sizes == {"n_sweep": 20, "paper": 1, "stiffness_sweep": 16}
+    assert sizes == {"exudyn_convergence": 80, "n_sweep": 20, "paper": 1, "stability": 9,
+                     "stiffness_sweep": 16}
     n_sweep = load_study(root / "n_sweep.toml")
     assert {(c.scene.n, c.scene.t_end) for c in n_sweep.cases} == {
         (n, t) for n in (2, 4, 8, 16, 32) for t in (1.0, 2.0, 5.0, 10.0)}
