@@ -16,13 +16,12 @@ import argparse
 import pathlib
 import time
 
-import numpy as np
 import pandas as pd
 
 from rodval import TABLE1_TIMES, paper_scene, simulate
+from rodval.crosscheck import TABLE1_RODS as RODS, table1_gaps as errors
 from reference_models.exudyn_chain import DEFAULTS
 
-RODS = (2, 4, 6, 8)
 SWEEPS = {
     "elements": [1, 2, 3, 4, 6, 8],
     "step": [1e-3, 5e-4, 2e-4, 1e-4, 5e-5],
@@ -30,18 +29,6 @@ SWEEPS = {
     "newton_atol_per_EA": [1e-16, 1e-14, 1e-12],
     "solver": ["generalized-alpha", "trapezoidal"],
 }
-
-
-def errors(tr, ref) -> dict[str, float]:
-    """Max errors on rods 2, 4, 6, 8 at the output times (see module docstring)."""
-    cols = [int(np.flatnonzero(ref.k_index["phi"] == k)[0]) for k in RODS]
-    out = {}
-    for q in ("phi", "dphi", "alpha", "beta"):
-        d = (tr[q] - ref[q])[:, cols]
-        if q == "dphi":
-            d = d / np.abs(ref[q][:, cols]).max(axis=0)
-        out[q] = float(np.abs(d).max())
-    return out
 
 
 def main(argv=None) -> None:

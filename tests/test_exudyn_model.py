@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from rodval import Chain, InitialState, Scene, paper_scene, simulate
+from rodval.crosscheck import ACCEPTANCE, crosscheck_paper, table1_gaps
 
 exu = pytest.importorskip("exudyn")
 from reference_models.exudyn_chain import ExudynModel  # noqa: E402
@@ -113,32 +114,21 @@ def test_ci_comparison_native_vs_exudyn_n3():
     ex = simulate(scene, "exudyn")
     assert ex.success, ex.stats.message
     for model in ("full", "reduced"):
-        nat = simulate(scene, model, rtol=1e-10, atol=1e-12)
+        gaps = table1_gaps(ex, simulate(scene, model, rtol=1e-10, atol=1e-12), rods=(1, 2, 3))
         for q, bound in (("phi", 5e-4), ("dphi", 1e-3), ("alpha", 2e-5), ("beta", 2e-5)):
-            d = np.abs(ex[q] - nat[q])
-            if q == "dphi":
-                d = d / np.abs(nat[q]).max(axis=0)
-            assert d.max() < bound, f"{model} {q}: max gap {d.max():.3g} >= {bound}"
+            assert gaps[q] < bound, f"{model} {q}: max gap {gaps[q]:.3g} >= {bound}"
 
 
-@pytest.mark.slow
 def test_paper_example_supports_printed_not_published():
     """Paper example (n = 8, 0..2 s), rods 2, 4, 6, 8 at t = 0.5, 1, 1.5, 2 s: exudyn at its
     converged defaults agrees with the native full model (printed coefficients) within phi
     1.5e-3 rad, dphi 2e-2 of the column scale, alpha/beta 2e-4 rad; against the ``published``
     variant the alpha/beta gap exceeds 2e-4 rad."""
-    from rodval import TABLE1_TIMES
-
-    scene = paper_scene(times=TABLE1_TIMES)
-    ex = simulate(scene, "exudyn")
-    assert ex.success, ex.stats.message
-    cols = [1, 3, 5, 7]
-    printed = simulate(scene, "full", rtol=1e-10, atol=1e-12)
-    published = simulate(scene, "full", rtol=1e-10, atol=1e-12, coefficients="published")
-    for q, bound in (("phi", 1.5e-3), ("dphi", 2e-2), ("alpha", 2e-4), ("beta", 2e-4)):
-        d = np.abs(ex[q] - printed[q])[:, cols]
-        if q == "dphi":
-            d = d / np.abs(printed[q][:, cols]).max(axis=0)
-        assert d.max() < bound, f"{q}: {d.max():.3g}"
+    table, runs = crosscheck_paper()
+    assert runs["exudyn"].success, runs["exudyn"].stats.message
+    rows = table.set_index("comparison")
+    for q, bound in ACCEPTANCE.items():
+        assert rows.loc["exudyn vs full printed", q] < bound, q
     for q in ("alpha", "beta"):
-        assert np.abs(ex[q] - published[q])[:, cols].max() > 2e-4
+        assert rows.loc["exudyn vs full published", q] > ACCEPTANCE[q], q
+    assert rows.loc["exudyn vs full printed", "within_acceptance"]

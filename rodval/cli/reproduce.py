@@ -1,24 +1,35 @@
-"""rodval reproduce paper --out DIR: the paper's Table 1 and Fig. 3."""
+"""rodval reproduce paper --out DIR: the paper's Table 1 and Fig. 3, and the exudyn cross-check."""
 from __future__ import annotations
 
+import importlib.util
 from pathlib import Path
 
 from ..reproduce import reproduce_paper
+from . import CliError
 
 
 def register(sub) -> None:
-    p = sub.add_parser("reproduce", help="reproduce the paper's example (Table 1, Fig. 3)",
-                       description="Run the paper's example with the full and reduced models "
-                                   "and write DIR/table1.csv, DIR/table1.md, DIR/configurations.png.")
+    p = sub.add_parser("reproduce", help="reproduce the paper's example (Table 1, Fig. 3, cross-check)",
+                       description="Run the paper's example with the full and reduced models and "
+                                   "write DIR/table1.csv, DIR/table1.md, DIR/configurations.png; "
+                                   "with exudyn installed, also cross-check against the independent "
+                                   "beam model (DIR/crosscheck.csv, DIR/crosscheck.md).")
     p.add_argument("target", choices=("paper",), help="what to reproduce")
     p.add_argument("--out", required=True, type=Path, help="output folder")
     p.add_argument("--variant", choices=("printed", "published"), default="printed",
                    help="coefficients: printed (from the kinematics, default) or published "
                         "(the erratum that reproduces the paper's alpha/beta)")
+    p.add_argument("--cross-check", dest="cross_check", action="store_true", default=None,
+                   help="require the exudyn cross-check (default: run it when exudyn is installed)")
+    p.add_argument("--no-cross-check", dest="cross_check", action="store_false",
+                   help="skip the exudyn cross-check")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
+    have_exudyn = importlib.util.find_spec("exudyn") is not None
+    if args.cross_check and not have_exudyn:
+        raise CliError("--cross-check needs exudyn: pip install 'rodval[exudyn]'")
     errors = reproduce_paper(args.out, args.variant)
     wide = errors.pivot_table(index=["quantity", "formulation"], columns="t", values="error",
                               sort=False)
@@ -26,4 +37,20 @@ def run(args) -> int:
           f"coefficients = {args.variant}:")
     print(wide.to_string(float_format=lambda v: f"{v:.2e}"))
     print(f"wrote {args.out}/table1.csv, table1.md, configurations.png")
-    return 0
+    if args.cross_check is False or not have_exudyn:
+        return 0
+    from ..crosscheck import crosscheck_paper
+
+    table, runs = crosscheck_paper()
+    table.to_csv(args.out / "crosscheck.csv", index=False)
+    ex = runs["exudyn"].stats
+    (args.out / "crosscheck.md").write_text(
+        "# Cross-check against the independent exudyn beam model\n\n"
+        "Paper example, rods 2, 4, 6, 8 at t = 0.5, 1, 1.5, 2 s. phi, alpha, beta: max |gap| "
+        "(rad); dphi: max |gap| / the reference column's max |value|.\n\n"
+        + table.to_markdown(index=False, floatfmt=".2e")
+        + f"\n\nexudyn settings: {runs['exudyn'].settings}; solve wall time {ex.wall_s:.2f} s.\n")
+    print("Cross-check against exudyn (phi/alpha/beta max |gap| in rad, dphi relative):")
+    print(table.drop(columns="status").to_string(index=False, float_format=lambda v: f"{v:.2e}"))
+    print(f"wrote {args.out}/crosscheck.csv, crosscheck.md")
+    return 0 if table.iloc[0]["within_acceptance"] else 1
