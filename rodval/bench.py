@@ -35,6 +35,28 @@ DOP853_FAMILY = ("DOP853", "DOP853-numba")
 #: The two references: (method, rtol, atol).
 REFERENCE_DOP = ("LSODA", 1e-12, 1e-14)
 REFERENCE_OTHER = ("DOP853-numba", 1e-13, 1e-15)
+#: Reference models (exudyn) integrate with a fixed step: their precision ladder is the step
+#: (s), and their reference is a run with a *different* solver at a much finer step.
+REFERENCE_MODEL_STEPS = (1e-3, 5e-4, 2e-4, 1e-4, 5e-5)
+REFERENCE_MODEL_REF = {"solver": "trapezoidal", "step": 2e-5}
+NATIVE = ("full", "reduced")
+
+
+def ladder(model: str, method: str, rtols) -> list[tuple[float, IntegratorSettings, dict]]:
+    """(precision knob, settings, model options), loosest first: the tolerance ladder
+    (atol = rtol / 100) for native models, the step ladder for fixed-step reference models."""
+    if model in NATIVE:
+        return [(r, IntegratorSettings(method=method, rtol=r, atol=r * 1e-2), {})
+                for r in sorted(rtols, reverse=True)]
+    return [(h, IntegratorSettings(), {"step": h}) for h in REFERENCE_MODEL_STEPS]
+
+
+def reference_model_reference(scene: Scene, model: str) -> Trajectory:
+    """A fixed-step reference model's reference: another solver at a much finer step."""
+    run = simulate(scene, model, **REFERENCE_MODEL_REF)
+    if not run.success:
+        raise RuntimeError(f"reference run of {model} failed: {run.stats.message}")
+    return run
 
 
 #: Runs whose warm-up takes longer than this (s) are timed once (their noise is relatively small).
@@ -108,36 +130,37 @@ def work_precision(scene: Scene, models: list[str], methods: list[str], rtols: l
         except ValueError as exc:
             notes.append(f"model {model} skipped: {exc}")
             continue
-        native = model in ("full", "reduced")
-        refs = references(scene, model) if native else None
-        if refs is not None:
+        native = model in NATIVE
+        if native:
+            refs = references(scene, model)
             uncertainty[model] = refs.uncertainty
-        else:   # a reference model: its own tightest run is the reference
-            own_ref = simulate(scene, model, rtol=1e-10, atol=1e-12)
-            notes.append(f"model {model}: reference = its own run at rtol 1e-10")
-        variants = [(m, "numba" if native else None) for m in methods]
-        if native and baseline:
-            variants.append(("DOP853", "numpy"))
+            variants = [(m, "numba") for m in methods] + ([("DOP853", "numpy")] if baseline else [])
+        else:
+            ref_model = reference_model_reference(scene, model)
+            notes.append(f"model {model}: step ladder {REFERENCE_MODEL_STEPS} s (its default "
+                         f"solver); reference = {REFERENCE_MODEL_REF}")
+            variants = [("default", "")]
         for method, kernel in variants:
-            if not native and method not in ("DOP853",):
-                continue
-            for rtol in sorted(rtols, reverse=True):
-                settings = IntegratorSettings(method=method, rtol=rtol, atol=rtol * 1e-2)
-                opts = {"kernel": kernel} if kernel else {}
+            for knob, settings, opts in ladder(model, method, rtols):
+                if native:
+                    opts = {"kernel": kernel}
                 traj, wall = timed(scene, model, settings, repeats, **opts)
-                ref = refs.for_method(method) if refs else own_ref
-                row = {"model": model, "method": method, "kernel": kernel or "", "rtol": rtol,
-                       "atol": settings.atol, "wall_s": wall, **traj.stats.as_dict(),
-                       "reference": f"{ref.settings['method']} rtol {ref.settings['rtol']:g}"}
+                ref = refs.for_method(method) if native else ref_model
+                row = {"model": model, "method": method if native else traj.settings["solver"],
+                       "kernel": kernel, "rtol": knob if native else math.nan,
+                       "atol": settings.atol if native else math.nan,
+                       "step": math.nan if native else knob, **traj.stats.as_dict(),
+                       "reference": (f"{ref.settings['method']} rtol {ref.settings['rtol']:g}"
+                                     if native else f"{model} {REFERENCE_MODEL_REF}")}
                 row["wall_s"] = wall   # the minimum, not the last run's
                 row.update(errors(traj, ref))
                 rows.append(row)
-                progress(f"{model:8s} {method:13s} {kernel or '':6s} rtol {rtol:7.0e}  "
-                         f"wall {wall * 1e3:9.2f} ms  nfev {traj.stats.nfev:7d}  "
-                         f"phi err {row.get('max_phi', math.nan):.2e}")
+                progress(f"{model:8s} {row['method']:13s} {kernel:6s} "
+                         f"{'rtol' if native else 'step'} {knob:7.0e}  wall {wall * 1e3:9.2f} ms  "
+                         f"nfev {traj.stats.nfev:7d}  phi err {row.get('max_phi', math.nan):.2e}")
                 if wall > budget_s:
-                    notes.append(f"{model} {method} {kernel or ''}: ladder stopped after rtol "
-                                 f"{rtol:g} ({wall:.1f} s > budget {budget_s:g} s)")
+                    notes.append(f"{model} {method} {kernel}: ladder stopped after {knob:g} "
+                                 f"({wall:.1f} s > budget {budget_s:g} s)")
                     break
     frame = pd.DataFrame(rows)
     return with_provenance(frame), uncertainty, notes
@@ -178,12 +201,14 @@ def plot_work_precision(frame: pd.DataFrame, out_dir, quantities=QUANTITIES) -> 
 
     paths = []
     for model, part in frame.groupby("model"):
-        for xcol, xlabel in (("wall_s", "wall time (s)"), ("nfev", "RHS evaluations")):
+        native = model in ("full", "reduced")
+        for xcol, xlabel in (("wall_s", "wall time (s)"),
+                             ("nfev", "RHS evaluations" if native else "Newton iterations")):
             qs = [q for q in quantities if f"max_{q}" in part and part[f"max_{q}"].notna().any()]
             fig, axes = plt.subplots(1, len(qs), figsize=(4.2 * len(qs), 3.8), squeeze=False)
             for ax, q in zip(axes[0], qs):
                 for (method, kernel), line in part.groupby(["method", "kernel"]):
-                    line = line.sort_values("rtol", ascending=False)
+                    line = line.sort_values(["rtol", "step"], ascending=False)  # loosest first
                     label = method + (f" ({kernel})" if kernel == "numpy" else "")
                     ax.loglog(line[xcol], line[f"max_{q}"], "o-", ms=3, label=label)
                 x, y = part[xcol].to_numpy(float), part[f"max_{q}"].to_numpy(float)
@@ -331,9 +356,11 @@ def _skip_row(skip: str, model: str, with_skip: float, without: float, note: str
 def speedup_vs_n(n_values=(2, 4, 8, 16, 32), tol: float = 1e-6,
                  rtols=(1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10), repeats: int = 3,
                  models=("full", "reduced", "exudyn"), progress=print) -> tuple[pd.DataFrame, list[str]]:
-    """For each n and model: the fastest compiled-DOP853 run (scipy DOP853 for a model without
-    a compiled form) with phi error <= tol against that model's own reference; then the
-    full/reduced (and exudyn/native) wall-time ratios at that equal accuracy."""
+    """For each n and model: the cheapest rung of its precision ladder (``ladder``: compiled
+    DOP853 tolerances for native models, the step for exudyn) with phi error <= tol against
+    that model's own reference; then the full/reduced (and exudyn/native) wall-time ratios at
+    that equal accuracy. For exudyn the accuracy is that of its time integration at fixed
+    spatial discretization (2 elements per rod by default)."""
     rows, notes = [], []
     available = []
     for model in models:
@@ -345,21 +372,22 @@ def speedup_vs_n(n_values=(2, 4, 8, 16, 32), tol: float = 1e-6,
     for n in n_values:
         scene = paper_scene(n, times=np.linspace(0, 2, 21), outputs=("phi", "dphi"))
         for model in available:
-            native = model in ("full", "reduced")
-            ref = references(scene, model).dop if native else simulate(scene, model, rtol=1e-10, atol=1e-12)
-            method = "DOP853-numba" if native else "DOP853"
+            native = model in NATIVE
+            ref = references(scene, model).dop if native else reference_model_reference(scene, model)
+            method = "DOP853-numba" if native else "default"
             best = None
-            for rtol in sorted(rtols, reverse=True):
-                traj, wall = timed(scene, model, IntegratorSettings(method, rtol=rtol,
-                                                                     atol=rtol * 1e-2), repeats)
+            for knob, settings, opts in ladder(model, method, rtols):
+                traj, wall = timed(scene, model, settings, repeats, **opts)
                 if errors(traj, ref, ("phi",))["max_phi"] <= tol:
-                    best = (rtol, wall, traj.stats.nfev)
+                    best = (knob, wall, traj.stats.nfev)
                     break
             rows.append({"n": n, "model": model, "method": method,
-                         "rtol": best[0] if best else math.nan,
+                         "rtol" if native else "step": best[0] if best else math.nan,
                          "wall_s": best[1] if best else math.nan,
                          "nfev": best[2] if best else math.nan})
-            progress(f"n = {n:3d} {model:8s}: {rows[-1]['wall_s'] * 1e3:9.2f} ms at rtol {rows[-1]['rtol']:g}")
+            knob = "rtol" if native else "step"
+            progress(f"n = {n:3d} {model:8s}: {rows[-1]['wall_s'] * 1e3:9.2f} ms at {knob} "
+                     f"{rows[-1][knob]:g}")
     frame = pd.DataFrame(rows)
     wide = frame.pivot(index="n", columns="model", values="wall_s")
     if {"full", "reduced"} <= set(wide):
