@@ -19,7 +19,7 @@ Format (every key optional except where noted)::
 
     [[loads]]                 # replaces the base scene's loads; `loads = []` for none
     type = "pulse"            # pulse: node, Xbar, Ybar, T;  constant: node, X, Y, t_on, t_off
-    node = 8
+    node = 8                  # or "last": node n (follows n in studies)
 
     [initial]                 # scalars or lists of length n (rad, rad/s)
     phi = 0.0
@@ -72,13 +72,15 @@ def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
     raise ValueError(f"{where} key 'times': must be a list of seconds or a table {{start, stop, num}}")
 
 
-def _load(spec: dict, where: str):
+def _load(spec: dict, n: int, where: str):
     if not isinstance(spec, dict) or "type" not in spec:
         raise ValueError(f"{where}: each load needs a 'type' (one of {', '.join(LOAD_FACTORIES)})")
     kind = spec["type"]
     if kind not in LOAD_FACTORIES:
         raise ValueError(f"{where}: load type must be one of {', '.join(LOAD_FACTORIES)}, got {kind!r}")
     args = {k: v for k, v in spec.items() if k != "type"}
+    if args.get("node") == "last":
+        args["node"] = n
     try:
         return LOAD_FACTORIES[kind](**args)
     except TypeError as exc:
@@ -109,7 +111,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
         if "loads" in d:
             if not isinstance(d["loads"], list):
                 raise ValueError("key 'loads' must be an array of tables [[loads]]")
-            loads = tuple(_load(s, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"]))
+            loads = tuple(_load(s, n, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"]))
         init_spec = d.get("initial", {})
         _check_keys(init_spec, INITIAL_KEYS, f"{where} [initial]")
         outputs = d.get("outputs", scene.outputs)

@@ -87,7 +87,7 @@ def test_shipped_studies_and_the_readme_example_are_valid():
 
     root = Path(__file__).parent.parent / "studies"
     sizes = {p.stem: len(load_study(p).cases) for p in sorted(root.glob("*.toml"))}
-    assert sizes == {"exudyn_convergence": 80, "n_sweep": 20, "paper": 1, "stability": 9,
+    assert sizes == {"exudyn_convergence": 80, "n_sweep": 20, "paper": 1, "stability": 18,
                      "stiffness_sweep": 16}
     n_sweep = load_study(root / "n_sweep.toml")
     assert {(c.scene.n, c.scene.t_end) for c in n_sweep.cases} == {
@@ -95,3 +95,19 @@ def test_shipped_studies_and_the_readme_example_are_valid():
     assert all(c.scene.loads[0].node == c.scene.n for c in n_sweep.cases)   # load at the tip
     block = re.search(r"```toml\n(.*?)```", (root / "README.md").read_text(), re.S).group(1)
     assert len(study_from_dict(tomllib.loads(block), "README").cases) == 24
+
+
+def test_several_grids_give_the_union_of_their_products(tmp_path):
+    """[[grid]] tables: each its own cartesian product; a load axis can follow n ("last")."""
+    path = tmp_path / "union.toml"
+    text = write_study(tmp_path).read_text().replace(
+        "[grid]\nscene.n = [2, 3]\nscene.t_end = [0.1, 0.2]\n",
+        "[[grid]]\nscene.n = [2, 3]\n\n[[grid]]\nscene.n = [4]\n"
+        'scene.loads = [[{ type = "pulse", node = "last", Ybar = 10.0 }]]\n')
+    path.write_text(text)
+    spec = load_study(path)
+    assert [c.id for c in spec.cases] == ["n=2", "n=3", "n=4,loads=pulse(node=last,Ybar=10)"]
+    assert spec.axes["scene.n"] == [2, 3, 4]
+    last = spec.case("n=4,loads=pulse(node=last,Ybar=10)").scene.loads
+    assert len(last) == 1 and last[0].node == 4 and last[0].params["Ybar"] == 10.0
+    assert spec.case("n=3").scene.loads[0].params["Ybar"] == 1200.0   # the paper's pulse

@@ -65,8 +65,30 @@ def _case_figures(out: Path, fig_dir: Path, meta: dict, tables: dict[str, pd.Dat
     return lines
 
 
+def _stability_map(runtime: pd.DataFrame, params: list[str]) -> list[str]:
+    """Case x model: how each run ended, its cost and (when audited) its energy residual."""
+    def cell(row) -> str:
+        text = f"{row['status']}, {row['wall_s']:.3g} s"
+        if row["status"] != "success":
+            text += f", t = {row['t_reached']:.3g} s"
+        res = row.get("energy_residual")
+        if res is not None and pd.notna(res):
+            text += f", R = {res:.2g}"
+        return text
+    grid = runtime.assign(cell=runtime.apply(cell, axis=1)).pivot_table(
+        index=["case", *params], columns="model", values="cell", aggfunc="first", sort=False)
+    return ["## Stability map
+",
+            "Each run: status, integration wall time, the time reached if it did not finish, "
+            "and R = max |E - E(0) - W_ext + D| / max(E, |W_ext|), the energy balance "
+            "residual (see docs/stability.md), when the scene asks for energy.\n",
+            to_markdown(grid.reset_index())]
+
+
 def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[str]) -> list[str]:
-    disc, runtime, ref = tables["discrepancies"], tables["runtime"], meta["reference"]
+    # a union of grids ([[grid]]) leaves some parameters unset in some cases
+    disc, runtime = (tables[k].fillna({p: "-" for p in params}) for k in ("discrepancies", "runtime"))
+    ref = meta["reference"]
     lines = []
     failed = runtime[runtime["status"] != "success"]
     lines.append(f"## Outcome\n\n{runtime['case'].nunique()} cases, {len(runtime)} model runs, "
@@ -101,6 +123,8 @@ def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[st
         wall = wall.join(sp.add_prefix("speed-up "))
     lines.append("Failed runs are left out.\n")
     lines.append(to_markdown(wall.reset_index()))
+    if not failed.empty or ("energy_residual" in runtime and runtime["energy_residual"].notna().any()):
+        lines += _stability_map(runtime, params)
     return lines
 
 

@@ -5,8 +5,9 @@ A study file has the tables ``[study]``, ``[scene]``, ``[integrator]``, ``[model
 rule for the grid is one: *each grid key is the dotted path of a key of this file, and each
 case is the file with those keys replaced* (e.g. ``scene.n``, ``scene.t_end``,
 ``scene.chain.EI``, ``integrator.rtol``, ``models.full.method``, ``models.exudyn.elements``).
-The cartesian product of the axes gives the cases; a case id is built from the axis values
-(``n=8,t_end=2``), so it stays the same when other axes or values are added.
+The cartesian product of the axes gives the cases; several ``[[grid]]`` tables give the union
+of their products (for maps whose parts vary different things). A case id is built from the
+axis values (``n=8,t_end=2``), so it stays the same when other axes or values are added.
 
 Every error is a ValueError naming the file and the key, raised before any work.
 """
@@ -148,10 +149,17 @@ def _set_path(doc: dict, path: str, value: Any) -> None:
 
 
 def _format_value(v: Any) -> str:
+    """Compact text of a grid value for case ids: 8, 1e-06, inf, pulse(node=last,Xbar=-1500)."""
     if isinstance(v, bool):
         return str(v).lower()
     if isinstance(v, float):
         return "inf" if math.isinf(v) else f"{v:.12g}"
+    if isinstance(v, dict):
+        kind = v.get("type", "")
+        return f"{kind}(" + ",".join(f"{k}={_format_value(x)}" for k, x in v.items()
+                                     if k != "type") + ")"
+    if isinstance(v, list):
+        return "+".join(_format_value(x) for x in v)
     return re.sub(r"[^A-Za-z0-9._+-]", "-", str(v))
 
 
@@ -238,7 +246,8 @@ def _grid_axes(grid: Any, doc: dict, where: str) -> dict[str, list[Any]]:
     if grid is None:
         return {}
     if not isinstance(grid, dict):
-        raise _err(where, "grid", "must be a table of dotted keys -> lists of values")
+        raise _err(where, "grid", "must be a table of dotted keys -> lists of values, "
+                                  "or an array of such tables ([[grid]])")
     axes = _flatten(grid)
     for path, values in axes.items():
         key = f"grid.{path}"
@@ -287,10 +296,16 @@ def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpe
     study["reference"] = reference
     if "scene" in doc and not isinstance(doc["scene"], dict):
         raise _err(where, "scene", "must be a table")
-    axes = _grid_axes(doc.get("grid"), doc, where)
+    grid = doc.get("grid")
+    grids = [_grid_axes(g, doc, where) for g in (grid if isinstance(grid, list) else [grid])]
+    axes: dict[str, list[Any]] = {}
+    for sub in grids:           # [[grid]]: the union of several grids' cartesian products
+        for path, values in sub.items():
+            axes.setdefault(path, [])
+            axes[path] += [v for v in values if v not in axes[path]]
     labels = _axis_labels(list(axes))
-    cases = tuple(_build_case(doc, dict(zip(axes, combo)), labels, where)
-                  for combo in itertools.product(*axes.values()))
+    cases = tuple(_build_case(doc, dict(zip(sub, combo)), labels, where)
+                  for sub in grids for combo in itertools.product(*sub.values()))
     ids = [c.id for c in cases]
     if len(set(ids)) != len(ids):
         raise _err(where, "grid", "two cases format to the same id; use values that differ "

@@ -41,7 +41,7 @@ def axis_columns(meta: dict[str, Any]) -> dict[str, str]:
 
 def _case_columns(rec: dict, axes: dict[str, str]) -> dict[str, Any]:
     return {"case": rec["case"], "n": rec["n"], "horizon": rec["horizon"],
-            **{col: rec["params"][label] for label, col in axes.items()}}
+            **{col: rec["params"].get(label) for label, col in axes.items()}}
 
 
 def cases_table(records: list[dict], axes: dict[str, str]) -> pd.DataFrame:
