@@ -77,8 +77,7 @@ def _stability_map(runtime: pd.DataFrame, params: list[str]) -> list[str]:
         return text
     grid = runtime.assign(cell=runtime.apply(cell, axis=1)).pivot_table(
         index=["case", *params], columns="model", values="cell", aggfunc="first", sort=False)
-    return ["## Stability map
-",
+    return ["## Stability map\n",
             "Each run: status, integration wall time, the time reached if it did not finish, "
             "and R = max |E - E(0) - W_ext + D| / max(E, |W_ext|), the energy balance "
             "residual (see docs/stability.md), when the scene asks for energy.\n",
