@@ -35,9 +35,10 @@ def _segments(scene: Scene) -> list[tuple[float, float]]:
 
 
 def _add_counts(stats: SolverStats, solver) -> None:
-    stats.nfev += solver.nfev
-    stats.njev += solver.njev
-    stats.nlu += solver.nlu
+    # plain ints: LSODA reports numpy int32 counters, which JSON case files cannot hold
+    stats.nfev += int(solver.nfev)
+    stats.njev += int(solver.njev)
+    stats.nlu += int(solver.nlu)
 
 
 def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,

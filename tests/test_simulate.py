@@ -1,4 +1,5 @@
 """The simulation entry point: outputs, loads across breakpoints, failures as data."""
+import json
 import math
 
 import numpy as np
@@ -109,3 +110,4 @@ def test_every_scipy_method_agrees_on_the_reduced_model(method):
     ref = simulate(scene, "reduced", rtol=1e-11, atol=1e-13)
     tr = simulate(scene, "reduced", method=method, rtol=1e-8, atol=1e-10)
     assert tr.success and np.max(np.abs(tr["phi"] - ref["phi"])) < 1e-5
+    json.dumps(tr.to_dict())          # counters are plain ints (LSODA's are numpy int32)

@@ -88,7 +88,8 @@ def test_shipped_studies_and_the_readme_example_are_valid():
     root = Path(__file__).parent.parent / "studies"
     sizes = {p.stem: len(load_study(p).cases) for p in sorted(root.glob("*.toml"))}
     assert sizes == {"exudyn_convergence": 80, "n_sweep": 20, "paper": 1, "stability": 18,
-                     "stiffness_sweep": 16}
+                     "stiffness_sweep": 16, "work_precision_full": 20,
+                     "work_precision_reduced": 20}
     n_sweep = load_study(root / "n_sweep.toml")
     assert {(c.scene.n, c.scene.t_end) for c in n_sweep.cases} == {
         (n, t) for n in (2, 4, 8, 16, 32) for t in (1.0, 2.0, 5.0, 10.0)}

@@ -34,6 +34,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Cross-validate plane rod-chain models: the paper's full and reduced\n"
                     "models against each other and an independent exudyn beam model.",
         epilog="examples:\n"
+               "  rodval reproduce paper --out out/paper\n"
                "  rodval simulate paper --model reduced --out out/paper-reduced\n"
                "  rodval study studies/paper.toml --out out/paper\n"
                "  rodval report out/paper\n"
