@@ -16,10 +16,6 @@ import numpy as np
 ForceLaw = Callable[[float], float]
 
 
-def _zero(t: float) -> float:
-    return 0.0
-
-
 @dataclass(frozen=True)
 class NodalForce:
     """A force acting on one node of the chain.
