@@ -101,8 +101,8 @@ class ReducedSystem(PaperSystem):
         """gamma = [alpha; beta] (rad) at one time from the algebraic bending rows."""
         n, cc = self.n, self.cc
         phi, dphi = y[:n], y[n:]
-        ddphi = self.rhs(t, y)[n:]
-        _, _, U, G_pa = self.reduced_matrices(phi)
+        M_r, G_r, U, G_pa = self.reduced_matrices(phi)      # once: phi'' and gamma share them
+        ddphi = np.linalg.solve(M_r, self.forces(t, phi, dphi, G_r))
         w2 = dphi * dphi
         Ut_dd = U.T @ ddphi
         GT_w2 = G_pa.T @ w2
