@@ -19,7 +19,7 @@ import time
 import pandas as pd
 
 from rodval import TABLE1_TIMES, paper_scene, simulate
-from rodval.crosscheck import TABLE1_RODS as RODS, table1_gaps as errors
+from rodval.analysis.crosscheck import TABLE1_RODS as RODS, table1_gaps as errors
 from reference_models.exudyn_chain import DEFAULTS
 
 SWEEPS = {

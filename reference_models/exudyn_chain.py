@@ -11,7 +11,7 @@ paper's example). Point masses mu_k sit on the end node of rod k; the scene's no
 there through exudyn load user functions, exactly zero outside each force's support.
 
 Nothing of the paper's equations is used: the quantities are measured on the beam solution by
-their definitions (see ``rodval.scene``):
+their definitions (see ``rodval.core.scene``):
 
 * phi_k: angle of the chord node k-1 -> node k, unwrapped continuously in time (every solver
   step is recorded), starting from the scene's initial phi;
@@ -39,10 +39,10 @@ from typing import Any
 
 import numpy as np
 
-from rodval.models.base import Model
-from rodval.scene import Scene
-from rodval.settings import IntegratorSettings
-from rodval.trajectory import (STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED, SolverStats,
+from rodval.core.contract import Model
+from rodval.core.scene import Scene
+from rodval.core.settings import IntegratorSettings
+from rodval.core.trajectory import (STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED, SolverStats,
                                Trajectory)
 
 ELEMENTS = ("cable2d",)

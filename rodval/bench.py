@@ -22,13 +22,14 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .integrate import integrate
-from .models import get_model
-from .provenance import machine, package_versions
-from .scene import Scene, paper_scene
-from .settings import IntegratorSettings
-from .simulate import simulate
-from .trajectory import Trajectory
+from rodval.solvers.driver import integrate
+from rodval.models import get_model
+from rodval.core.provenance import machine, package_versions
+from rodval.core.scene import Scene, paper_scene
+from rodval.core.settings import IntegratorSettings
+from rodval.models.registry import simulate
+from rodval.core.trajectory import Trajectory
+from rodval.analysis.metrics import pareto_front, scaled_errors  # noqa: F401 - pareto_front: bench API
 
 QUANTITIES = ("phi", "dphi", "alpha", "beta")
 DOP853_FAMILY = ("DOP853", "DOP853-numba")
@@ -73,8 +74,9 @@ def timed(scene: Scene, model: str, settings: IntegratorSettings, repeats: int =
 
 
 def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str, float]:
-    """Relative errors of ``traj`` against ``ref`` (see module docstring); NaN for a run that
-    did not reach every output time."""
+    """Relative errors of ``traj`` against ``ref`` (``rodval.analysis.metrics.scaled_errors``
+    per quantity as ``final_q``, ``rms_q``, ``max_q``, and ``scd``; see module docstring); NaN
+    for a run that did not reach every output time."""
     out: dict[str, float] = {}
     worst = 0.0
     for q in quantities:
@@ -84,10 +86,7 @@ def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str
             out.update({f"final_{q}": math.nan, f"rms_{q}": math.nan, f"max_{q}": math.nan})
             worst = math.inf
             continue
-        d, s = traj[q] - ref[q], np.max(np.abs(ref[q]))
-        out[f"final_{q}"] = float(np.max(np.abs(d[-1])) / s)
-        out[f"rms_{q}"] = float(np.sqrt(np.mean(d * d)) / s)
-        out[f"max_{q}"] = float(np.max(np.abs(d)) / s)
+        out.update({f"{k}_{q}": v for k, v in scaled_errors(traj[q], ref[q]).items()})
         worst = max(worst, out[f"max_{q}"])
     out["scd"] = -math.log10(worst) if 0 < worst < math.inf else (math.inf if worst == 0 else math.nan)
     return out
@@ -178,53 +177,6 @@ def cheapest(frame: pd.DataFrame, quantity: str = "phi", tol: float = 1e-6) -> p
     ok = frame[frame[f"max_{quantity}"] <= tol]
     idx = ok.groupby(["model", "method", "kernel"])["wall_s"].idxmin()
     return ok.loc[idx].sort_values(["model", "wall_s"])
-
-
-def pareto_front(cost: np.ndarray, err: np.ndarray) -> np.ndarray:
-    """Indices of the points not dominated in (cost, error), by increasing cost: along the
-    front the error decreases strictly as the cost grows (a monotone front)."""
-    order = np.argsort(cost, kind="stable")
-    front, best = [], math.inf
-    for i in order:
-        if np.isfinite(err[i]) and err[i] < best:
-            front.append(i)
-            best = err[i]
-    return np.array(front, dtype=int)
-
-
-def plot_work_precision(frame: pd.DataFrame, out_dir, quantities=QUANTITIES) -> list:
-    """One figure per model and x axis (wall, nfev): error against cost per quantity, one
-    line per method/kernel, and the monotone front over all of them. Returns the paths."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    paths = []
-    for model, part in frame.groupby("model"):
-        native = model in ("full", "reduced")
-        for xcol, xlabel in (("wall_s", "wall time (s)"),
-                             ("nfev", "RHS evaluations" if native else "Newton iterations")):
-            qs = [q for q in quantities if f"max_{q}" in part and part[f"max_{q}"].notna().any()]
-            fig, axes = plt.subplots(1, len(qs), figsize=(4.2 * len(qs), 3.8), squeeze=False)
-            for ax, q in zip(axes[0], qs):
-                for (method, kernel), line in part.groupby(["method", "kernel"]):
-                    line = line.sort_values(["rtol", "step"], ascending=False)  # loosest first
-                    label = method + (f" ({kernel})" if kernel == "numpy" else "")
-                    ax.loglog(line[xcol], line[f"max_{q}"], "o-", ms=3, label=label)
-                x, y = part[xcol].to_numpy(float), part[f"max_{q}"].to_numpy(float)
-                f = pareto_front(x, y)
-                ax.loglog(x[f], y[f], "k--", lw=1.2, label="front")
-                ax.set_xlabel(xlabel)
-                ax.set_ylabel(f"max rel. error {q}")
-                ax.set_title(f"{model}: {q}")
-                ax.grid(True, which="both", alpha=0.3)
-            axes[0][0].legend(fontsize=7)
-            fig.tight_layout()
-            path = out_dir / f"wp_{model}_{'wall' if xcol == 'wall_s' else 'nfev'}.png"
-            fig.savefig(path, dpi=110)
-            plt.close(fig)
-            paths.append(path)
-    return paths
 
 
 def baseline_ratios(scene: Scene, tol: float = 1e-6, rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),

@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rodval import Chain, InitialState, IntegratorSettings, Scene, paper_scene, pulse, simulate
-from rodval.scene_file import scene_from_dict
+from rodval.core.scene_file import scene_from_dict
 
 FAST = settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 

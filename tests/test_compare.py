@@ -3,8 +3,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rodval.compare import discrepancies, error_metrics
-from rodval.trajectory import SolverStats, Trajectory
+from rodval.analysis.metrics import discrepancies, error_metrics
+from rodval.core.trajectory import SolverStats, Trajectory
 
 
 def _traj(values: dict, times, model="m") -> Trajectory:

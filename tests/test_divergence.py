@@ -4,9 +4,9 @@ import math
 import numpy as np
 
 from rodval import IntegratorSettings, paper_scene, simulate
-from rodval.divergence import DivergenceGuard
+from rodval.solvers.guard import DivergenceGuard
 from rodval.models.full import FullSystem
-from rodval.trajectory import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_STALLED
+from rodval.core.trajectory import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_STALLED
 
 SCENE = paper_scene(times=[0.5, 1.0, 1.5, 2.0])
 

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from rodval import Chain, InitialState, Scene, constant, paper_scene, simulate
-from rodval.energy import balance
+from rodval.solvers.audit import balance
 
 
 def test_rigid_limit_closes_the_balance_with_load_and_damping():

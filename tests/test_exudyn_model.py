@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from rodval import Chain, InitialState, Scene, paper_scene, simulate
-from rodval.crosscheck import ACCEPTANCE, crosscheck_paper, table1_gaps
+from rodval.analysis.crosscheck import ACCEPTANCE, crosscheck_paper, table1_gaps
 
 exu = pytest.importorskip("exudyn")
 from reference_models.exudyn_chain import ExudynModel  # noqa: E402

@@ -7,9 +7,9 @@ import pandas as pd
 import pytest
 
 from rodval import paper_scene, simulate
-from rodval.loads import NodalForce
-from rodval.scene import TABLE1_TIMES, Chain, Scene
-from rodval.settings import METHODS, IntegratorSettings
+from rodval.core.loads import NodalForce
+from rodval.core.scene import TABLE1_TIMES, Chain, Scene
+from rodval.core.settings import METHODS, IntegratorSettings
 
 TABLE1 = pd.read_csv(__import__("rodval").__path__[0] + "/data/table1.csv")
 

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from rodval import paper_scene
-from rodval.loads import LoadSet, NodalForce, constant, pulse
+from rodval.core.loads import LoadSet, NodalForce, constant, pulse
 from rodval.models import kernels
 from rodval.models.full import FullSystem
 from rodval.models.reduced import ReducedSystem
-from rodval.scene import Chain, Scene
+from rodval.core.scene import Chain, Scene
 
 SYSTEMS = {"full": (FullSystem, 6), "reduced": (ReducedSystem, 2)}
 
@@ -81,7 +81,7 @@ def test_analytic_jacobian_matches_differences(model, coefficients, damped):
     system = cls(scene(n, damped, loaded=True), coefficients, "numpy")
     y = np.random.default_rng(3).normal(scale=0.8, size=width * n)
     t = 0.3
-    J = system.jac(t, y)
+    J = system.jacobian(t, y)
     h = 1e-6
     Jd = np.column_stack([(system.rhs(t, y + h * e) - system.rhs(t, y - h * e)) / (2 * h)
                           for e in np.eye(y.size)])

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from rodval import Chain, InitialState, NodalForce, Scene, constant, paper_scene, pulse
-from rodval.scene_file import load_scene, scene_from_dict
+from rodval.core.scene_file import load_scene, scene_from_dict
 
 
 @pytest.mark.parametrize("field,value,match", [

@@ -8,7 +8,7 @@ import pytest
 from rodval import (Chain, InitialState, IntegratorSettings, NodalForce, Scene, constant,
                     paper_scene, simulate)
 from rodval.models.reduced import ReducedSystem
-from rodval.trajectory import STATUS_ERROR
+from rodval.core.trajectory import STATUS_ERROR
 
 
 def small_scene(**kw):

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from rodval.reproduce import column_errors, compare_table1, run_paper_models
+from rodval.analysis.reproduce import column_errors, compare_table1, run_paper_models
 
 
 @pytest.fixture(scope="module", params=["printed", "published"])

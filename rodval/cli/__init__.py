@@ -40,7 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  rodval report out/paper\n"
                "Run `rodval COMMAND --help` for the options of a command.",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    from .. import __version__
+    from rodval import __version__
     parser.add_argument("--version", action="version", version=f"rodval {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in COMMANDS:

@@ -12,11 +12,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import bench
-from ..provenance import provenance
-from ..scene import paper_scene
-from ..settings import METHODS
-from .options import positive_float
+from rodval import bench
+from rodval.core.provenance import provenance
+from rodval.core.scene import paper_scene
+from rodval.core.settings import METHODS
+from rodval.cli.options import positive_float
+from rodval.report.figures import plot_work_precision
+from rodval.report.markdown import to_markdown
 
 DEFAULT_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "DOP853-numba")
 DEFAULT_RTOLS = "1e-4,1e-6,1e-8,1e-10"
@@ -106,7 +108,7 @@ def _write(out: Path, stem: str, frame, title: str, body: list[str]) -> None:
 
 
 def _table(frame, columns, floatfmt=".3g") -> str:
-    return frame[columns].to_markdown(index=False, floatfmt=floatfmt)
+    return to_markdown(frame[columns], floatfmt)
 
 
 def run_work_precision(args) -> int:
@@ -116,7 +118,7 @@ def run_work_precision(args) -> int:
     frame, unc, notes = bench.work_precision(scene, args.models, args.methods, args.rtols,
                                              repeats=args.repeats, budget_s=args.budget)
     args.out.mkdir(parents=True, exist_ok=True)
-    plots = bench.plot_work_precision(frame, args.out)
+    plots = plot_work_precision(frame, args.out)
     ratios = bench.baseline_ratios(paper_scene(args.n, times=np.linspace(0, 2, 41)),
                                    repeats=args.repeats)
     ratios.to_csv(args.out / "baseline_ratios.csv", index=False)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ..settings import METHODS
+from rodval.core.settings import DEFAULTS, METHODS
 
 
 def positive_float(name: str, *, finite: bool = True, below: float = math.inf):
@@ -68,12 +68,31 @@ def key_value(text: str) -> tuple[str, object]:
 
 
 def add_integrator_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--method", default="DOP853", choices=METHODS,
-                   help="scipy solve_ivp method, or DOP853-numba (compiled loop), for native "
-                        "models (default DOP853)")
-    p.add_argument("--rtol", type=positive_float("--rtol", below=1.0), default=1e-10,
-                   help="relative tolerance in (0, 1) (default 1e-10)")
-    p.add_argument("--atol", type=positive_float("--atol"), default=1e-12,
-                   help="absolute tolerance > 0 (default 1e-12)")
-    p.add_argument("--max-step", type=positive_float("--max-step", finite=False), default=math.inf,
-                   help="largest step, s (default unbounded)")
+    """--method, --rtol, --atol, --max-step, --max-evaluations, --max-wall with the defaults of
+    ``rodval.core.settings.DEFAULTS`` (the same as the Python API and study files)."""
+    d = DEFAULTS
+    p.add_argument("--method", default=d["method"], choices=METHODS,
+                   help="auto (default: the compiled DOP853 where the model and scene have a "
+                        "compiled form, scipy's DOP853 otherwise), a scipy solve_ivp method, or "
+                        "DOP853-numba (native models)")
+    p.add_argument("--rtol", type=positive_float("--rtol", below=1.0), default=d["rtol"],
+                   help=f"relative tolerance in (0, 1) (default {d['rtol']:g})")
+    p.add_argument("--atol", type=positive_float("--atol"), default=d["atol"],
+                   help=f"absolute tolerance > 0 (default {d['atol']:g})")
+    p.add_argument("--max-step", type=positive_float("--max-step", finite=False),
+                   default=d["max_step"], help="largest step, s (default unbounded)")
+    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"),
+                   default=d["max_evaluations"],
+                   help=f"right-hand-side evaluations a run may use (default {d['max_evaluations']})")
+    p.add_argument("--max-wall", type=positive_float("--max-wall", finite=False),
+                   default=d["max_wall_s"], help="wall-clock seconds a run may use (default: no limit)")
+
+
+def integrator_settings(args: argparse.Namespace) -> dict:
+    """The integrator settings the user gave on the command line (only those that differ
+    from the defaults, so that a reference model with its own integrator is not handed
+    settings nobody asked for)."""
+    given = {"method": args.method, "rtol": args.rtol, "atol": args.atol,
+             "max_step": args.max_step, "max_evaluations": args.max_evaluations,
+             "max_wall_s": args.max_wall}
+    return {k: v for k, v in given.items() if v != DEFAULTS[k]}

@@ -13,7 +13,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..report import build_report
+    from rodval.report.study_report import build_report
 
     print(build_report(args.dir))
     return 0

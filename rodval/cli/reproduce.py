@@ -4,8 +4,8 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
-from ..reproduce import reproduce_paper
-from . import CliError
+from rodval.report.paper import crosscheck_markdown, reproduce_paper
+from rodval.cli import CliError
 
 
 def register(sub) -> None:
@@ -39,17 +39,11 @@ def run(args) -> int:
     print(f"wrote {args.out}/table1.csv, table1.md, configurations.png")
     if args.cross_check is False or not have_exudyn:
         return 0
-    from ..crosscheck import crosscheck_paper
+    from rodval.analysis.crosscheck import crosscheck_paper
 
     table, runs = crosscheck_paper()
     table.to_csv(args.out / "crosscheck.csv", index=False)
-    ex = runs["exudyn"].stats
-    (args.out / "crosscheck.md").write_text(
-        "# Cross-check against the independent exudyn beam model\n\n"
-        "Paper example, rods 2, 4, 6, 8 at t = 0.5, 1, 1.5, 2 s. phi, alpha, beta: max |gap| "
-        "(rad); dphi: max |gap| / the reference column's max |value|.\n\n"
-        + table.to_markdown(index=False, floatfmt=".2e")
-        + f"\n\nexudyn settings: {runs['exudyn'].settings}; solve wall time {ex.wall_s:.2f} s.\n")
+    (args.out / "crosscheck.md").write_text(crosscheck_markdown(table, runs["exudyn"]))
     print("Cross-check against exudyn (phi/alpha/beta max |gap| in rad, dphi relative):")
     print(table.drop(columns="status").to_string(index=False, float_format=lambda v: f"{v:.2e}"))
     print(f"wrote {args.out}/crosscheck.csv, crosscheck.md")

@@ -1,25 +1,38 @@
-"""rodval simulate SCENE --model M --out DIR: one run, tidy CSV + run.json."""
+"""rodval simulate SCENE --model M --out DIR: one run, tidy CSV + run.json.
+
+SCENE is 'paper', a TOML scene file, or the run.json of an earlier run (rerun exactly: the
+same resolved scene, model, options and integrator settings; options given here override).
+"""
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
+from typing import Any
 
-from ..models import REGISTRY
-from ..provenance import provenance
-from ..scene_file import load_scene
-from ..settings import IntegratorSettings
-from ..simulate import simulate
-from .options import add_integrator_options, key_value, positive_float, time_list
+from rodval.cli.options import (add_integrator_options, integrator_settings, key_value,
+                                positive_float, time_list)
+from rodval.core.provenance import provenance
+from rodval.core.scene_file import (read_scene_document, scene_from_dict, scene_to_dict,
+                                    with_horizon)
+from rodval.core.settings import SETTING_NAMES, IntegratorSettings
+from rodval.models import REGISTRY, simulate
+from rodval.solvers.progress import progress_bar
 
 
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="run one scene with one model",
-                       description="Run SCENE ('paper' or a TOML scene file) with one model and "
-                                   "write DIR/trajectory.csv (t, quantity, k, value) and DIR/run.json.")
-    p.add_argument("scene", metavar="SCENE", help="'paper' or a TOML scene file")
-    p.add_argument("--model", default="full", choices=tuple(REGISTRY))
+                       description="Run SCENE ('paper', a TOML scene file, or the run.json of "
+                                   "an earlier run) with one model and write "
+                                   "DIR/trajectory.csv (t, quantity, k, value) and DIR/run.json "
+                                   "(the complete resolved scene, model, options, settings "
+                                   "and how the run ended).")
+    p.add_argument("scene", metavar="SCENE", help="'paper', a TOML scene file or a run.json")
+    p.add_argument("--model", choices=tuple(REGISTRY),
+                   help="model (default full; a run.json's own model)")
     add_integrator_options(p)
-    p.add_argument("--t-end", type=positive_float("--t-end"), help="horizon, s (> 0)")
+    p.add_argument("--t-end", type=positive_float("--t-end"),
+                   help="horizon, s (> 0); the scene's output times up to it are kept")
     p.add_argument("--times", type=time_list, help="output times t1,t2,... (s), increasing")
     p.add_argument("--coefficients", choices=("printed", "published"),
                    help="coefficient variant of the native models (default printed)")
@@ -29,28 +42,53 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def _previous_run(path: Path) -> dict[str, Any] | None:
+    """The run record if ``path`` is a run.json written by `rodval simulate`."""
+    if path.suffix != ".json":
+        return None
+    if not path.is_file():
+        raise ValueError(f"SCENE {str(path)!r} does not exist")
+    try:
+        rec = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"{path}: not a readable run.json ({exc})") from None
+    missing = [k for k in ("scene", "model", "settings", "options") if not isinstance(rec, dict)
+               or k not in rec]
+    if missing:
+        raise ValueError(f"{path}: not a run.json of rodval simulate (no {missing[0]!r})")
+    return rec
+
+
 def run(args) -> int:
-    scene = load_scene(args.scene)
-    changes = {}
+    previous = _previous_run(Path(args.scene))
+    if previous is not None:
+        doc, model = dict(previous["scene"]), args.model or previous["model"]
+        settings_kw = {k: v for k, v in previous["settings"].items() if k in SETTING_NAMES}
+        settings_kw["method"] = previous["settings"].get("requested_method",
+                                                         settings_kw.get("method"))
+        options = dict(previous["options"]) if model == previous["model"] else {}
+    else:
+        doc, model, settings_kw, options = read_scene_document(args.scene), args.model or "full", {}, {}
+    where = str(args.scene)
     if args.t_end is not None:
-        changes["t_end"] = args.t_end
-        if args.times is None:
-            changes["times"] = None
+        scene = with_horizon(doc, args.t_end, where)
+    else:
+        scene = scene_from_dict(doc, where=where)
     if args.times is not None:
-        changes["times"] = args.times
-    if changes:
-        scene = scene.with_(**changes)
-    options = dict(args.options)
+        scene = scene.with_(times=args.times)
+    options.update(dict(args.options))
     if args.coefficients:
         options["coefficients"] = args.coefficients
-    settings = IntegratorSettings(method=args.method, rtol=args.rtol, atol=args.atol,
-                                  max_step=args.max_step)
-    traj = simulate(scene, args.model, settings=settings, **options)
+    settings_kw.update(integrator_settings(args))
+    with progress_bar(scene.t_end, enabled=sys.stderr.isatty()):
+        traj = simulate(scene, model, settings=IntegratorSettings(**settings_kw), **options)
     args.out.mkdir(parents=True, exist_ok=True)
     traj.to_frame().to_csv(args.out / "trajectory.csv", index=False)
-    record = {"scene": scene.name, "model": traj.model, "settings": traj.settings,
-              **traj.stats.as_dict(), **provenance()}
+    record = {"scene": scene_to_dict(scene), "model": traj.model, "options": traj.options,
+              "settings": traj.settings, "stats": traj.stats.as_dict(), "events": traj.events,
+              "provenance": provenance()}
     (args.out / "run.json").write_text(json.dumps(record, indent=2, default=str))
-    print(f"{traj.model}: {traj.stats.message}, t_reached = {traj.stats.t_reached:g} s, "
-          f"nfev = {traj.stats.nfev}, wall = {traj.stats.wall_s:.3f} s -> {args.out}")
+    print(f"{traj.model}: {traj.stats.message}, method {traj.settings.get('method')}, "
+          f"t_reached = {traj.stats.t_reached:g} s, nfev = {traj.stats.nfev}, "
+          f"wall = {traj.stats.wall_s:.3f} s -> {args.out}")
     return 0 if traj.success else 1

@@ -6,7 +6,7 @@ import signal
 import sys
 from pathlib import Path
 
-from .options import positive_float, positive_int
+from rodval.cli.options import positive_float, positive_int
 
 
 def register(sub) -> None:
@@ -27,13 +27,15 @@ def register(sub) -> None:
     p.add_argument("--backend", choices=("processes", "dask"), default="processes",
                    help="processes on this machine (default) or an existing dask.distributed cluster")
     p.add_argument("--scheduler", metavar="ADDR", help="dask scheduler address, e.g. tcp://host:8786")
+    p.add_argument("--fresh", action="store_true",
+                   help="empty DIR first (needed when DIR holds another study)")
     p.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from ..study import load_study, run_study
-    from ..study.runner import case_path
+    from rodval.study import load_study, run_study
+    from rodval.study.store import StudyStore
 
     spec = load_study(args.file)
     if args.backend == "dask" and not args.scheduler:
@@ -42,12 +44,15 @@ def run(args) -> int:
     try:
         res = run_study(spec, args.out, workers=args.workers, case_timeout=args.case_timeout,
                         resume=args.resume, backend=args.backend, scheduler=args.scheduler,
-                        progress=args.progress)
+                        progress=args.progress, fresh=args.fresh)
     except KeyboardInterrupt:
-        done = sum(case_path(args.out, c.id).is_file() for c in spec.cases)
+        store = StudyStore(args.out)
+        done = sum(store.case_path(c.id).is_file() for c in spec.cases)
         print(f"rodval study: interrupted; {done} of {len(spec.cases)} cases are in "
               f"{args.out / 'cases'}; run the same command again to resume", file=sys.stderr)
         return 130
+    for warning in res.warnings:
+        print(f"rodval study: warning: {warning}", file=sys.stderr)
     print(f"{spec.name}: {len(res.ran)} cases run, {len(res.reused)} reused, "
           f"{res.failed_runs} failed model runs, {res.wall_s:.1f} s -> {res.out / 'report.md'}")
     return 0

@@ -8,14 +8,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..scene import Scene
-from . import kernels
-from .paper_matrices import angle_differences, angle_jacobian, assemble_mass, convective_terms
-from .paper_system import PaperModel, PaperSystem
+from rodval.core.scene import Scene
+from rodval.models import kernels
+from rodval.models.paper_matrices import angle_differences, angle_jacobian, assemble_mass, convective_terms
+from rodval.models.paper_system import PaperModel, PaperSystem
 
 
 class FullSystem(PaperSystem):
-    kernel_kind = kernels.KIND_FULL
+    accel_kernel = staticmethod(kernels.full_accel)
+    compiled_rhs = staticmethod(kernels.full_rhs)
 
     def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
         super().__init__(scene, coefficients, kernel)
@@ -48,7 +49,7 @@ class FullSystem(PaperSystem):
         f = self.forces(t, q, v, skj)
         return np.concatenate([v, np.linalg.solve(assemble_mass(self.cc, ckj), f)])
 
-    def jac(self, t: float, y: np.ndarray) -> np.ndarray:
+    def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         """Analytic Jacobian df/dy (6n, 6n): [[0, I], [M^-1 (df/dq - dM/dphi q''), M^-1 df/dq']]."""
         n, cc = self.n, self.cc
         q, v = y[:3 * n], y[3 * n:]
@@ -88,9 +89,9 @@ class FullSystem(PaperSystem):
     def generalized_rates(self, y):
         return y[3 * self.n:]
 
-    def stored_energy(self, y):
+    def energy_budget(self, t, y):
         q = y[:3 * self.n]
-        return self.kinetic_energy(y) + 0.5 * float(q @ self.K @ q)
+        return self.kinetic_energy(t, y) + 0.5 * float(q @ self.K @ q)
 
     def rigid(self, Y):
         n = self.n

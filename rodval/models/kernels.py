@@ -18,10 +18,13 @@ structure exploited (``kernel="numba"``, the default):
 The reduced model's M_r = M_pp - P M_gp has the dense constant factor P = K_pg B^-1, so it
 is assembled in O(n^2) and solved densely (O(n^3), n is small for that model).
 
-Parameters are packed into plain arrays so that one compiled integrator
-(``rodval.integrators.dop853``) can call either model through ``accel``:
+Each model has an acceleration kernel with one argument list,
+``*_accel(V, Mt, y, has_load, SX, SY, damped, out)`` (used by the Python-side right-hand side,
+whose loads may be any callable), and a right-hand side of the compiled integrators' type
+``rodval.solvers.compiled.RHS_TYPE`` (``full_rhs``, ``reduced_rhs``; loads from the compiled
+load table, ``rodval.core.loads.load_sums``). Parameters are packed into plain arrays:
 ``V`` (rows of length-n vectors, layout ``V_*`` below), ``Mt`` (stack of n x n matrices of the
-reduced model, layout ``M_*``), and the load table ``L`` (see ``load_table``).
+reduced model, layout ``M_*``; empty for the full model), ``S = [damped]``.
 """
 from __future__ import annotations
 
@@ -30,22 +33,16 @@ import math
 import numpy as np
 from numba import njit
 
-from ..loads import LoadSet
-
-#: Model kinds understood by ``accel``.
-KIND_FULL, KIND_REDUCED = 0, 1
+from rodval.core.loads import load_sums
+from rodval.solvers.compiled import RHS_SIGNATURE
 
 # Rows of V (per-rod vectors). Shared by both models.
 V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB = range(7)
 # Full model only: Schur-complement constants per rod (see full_constants).
 V_PA, V_PB, V_AP, V_BP, V_AA, V_AB, V_EPS, V_PI, V_RHO, V_TAU = range(7, 17)
-N_V_FULL = 17
 # Stack Mt of the reduced model: P_a - P_b, P_a ap + P_b bp, K_r, C_r.
 M_PDIFF, M_PDIAG, M_KR, M_CR = range(4)
 
-# Load table columns: node (0-based), component (0 = X, 1 = Y), law (0 = constant,
-# 1 = raised cosine amp (1/2 - 1/2 cos(omega t))), amp (N), omega (rad/s), t0, t1 (s).
-LAW_CONSTANT, LAW_RAISED_COSINE = 0, 1
 
 
 def _rows(cc, chain) -> list[np.ndarray]:
@@ -74,53 +71,6 @@ def reduced_constants(cc, chain, P_diff, P_diag, K_r, C_r) -> tuple[np.ndarray, 
     V = np.ascontiguousarray(np.vstack(_rows(cc, chain)), dtype=np.float64)
     Mt = np.ascontiguousarray(np.stack([P_diff, P_diag, K_r, C_r]), dtype=np.float64)
     return V, Mt
-
-
-def load_table(loads: LoadSet) -> np.ndarray | None:
-    """The scene's loads as a table the compiled kernels evaluate, or None when a load is an
-    arbitrary callable (only ``pulse`` and ``constant`` laws have a compiled form)."""
-    rows = []
-    for f in loads.loads:
-        p = f.params
-        if f.name == "pulse":
-            T = p["T"]
-            rows.append((f.node - 1, 0, LAW_RAISED_COSINE, p["Xbar"], 4 * math.pi / T, 0.0, 0.5 * T))
-            rows.append((f.node - 1, 1, LAW_RAISED_COSINE, p["Ybar"], 2 * math.pi / T, 0.0, T))
-        elif f.name == "constant":
-            for comp, key in ((0, "X"), (1, "Y")):
-                if p[key]:
-                    rows.append((f.node - 1, comp, LAW_CONSTANT, p[key], 0.0, p["t_on"], p["t_off"]))
-        else:
-            return None
-    return np.array(rows, dtype=np.float64).reshape(-1, 7)
-
-
-@njit(cache=True)
-def load_sums(L, t, SX, SY):
-    """Suffix sums SX_k = sum_{j>=k} X_j, SY_k (N) at t from the load table ``L``; returns
-    False (and leaves SX, SY untouched) when no load acts at t. A law is evaluated only
-    inside its support [t0, t1]."""
-    n = SX.shape[0]
-    active = False
-    for r in range(L.shape[0]):
-        if L[r, 5] <= t <= L[r, 6]:
-            if not active:
-                SX[:] = 0.0
-                SY[:] = 0.0
-                active = True
-            if L[r, 2] == LAW_RAISED_COSINE:
-                value = L[r, 3] * (0.5 - 0.5 * math.cos(L[r, 4] * t))
-            else:
-                value = L[r, 3]
-            if L[r, 1] == 0:
-                SX[int(L[r, 0])] += value
-            else:
-                SY[int(L[r, 0])] += value
-    if active:
-        for k in range(n - 2, -1, -1):
-            SX[k] += SX[k + 1]
-            SY[k] += SY[k + 1]
-    return active
 
 
 @njit(cache=True)
@@ -255,10 +205,12 @@ def _schur_solve(V, c, s, r, x):
 
 
 @njit(cache=True)
-def full_accel(V, q, v, has_load, SX, SY, damped, out):
-    """Accelerations q'' (3n) of the full model into ``out``: M(phi) q'' = [Q; 0; 0] - h
-    - C q' - K q. SX, SY are the load suffix sums (N), used when ``has_load``."""
+def full_accel(V, Mt, y, has_load, SX, SY, damped, out):
+    """Accelerations q'' (3n) of the full model at y = [q; q'] into ``out``: M(phi) q'' =
+    [Q; 0; 0] - h - C q' - K q. SX, SY are the load suffix sums (N), used when ``has_load``.
+    O(n) time and memory (``Mt`` is unused)."""
     n = V.shape[1]
+    q, v = y[:3 * n], y[3 * n:]
     phi, alpha, beta = q[:n], q[n:2 * n], q[2 * n:]
     dphi, dalpha, dbeta = v[:n], v[n:2 * n], v[2 * n:]
     c = np.cos(phi)
@@ -333,10 +285,12 @@ def reduced_matrix(V, Mt, c, s):
 
 
 @njit(cache=True)
-def reduced_accel(V, Mt, phi, dphi, has_load, SX, SY, damped, out):
-    """phi'' of the reduced model into ``out``: M_r phi'' = Q - G_r phi'^2 - C_r phi' - K_r phi,
-    G_r phi'^2 = G_pp phi'^2 + (P_a - P_b) G_pa^T phi'^2."""
-    n = phi.shape[0]
+def reduced_accel(V, Mt, y, has_load, SX, SY, damped, out):
+    """phi'' of the reduced model at y = [phi; phi'] into ``out``: M_r phi'' = Q - G_r phi'^2
+    - C_r phi' - K_r phi, G_r phi'^2 = G_pp phi'^2 + (P_a - P_b) G_pa^T phi'^2.
+    O(n^2) assembly and O(n^3) dense solve."""
+    n = V.shape[1]
+    phi, dphi = y[:n], y[n:]
     c = np.cos(phi)
     s = np.sin(phi)
     w2 = dphi * dphi
@@ -354,25 +308,25 @@ def reduced_accel(V, Mt, phi, dphi, has_load, SX, SY, damped, out):
     out[:] = np.linalg.solve(reduced_matrix(V, Mt, c, s), f)
 
 
-@njit(cache=True)
-def accel(kind, V, Mt, y, has_load, SX, SY, damped, out):
-    """Second derivatives (the lower half of y') of model ``kind`` (KIND_FULL or
-    KIND_REDUCED) at state y = [q; q'] into ``out``."""
-    half = y.shape[0] // 2
-    if kind == KIND_FULL:
-        full_accel(V, y[:half], y[half:], has_load, SX, SY, damped, out)
-    else:
-        reduced_accel(V, Mt, y[:half], y[half:], has_load, SX, SY, damped, out)
-
-
-@njit(cache=True)
-def rhs(kind, t, y, V, Mt, L, damped, out):
-    """y' = f(t, y) of model ``kind`` into ``out``, loads from table ``L`` (the compiled
-    integrator's right-hand side)."""
+@njit(RHS_SIGNATURE, cache=True)
+def full_rhs(t, y, P, S, M, L, out):
+    """y' of the full model (compiled integrators' right-hand side, loads from table L)."""
     half = y.shape[0] // 2
     out[:half] = y[half:]
-    n = V.shape[1]
+    n = P.shape[1]
     SX = np.empty(n)
     SY = np.empty(n)
     has_load = load_sums(L, t, SX, SY)
-    accel(kind, V, Mt, y, has_load, SX, SY, damped, out[half:])
+    full_accel(P, M, y, has_load, SX, SY, S[0] != 0.0, out[half:])
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def reduced_rhs(t, y, P, S, M, L, out):
+    """y' of the reduced model (compiled integrators' right-hand side, loads from table L)."""
+    half = y.shape[0] // 2
+    out[:half] = y[half:]
+    n = P.shape[1]
+    SX = np.empty(n)
+    SY = np.empty(n)
+    has_load = load_sums(L, t, SX, SY)
+    reduced_accel(P, M, y, has_load, SX, SY, S[0] != 0.0, out[half:])

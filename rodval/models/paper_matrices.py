@@ -1,6 +1,6 @@
 """The paper's matrices (equations (9)-(10) of Russkikh 2022, restated in shared/paper/model.md).
 
-Generalized coordinates q = [phi; alpha; beta] (3n), see ``rodval.scene`` for conventions.
+Generalized coordinates q = [phi; alpha; beta] (3n), see ``rodval.core.scene`` for conventions.
 Kinetic energy T = 1/2 q'^T M(phi) q' to first order in the bending coordinates; potential
 Pi = 1/2 q^T K q; dissipation 1/2 q'^T C q'. The equations of motion of the full model are
 
@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..scene import Chain
+from rodval.core.scene import Chain
 
 VARIANTS = ("printed", "published")
 

@@ -1,13 +1,16 @@
 """What the full and reduced models share: scene constants, loads and the observation map."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from ..loads import LoadSet
-from ..scene import Scene
-from . import kernels
-from .base import OdeModel, OdeSystem
-from .paper_matrices import (VARIANTS, angle_differences, assemble_mass, chain_constants, damping_matrix,
+from rodval.core.loads import LoadSet, load_table
+from rodval.core.scene import Scene
+from rodval.models import kernels
+from rodval.solvers.ode_model import OdeModel
+from rodval.solvers.system import CompiledForm, OdeSystem
+from rodval.models.paper_matrices import (VARIANTS, angle_differences, assemble_mass, chain_constants, damping_matrix,
                              generalized_forces, hinge_matrix, node_positions, stiffness_matrix)
 
 
@@ -18,10 +21,14 @@ KERNELS = ("numba", "numpy")
 
 class PaperSystem(OdeSystem):
     """Base of the paper's ODE systems. Subclasses provide ``numpy_rhs``, the compiled
-    kernel's constants (``kernel_kind``, ``kernel_constants``), ``jac`` and ``bending``
-    (alpha, beta, alpha', beta' at output times)."""
+    kernels (``accel_kernel``, ``compiled_rhs``) and their constants (``kernel_constants``),
+    ``jacobian`` and ``bending`` (alpha, beta, alpha', beta' at output times)."""
 
-    kernel_kind: int
+    has_jacobian = True
+    has_energy = True
+    #: kernels.*_accel(V, Mt, y, has_load, SX, SY, damped, out) and the RHS_TYPE function.
+    accel_kernel: Any
+    compiled_rhs: Any
 
     def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
         if kernel not in KERNELS:
@@ -48,7 +55,8 @@ class PaperSystem(OdeSystem):
         if self.kernel == "numba":
             self.V, self.Mt = self.kernel_constants()
             self._no_load = np.zeros(self.n)
-            self.rhs(0.0, self.y0)
+            self._flags = np.array([1.0 if self.damped else 0.0])
+        self.rhs(0.0, self.y0)
 
     def kernel_constants(self) -> tuple[np.ndarray, np.ndarray]:
         """(V, Mt) of ``rodval.models.kernels`` for this system."""
@@ -65,19 +73,19 @@ class PaperSystem(OdeSystem):
         half = y.size // 2
         out = np.empty_like(y)
         out[:half] = y[half:]
-        kernels.accel(self.kernel_kind, self.V, self.Mt, y, sums is not None, SX, SY,
-                      self.damped, out[half:])
+        self.accel_kernel(self.V, self.Mt, y, sums is not None, SX, SY, self.damped, out[half:])
         return out
 
-    def compiled(self) -> tuple | None:
-        """(kind, V, Mt, load table, damped) for the compiled integrator, or None when this
-        system has no compiled form (numpy kernel, or a load law without a table form)."""
+    def compiled(self) -> CompiledForm | None:
+        """The compiled form, or None with the numpy kernel or a load that is a plain
+        Python callable (no load-table form)."""
         if self.kernel != "numba":
             return None
-        table = kernels.load_table(self.loads)
+        table = load_table(self.scene.loads)
         if table is None:
             return None
-        return self.kernel_kind, self.V, self.Mt, table, self.damped
+        return CompiledForm(self.compiled_rhs, self.V, self._flags, self.Mt, table,
+                            name=type(self).__name__)
 
     def generalized_force(self, t: float, phi: np.ndarray) -> np.ndarray | None:
         """Q(phi, t) (N m) on the phi coordinates, or None when no load acts at t."""
@@ -147,7 +155,7 @@ class PaperSystem(OdeSystem):
     def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
         return 0.5 * float(v @ assemble_mass(self.cc_kinetic, angle_differences(phi)[0]) @ v)
 
-    def kinetic_energy(self, y: np.ndarray) -> float:
+    def kinetic_energy(self, t: float, y: np.ndarray) -> float:
         """T = 1/2 q'^T M(phi) q' (J) at one state, without recovering bending angles."""
         return self._kinetic(self.rigid(y[None, :])[0][0], self.generalized_rates(y))
 
@@ -168,6 +176,7 @@ class PaperModel(OdeModel):
     dense right-hand side, kept as the reference and benchmark baseline)."""
 
     system_class: type[PaperSystem]
+    OPTIONS = ("coefficients", "kernel")
 
     def __init__(self, coefficients: str = "printed", kernel: str = "numba"):
         if coefficients not in VARIANTS:

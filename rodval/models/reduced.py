@@ -15,14 +15,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..scene import Scene
-from . import kernels
-from .paper_matrices import angle_differences, angle_jacobian
-from .paper_system import PaperModel, PaperSystem
+from rodval.core.scene import Scene
+from rodval.models import kernels
+from rodval.models.paper_matrices import angle_differences, angle_jacobian
+from rodval.models.paper_system import PaperModel, PaperSystem
 
 
 class ReducedSystem(PaperSystem):
-    kernel_kind = kernels.KIND_REDUCED
+    accel_kernel = staticmethod(kernels.reduced_accel)
+    compiled_rhs = staticmethod(kernels.reduced_rhs)
 
     def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
         super().__init__(scene, coefficients, kernel)
@@ -74,7 +75,7 @@ class ReducedSystem(PaperSystem):
         M_r, G_r, _, _ = self.reduced_matrices(phi)
         return np.concatenate([dphi, np.linalg.solve(M_r, self.forces(t, phi, dphi, G_r))])
 
-    def jac(self, t: float, y: np.ndarray) -> np.ndarray:
+    def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         """Analytic Jacobian df/dy (2n, 2n): [[0, I], [M_r^-1 (df_r/dphi - dM_r/dphi phi''),
         M_r^-1 df_r/dphi']]."""
         n, cc = self.n, self.cc
@@ -119,11 +120,11 @@ class ReducedSystem(PaperSystem):
         n = self.n
         return np.concatenate([y[n:], np.zeros(2 * n)])
 
-    def stored_energy(self, y):
+    def energy_budget(self, t, y):
         """T + 1/2 phi^T K_r phi: K_r is the Schur complement of B in K, so this is Pi at the
         quasi-static bending gamma = -B^-1 K_gp phi (exact when phi'' = phi' = 0)."""
         phi = y[:self.n]
-        return self.kinetic_energy(y) + 0.5 * float(phi @ self.K_r @ phi)
+        return self.kinetic_energy(t, y) + 0.5 * float(phi @ self.K_r @ phi)
 
     def rigid(self, Y):
         n = self.n

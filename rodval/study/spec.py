@@ -24,18 +24,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..models import REGISTRY, get_model
-from ..scene import QUANTITIES, Scene
-from ..scene_file import scene_from_dict
-from ..settings import IntegratorSettings
+from rodval.models import REGISTRY, get_model, model_class
+from rodval.core.scene import QUANTITIES, Scene
+from rodval.core.scene_file import scene_from_dict
+from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 
 TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report"}
 STUDY_KEYS = {"name", "description", "reference"}
-INTEGRATOR_KEYS = {"method", "rtol", "atol", "max_step", "first_step", "blowup_factor",
-                   "min_step_fraction", "stall_steps"}
+INTEGRATOR_KEYS = set(SETTING_NAMES)
 REPORT_KEYS = {"cases", "rods", "quantities", "times"}
 GRID_ROOTS = ("scene", "integrator", "models")
-DEFAULT_INTEGRATOR = {"method": "DOP853", "rtol": 1e-8, "atol": 1e-10}
 
 
 @dataclass(frozen=True)
@@ -107,7 +105,6 @@ class StudySpec:
     labels: dict[str, str]            # grid path -> short label used in case ids and tables
     cases: tuple[Case, ...]
     report: ReportSpec
-    extra: dict[str, Any] = field(default_factory=dict)
 
     def case(self, case_id: str) -> Case:
         for c in self.cases:
@@ -192,8 +189,15 @@ def _model_specs(doc: dict, where: str) -> tuple[ModelSpec, ...]:
         if name not in REGISTRY:
             raise _err(where, f"{key}.model" if "model" in table else key,
                        f"model must be one of {', '.join(REGISTRY)}, got {name!r}")
-        settings_kw = {**DEFAULT_INTEGRATOR, **integ,
-                       **{k: v for k, v in table.items() if k in INTEGRATOR_KEYS}}
+        own = {k: v for k, v in table.items() if k in INTEGRATOR_KEYS}
+        if not _uses_rodval_integrator(name):
+            if own:
+                raise _err(where, f"{key}.{sorted(own)[0]}",
+                           f"model {name!r} integrates with its own options, not rodval's "
+                           "integrator settings (see its options, e.g. step, solver)")
+            settings_kw = {}        # [integrator] applies to the models rodval integrates
+        else:
+            settings_kw = {**integ, **own}
         try:
             settings = IntegratorSettings(**settings_kw)
         except (TypeError, ValueError) as exc:
@@ -204,6 +208,15 @@ def _model_specs(doc: dict, where: str) -> tuple[ModelSpec, ...]:
         _check_model_options(name, options, where, key)
         specs.append(ModelSpec(label=str(label), model=name, options=options, settings=settings))
     return tuple(specs)
+
+
+def _uses_rodval_integrator(name: str) -> bool:
+    """Whether model ``name`` is integrated by rodval's driver (its IntegratorSettings apply);
+    a model that cannot be imported here is taken to be (its runs fail and say why)."""
+    try:
+        return bool(getattr(model_class(name), "USES_INTEGRATOR_SETTINGS", True))
+    except ValueError:
+        return True
 
 
 def _check_model_options(name: str, options: dict, where: str, key: str) -> None:

@@ -1,37 +1,33 @@
-"""Running one case: in this process (``run_case``) or isolated in a child process
-(``run_case_isolated``) that can be stopped at a time limit and whose crash (even a segfault
-in a compiled library) is recorded instead of taking the study down.
+"""Running one case in a worker process.
 
-The child is ``python -m rodval.study.worker``: it reads a case payload (JSON, see
-``Case.payload``) on stdin and prints one JSON line per model run as soon as it finishes, so
-runs finished before a timeout or crash are kept.
+``python -m rodval.study.worker`` is a warm worker: it imports rodval and loads the compiled
+kernels and integrator once, then reads case payloads (JSON, one per line, see
+``Case.payload``) on stdin and, for each, prints one JSON line per model run as soon as it
+finishes and a final ``{"done": CASE}`` line. The parent (``rodval.study.schedule``) kills it
+at a case's time limit or when it crashes and starts a fresh one; the runs it had finished
+are kept.
 """
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
-import threading
 import time
 from typing import Any, Iterator
 
 import numpy as np
 
-from ..models import get_model
-from ..scene_file import scene_from_dict
-from ..settings import IntegratorSettings
-from ..trajectory import (STATUS_CRASHED, STATUS_ERROR, STATUS_TIMEOUT, SolverStats,
-                          Trajectory)
-
-_LIVE: set[subprocess.Popen] = set()
-_LIVE_LOCK = threading.Lock()
+from rodval.core.scene_file import scene_from_dict
+from rodval.core.settings import IntegratorSettings
+from rodval.core.status import STATUS_ERROR
+from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.models import get_model
 
 
 def failed_run(model: dict, scene_name: str, status: int, message: str) -> dict[str, Any]:
     """A run record for a model that produced nothing (error before integration, timeout...)."""
     traj = Trajectory(model=model["model"], scene_name=scene_name, times=np.zeros(0), values={},
                       k_index={}, stats=SolverStats(status=status, message=message),
-                      settings={**model["settings"], **model["options"]})
+                      settings=dict(model["settings"]), options=dict(model["options"]))
     return {"label": model["label"], "setup_s": 0.0, "trajectory": traj.to_dict()}
 
 
@@ -55,63 +51,23 @@ def iter_case(payload: dict[str, Any]) -> Iterator[dict[str, Any]]:
                "trajectory": traj.to_dict()}
 
 
-def run_case(payload: dict[str, Any]) -> list[dict[str, Any]]:
-    """Run a case in this process (no time limit, no crash isolation)."""
-    return list(iter_case(payload))
-
-
-def complete_runs(payload: dict, runs: list[dict], status: int, message: str) -> list[dict]:
-    done = {r["label"] for r in runs}
-    name = payload["scene"].get("name", payload["case"])
-    return runs + [failed_run(m, name, status, message)
-                   for m in payload["models"] if m["label"] not in done]
-
-
-def run_case_isolated(payload: dict[str, Any], timeout: float | None = None) -> list[dict[str, Any]]:
-    """Run a case in a child process; after ``timeout`` seconds (None: no limit) the child is
-    killed and the models it had not finished are recorded with status ``timeout``."""
-    proc = subprocess.Popen([sys.executable, "-m", "rodval.study.worker"], stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    with _LIVE_LOCK:
-        _LIVE.add(proc)
-    timed_out = False
-    try:
-        try:
-            out, err = proc.communicate(json.dumps(payload), timeout=timeout)
-        except subprocess.TimeoutExpired:
-            timed_out = True
-            proc.kill()
-            out, err = proc.communicate()
-    finally:
-        with _LIVE_LOCK:
-            _LIVE.discard(proc)
-    runs = []
-    for line in out.splitlines():
-        try:
-            runs.append(json.loads(line))
-        except json.JSONDecodeError:
-            break  # a line cut short by the kill
-    if timed_out:
-        return complete_runs(payload, runs, STATUS_TIMEOUT, f"case exceeded its time limit of {timeout:g} s")
-    if proc.returncode != 0 or len(runs) < len(payload["models"]):
-        tail = " | ".join(err.strip().splitlines()[-2:]) or "no message"
-        return complete_runs(payload, runs, STATUS_CRASHED,
-                         f"worker exited with code {proc.returncode}: {tail}")
-    return runs
-
-
-def kill_live_workers() -> None:
-    """Kill the child processes of this process's running cases (on interrupt)."""
-    with _LIVE_LOCK:
-        procs = list(_LIVE)
-    for p in procs:
-        p.kill()
+def warm_up() -> None:
+    """Load what every case needs (compiled kernels and integrator) once per process."""
+    from rodval.solvers import dop853  # noqa: F401 - loading it is the point
 
 
 def main() -> int:
-    payload = json.loads(sys.stdin.read())
-    for run in iter_case(payload):
-        sys.stdout.write(json.dumps(run) + "\n")
+    warm_up()
+    sys.stdout.write(json.dumps({"ready": True}) + "\n")
+    sys.stdout.flush()
+    for line in sys.stdin:
+        if not line.strip():
+            continue
+        payload = json.loads(line)
+        for run in iter_case(payload):
+            sys.stdout.write(json.dumps(run) + "\n")
+            sys.stdout.flush()
+        sys.stdout.write(json.dumps({"done": payload["case"]}) + "\n")
         sys.stdout.flush()
     return 0
 

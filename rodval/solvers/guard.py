@@ -1,6 +1,6 @@
 """Divergence detection, checked after every accepted integrator step.
 
-Three verdicts, each with its own status (``rodval.trajectory``):
+Three verdicts, each with its own status (``rodval.core.status``):
 
 * ``STATUS_DIVERGED``: a non-finite state (NaN or inf).
 * ``STATUS_BLOWUP``: the kinetic energy T(t) exceeds ``blowup_factor`` times its physical
@@ -12,7 +12,7 @@ Three verdicts, each with its own status (``rodval.trajectory``):
 * ``STATUS_STALLED``: ``stall_steps`` consecutive accepted steps shorter than
   ``min_step_fraction * t_end``.
 
-The energy check needs ``OdeSystem.kinetic_energy`` (and ``power`` for loaded scenes); it
+The energy check needs the system's energy capability (``OdeSystem.has_energy``); it
 costs one kinetic-energy evaluation per step: a mass-matrix product, no linear solve, and no
 bending recovery in the reduced model (its bending angles stay computed at output times only).
 """
@@ -22,9 +22,9 @@ import math
 
 import numpy as np
 
-from .models.base import OdeSystem
-from .settings import IntegratorSettings
-from .trajectory import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_ERROR, STATUS_STALLED
+from rodval.core.settings import IntegratorSettings
+from rodval.core.status import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_ERROR, STATUS_STALLED
+from rodval.solvers.system import OdeSystem
 
 #: Absolute slack of the energy budget (J): below it no energy counts as a blow-up (a chain
 #: at rest without loads has E(0) = W+ = 0 and may pick up rounding-level motion).
@@ -40,15 +40,15 @@ class DivergenceGuard:
         self.stall_steps = settings.stall_steps
         self.n_short = 0
         self.factor = settings.blowup_factor
-        self.energy = system.kinetic_energy if math.isfinite(self.factor) else None
-        self.power = system.power
-        if self.energy is not None:
-            self.E0 = system.stored_energy(y0) if system.stored_energy is not None else self.energy(y0)
+        self.system = system if (system.has_energy and math.isfinite(self.factor)) else None
+        if self.system is not None:
+            self.E0 = system.energy_budget(0.0, y0)
             self.w_plus = 0.0
             self.p_prev = self._positive_power(0.0, y0)
 
     def _positive_power(self, t: float, y: np.ndarray) -> float:
-        return max(self.power(t, y)[0], 0.0) if self.power is not None else 0.0
+        assert self.system is not None
+        return max(self.system.power(t, y)[0], 0.0)
 
     def check(self, t0: float, t1: float, y: np.ndarray) -> tuple[int, str] | None:
         """Verdict after the accepted step [t0, t1] that ended in state y."""
@@ -60,11 +60,11 @@ class DivergenceGuard:
                 f"step size collapse: {self.n_short} consecutive steps shorter than "
                 f"min_step_fraction x t_end = {self.h_min:.3g} s (last {t1 - t0:.3g} s) "
                 f"at t = {t1:.6g} s")
-        if self.energy is None:
+        if self.system is None:
             return None
         try:
             p = self._positive_power(t1, y)
-            E = self.energy(y)
+            E = self.system.kinetic_energy(t1, y)
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
             return STATUS_ERROR, f"energy check failed at t = {t1:.6g} s: {type(exc).__name__}: {exc}"
         self.w_plus += 0.5 * (t1 - t0) * (self.p_prev + p)

@@ -3,7 +3,7 @@
 E = T + Pi is the mechanical energy the model reports (quantities "kinetic", "potential",
 "energy"); W_ext(t) = int_0^t P_ext dt is the work of the nodal forces, P_ext = Q . phi' (J);
 D(t) = int_0^t P_diss dt >= 0 is the energy taken out by the hinge dampers,
-P_diss = q'^T C q' (J). Both powers come from the model's ``OdeSystem.power``.
+P_diss = q'^T C q' (W). Both powers come from the model's ``OdeSystem.power``.
 
 The powers are integrated per accepted step of the integrator by Gauss-Legendre quadrature on
 the step's dense output (``GAUSS_NODES`` nodes, exact for polynomials of degree
@@ -20,9 +20,6 @@ import numpy as np
 #: Gauss-Legendre nodes per integrator step.
 GAUSS_NODES = 4
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(GAUSS_NODES)
-
-#: Trajectory quantities added by the audit (k = 0), beside "kinetic", "potential", "energy".
-AUDIT_QUANTITIES = ("work", "dissipated", "energy_residual")
 
 Power = Callable[[float, np.ndarray], tuple[float, float]]
 Dense = Callable[[np.ndarray], np.ndarray]

@@ -17,12 +17,13 @@ Conventions (used throughout rodval)
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field, replace
 from typing import Iterable, Mapping
 
 import numpy as np
 
-from .loads import NodalForce
+from rodval.core.loads import NodalForce
 
 #: Quantities a scene may ask for. "x"/"y" are node positions (k = 0..n); "energy" yields
 #: kinetic, potential and total energy (k = 0).
@@ -30,10 +31,13 @@ QUANTITIES = ("phi", "dphi", "alpha", "beta", "x", "y", "energy")
 ENERGY_QUANTITIES = ("kinetic", "potential", "energy")
 
 
-def _as_rod_array(name: str, value, n: int, *, positive: bool) -> np.ndarray:
-    raw = np.asarray(value)
-    if raw.dtype.kind not in "iuf":          # strings, booleans, objects: refused, not converted
-        raise ValueError(f"{name} must be a number or a list of n = {n} numbers, got {value!r}")
+def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndarray:
+    """A length-n float array from a scalar or sequence of real numbers; ``positive``: True
+    for > 0, False for >= 0, None for any finite value."""
+    raw = np.asarray(value) if not isinstance(value, (str, bytes, dict)) else np.asarray(None)
+    if raw.dtype.kind not in "iuf":          # strings, booleans, complex, objects: refused
+        raise ValueError(f"{name} must be a real number or a list of n = {n} real numbers, "
+                         f"got {value!r}")
     arr = raw.astype(float)
     if arr.ndim == 0:
         arr = np.full(n, float(arr))
@@ -41,9 +45,9 @@ def _as_rod_array(name: str, value, n: int, *, positive: bool) -> np.ndarray:
         raise ValueError(f"{name} must be a scalar or have length n = {n}, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-    if positive and np.any(arr <= 0):
+    if positive is True and np.any(arr <= 0):
         raise ValueError(f"{name} must be > 0 (allowed range (0, inf)), got {arr.tolist()}")
-    if not positive and np.any(arr < 0):
+    if positive is False and np.any(arr < 0):
         raise ValueError(f"{name} must be >= 0 (allowed range [0, inf)), got {arr.tolist()}")
     arr.setflags(write=False)
     return arr
@@ -128,20 +132,35 @@ class InitialState:
             if v is None:
                 out[key] = np.zeros(n)
                 continue
-            arr = np.asarray(v, dtype=float)
-            if arr.ndim == 0:
-                arr = np.full(n, float(arr))
-            if arr.shape != (n,):
-                raise ValueError(f"initial {key} must be a scalar or have length n = {n}, "
-                                 f"got shape {arr.shape}")
-            if not np.all(np.isfinite(arr)):
-                raise ValueError(f"initial {key} must be finite, got {arr.tolist()}")
-            out[key] = arr
+            out[key] = _as_rod_array(f"initial {key}", v, n, positive=None)
         return out
 
 
-def default_times(t_end: float, num: int = 201) -> np.ndarray:
-    return np.linspace(0.0, t_end, num)
+#: Output times when a scene gives none, and the most a scene may ask for.
+DEFAULT_NUM_TIMES = 201
+MAX_TIMES = 1_000_000
+
+
+def output_times(start: float, stop: float, num: int) -> np.ndarray:
+    """``num`` equally spaced output times from ``start`` to ``stop`` (s), each the shortest
+    decimal within 1e-12 s of the exact grid value (no float noise such as 0.30000000000000004
+    in tables), the end points exact."""
+    grid = np.linspace(start, stop, num)
+    clean = np.array([float(f"{t:.12g}") for t in grid]) if num <= 100_000 else np.round(grid, 12)
+    clean[0], clean[-1] = start, stop
+    return clean
+
+
+def _times_array(value) -> np.ndarray:
+    """Output times as given: a 1-D sequence of real numbers (s), nothing converted."""
+    if isinstance(value, (str, bytes, dict, set)) or np.ndim(value) != 1:
+        raise ValueError(f"times (output times) must be a 1-D sequence of seconds, got {value!r}")
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "iuf":
+        raise ValueError(f"times (output times) must be real numbers (s), got {value!r}")
+    if arr.size > MAX_TIMES:
+        raise ValueError(f"times (output times): at most {MAX_TIMES}, got {arr.size}")
+    return arr.astype(float)
 
 
 @dataclass(frozen=True, eq=False)
@@ -174,13 +193,15 @@ class Scene:
         if not isinstance(self.chain, Chain):
             raise ValueError(f"chain must be a rodval.Chain, got {type(self.chain).__name__}")
         n = self.chain.n
-        try:
-            t_end = float(self.t_end)
-        except (TypeError, ValueError):
-            raise ValueError(f"t_end (horizon) must be a number > 0 s, got {self.t_end!r}") from None
+        if isinstance(self.t_end, bool) or not isinstance(self.t_end, numbers.Real):
+            raise ValueError(f"t_end (horizon) must be a real number > 0 s, got {self.t_end!r}")
+        t_end = float(self.t_end)
         if not (math.isfinite(t_end) and t_end > 0):
             raise ValueError(f"t_end (horizon) must be finite and > 0 s, got {self.t_end!r}")
         object.__setattr__(self, "t_end", t_end)
+        if isinstance(self.loads, (str, bytes, dict)) or not isinstance(self.loads, Iterable):
+            raise ValueError(f"loads must be a sequence of NodalForce (e.g. () for none), "
+                             f"got {self.loads!r}")
         loads = tuple(self.loads)
         for f in loads:
             if not isinstance(f, NodalForce):
@@ -188,7 +209,7 @@ class Scene:
             if f.node > n:
                 raise ValueError(f"load node must be in 1..n = 1..{n}, got {f.node}")
         object.__setattr__(self, "loads", loads)
-        times = default_times(t_end) if self.times is None else np.asarray(self.times, float)
+        times = output_times(0.0, t_end, DEFAULT_NUM_TIMES) if self.times is None else _times_array(self.times)
         if times.ndim != 1 or times.size == 0:
             raise ValueError("times (output times) must be a non-empty 1-D sequence of seconds")
         if not np.all(np.isfinite(times)):
@@ -236,7 +257,7 @@ def paper_scene(n: int = 8, *, t_end: float = 2.0, times: Iterable[float] | None
     l = 2 m, m = 3 kg/m, mu = 3 kg, EI = 1e5 N m^2, kappa = 100 N m/rad, nu = 0.01 N m s/rad,
     Xbar = -150 N, Ybar = 1200 N, T = 1 s; straight along x at rest; 0 <= t <= 2 T.
     """
-    from .loads import pulse
+    from rodval.core.loads import pulse
 
     chain = Chain.uniform(n, **chain_overrides)
     node = n if load_node is None else load_node

@@ -7,7 +7,7 @@ Format (every key optional except where noted)::
     n = 8                     # number of rods (the paper's per-rod data are repeated)
     t_end = 2.0               # horizon, s
     times = [0.5, 1.0, 1.5, 2.0]          # or {start = 0.0, stop = 2.0, num = 201}
-    outputs = ["phi", "dphi", "alpha", "beta"]   # from rodval.scene.QUANTITIES
+    outputs = ["phi", "dphi", "alpha", "beta"]   # from rodval.core.scene.QUANTITIES
 
     [chain]                   # scalars or lists of length n
     l = 2.0
@@ -26,14 +26,16 @@ Format (every key optional except where noted)::
 """
 from __future__ import annotations
 
+import inspect
 import tomllib
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .loads import LOAD_FACTORIES
-from .scene import QUANTITIES, Chain, InitialState, Scene, paper_scene
+from rodval.core.loads import LOAD_FACTORIES
+from rodval.core.scene import (DEFAULT_NUM_TIMES, MAX_TIMES, QUANTITIES, Chain, InitialState,
+                               Scene, output_times, paper_scene)
 
 BASES = ("paper",)
 TOP_KEYS = {"base", "name", "n", "t_end", "times", "outputs", "chain", "loads", "initial"}
@@ -55,20 +57,23 @@ def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
         return None
     if isinstance(value, dict):
         _check_keys(value, TIMES_KEYS, f"{where} key 'times'")
-        try:
-            num = int(value.get("num", 201))
-            start = float(value.get("start", 0.0))
-            stop = float(value.get("stop", t_end))
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"{where} key 'times': {exc}") from None
-        if num < 1:
-            raise ValueError(f"{where} key 'times': num must be >= 1, got {num}")
-        return np.linspace(start, stop, num)
+        num = value.get("num", DEFAULT_NUM_TIMES)
+        if isinstance(num, bool) or not isinstance(num, int):
+            raise ValueError(f"{where} key 'times.num': must be an integer in [1, {MAX_TIMES}], "
+                             f"got {num!r}")
+        if not 1 <= num <= MAX_TIMES:
+            raise ValueError(f"{where} key 'times.num': must be in [1, {MAX_TIMES}], got {num}")
+        for key in ("start", "stop"):
+            v = value.get(key)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
+                raise ValueError(f"{where} key 'times.{key}': must be a number (s), got {v!r}")
+        return output_times(float(value.get("start", 0.0)), float(value.get("stop", t_end)), num)
     if isinstance(value, (list, tuple)):
-        try:
-            return np.array([float(v) for v in value])
-        except (TypeError, ValueError):
-            raise ValueError(f"{where} key 'times': must be a list of numbers (s)") from None
+        if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value):
+            raise ValueError(f"{where} key 'times': must be a list of numbers (s), got {value!r}")
+        if len(value) > MAX_TIMES:
+            raise ValueError(f"{where} key 'times': at most {MAX_TIMES} output times, got {len(value)}")
+        return np.array([float(v) for v in value])
     raise ValueError(f"{where} key 'times': must be a list of seconds or a table {{start, stop, num}}")
 
 
@@ -81,10 +86,15 @@ def _load(spec: dict, n: int, where: str):
     args = {k: v for k, v in spec.items() if k != "type"}
     if args.get("node") == "last":
         args["node"] = n
-    try:
-        return LOAD_FACTORIES[kind](**args)
-    except TypeError as exc:
-        raise ValueError(f"{where}: load {kind!r}: {exc}") from None
+    factory = LOAD_FACTORIES[kind]
+    allowed = [p for p in inspect.signature(factory).parameters]
+    unknown = sorted(set(args) - set(allowed))
+    if unknown:
+        raise ValueError(f"{where}: load {kind!r} has no key {unknown[0]!r} "
+                         f"(allowed: {', '.join(allowed)})")
+    if "node" not in args:
+        raise ValueError(f"{where}: load {kind!r} needs 'node' (1..n or \"last\")")
+    return factory(**args)
 
 
 def scene_from_dict(d: dict, where: str = "scene") -> Scene:
@@ -126,16 +136,48 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
         raise ValueError(msg if msg.startswith(where) else f"{where}: {msg}") from None
 
 
-def load_scene(source: str | Path) -> Scene:
-    """``"paper"`` (the paper's example) or the path of a TOML scene file."""
+def read_scene_document(source: str | Path) -> dict[str, Any]:
+    """The scene document (dict form) of ``"paper"`` or a TOML scene file, not yet validated."""
     if str(source) in BASES:
-        return scene_from_dict({"base": str(source)}, where=str(source))
+        return {"base": str(source)}
     path = Path(source)
     if not path.is_file():
         raise ValueError(f"SCENE must be 'paper' or an existing TOML file, got {str(source)!r}")
     try:
         data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
     data.setdefault("name", path.stem)
-    return scene_from_dict(data, where=str(path))
+    return data
+
+
+def load_scene(source: str | Path) -> Scene:
+    """``"paper"`` (the paper's example) or the path of a TOML scene file."""
+    return scene_from_dict(read_scene_document(source), where=str(source))
+
+
+def with_horizon(doc: dict[str, Any], t_end: float, where: str) -> Scene:
+    """The scene of ``doc`` over a new horizon ``t_end`` (s): output times the document lists
+    are kept up to t_end (ValueError if none is left); without output times the default grid
+    of the new horizon is used. Nothing else changes."""
+    if "times" not in doc:
+        return scene_from_dict({**doc, "t_end": t_end}, where=where)
+    scene = scene_from_dict(doc, where=where)
+    keep = scene.times[scene.times <= t_end]
+    if keep.size == 0:
+        raise ValueError(f"{where}: --t-end {t_end:g} s leaves none of the scene's output times "
+                         f"(the first is {scene.times[0]:g} s); give --times as well")
+    return scene.with_(t_end=t_end, times=keep)
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """The complete resolved scene in the scene-file format (chain arrays, loads with their
+    parameters, initial state, output times, outputs): ``scene_from_dict`` rebuilds the same
+    scene from it, bit for bit. A load that is a plain Python callable has no such form: it
+    is recorded as ``{"type": "callable", "node": k}``, which ``scene_from_dict`` refuses."""
+    init = scene.initial.resolve(scene.n)
+    return {"name": scene.name, "n": scene.n, "t_end": scene.t_end,
+            "times": [float(t) for t in scene.times], "outputs": list(scene.outputs),
+            "chain": scene.chain.as_dict(),
+            "loads": [{"type": f.name, "node": f.node, **f.params} for f in scene.loads],
+            "initial": {k: v.tolist() for k, v in init.items()}}

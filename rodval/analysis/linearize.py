@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from .models.full import FullSystem
-from .models.reduced import ReducedSystem
-from .scene import Chain, InitialState, Scene
+from rodval.models.full import FullSystem
+from rodval.models.reduced import ReducedSystem
+from rodval.core.scene import Chain, InitialState, Scene
 
 _SYSTEMS = {"full": FullSystem, "reduced": ReducedSystem}
 
@@ -26,7 +26,7 @@ def linear_matrices(chain: Chain, model: str = "full", phi0=None,
     system = _SYSTEMS[model](scene, coefficients)
     phi = system.initial["phi"]
     if model == "full":
-        from .models.paper_matrices import mass_matrix
+        from rodval.models.paper_matrices import mass_matrix
         return mass_matrix(system.cc, phi), system.K
     return system.reduced_matrices(phi)[0], system.K_r
 

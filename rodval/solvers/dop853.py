@@ -4,16 +4,25 @@ The same method, coefficients (scipy's ``dop853_coefficients``), error norm, ste
 initial-step selection and 7th-order dense output as ``scipy.integrate.DOP853``, but the whole
 integration (all steps, across the scene's load breakpoints, dense output at output times)
 runs without returning to Python, so the per-step overhead of the Python loop (~50-100 us)
-disappears. The right-hand side is one of the compiled model kernels
-(``rodval.models.kernels.rhs``), loads from a load table.
+disappears. The right-hand side is the system's compiled form (``rodval.solvers.system.CompiledForm``):
+a first-class numba function of type ``RHS_TYPE`` called with the form's arrays, so this loop
+imports no model and is compiled (and cached on disk) once for every model.
+
+Cost: 12 right-hand-side evaluations per accepted step (+3 on steps holding output times), and
+O(N) work per stage combination.
 """
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 from scipy.integrate._ivp import dop853_coefficients as dc
 
-from ..models.kernels import rhs
+_F1 = types.float64[::1]
+_F2 = types.float64[:, ::1]
+_F3 = types.float64[:, :, ::1]
+#: rhs(t, y, P, S, M, L, out): writes y' into out (see CompiledForm).
+RHS_SIGNATURE = types.void(types.float64, _F1, _F2, _F1, _F3, _F2, _F1)
+RHS_TYPE = types.FunctionType(RHS_SIGNATURE)
 
 N_STAGES = dc.N_STAGES
 _A = np.ascontiguousarray(dc.A)
@@ -24,7 +33,7 @@ _E5 = np.ascontiguousarray(dc.E5)
 _D = np.ascontiguousarray(dc.D)
 
 #: Return codes of ``run``.
-OK, STEP_TOO_SMALL, NON_FINITE = 0, 1, 2
+OK, STEP_TOO_SMALL, NON_FINITE, BUDGET = 0, 1, 2, 3
 
 SAFETY, MIN_FACTOR, MAX_FACTOR, ERROR_EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
 
@@ -35,7 +44,7 @@ def _rms(x):
 
 
 @njit(cache=True)
-def _initial_step(kind, V, Mt, L, damped, t0, y0, f0, t_bound, rtol, atol, max_step, tmp, f1):
+def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, tmp, f1):
     """scipy's select_initial_step (Hairer, Sec. II.4) for order 7; uses one evaluation."""
     scale = atol + np.abs(y0) * rtol
     d0 = _rms(y0 / scale)
@@ -43,7 +52,7 @@ def _initial_step(kind, V, Mt, L, damped, t0, y0, f0, t_bound, rtol, atol, max_s
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, t_bound - t0)
     tmp[:] = y0 + h0 * f0
-    rhs(kind, t0 + h0, tmp, V, Mt, L, damped, f1)
+    rhs(t0 + h0, tmp, P, S, M, L, f1)
     d2 = _rms((f1 - f0) / scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
@@ -52,11 +61,17 @@ def _initial_step(kind, V, Mt, L, damped, t0, y0, f0, t_bound, rtol, atol, max_s
     return min(100.0 * h0, h1, t_bound - t0, max_step)
 
 
-@njit(cache=True)
-def run(kind, V, Mt, L, damped, y0, edges, times, rtol, atol, max_step, first_step,
+_RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64, types.float64))(
+    RHS_TYPE, _F2, _F1, _F3, _F2, _F1, _F1, _F1, types.float64, types.float64, types.float64,
+    types.float64, types.int64, _F2, _F1, _F1, _F1, _F1, _F2, _F2)
+
+
+@njit(_RUN_SIGNATURE, cache=True)
+def run(rhs, P, S, M, L, y0, edges, times, rtol, atol, max_step, first_step, max_nfev,
         A, B, C, E3, E5, D, Y):
     """Integrate from edges[0] to edges[-1], restarting at each interior edge (breakpoint),
-    writing the state at ``times`` into Y. ``first_step`` <= 0 selects it automatically.
+    writing the state at ``times`` into Y. ``first_step`` <= 0 selects it automatically; the
+    run stops with ``BUDGET`` once ``max_nfev`` evaluations are used.
 
     Returns (number of output times written, nfev, accepted steps, code, t reached).
     """
@@ -78,12 +93,12 @@ def run(kind, V, Mt, L, damped, y0, edges, times, rtol, atol, max_step, first_st
     for seg in range(edges.shape[0] - 1):
         t = edges[seg]
         t_bound = edges[seg + 1]
-        rhs(kind, t, y, V, Mt, L, damped, K[0])
+        rhs(t, y, P, S, M, L, K[0])
         nfev += 1
         if first_step > 0:
             h_abs = min(first_step, t_bound - t)
         else:
-            h_abs = _initial_step(kind, V, Mt, L, damped, t, y, K[0], t_bound, rtol, atol,
+            h_abs = _initial_step(rhs, P, S, M, L, t, y, K[0], t_bound, rtol, atol,
                                   max_step, tmp, f1)
             nfev += 1
         while t < t_bound:
@@ -93,6 +108,8 @@ def run(kind, V, Mt, L, damped, y0, edges, times, rtol, atol, max_step, first_st
             while True:
                 if h_abs < min_step:
                     return n_out, nfev, nsteps, STEP_TOO_SMALL, t
+                if nfev >= max_nfev:
+                    return n_out, nfev, nsteps, BUDGET, t
                 t_new = t + h_abs
                 if t_new > t_bound:
                     t_new = t_bound
@@ -103,11 +120,11 @@ def run(kind, V, Mt, L, damped, y0, edges, times, rtol, atol, max_step, first_st
                     for j in range(s):
                         if A[s, j] != 0.0:
                             tmp += (h * A[s, j]) * K[j]
-                    rhs(kind, t + C[s] * h, tmp, V, Mt, L, damped, K[s])
+                    rhs(t + C[s] * h, tmp, P, S, M, L, K[s])
                 y_new[:] = y
                 for j in range(N_STAGES):
                     y_new += (h * B[j]) * K[j]
-                rhs(kind, t_new, y_new, V, Mt, L, damped, K[N_STAGES])
+                rhs(t_new, y_new, P, S, M, L, K[N_STAGES])
                 nfev += N_STAGES
                 err5 = 0.0
                 err3 = 0.0
@@ -144,7 +161,7 @@ def run(kind, V, Mt, L, damped, y0, edges, times, rtol, atol, max_step, first_st
                     for j in range(s):
                         if A[s, j] != 0.0:
                             tmp += (h * A[s, j]) * K[j]
-                    rhs(kind, t + C[s] * h, tmp, V, Mt, L, damped, K[s])
+                    rhs(t + C[s] * h, tmp, P, S, M, L, K[s])
                 nfev += 3
                 F[0] = y_new - y
                 F[1] = h * K[0] - F[0]
@@ -168,13 +185,12 @@ def run(kind, V, Mt, L, damped, y0, edges, times, rtol, atol, max_step, first_st
     return n_out, nfev, nsteps, OK, t
 
 
-def integrate_compiled(kind: int, V: np.ndarray, Mt: np.ndarray, L: np.ndarray, damped: bool,
-                       y0: np.ndarray, edges: np.ndarray, times: np.ndarray, rtol: float,
-                       atol: float, max_step: float, first_step: float | None, Y: np.ndarray
-                       ) -> tuple[int, int, int, int, float]:
-    """Run ``run`` with scipy's DOP853 coefficients (see ``run`` for the result)."""
+def integrate_compiled(form, y0: np.ndarray, edges: np.ndarray, times: np.ndarray, rtol: float,
+                       atol: float, max_step: float, first_step: float | None,
+                       max_nfev: int, Y: np.ndarray) -> tuple[int, int, int, int, float]:
+    """Run ``run`` on a CompiledForm with scipy's DOP853 coefficients (see ``run``)."""
     n_out, nfev, nsteps, code, t = run(
-        kind, V, Mt, L, damped, np.array(y0, float), np.array(edges, float),
+        form.rhs, form.P, form.S, form.M, form.L, np.array(y0, float), np.array(edges, float),
         np.array(times, float), rtol, atol, max_step, -1.0 if first_step is None else first_step,
-        _A, _B, _C, _E3, _E5, _D, Y)
+        max_nfev, _A, _B, _C, _E3, _E5, _D, Y)
     return int(n_out), int(nfev), int(nsteps), int(code), float(t)

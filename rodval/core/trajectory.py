@@ -6,19 +6,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-#: Status codes. 0 and -1 follow scipy's OdeResult; the others are rodval's.
-STATUS_SUCCESS = 0
-STATUS_FAILED = -1          # the integrator gave up (step size too small, singular matrix, ...)
-STATUS_ERROR = -2           # the model raised an exception
-STATUS_DIVERGED = -3        # NaN/inf in the state
-STATUS_TIMEOUT = -4         # a study runner stopped the run at its time limit
-STATUS_CRASHED = -5         # the process running the model died (e.g. a segfault in a library)
-STATUS_BLOWUP = -6          # energy grew beyond settings.blowup_factor x its physical budget
-STATUS_STALLED = -7         # step size collapsed below settings.min_step_fraction x t_end
-STATUS_MESSAGES = {0: "success", -1: "integration failed", -2: "model error",
-                   -3: "diverged (non-finite state)", -4: "timeout", -5: "worker crashed",
-                   -6: "diverged (energy blow-up)", -7: "stalled (step size collapse)"}
-
+from rodval.core.status import STATUS_SUCCESS
 
 @dataclass
 class SolverStats:
@@ -64,7 +52,14 @@ class Trajectory:
     values: dict[str, np.ndarray]
     k_index: dict[str, np.ndarray]
     stats: SolverStats
+    #: The integrator settings as the run used them (for "auto": the method that ran, and
+    #: ``requested_method``); a reference model's own integrator (method, step).
     settings: dict = field(default_factory=dict)
+    #: The model's options (e.g. coefficients, kernel; exudyn's discretization).
+    options: dict = field(default_factory=dict)
+    #: State events in time order (e.g. latches locking), each a plain dict with "t" (s),
+    #: "label" and the model's own measures.
+    events: list = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -88,7 +83,8 @@ class Trajectory:
         return {"model": self.model, "scene_name": self.scene_name, "times": self.times.tolist(),
                 "values": {q: v.tolist() for q, v in self.values.items()},
                 "k_index": {q: k.tolist() for q, k in self.k_index.items()},
-                "stats": self.stats.as_dict(), "settings": self.settings}
+                "stats": self.stats.as_dict(), "settings": self.settings,
+                "options": self.options, "events": self.events}
 
     @classmethod
     def from_dict(cls, d: dict) -> "Trajectory":
@@ -99,7 +95,8 @@ class Trajectory:
                    values={q: np.asarray(v, dtype=float).reshape(times.size, k_index[q].size)
                            for q, v in d["values"].items()},
                    k_index=k_index,
-                   stats=SolverStats(**stats), settings=dict(d.get("settings", {})))
+                   stats=SolverStats(**stats), settings=dict(d.get("settings", {})),
+                   options=dict(d.get("options", {})), events=list(d.get("events", [])))
 
     @classmethod
     def from_frame(cls, frame: pd.DataFrame, model: str, scene_name: str = "scene") -> "Trajectory":

@@ -1,0 +1,117 @@
+"""How to integrate: the integrator, its tolerances and budgets (independent of scene and model).
+
+This module is the one source of defaults for the Python API, the CLI and study files
+(``DEFAULTS``): every surface builds an ``IntegratorSettings`` and never repeats a value.
+"""
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+#: scipy.integrate.solve_ivp methods; implicit ones use the model's Jacobian where it has one.
+SCIPY_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
+#: rodval's compiled integrators (``rodval.solvers.compiled``): the whole run in one compiled
+#: loop, for systems that have a compiled form (native models, tabulated load laws).
+COMPILED_METHODS = ("DOP853-numba",)
+#: "auto": the compiled DOP853 when the model and scene have a compiled form and nothing the
+#: compiled loop cannot do is asked for (the energy audit), scipy's DOP853 otherwise. The
+#: Trajectory records the method that ran.
+AUTO = "auto"
+#: Every method name accepted by IntegratorSettings (simulate, CLI, studies).
+METHODS = (AUTO,) + SCIPY_METHODS + COMPILED_METHODS
+IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+
+
+@dataclass(frozen=True)
+class IntegratorSettings:
+    """Integrator choice for ODE models.
+
+    method : one of ``METHODS``; default "auto" (see ``AUTO``).
+    rtol, atol : relative tolerance in (0, 1) and absolute tolerance > 0, finite (absolute in
+        the state's units: rad, rad/s).
+    max_step : largest step (s), > 0; inf means unbounded.
+    first_step : initial step (s), > 0, or None to let the integrator choose.
+
+    Budgets (each ends the run with its own status, see ``rodval.core.status``):
+
+    max_evaluations : integer >= 1, right-hand-side evaluations a run may use.
+    max_wall_s : wall-clock seconds a run may use (> 0), or inf for no limit.
+
+    Divergence detection (``rodval.solvers.guard``):
+
+    blowup_factor : > 1, or inf to disable. The run stops as "energy blow-up" when the
+        kinetic energy exceeds ``blowup_factor`` times its physical budget E(0) + W+(t)
+        (W+: the positive work of the loads so far). The hinge dampers only remove energy, so
+        a valid solution stays within its budget up to the model's own balance residual
+        (below 1 % in every case of the stability study); 100x cannot be a solution.
+    min_step_fraction, stall_steps : the run stops as "step size collapse" when
+        ``stall_steps`` consecutive accepted steps are all shorter than
+        ``min_step_fraction * t_end``.
+    """
+
+    method: str = AUTO
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    max_step: float = math.inf
+    first_step: float | None = None
+    max_evaluations: int = 2_000_000
+    max_wall_s: float = math.inf
+    blowup_factor: float = 100.0
+    min_step_fraction: float = 1e-9
+    stall_steps: int = 1000
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.method, str) or self.method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
+        for name in ("rtol", "atol", "max_step", "max_wall_s", "blowup_factor",
+                     "min_step_fraction"):
+            _number(name, getattr(self, name))
+        if not (0 < self.rtol < 1):
+            raise ValueError(f"rtol must be in (0, 1), got {self.rtol!r}")
+        if not (0 < self.atol < math.inf):
+            raise ValueError(f"atol must be a finite number > 0, got {self.atol!r}")
+        for name in ("max_step", "max_wall_s"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be > 0 (inf: no limit), got {getattr(self, name)!r}")
+        if self.first_step is not None:
+            _number("first_step", self.first_step)
+            if not (0 < self.first_step < math.inf):
+                raise ValueError(f"first_step must be a finite number > 0 or None, "
+                                 f"got {self.first_step!r}")
+        if not (self.blowup_factor > 1):
+            raise ValueError(f"blowup_factor must be > 1 (inf disables), got {self.blowup_factor!r}")
+        if not (0 <= self.min_step_fraction < 1):
+            raise ValueError(f"min_step_fraction must be in [0, 1), got {self.min_step_fraction!r}")
+        for name in ("stall_steps", "max_evaluations"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 1:
+                raise ValueError(f"{name} must be an integer >= 1, got {v!r}")
+
+    @property
+    def compiled(self) -> bool:
+        return self.method in COMPILED_METHODS
+
+    @property
+    def implicit(self) -> bool:
+        return self.method in IMPLICIT_METHODS
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    def with_(self, **changes: Any) -> IntegratorSettings:
+        """A copy with fields replaced (validated again)."""
+        return IntegratorSettings(**{**self.as_dict(), **changes})
+
+
+def _number(name: str, value: Any) -> None:
+    """Types before values: a real number (not a bool, string or complex), not NaN."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or math.isnan(value):
+        raise ValueError(f"{name} must be a real number, got {value!r}")
+
+
+#: The defaults of every integrator setting (API keywords, CLI options, study files).
+DEFAULTS: dict[str, Any] = IntegratorSettings().as_dict()
+#: The settings' names (study files' [integrator] keys, simulate keywords).
+SETTING_NAMES: tuple[str, ...] = tuple(f.name for f in fields(IntegratorSettings))

@@ -1,0 +1,74 @@
+"""Models by name, and the entry point: scene + model + integrator settings -> Trajectory.
+
+Native models: ``full``, ``reduced``; reference models (``reference_models``) are imported by
+name only when asked for, so the models layer does not depend on them.
+"""
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from rodval.core.contract import Model
+from rodval.core.scene import Scene
+from rodval.core.settings import SETTING_NAMES, IntegratorSettings
+from rodval.core.trajectory import Trajectory
+
+#: name -> "module:Class". Each class lists its option names in ``OPTIONS``.
+REGISTRY: dict[str, str] = {
+    "full": "rodval.models.full:FullModel",
+    "reduced": "rodval.models.reduced:ReducedModel",
+    "exudyn": "reference_models.exudyn_chain:ExudynModel",
+}
+
+
+def model_class(name: str) -> type[Model]:
+    """The class registered as ``name`` (ValueError if unknown or not importable)."""
+    if not isinstance(name, str) or name not in REGISTRY:
+        raise ValueError(f"model must be one of {tuple(REGISTRY)}, got {name!r}")
+    module, cls = REGISTRY[name].split(":")
+    try:
+        mod = importlib.import_module(module)
+    except ImportError as exc:
+        raise ValueError(f"model {name!r} is not available: {exc}") from exc
+    return getattr(mod, cls)
+
+
+def get_model(name: str | Model, **options: Any) -> Model:
+    """The model called ``name`` with its options (a Model instance is returned as is).
+    Unknown option names are a ValueError listing the allowed ones."""
+    if isinstance(name, Model):
+        if options:
+            raise ValueError("model options can only be given with a model name")
+        return name
+    cls = model_class(name)
+    allowed = tuple(getattr(cls, "OPTIONS", ()))
+    unknown = sorted(set(options) - set(allowed))
+    if unknown:
+        raise ValueError(f"model {name!r} has no option {unknown[0]!r} "
+                         f"(allowed: {', '.join(allowed) or 'none'})")
+    return cls(**options)
+
+
+def simulate(scene: Scene, model: str | Model = "full", *,
+             settings: IntegratorSettings | None = None, **keywords: Any) -> Trajectory:
+    """Simulate ``scene`` with ``model`` ("full", "reduced", "exudyn" or a Model instance).
+
+    Integrator settings are given either as keywords (``method``: "auto" (default), any
+    solve_ivp method or "DOP853-numba"; ``rtol``, ``atol``; ``max_step`` in s; budgets; see
+    ``IntegratorSettings``) or as one ``settings`` object, not both. The other keywords are
+    model options (e.g. ``coefficients="published"``; exudyn: ``elements``, ``step``).
+    A failed integration does not raise: see ``trajectory.stats.status`` / ``message``.
+    """
+    if not isinstance(scene, Scene):
+        raise ValueError(f"scene must be a rodval.Scene, got {type(scene).__name__}")
+    integ = {k: v for k, v in keywords.items() if k in SETTING_NAMES}
+    options = {k: v for k, v in keywords.items() if k not in SETTING_NAMES}
+    if settings is None:
+        settings = IntegratorSettings(**integ)
+    elif not isinstance(settings, IntegratorSettings):
+        raise ValueError(f"settings must be a rodval.IntegratorSettings or None, "
+                         f"got {type(settings).__name__}")
+    elif integ:
+        raise ValueError(f"give integrator settings either as settings= or as keywords, not "
+                         f"both (got settings= and {', '.join(sorted(integ))})")
+    return get_model(model, **options).simulate(scene, settings)

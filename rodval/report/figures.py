@@ -1,0 +1,241 @@
+"""Every figure of rodval: chain configurations, time histories, study figures (discrepancy,
+run time and speed-up against a grid parameter) and work-precision plots.
+
+Figures are drawn on ``matplotlib.figure.Figure`` objects and saved as PNG directly, without
+pyplot: no GUI backend is ever selected, whatever the machine, and nothing happens at import.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+from matplotlib import colormaps, ticker
+from matplotlib.figure import Figure
+
+from rodval.analysis.metrics import pareto_front
+from rodval.core.trajectory import Trajectory
+
+
+def _figure(nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
+    """A new figure and its axes (``Figure.subplots`` arguments)."""
+    figsize = kw.pop("figsize", None)
+    fig = Figure(figsize=figsize)
+    return fig, fig.subplots(nrows, ncols, **kw)
+
+LINESTYLES = ("-", "--", ":", "-.")
+
+
+def chain_nodes(traj: Trajectory, t: float, l: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Node coordinates (m) at output time t, from x/y if recorded, else from phi and lengths."""
+    i = int(np.argmin(np.abs(traj.times - t)))
+    if abs(traj.times[i] - t) > 1e-9:
+        raise ValueError(f"t = {t} s is not an output time of trajectory {traj.model!r}")
+    if "x" in traj.values and "y" in traj.values:
+        return traj.values["x"][i], traj.values["y"][i]
+    phi = traj.values["phi"][i]
+    return (np.concatenate([[0.0], np.cumsum(l * np.cos(phi))]),
+            np.concatenate([[0.0], np.cumsum(l * np.sin(phi))]))
+
+
+def _min_height(ax, ratio: float) -> None:
+    """Widen the y limits to at least ``ratio`` of the x span (a nearly straight chain would
+    otherwise be drawn as a sliver)."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    need = ratio * (x1 - x0)
+    if y1 - y0 < need:
+        mid = 0.5 * (y0 + y1)
+        ax.set_ylim(mid - need / 2, mid + need / 2)
+
+
+def plot_configurations(trajectories: Mapping[str, Trajectory], times: Sequence[float],
+                        l: np.ndarray, path: Path | str, title: str = "") -> Path:
+    """Chain configurations at ``times`` (one colour per time), one line style per model.
+
+    Like Fig. 3 of the paper: the chord polygon through the nodes, root at the origin.
+    """
+    fig, ax = _figure(figsize=(7, 6))
+    colours = colormaps["viridis"](np.linspace(0, 0.9, len(times)))
+    for (label, traj), ls in zip(trajectories.items(), LINESTYLES * 4):
+        for t, c in zip(times, colours):
+            if not np.any(np.abs(traj.times - t) < 1e-9):
+                continue  # a failed run may not have reached t
+            x, y = chain_nodes(traj, t, l)
+            ax.plot(x, y, ls, color=c, marker="o", ms=3,
+                    label=f"{label}, t = {t:.4g} s")
+    ax.plot([0], [0], "k^", ms=10)
+    _min_height(ax, 0.3)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x, m")
+    ax.set_ylabel("y, m")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=1 + len(trajectories) * len(times) // 12,
+              loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    if title:
+        ax.set_title(title)
+    path = Path(path)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    return path
+
+
+def model_styles(labels: Sequence[str]) -> dict[str, dict]:
+    """One colour and line style per model label, the same in every figure of a report."""
+    colours = colormaps["tab10"].colors
+    return {lab: {"color": colours[i % len(colours)], "ls": LINESTYLES[i % len(LINESTYLES)]}
+            for i, lab in enumerate(labels)}
+
+
+QUANTITY_UNITS = {"phi": "rad", "dphi": "rad/s", "alpha": "rad", "beta": "rad", "x": "m",
+                  "y": "m", "kinetic": "J", "potential": "J", "energy": "J"}
+
+
+def plot_time_histories(trajectories: Mapping[str, Trajectory], quantities: Sequence[str],
+                        rods: Sequence[int], path: Path | str, title: str = "") -> Path:
+    """Time histories of ``quantities`` (rows) for rods ``rods`` (columns), every model
+    overlaid; a model that lacks a quantity or rod (or failed early) draws what it has."""
+    styles = model_styles(list(trajectories))
+    fig, axes = _figure(len(quantities), len(rods), figsize=(4.2 * len(rods), 2.4 * len(quantities)),
+                             sharex=True, squeeze=False)
+    for r, q in enumerate(quantities):
+        for c, k in enumerate(rods):
+            ax = axes[r, c]
+            for label, traj in trajectories.items():
+                if q not in traj.values or k not in traj.k_index[q]:
+                    continue
+                j = int(np.flatnonzero(traj.k_index[q] == k)[0])
+                ax.plot(traj.times, traj.values[q][:, j], label=label, lw=1.2, **styles[label])
+            ax.set_ylabel(f"{q}_{k}, {QUANTITY_UNITS.get(q, '')}")
+            ax.grid(alpha=0.3)
+            if r == len(quantities) - 1:
+                ax.set_xlabel("t, s")
+    axes[0, 0].legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def _label(model: str, others: Sequence[str], key: tuple) -> str:
+    parts = [f"{o}={v:g}" if isinstance(v, (int, float, np.number)) else f"{o}={v}"
+             for o, v in zip(others, key)]
+    return ", ".join([model, *parts])
+
+
+def _lines(ax, df: pd.DataFrame, x: str, y: str, others: Sequence[str], styles: dict,
+           logx: bool, logy: bool = True) -> None:
+    """One line per model and combination of ``others``; log scales where the data allow."""
+    markers = "os^dvP*X"
+    df = df[np.isfinite(df[y]) & (df[y] > 0 if logy else True)]
+    if logx and (df[x] > 0).all() and not df.empty:
+        ax.set_xscale("log")
+        ax.set_xticks(sorted(df[x].unique()))           # label the grid values themselves
+        ax.xaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_locator(ticker.NullLocator())
+    if logy and not df.empty:
+        ax.set_yscale("log")
+    for model, part in df.groupby("model", sort=False):
+        groups = part.groupby(list(others), sort=True) if others else [((), part)]
+        for i, (key, sub) in enumerate(groups):
+            key = key if isinstance(key, tuple) else (key,)
+            sub = sub.sort_values(x)
+            ax.plot(sub[x], sub[y], marker=markers[i % len(markers)], ms=4, lw=1,
+                    color=styles[model]["color"], ls=styles[model]["ls"],
+                    label=_label(str(model), others, key))
+
+
+def _finish(fig, axes, path: Path, title: str) -> Path:
+    axes[0].legend(fontsize=7)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def plot_discrepancy_vs(disc: pd.DataFrame, x: str, others: Sequence[str], models: Sequence[str],
+                        path: Path, metric: str = "max_abs", logx: bool = False) -> Path:
+    """``metric`` of every compared quantity against ``x`` (log y); rows with status "ok" only."""
+    ok = disc[disc["status"] == "ok"]
+    quantities = list(dict.fromkeys(ok["quantity"]))
+    ncol = min(2, max(len(quantities), 1))
+    nrow = max(1, -(-len(quantities) // ncol))
+    fig, axes = _figure(nrow, ncol, figsize=(5.2 * ncol, 3.3 * nrow), squeeze=False)
+    axes = axes.ravel()
+    for ax in axes[len(quantities):]:
+        ax.set_visible(False)
+    styles = model_styles(models)
+    for ax, q in zip(axes, quantities):
+        _lines(ax, ok[ok["quantity"] == q], x, metric, others, styles, logx)
+        ax.set_title(f"{q}, {QUANTITY_UNITS.get(q, '')}")
+        ax.set_xlabel(x)
+        ax.set_ylabel(metric)
+        ax.grid(alpha=0.3, which="both")
+    return _finish(fig, axes, path, f"Discrepancy ({metric}) against {x}")
+
+
+def plot_runtime_vs(runtime: pd.DataFrame, x: str, others: Sequence[str], models: Sequence[str],
+                    path: Path, logx: bool = True) -> Path:
+    """Integration wall time of successful runs against ``x`` (log-log)."""
+    ok = runtime[runtime["status"] == "success"]
+    fig, ax = _figure(figsize=(6.5, 4.5))
+    _lines(ax, ok, x, "wall_s", others, model_styles(models), logx)
+    ax.set_xlabel(x)
+    ax.set_ylabel("integration wall time, s")
+    ax.grid(alpha=0.3, which="both")
+    return _finish(fig, [ax], path, f"Run time against {x}")
+
+
+def speedups(runtime: pd.DataFrame, reference: str, params: Sequence[str]) -> pd.DataFrame:
+    """wall_s(reference) / wall_s(model) per case for every other model whose run and the
+    reference's run both succeeded: columns case, params..., model, speedup."""
+    ok = runtime[runtime["status"] == "success"]
+    wide = ok.pivot_table(index=["case", *params], columns="model", values="wall_s", sort=False)
+    if reference not in wide.columns:
+        return pd.DataFrame(columns=["case", *params, "model", "speedup"])
+    ratio = (1.0 / wide.drop(columns=reference)).mul(wide[reference], axis=0)
+    long = ratio.reset_index().melt(id_vars=["case", *params], var_name="model", value_name="speedup")
+    return long.dropna(subset=["speedup"])
+
+
+def plot_speedup_vs(speed: pd.DataFrame, x: str, others: Sequence[str], models: Sequence[str],
+                    reference: str, path: Path, logx: bool = True) -> Path:
+    fig, ax = _figure(figsize=(6.5, 4.5))
+    _lines(ax, speed, x, "speedup", others, model_styles(models), logx)
+    ax.axhline(1.0, color="k", lw=0.8)
+    ax.set_xlabel(x)
+    ax.set_ylabel(f"speed-up: wall time of {reference} / of model")
+    ax.grid(alpha=0.3, which="both")
+    return _finish(fig, [ax], path, f"Speed-up relative to {reference} against {x}")
+
+
+def plot_work_precision(frame: pd.DataFrame, out_dir: Path,
+                        quantities: Sequence[str] = ("phi", "dphi", "alpha", "beta")) -> list[Path]:
+    """One figure per model and x axis (wall, nfev): error against cost per quantity, one
+    line per method/kernel, and the monotone front over all of them. Returns the paths."""
+    paths = []
+    for model, part in frame.groupby("model"):
+        native = model in ("full", "reduced")
+        for xcol, xlabel in (("wall_s", "wall time (s)"),
+                             ("nfev", "RHS evaluations" if native else "Newton iterations")):
+            qs = [q for q in quantities if f"max_{q}" in part and part[f"max_{q}"].notna().any()]
+            fig, axes = _figure(1, len(qs), figsize=(4.2 * len(qs), 3.8), squeeze=False)
+            for ax, q in zip(axes[0], qs):
+                for (method, kernel), line in part.groupby(["method", "kernel"]):
+                    line = line.sort_values(["rtol", "step"], ascending=False)  # loosest first
+                    label = method + (f" ({kernel})" if kernel == "numpy" else "")
+                    ax.loglog(line[xcol], line[f"max_{q}"], "o-", ms=3, label=label)
+                x, y = part[xcol].to_numpy(float), part[f"max_{q}"].to_numpy(float)
+                f = pareto_front(x, y)
+                ax.loglog(x[f], y[f], "k--", lw=1.2, label="front")
+                ax.set_xlabel(xlabel)
+                ax.set_ylabel(f"max rel. error {q}")
+                ax.set_title(f"{model}: {q}")
+                ax.grid(True, which="both", alpha=0.3)
+            axes[0][0].legend(fontsize=7)
+            fig.tight_layout()
+            path = out_dir / f"wp_{model}_{'wall' if xcol == 'wall_s' else 'nfev'}.png"
+            fig.savefig(path, dpi=110)
+            paths.append(path)
+    return paths

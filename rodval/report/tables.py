@@ -1,0 +1,88 @@
+"""The study tables as the report reads them: their names, the columns a grid axis becomes,
+checked reading of the CSV files, and the Table-1-like sample of values at report times.
+
+The tables themselves are written by ``rodval.study.tables``; this module is what a reader of
+a study folder needs (the report, ``rodval report``), so it lies below the study layer.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from rodval.analysis.metrics import METRICS
+
+TABLES = ("cases", "trajectories", "discrepancies", "runtime")
+FIXED = ("case", "n", "horizon", "model", "reference", "quantity", "method", "rtol", "atol",
+         "max_step", "step", "wall_s", "setup_s", "nfev", "njev", "nlu", "nsteps", "t_reached",
+         "status", "message", "t", "k", "value", "l", "fingerprint", *METRICS)
+#: Columns each table must have for the report (a grid axis adds more).
+REQUIRED = {
+    "cases": ("case", "n", "horizon", "l"),
+    "trajectories": ("case", "model", "t", "quantity", "k", "value"),
+    "discrepancies": ("case", "model", "reference", "quantity", "status"),
+    "runtime": ("case", "model", "method", "wall_s", "t_reached", "status", "message"),
+}
+
+
+def axis_columns(meta: dict[str, Any]) -> dict[str, str]:
+    """Case parameter label -> table column. scene.n and scene.t_end are the n and horizon
+    columns already; a label clashing with a fixed column keeps its full grid path."""
+    cols = {}
+    for path, label in meta["labels"].items():
+        if path in ("scene.n", "scene.t_end"):
+            continue
+        cols[label] = path if label in FIXED else label
+    return cols
+
+
+def read_tables(out: Path) -> dict[str, pd.DataFrame]:
+    """The study tables in ``out``, checked: every file present, readable as CSV and with the
+    columns the report needs. ValueError naming the file and what is wrong otherwise."""
+    tables = {}
+    for name in TABLES:
+        path = out / f"{name}.csv"
+        if not path.is_file():
+            raise ValueError(f"{out} is not a complete study folder: {path.name} is missing "
+                             "(run `rodval study FILE --out DIR` first)")
+        try:
+            df = pd.read_csv(path)
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError,
+                ValueError) as exc:
+            raise ValueError(f"{path}: not a readable CSV table ({type(exc).__name__}: "
+                             f"{str(exc).splitlines()[0] if str(exc) else ''})") from None
+        missing = [c for c in REQUIRED[name] if c not in df.columns]
+        if missing:
+            raise ValueError(f"{path}: column {missing[0]!r} is missing "
+                             f"(needed: {', '.join(REQUIRED[name])})")
+        tables[name] = df
+    cases = set(tables["cases"]["case"])
+    for name in ("runtime", "discrepancies"):
+        unknown = sorted(set(tables[name]["case"]) - cases)
+        if unknown:
+            raise ValueError(f"{out / (name + '.csv')}: case {unknown[0]!r} is not in cases.csv")
+    return tables
+
+
+def trajectory_samples(traj: pd.DataFrame, meta: dict[str, Any], cases: pd.DataFrame) -> pd.DataFrame:
+    """The report cases' values at the report times (nearest output time) for the report rods
+    and quantities, one column per model: a small table like the paper's Table 1."""
+    rep = meta["report"]
+    parts = []
+    for cid in rep["cases"]:
+        sub = traj[traj["case"] == cid]
+        if sub.empty:
+            continue
+        horizon = float(cases.loc[cases["case"] == cid, "horizon"].iloc[0])
+        n = int(cases.loc[cases["case"] == cid, "n"].iloc[0])
+        rods = sorted({n if r == "last" else int(r) for r in rep["rods"] if r == "last" or int(r) <= n})
+        want = rep["times"] or [horizon * f for f in (0.25, 0.5, 0.75, 1.0)]
+        out_times = sub["t"].unique()
+        snapped = sorted({float(out_times[abs(out_times - t).argmin()]) for t in want if t <= horizon})
+        pick = sub[sub["t"].isin(snapped) & sub["k"].isin(rods) & sub["quantity"].isin(rep["quantities"])]
+        wide = pick.pivot_table(index=["quantity", "k", "t"], columns="model", values="value",
+                                sort=False).reset_index()
+        wide.insert(0, "case", cid)
+        parts.append(wide)
+    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()

@@ -1,0 +1,45 @@
+"""rodval's compiled integrators: whole runs in one compiled loop (``settings.COMPILED_METHODS``).
+
+They take a system's ``CompiledForm`` (its own jitted right-hand side and arrays) and import
+no model. ``run_compiled`` is called by the driver (``rodval.solvers.driver``).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from rodval.core.scene import Scene
+from rodval.core.settings import IntegratorSettings
+from rodval.core.status import STATUS_BUDGET, STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED
+from rodval.core.trajectory import SolverStats
+from rodval.solvers import dop853
+from rodval.solvers.system import CompiledForm
+
+RHS_TYPE = dop853.RHS_TYPE
+RHS_SIGNATURE = dop853.RHS_SIGNATURE
+
+_CODES = {dop853.STEP_TOO_SMALL: (STATUS_FAILED, "Required step size is less than spacing between numbers."),
+          dop853.NON_FINITE: (STATUS_DIVERGED, "diverged: non-finite state"),
+          dop853.BUDGET: (STATUS_BUDGET, "evaluation budget exhausted: max_evaluations")}
+
+
+def run_compiled(form: CompiledForm, y0: np.ndarray, edges: np.ndarray, scene: Scene,
+                 settings: IntegratorSettings, Y: np.ndarray, stats: SolverStats) -> int:
+    """Integrate over [edges[0], edges[-1]] restarting at each interior edge (the scene's
+    breakpoints), writing states at the output times into Y; fills ``stats`` (status,
+    message, t_reached, nfev, nsteps) and returns the number of output times reached."""
+    try:
+        n_out, nfev, nsteps, code, t = dop853.integrate_compiled(
+            form, y0, edges, np.asarray(scene.times, float), settings.rtol, settings.atol,
+            settings.max_step, settings.first_step, settings.max_evaluations, Y)
+    except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
+        stats.status, stats.message = STATUS_ERROR, f"{type(exc).__name__}: {exc}"
+        return 0
+    stats.nfev += nfev
+    stats.nsteps += nsteps
+    stats.t_reached = t
+    if code != dop853.OK:
+        stats.status, message = _CODES[code]
+        stats.message = f"{message} (t = {t:.6g} s)"
+        if code == dop853.BUDGET:
+            stats.message = f"{message} = {settings.max_evaluations} used (t = {t:.6g} s)"
+    return n_out

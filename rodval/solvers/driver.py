@@ -1,0 +1,261 @@
+"""ODE driver: integrates an ``OdeSystem`` over [0, t_end] and observes it at the output times.
+
+Small parts, each in its own place:
+
+* method choice (``choose_method``): "auto" takes the compiled DOP853 when the system has a
+  compiled form and nothing the compiled loop cannot do is asked for (energy audit, events),
+  scipy's DOP853 otherwise;
+* stepping: a scipy ``OdeSolver`` across the scene's load breakpoints (``_ScipyRun``), or a
+  compiled loop (``rodval.solvers.compiled``);
+* budgets and non-finite derivatives, checked on every evaluation, including those of rejected
+  step attempts (so a NaN step size never loops);
+* events (``rodval.solvers.events``): crossing located, state jump applied, step restarted;
+* divergence guard (``rodval.solvers.guard``) after every accepted step;
+* energy audit (``rodval.solvers.audit``) on the dense output of every accepted step;
+* observation at the output times reached.
+
+Dense output is formed only on steps that contain output times, events, or when the scene asks
+for "energy". A failure ends the run early with a status, a message and the time reached; the
+output times reached so far are kept.
+"""
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
+
+from rodval.core.scene import Scene
+from rodval.core.settings import AUTO, COMPILED_METHODS, IntegratorSettings
+from rodval.core.status import (STATUS_BUDGET, STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED,
+                                STATUS_WALL)
+from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.solvers.audit import PowerLedger, audit_quantities
+from rodval.solvers.events import EventMonitor
+from rodval.solvers.guard import DivergenceGuard
+from rodval.solvers.progress import report
+from rodval.solvers.system import OdeSystem
+
+_SOLVERS = {"RK23": RK23, "RK45": RK45, "DOP853": DOP853, "Radau": Radau, "BDF": BDF,
+            "LSODA": LSODA}
+
+
+class _Stop(Exception):
+    """Ends a scipy run from inside the right-hand side (status, message)."""
+
+    def __init__(self, status: int, message: str):
+        super().__init__(message)
+        self.status = status
+
+
+def choose_method(system: OdeSystem, scene: Scene, settings: IntegratorSettings) -> str:
+    """The method that will run. ValueError (before any work) when a compiled method is asked
+    for what it cannot do."""
+    audit = scene.wants("energy") and system.has_energy
+    events = bool(system.event_functions())
+    if settings.method == AUTO:
+        if not audit and not events and system.compiled() is not None:
+            return "DOP853-numba"
+        return "DOP853"
+    if settings.compiled:
+        if system.compiled() is None:
+            raise ValueError(f"method {settings.method!r} needs a system with a compiled form "
+                             "(native models with kernel='numba' and loads built from rodval's "
+                             "load laws, not plain callables); use a scipy method or 'auto'")
+        if audit:
+            raise ValueError(f"method {settings.method!r} runs in one compiled loop and cannot "
+                             "audit energy; use a scipy method or 'auto' for 'energy' outputs")
+        if events:
+            raise ValueError(f"method {settings.method!r} cannot handle this scene's events; "
+                             "use a scipy method or 'auto'")
+    return settings.method
+
+
+def segment_edges(scene: Scene) -> np.ndarray:
+    """0, the load breakpoints, and the end: t_end, or the last output time when it lies
+    beyond t_end by round-off (the Scene accepts it, so it is reached and returned)."""
+    end = max(scene.t_end, float(scene.times[-1]))
+    return np.concatenate([[0.0], scene.breakpoints, [end]])
+
+
+class _Outputs:
+    """States at the output times, filled in time order."""
+
+    def __init__(self, times: np.ndarray, size: int):
+        self.times = times
+        self.Y = np.empty((times.size, size))
+        self.n = 0
+
+    def upto(self, t: float) -> np.ndarray:
+        """The output times not yet written that are <= t."""
+        end = int(np.searchsorted(self.times, t, side="right"))
+        return self.times[self.n:end]
+
+    def write(self, values: np.ndarray) -> None:
+        """values (k, N) for the next k output times."""
+        self.Y[self.n:self.n + len(values)] = values
+        self.n += len(values)
+
+
+class _ScipyRun:
+    """One run on a scipy OdeSolver with evaluation and wall budgets, events, guard and audit."""
+
+    def __init__(self, system: OdeSystem, scene: Scene, settings: IntegratorSettings,
+                 method: str, stats: SolverStats, out: _Outputs, ledger: PowerLedger | None,
+                 guard: DivergenceGuard):
+        self.system, self.scene, self.settings = system, scene, settings
+        self.cls = _SOLVERS[method]
+        self.stats, self.out, self.ledger, self.guard = stats, out, ledger, guard
+        self.nfev = 0
+        #: event records (plain dicts) in time order
+        self.events: list[dict[str, Any]] = []
+        self.deadline = time.perf_counter() + settings.max_wall_s
+        self.extra: dict[str, Any] = {}
+        if settings.implicit and system.has_jacobian:
+            self.extra["jac"] = system.jacobian
+        if settings.first_step is not None:
+            self.extra["first_step"] = settings.first_step
+
+    def fun(self, t: float, y: np.ndarray) -> np.ndarray:
+        self.nfev += 1
+        if self.nfev > self.settings.max_evaluations:
+            raise _Stop(STATUS_BUDGET, f"evaluation budget exhausted: max_evaluations = "
+                                       f"{self.settings.max_evaluations} used (t = {t:.6g} s)")
+        if time.perf_counter() > self.deadline:
+            raise _Stop(STATUS_WALL, f"wall-clock budget exhausted: max_wall_s = "
+                                     f"{self.settings.max_wall_s:g} s used (t = {t:.6g} s)")
+        if not np.all(np.isfinite(y)):
+            raise _Stop(STATUS_DIVERGED, f"diverged: non-finite state in a step attempt at "
+                                         f"t = {t:.6g} s")
+        try:
+            f = self.system.rhs(t, y)
+        except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
+            raise _Stop(STATUS_ERROR, f"{type(exc).__name__}: {exc}") from exc
+        if not np.all(np.isfinite(f)):
+            raise _Stop(STATUS_DIVERGED, f"diverged: non-finite derivative at t = {t:.6g} s")
+        return f
+
+    def run(self, y: np.ndarray, edges: np.ndarray) -> float:
+        """Integrate from edges[0]; returns the time reached."""
+        events = EventMonitor(self.system, float(edges[0]), y)
+        t_now = float(edges[0])
+        for a, b in zip(edges[:-1], edges[1:]):
+            t_start = float(a)
+            while t_start < b:
+                y, t_now, t_start = self._segment(y, t_start, float(b), events)
+                if self.stats.status != 0:
+                    return t_now
+        return t_now
+
+    def _segment(self, y: np.ndarray, a: float, b: float,
+                 events: EventMonitor) -> tuple[np.ndarray, float, float]:
+        """Step from a towards b; returns (state, time reached, where to restart): b at the
+        segment's end, the event time after a jump."""
+        s = self.settings
+        solver = self.cls(self.fun, a, y, b, rtol=s.rtol, atol=s.atol, max_step=s.max_step,
+                          **self.extra)
+        t_now = a
+        try:
+            while solver.status == "running":
+                msg = solver.step()
+                self.stats.nsteps += 1
+                if solver.status == "failed":
+                    self.stats.status, self.stats.message = STATUS_FAILED, str(msg)
+                    break
+                verdict = self.guard.check(solver.t_old, solver.t, solver.y)
+                if verdict:
+                    self.stats.status, self.stats.message = verdict
+                    break
+                t0, t1 = solver.t_old, solver.t
+                hit = events.first_crossing(t0, t1, solver.y, solver.dense_output()) \
+                    if events.active else None
+                t_end = hit[1] if hit else t1
+                pending = self.out.upto(t_end)
+                if pending.size or self.ledger or hit:
+                    dense = solver.dense_output()
+                    if pending.size:
+                        self.out.write(dense(pending).T)
+                    if self.ledger:
+                        self.ledger.step(dense, t0, t_end, pending)
+                t_now = t_end
+                report(t_now)
+                if hit:
+                    index, t_event = hit
+                    y_event = solver.dense_output()(t_event)
+                    y_new, record = self.system.apply_event(index, t_event, y_event)
+                    self.events.append(record.as_dict())
+                    events.reset(t_event, y_new)
+                    self._count(solver)
+                    return y_new, t_event, t_event
+        except _Stop as stop:
+            self.stats.status, self.stats.message = stop.status, str(stop)
+        self._count(solver)
+        return solver.y.copy(), t_now, b
+
+    def _count(self, solver) -> None:
+        # plain ints: LSODA reports numpy int32 counters, which JSON cannot hold
+        self.stats.nfev = self.nfev
+        self.stats.njev += int(solver.njev)
+        self.stats.nlu += int(solver.nlu)
+
+
+def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
+              model: str, options: dict | None = None) -> Trajectory:
+    """Integrate ``system`` over [0, scene.t_end] and observe it at ``scene.times``.
+
+    Never raises for a failed run: status, message and time reached are in ``stats``; a bad
+    request (a compiled method for a system without compiled form) is a ValueError.
+    """
+    method = choose_method(system, scene, settings)
+    ran = {**settings.as_dict(), "method": method}
+    if settings.method == AUTO:
+        ran["requested_method"] = AUTO
+    form = system.compiled() if method in COMPILED_METHODS else None
+    if form is not None:
+        from rodval.solvers.compiled import run_compiled   # loads the compiled loop once
+    times = np.asarray(scene.times)
+    out = _Outputs(times, system.y0.size)
+    stats = SolverStats()
+    y = system.y0.astype(float).copy()
+    audit = scene.wants("energy") and system.has_energy
+    ledger = PowerLedger(system.power) if audit else None
+    start = time.perf_counter()
+    t_now = 0.0
+    events: list[dict[str, Any]] = []
+    edges = segment_edges(scene)
+    try:
+        guard = DivergenceGuard(system, settings, scene.t_end, y)
+        at_zero = out.upto(0.0)
+        out.write(np.repeat(y[None, :], at_zero.size, axis=0))
+        if ledger:
+            for _ in at_zero:
+                ledger.record()
+        if form is not None:
+            out.n = run_compiled(form, y, edges, scene, settings, out.Y, stats)
+            t_now = stats.t_reached
+        else:
+            scipy_run = _ScipyRun(system, scene, settings, method, stats, out, ledger, guard)
+            t_now = scipy_run.run(y, edges)
+            events = scipy_run.events
+    except Exception as exc:  # noqa: BLE001 - e.g. the model's energy at y0: a run never raises
+        stats.status, stats.message = STATUS_ERROR, f"{type(exc).__name__}: {exc}"
+    stats.t_reached = float(t_now)
+    if stats.status == 0:
+        stats.message = "reached t_end"
+    reached = times[:out.n]
+    try:
+        observed = system.observe(reached, out.Y[:out.n]) if out.n else {}
+        if ledger and out.n:
+            audited, stats.energy_residual = audit_quantities(
+                observed["energy"][0][:, 0], system.energy(0.0, system.y0), ledger)
+            observed.update(audited)
+    except Exception as exc:  # noqa: BLE001
+        observed = {}
+        stats.status, stats.message = STATUS_ERROR, f"observation failed: {type(exc).__name__}: {exc}"
+    stats.wall_s = time.perf_counter() - start
+    return Trajectory(model=model, scene_name=scene.name, times=reached,
+                      values={q: v for q, (v, _) in observed.items()},
+                      k_index={q: k for q, (_, k) in observed.items()},
+                      stats=stats, settings=ran, options=dict(options or {}),
+                      events=events)

@@ -1,0 +1,39 @@
+"""A model that is an ODE system integrated by rodval's driver."""
+from __future__ import annotations
+
+import time
+from abc import abstractmethod
+
+import numpy as np
+
+from rodval.core.contract import Model
+from rodval.core.scene import Scene
+from rodval.core.settings import IntegratorSettings
+from rodval.core.status import STATUS_ERROR
+from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.solvers.driver import integrate
+from rodval.solvers.system import OdeSystem
+
+
+class OdeModel(Model):
+    """A model whose ``system(scene)`` is an ``OdeSystem`` run by ``rodval.solvers.driver``."""
+
+    @abstractmethod
+    def system(self, scene: Scene) -> OdeSystem:
+        """Build the ODE system of ``scene`` (all scene-constant work happens here)."""
+
+    def simulate(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
+        """Build the system and integrate it. A failure while building it (its constants,
+        its first evaluation) is reported like a failure during integration: status
+        ``model error``, the message, t_reached = 0."""
+        start = time.perf_counter()
+        try:
+            system = self.system(scene)
+        except Exception as exc:  # noqa: BLE001 - failures are data
+            stats = SolverStats(status=STATUS_ERROR,
+                                message=f"model set-up failed: {type(exc).__name__}: {exc}",
+                                wall_s=time.perf_counter() - start)
+            return Trajectory(model=self.name, scene_name=scene.name, times=np.zeros(0),
+                              values={}, k_index={}, stats=stats,
+                              settings=settings.as_dict(), options=self.options())
+        return integrate(system, scene, settings, model=self.name, options=self.options())

@@ -1,0 +1,130 @@
+"""The contract between an ODE model and rodval's driver.
+
+A model that is integrated by the driver builds one ``OdeSystem`` per scene: a first-order ODE
+y' = f(t, y) with its initial state, its observation map, and optional capabilities, each a
+method with the same (t, y) signature:
+
+* ``jacobian(t, y)``: analytic df/dy, used by implicit scipy methods (``has_jacobian``);
+* ``kinetic_energy``, ``energy``, ``energy_budget``, ``power`` (``has_energy``): used by the
+  divergence guard (``rodval.solvers.guard``) and the energy audit (``rodval.solvers.audit``);
+* ``event_functions`` / ``apply_event``: state events (a hybrid system whose state jumps and
+  whose equations switch at a crossing, e.g. a hinge latching), handled by the driver's event
+  loop (``rodval.solvers.events``);
+* ``compiled()``: a ``CompiledForm`` that rodval's compiled integrators run without returning
+  to Python (``rodval.solvers.compiled``).
+
+The solvers layer imports no model: models implement this contract.
+"""
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+#: quantity -> (values (len(times), n_k), k labels (n_k,))
+Observed = dict[str, tuple[np.ndarray, np.ndarray]]
+
+
+@dataclass(frozen=True, eq=False)
+class CompiledForm:
+    """A system's compiled right-hand side and the arrays it reads.
+
+    ``rhs`` is a numba function of the first-class type ``rodval.solvers.compiled.RHS_TYPE``:
+    ``rhs(t, y, P, S, M, L, out)`` writes y' (same length as y) into ``out``. What the arrays
+    hold is the model's business: ``P`` (rows of per-rod constants, float64 2-D), ``S``
+    (scalars, float64 1-D), ``M`` (dense matrices, float64 3-D, may be empty), ``L`` (the load
+    table, ``rodval.core.loads.load_table``). The integrator passes them through untouched.
+    """
+
+    rhs: Any
+    P: np.ndarray
+    S: np.ndarray
+    M: np.ndarray
+    L: np.ndarray
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        for label, arr, ndim in (("P", self.P, 2), ("S", self.S, 1), ("M", self.M, 3),
+                                 ("L", self.L, 2)):
+            if not (isinstance(arr, np.ndarray) and arr.dtype == np.float64 and arr.ndim == ndim
+                    and arr.flags.c_contiguous):
+                raise TypeError(f"CompiledForm.{label} must be a C-contiguous float64 array "
+                                f"with {ndim} dimensions")
+
+
+@dataclass(frozen=True)
+class EventSpec:
+    """One state event: ``g(t, y)`` crosses zero in ``direction`` (+1 rising, -1 falling,
+    0 both). ``label`` names it in reports (e.g. "latch hinge 1")."""
+
+    g: Callable[[float, np.ndarray], float]
+    direction: int = 0
+    label: str = ""
+
+
+@dataclass
+class EventRecord:
+    """What happened at one event: its time (s), label and the model's own measures (e.g.
+    impulses, energies before and after)."""
+
+    t: float
+    label: str
+    data: dict[str, Any] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"t": self.t, "label": self.label, **self.data}
+
+
+class OdeSystem(ABC):
+    """A first-order ODE y' = f(t, y) built for one scene, plus its observation map."""
+
+    #: Initial state (N,).
+    y0: np.ndarray
+    #: True when ``jacobian`` is implemented.
+    has_jacobian: bool = False
+    #: True when ``kinetic_energy``, ``energy``, ``energy_budget`` and ``power`` are.
+    has_energy: bool = False
+
+    @abstractmethod
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Time derivative of the state."""
+
+    @abstractmethod
+    def observe(self, times: np.ndarray, Y: np.ndarray) -> Observed:
+        """The scene's requested quantities from states Y (len(times), N)."""
+
+    def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
+        """df/dy (N, N)."""
+        raise NotImplementedError
+
+    def kinetic_energy(self, t: float, y: np.ndarray) -> float:
+        """Kinetic energy T (J); cheap (called after every step by the divergence guard)."""
+        raise NotImplementedError
+
+    def energy(self, t: float, y: np.ndarray) -> float:
+        """Mechanical energy E = T + Pi (J), the same the observation reports."""
+        raise NotImplementedError
+
+    def energy_budget(self, t: float, y: np.ndarray) -> float:
+        """E = T + Pi (J) without expensive recovery: the divergence guard's initial budget."""
+        raise NotImplementedError
+
+    def power(self, t: float, y: np.ndarray) -> tuple[float, float]:
+        """(P_ext, P_diss) (W): power of the applied loads and power taken out by dampers."""
+        raise NotImplementedError
+
+    def event_functions(self) -> tuple[EventSpec, ...]:
+        """The system's state events in its current mode (none by default)."""
+        return ()
+
+    def apply_event(self, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:
+        """At the located crossing of event ``index`` in state y: the state after the jump
+        and the record; the system switches its mode (its ``rhs`` and ``event_functions``
+        may change)."""
+        raise NotImplementedError
+
+    def compiled(self) -> CompiledForm | None:
+        """The compiled form, or None when the system has none."""
+        return None

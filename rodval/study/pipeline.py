@@ -1,0 +1,143 @@
+"""Run a study: spec -> cases on workers -> one verified record per case -> tables -> report.
+
+Resuming: a case whose record exists, verifies (``rodval.study.records``) and has the same
+fingerprint (same scene, models and settings) is not run again, unless one of its runs ended
+by ``timeout`` or ``worker crashed`` (conditions of the run, not of the case). A damaged or
+incomplete record is named in a warning and recomputed. The pipeline knows nothing of the
+physics: comparisons come from ``rodval.analysis.metrics``.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from rodval.analysis.metrics import compare_runs
+from rodval.core.provenance import provenance
+from rodval.core.scene_file import scene_to_dict
+from rodval.core.status import STATUS_CRASHED, STATUS_TIMEOUT
+from rodval.core.trajectory import Trajectory
+from rodval.study.records import CaseRecord, DamagedRecord, RunRecord, read_case
+from rodval.study.schedule import BACKENDS, default_workers, run_dask, run_processes
+from rodval.study.spec import Case, StudySpec
+from rodval.study.store import StudyStore, write_json_atomic, write_text_atomic
+
+RETRIED = (STATUS_TIMEOUT, STATUS_CRASHED)
+
+
+def study_meta(spec: StudySpec) -> dict[str, Any]:
+    """The study's description saved beside the tables (the report reads it)."""
+    return {"name": spec.name, "description": spec.description, "source": spec.source,
+            "reference": spec.reference, "models": [m.as_dict() for m in spec.models],
+            "axes": spec.axes, "labels": spec.labels, "report": spec.report.as_dict(),
+            "cases": [{"id": c.id, "params": c.params, "fingerprint": c.fingerprint}
+                      for c in spec.cases]}
+
+
+def case_record(case: Case, runs: list[dict[str, Any]]) -> CaseRecord:
+    """The record of a finished case: its runs in the study's model order, and the
+    discrepancies of every model against the reference."""
+    order = {m.label: i for i, m in enumerate(case.models)}
+    typed = sorted((RunRecord.from_dict(r) for r in runs), key=lambda r: order[r.label])
+    trajs: dict[str, Trajectory] = {r.label: r.trajectory for r in typed}
+    return CaseRecord(case=case.id, fingerprint=case.fingerprint, params=case.params,
+                      scene=scene_to_dict(case.scene), reference=case.reference, runs=typed,
+                      discrepancies=compare_runs(trajs, case.reference, case.scene.outputs))
+
+
+def _reusable(store: StudyStore, case: Case, warnings: list[str]) -> bool:
+    path = store.case_path(case.id)
+    if not path.exists():
+        return False
+    try:
+        rec = read_case(path, labels=[m.label for m in case.models])
+    except DamagedRecord as exc:
+        warnings.append(f"{exc}; recomputing case {case.id!r}")
+        return False
+    if rec.fingerprint != case.fingerprint or rec.case != case.id:
+        return False
+    return all(r.status not in RETRIED for r in rec.runs)
+
+
+@dataclass
+class StudyRun:
+    """What a study run did: cases run now, cases reused from disk, failed model runs, and
+    warnings (damaged records that were recomputed)."""
+
+    out: Path
+    ran: list[str]
+    reused: list[str]
+    failed_runs: int
+    wall_s: float
+    warnings: list[str] = field(default_factory=list)
+
+
+def run_study(spec: StudySpec, out: str | Path, *, workers: int | None = None,
+              case_timeout: float | None = None, resume: bool = True,
+              backend: str = "processes", scheduler: str | None = None,
+              progress: bool = True, report: bool = True, fresh: bool = False) -> StudyRun:
+    """Run the cases of ``spec`` not yet on disk in ``out``, then write tables and report.
+
+    workers: parallel cases for the processes backend (default: all cores).
+    case_timeout: seconds after which a case's unfinished runs are stopped (None: no limit).
+    resume: reuse finished cases in ``out`` (False: run every case again).
+    backend: "processes" or "dask" (then ``scheduler`` is the address of a running
+    dask.distributed scheduler).
+    fresh: empty ``out`` first (needed when it holds another study).
+    Every argument is checked before any work; a second run on the same folder at the same
+    time is refused (``FolderBusy``).
+    """
+    if backend not in BACKENDS:
+        raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
+    if backend == "dask" and not scheduler:
+        raise ValueError("backend 'dask' needs --scheduler ADDRESS of a running dask scheduler")
+    workers = default_workers() if workers is None else workers
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    if case_timeout is not None and (isinstance(case_timeout, bool) or not case_timeout > 0):
+        raise ValueError(f"case_timeout must be > 0 s or None, got {case_timeout!r}")
+    start = time.perf_counter()
+    store = StudyStore(out)
+    warnings: list[str] = []
+    with store.lock():
+        store.claim(study_meta(spec), fresh=fresh)
+        write_json_atomic(store.out / "provenance.json", provenance())
+        write_text_atomic(store.out / "study.toml", spec.text)
+        reused = [c.id for c in spec.cases if resume and _reusable(store, c, warnings)]
+        # Longest first (rods x horizon as the cost guess) so that no big case starts last.
+        todo = sorted((c for c in spec.cases if c.id not in reused),
+                      key=lambda c: -c.scene.n * c.scene.t_end)
+        by_id = {c.id: c for c in todo}
+        failed = 0
+        bar = tqdm(total=len(todo), desc=spec.name, unit="case", disable=not progress or not todo)
+
+        def done(payload: dict[str, Any], runs: list[dict[str, Any]]) -> None:
+            nonlocal failed
+            case = by_id[payload["case"]]
+            record = case_record(case, runs)
+            write_text_atomic(store.case_path(case.id), record.to_json())
+            failed += sum(r.status != 0 for r in record.runs)
+            bar.update(1)
+            bar.set_postfix(failed_runs=failed)
+
+        payloads = [c.payload() for c in todo]
+        try:
+            if backend == "processes":
+                run_processes(payloads, done, workers, case_timeout)
+            else:
+                assert scheduler is not None
+                run_dask(payloads, done, scheduler, case_timeout)
+        finally:
+            bar.close()
+        from rodval.study.tables import write_tables
+
+        write_tables(store.out, spec)
+        if report:
+            from rodval.report.study_report import build_report
+
+            build_report(store.out)
+    return StudyRun(out=store.out, ran=[c.id for c in todo], reused=reused, failed_runs=failed,
+                    wall_s=time.perf_counter() - start, warnings=warnings)
