@@ -25,10 +25,19 @@ Values between solver steps come from cubic Hermite interpolation of the recorde
 coordinates (with their velocities) and velocities (with their accelerations); output times on
 the step grid are taken as recorded.
 
+Initial state: every rod starts on the assumed-mode curve with end tangent angles phi + alpha,
+phi + beta and arc length exactly l (its chord slightly shorter than l), beam nodes at equal arc
+length with unit slopes: unstretched at the nodes (``_bent_rod``). Velocities follow the same
+curve (dphi, dalpha, dbeta).
+
 Solver: exudyn's implicit generalized-alpha (or trapezoidal index-2) integrator with a fixed
 step (halved, down to step/64, only if Newton fails), sparse linear solver (EigenSparse), no solution files, no
 graphics and no console output. Newton's absolute tolerance is ``newton_atol_per_EA * EA``
 (N): the default absolute tolerance lies below the round-off of the stiff axial forces.
+rodval's native integrator settings are refused unless at their defaults (``check_settings``;
+``blowup_factor`` applies). Before every step ``_Guard`` checks the state: non-finite
+(STATUS_DIVERGED), kinetic energy above blowup_factor x (E(0) + W+ + 1e-6 J) (STATUS_BLOWUP),
+rotation per step above ``max_rotation_per_step`` (STATUS_FAILED); a verdict stops the run.
 """
 from __future__ import annotations
 
@@ -544,8 +553,6 @@ class _Guard:
 
     def __init__(self, built: _Built, scene: Scene, E: int, EA: float, factor: float,
                  max_rotation: float):
-        from scipy.sparse import coo_matrix
-
         mbs, chain = built.mbs, scene.chain
         ref, q0, v0 = built.initial
         self.mbs, self.solver = mbs, None
@@ -556,7 +563,7 @@ class _Guard:
         for k, rod in enumerate(ltg):
             for j, idx in enumerate(rod):
                 self.ref[idx] = ref[k, j]
-        rows, cols, vals = [], [], []
+        self.M = np.zeros((size, size))   # dense: a 4 us product at n = 8, 2 elements/rod
         for k in range(chain.n):
             le = chain.l[k] / E
             s = 0.5 * le * (_GAUSS_X + 1.0)
@@ -566,16 +573,17 @@ class _Guard:
                 a, b = ltg[k][j], ltg[k][j + 1]
                 dofs = np.array([a[:2], a[2:], b[:2], b[2:]])                       # (4, 2)
                 for c in range(2):
-                    rows.append(np.repeat(dofs[:, c], 4))
-                    cols.append(np.tile(dofs[:, c], 4))
-                    vals.append(Me.ravel())
+                    self.M[np.ix_(dofs[:, c], dofs[:, c])] += Me
             if chain.mu[k] > 0:
                 tip = ltg[k][E][:2]
-                rows.append(tip), cols.append(tip), vals.append(np.full(2, chain.mu[k]))
-        self.M = coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                            shape=(size, size)).tocsr()
-        self.start = np.array([ltg[k][0][:2] for k in range(chain.n)])       # (n, 2)
-        self.end = np.array([ltg[k][E][:2] for k in range(chain.n)])
+                self.M[tip, tip] += chain.mu[k]
+        # chord vectors d = A q + d_ref (rows: x, y of rod 1, 2, ...)
+        self.A = np.zeros((2 * chain.n, size))
+        for k in range(chain.n):
+            for c in range(2):
+                self.A[2 * k + c, ltg[k][E][c]] += 1.0
+                self.A[2 * k + c, ltg[k][0][c]] -= 1.0
+        self.d_ref = self.A @ self.ref
         self.loads = [(f, ltg[f.node - 1][E][:2]) for f in scene.loads]
         ini = scene.initial.resolve(chain.n)
         at0 = {(k, j): ((ref + q0)[k, j][None], v0[k, j][None])
@@ -609,16 +617,21 @@ class _Guard:
         try:
             sd = self.mbs.systemData
             q, v = sd.GetODE2Coordinates(), sd.GetODE2Coordinates_t()
-            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+            if not math.isfinite(float(q @ q) + float(v @ v)):
                 self.verdict = (STATUS_DIVERGED, f"diverged: non-finite state at t = {t:.6g} s",
                                 t, False)
                 return False
             if math.isfinite(self.factor):
-                p = max(self._power(t, v), 0.0)
+                p = self._power(t, v)
+                if not math.isfinite(p):
+                    self.verdict = (STATUS_ERROR, f"a load is not finite at t = {t:.6g} s "
+                                    f"(load power {p!r} W)", t, False)
+                    return False
+                p = max(p, 0.0)
                 if self.p_prev is not None:
                     self.w_plus += 0.5 * (t - self.t_prev) * (self.p_prev + p)
                 self.p_prev, self.t_prev = p, t
-                T = 0.5 * float(v @ (self.M @ v))
+                T = 0.5 * float(v @ self.M @ v)
                 budget = self.E0 + self.w_plus + ENERGY_FLOOR_J
                 if not T <= self.factor * budget:
                     self.verdict = (STATUS_BLOWUP, (
@@ -626,10 +639,9 @@ class _Guard:
                         f"x budget E(0) + W+ = {budget:.4g} J at t = {t:.6g} s"), t, False)
                     return False
             if h > 0:
-                x = self.ref + q
-                d = x[self.end] - x[self.start]
-                dd = v[self.end] - v[self.start]
-                rate = np.abs(d[:, 0] * dd[:, 1] - d[:, 1] * dd[:, 0]) / np.sum(d**2, -1)
+                d, dd = self.A @ q + self.d_ref, self.A @ v
+                dx, dy, ddx, ddy = d[0::2], d[1::2], dd[0::2], dd[1::2]
+                rate = np.abs(dx * ddy - dy * ddx) / (dx * dx + dy * dy)
                 rot = float(rate.max()) * h
                 self.max_rotation_seen = max(self.max_rotation_seen, rot)
                 if rot > self.max_rotation:
