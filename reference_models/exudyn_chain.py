@@ -464,7 +464,7 @@ class ExudynModel(Model):
         finally:
             stats.wall_s = time.perf_counter() - start
             exu.config.printToConsole = console
-        stats.nsteps = int(solver.it.currentStepIndex)
+        stats.nsteps = max(int(solver.it.currentStepIndex) - 1, 0)   # the index ends one past
         stats.njev = int(solver.it.newtonJacobiCount)
         stats.nfev = int(solver.it.newtonStepsCount)
         run_info.update(steps=stats.nsteps, min_step_used=guard.min_step,
