@@ -467,7 +467,8 @@ class ExudynModel(Model):
         stats.nsteps = max(int(solver.it.currentStepIndex) - 1, 0)   # the index ends one past
         stats.njev = int(solver.it.newtonJacobiCount)
         stats.nfev = int(solver.it.newtonStepsCount)
-        run_info.update(steps=stats.nsteps, min_step_used=guard.min_step,
+        run_info.update(steps=stats.nsteps,
+                        min_step_used=guard.min_step if math.isfinite(guard.min_step) else None,
                         max_rotation_per_step_seen=guard.max_rotation_seen)
         try:
             t_rec, records, diverged = self._records(built)
@@ -482,7 +483,7 @@ class ExudynModel(Model):
             stats.t_reached = min(stats.t_reached, t_detected) if t_rec.size else 0.0
         if stats.status == 0 and stats.t_reached < scene.t_end * (1 - 1e-9):
             stats.status, stats.message = STATUS_FAILED, "solver stopped before t_end"
-        if stats.status == STATUS_FAILED and diverged:
+        if stats.status == STATUS_FAILED and diverged and guard.verdict is None:
             stats.status = STATUS_DIVERGED
             stats.message = f"non-finite state after t = {stats.t_reached:.6g} s"
         if stats.status == 0:
