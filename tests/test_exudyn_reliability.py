@@ -195,3 +195,28 @@ def test_settings_record_what_was_used():
     assert s["steps"] == tr.stats.nsteps == 34
     assert s["min_step_used"] == pytest.approx(0.01 / 34)
     assert s["blowup_factor"] == IntegratorSettings().blowup_factor
+
+
+def test_guard_verdicts_on_a_set_state():
+    """The per-step check on states set by hand: a NaN velocity is STATUS_DIVERGED (exudyn's
+    Newton usually gives up before a state turns non-finite, so no run reaches this), a huge
+    one STATUS_BLOWUP, and its kinetic energy agrees with the measured one."""
+    from reference_models.exudyn_chain import _Guard
+    from rodval.trajectory import STATUS_DIVERGED
+
+    scene = Scene(chain=Chain.uniform(2), t_end=1.0, outputs=("energy",),
+                  initial=InitialState(dphi=[0.5, -0.3], dalpha=[2.0, 1.0]))
+    built = ExudynModel()._build(scene)
+    guard = _Guard(built, scene, 2, 1e10, 100.0, 0.1)
+    sd = built.mbs.systemData
+    v0 = sd.GetODE2Coordinates_t()
+    assert 0.5 * v0 @ guard.M @ v0 == pytest.approx(
+        simulate(scene.with_(t_end=1e-3, times=[0.0]), "exudyn", step=1e-4)["kinetic"][0, 0], rel=1e-12)
+    assert guard.check(0.0, 1e-4) and guard.verdict is None
+    sd.SetODE2Coordinates_t(1e4 * v0)
+    assert not guard.check(0.1, 1e-6) and guard.verdict[0] == STATUS_BLOWUP
+    guard.verdict = None
+    bad = v0.copy()
+    bad[3] = np.nan
+    sd.SetODE2Coordinates_t(bad)
+    assert not guard.check(0.2, 1e-6) and guard.verdict[0] == STATUS_DIVERGED
