@@ -302,7 +302,8 @@ class ExudynModel(Model):
         (defaults filled in), or ValueError naming an unknown key (and listing the allowed
         ones) or a bad value."""
         if not isinstance(options, dict):
-            raise ValueError(f"exudyn model options must be a dict, got {type(options).__name__}")
+            raise ValueError(  # noqa: TRY004 - rodval reports every bad input as ValueError
+                f"exudyn model options must be a dict, got {type(options).__name__}")
         return cls(**options).options()
 
     def options(self) -> dict[str, Any]:
@@ -625,8 +626,8 @@ class _Guard:
             if math.isfinite(self.factor):
                 p = self._power(t, v)
                 if not math.isfinite(p):
-                    self.verdict = (STATUS_ERROR, f"a load is not finite at t = {t:.6g} s "
-                                    f"(load power {p!r} W)", t, False)
+                    self.verdict = (STATUS_ERROR, (f"a load is not finite at t = {t:.6g} s "
+                                                   f"(load power {p!r} W)"), t, False)
                     return False
                 p = max(p, 0.0)
                 if self.p_prev is not None:
@@ -653,8 +654,8 @@ class _Guard:
                         f"max_rotation_per_step = {self.max_rotation:g} rad; reduce step"), t, True)
                     return False
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
-            self.verdict = (STATUS_ERROR, f"divergence check failed at t = {t:.6g} s: "
-                            f"{type(exc).__name__}: {exc}", t, True)
+            self.verdict = (STATUS_ERROR, (f"divergence check failed at t = {t:.6g} s: "
+                                           f"{type(exc).__name__}: {exc}"), t, True)
             return False
         return True
 
