@@ -25,10 +25,19 @@ Values between solver steps come from cubic Hermite interpolation of the recorde
 coordinates (with their velocities) and velocities (with their accelerations); output times on
 the step grid are taken as recorded.
 
+Initial state: every rod starts on the assumed-mode curve with end tangent angles phi + alpha,
+phi + beta and arc length exactly l (its chord slightly shorter than l), beam nodes at equal arc
+length with unit slopes: unstretched at the nodes (``_bent_rod``). Velocities follow the same
+curve (dphi, dalpha, dbeta).
+
 Solver: exudyn's implicit generalized-alpha (or trapezoidal index-2) integrator with a fixed
 step (halved, down to step/64, only if Newton fails), sparse linear solver (EigenSparse), no solution files, no
 graphics and no console output. Newton's absolute tolerance is ``newton_atol_per_EA * EA``
 (N): the default absolute tolerance lies below the round-off of the stiff axial forces.
+rodval's native integrator settings are refused unless at their defaults (``check_settings``;
+``blowup_factor`` applies). Before every step ``_Guard`` checks the state: non-finite
+(STATUS_DIVERGED), kinetic energy above blowup_factor x (E(0) + W+ + 1e-6 J) (STATUS_BLOWUP),
+rotation per step above ``max_rotation_per_step`` (STATUS_FAILED); a verdict stops the run.
 """
 from __future__ import annotations
 
@@ -42,8 +51,8 @@ import numpy as np
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
-from rodval.core.trajectory import (STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED, SolverStats,
-                               Trajectory)
+from rodval.core.status import (STATUS_BLOWUP, STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED)
+from rodval.core.trajectory import SolverStats, Trajectory
 
 ELEMENTS = ("cable2d",)
 SOLVERS = ("generalized-alpha", "trapezoidal")
@@ -58,7 +67,17 @@ DEFAULTS: dict[str, Any] = {
     "spectral_radius": 0.9,
     "newton_rtol": 1e-8,
     "newton_atol_per_EA": 1e-12,
+    "max_rotation_per_step": 0.1,
 }
+
+#: IntegratorSettings fields that belong to rodval's ODE integrators: exudyn cannot honour
+#: them (its integrator is set by this model's options), so any non-default value is refused.
+NATIVE_INTEGRATOR_FIELDS = ("method", "rtol", "atol", "max_step", "first_step", "max_evaluations",
+                            "max_wall_s")
+
+#: Absolute slack of the blow-up budget (J), as in the native runs' check (rodval.solvers.guard):
+#: a chain at rest without loads has E(0) = W+ = 0 and may pick up rounding-level motion.
+ENERGY_FLOOR_J = 1e-6
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(5)
 
@@ -89,34 +108,116 @@ def _hermite(s: np.ndarray, le: float) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return S, dS, ddS
 
 
+#: Composite Gauss-Legendre rule on [0, 1] for the arc-length integrals of the initial shape.
+_ARC_PANELS = 8
+_ARC_X, _ARC_W = np.polynomial.legendre.leggauss(16)
+
+
+def _arc_rule(upper: float) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes and weights integrating over [0, upper] (composite Gauss, exact to round-off for
+    the smooth integrands of ``_bent_rod``)."""
+    edges = np.linspace(0.0, upper, _ARC_PANELS + 1)
+    half = 0.5 * np.diff(edges)[:, None]
+    x = (edges[:-1, None] + half * (_ARC_X + 1.0)).ravel()
+    return x, (half * _ARC_W).ravel()
+
+
+def _bent_rod(alpha: float, beta: float, l: float, elements: int):
+    """One rod bent into the assumed shape with end tangent angles alpha, beta (rad) to its
+    chord and arc length exactly l, in its chord frame (x along the chord from the root).
+
+    The curve is y = eta(x) = X (ta sig(xi) + tb tau(xi)), xi = x / X, sig = xi (1 - xi)^2,
+    tau = -xi^2 (1 - xi), ta = tan(alpha), tb = tan(beta): the paper's shape functions on a
+    chord of length X, with end slopes whose angles are alpha and beta exactly. X = l / c with
+    c = int_0^1 sqrt(1 + g^2) dxi, g = eta'(x) (g depends on xi only), so the arc length is l.
+    Beam node j (of elements + 1) sits at arc length j l / elements.
+
+    Returns positions p (E+1, 2), unit tangents t (E+1, 2), and their derivatives with
+    respect to alpha and beta: dp (2, E+1, 2), dt (2, E+1, 2)."""
+    if not (abs(alpha) < 0.5 * math.pi and abs(beta) < 0.5 * math.pi):
+        raise ValueError(f"initial alpha and beta must lie in (-pi/2, pi/2), got {alpha!r}, {beta!r}")
+    ta, tb = math.tan(alpha), math.tan(beta)
+
+    def g(xi):
+        return ta * (1 - xi) * (1 - 3 * xi) - tb * xi * (2 - 3 * xi)
+
+    def gp(xi):   # dg/dta, dg/dtb
+        return np.stack([(1 - xi) * (1 - 3 * xi), -xi * (2 - 3 * xi)])
+
+    def w(xi):
+        return np.sqrt(1.0 + g(xi) ** 2)
+
+    x1, w1 = _arc_rule(1.0)
+    c = float(np.sum(w1 * w(x1)))
+    dc = np.sum(w1 * g(x1) * gp(x1) / w(x1), axis=-1)                   # (2,)
+    X = l / c
+    dX = -l / c**2 * dc
+    # arc-length positions of the beam nodes: int_0^xi w = (j / E) c, by Newton
+    frac = np.arange(elements + 1) / elements
+    xi = frac.copy()
+    for _ in range(50):
+        A = np.array([np.sum(wq * w(xq)) for xq, wq in map(_arc_rule, xi)])
+        step = (A - frac * c) / w(xi)
+        xi = np.clip(xi - step, 0.0, 1.0)
+        if np.max(np.abs(step)) < 1e-15:
+            break
+    xi[0], xi[-1] = 0.0, 1.0
+    dA = np.stack([np.sum(wq * g(xq) * gp(xq) / w(xq), axis=-1) for xq, wq in map(_arc_rule, xi)], -1)
+    dxi = (frac * dc[:, None] - dA) / w(xi)                               # (2, E+1)
+    dxi[:, 0] = dxi[:, -1] = 0.0
+    sig, tau = xi * (1 - xi) ** 2, -xi**2 * (1 - xi)
+    eta_hat = ta * sig + tb * tau
+    gj, wj = g(xi), w(xi)
+    dg_dxi = ta * (-4 + 6 * xi) + tb * (-2 + 6 * xi)
+    p = np.stack([X * xi, X * eta_hat], -1)
+    t = np.stack([1.0 / wj, gj / wj], -1)
+    dp = np.empty((2, elements + 1, 2))
+    dt = np.empty((2, elements + 1, 2))
+    for i, (shape, dtan) in enumerate(((sig, 1.0 + ta**2), (tau, 1.0 + tb**2))):
+        dp_i = (dX[i] * np.stack([xi, eta_hat], -1)
+                + X * np.stack([dxi[i], gj * dxi[i] + shape], -1))        # per unit d(tan)
+        dgj = gp(xi)[i] + dg_dxi * dxi[i]
+        dt_i = np.stack([-gj / wj**3, 1.0 / wj**3], -1) * dgj[:, None]
+        dp[i], dt[i] = dp_i * dtan, dt_i * dtan                           # per unit angle
+    return p, t, dp, dt
+
+
 def _initial_node_states(scene: Scene, elements: int):
     """Reference coordinates (straight rods along the initial chords) and initial coordinate
     offsets and velocities of every beam node, per rod: arrays (n, elements+1, 4) with
-    [x, y, slope_x, slope_y] (m, m, -, -) and their rates. The bent shape is the scene's
-    assumed mode eta = alpha sigma + beta tau (its definition of alpha, beta)."""
+    [x, y, slope_x, slope_y] (m, m, -, -) and their rates.
+
+    Each rod starts on the bent curve of ``_bent_rod``: arc length exactly l, nodes at equal
+    arc-length spacing and slopes equal to the unit tangents, so the axial strain is zero at
+    the nodes (the Hermite interpolation between them departs from it at the order of the
+    fourth power of curvature x element length); the chord points along phi_k, the end
+    tangents at phi_k + alpha_k and phi_k + beta_k. The velocities are those of the same
+    curve moving with dphi (rigid rotation about the rod's root), dalpha and dbeta (shape
+    rates, with the chord length following the constant arc length)."""
     chain, ini = scene.chain, scene.initial.resolve(scene.n)
     n, l = chain.n, chain.l
     phi, dphi = ini["phi"], ini["dphi"]
-    e = np.stack([np.cos(phi), np.sin(phi)], -1)
-    nrm = np.stack([-np.sin(phi), np.cos(phi)], -1)
-    roots = np.vstack([np.zeros(2), np.cumsum(l[:, None] * e, axis=0)])[:-1]
-    root_vel = np.vstack([np.zeros(2), np.cumsum((l * dphi)[:, None] * nrm, axis=0)])[:-1]
-    s = np.linspace(0.0, 1.0, elements + 1)[None, :] * l[:, None]           # (n, E+1)
-    lk = l[:, None]
-    sig, tau = s * (lk - s) ** 2 / lk**2, -s**2 * (lk - s) / lk**2
-    dsig, dtau = (lk - s) * (lk - 3 * s) / lk**2, -s * (2 * lk - 3 * s) / lk**2
-    a, b = ini["alpha"][:, None], ini["beta"][:, None]
-    da, db, w = ini["dalpha"][:, None], ini["dbeta"][:, None], dphi[:, None, None]
-    eta, deta = a * sig + b * tau, a * dsig + b * dtau
-    eta_t, deta_t = da * sig + db * tau, da * dsig + db * dtau
-    E, N = e[:, None, :], nrm[:, None, :]
-    ref = np.concatenate([roots[:, None, :] + s[..., None] * E, np.broadcast_to(E, s.shape + (2,))], -1)
-    pos = roots[:, None, :] + s[..., None] * E + eta[..., None] * N
-    slope = E + deta[..., None] * N
-    vel = (root_vel[:, None, :] + w * (s[..., None] * N - eta[..., None] * E)
-           + eta_t[..., None] * N)
-    slope_t = w * (N - deta[..., None] * E) + deta_t[..., None] * N
-    return ref, np.concatenate([pos, slope], -1) - ref, np.concatenate([vel, slope_t], -1)
+    J = np.array([[0.0, -1.0], [1.0, 0.0]])
+    root, root_vel = np.zeros(2), np.zeros(2)
+    s = np.linspace(0.0, 1.0, elements + 1)
+    ref = np.empty((n, elements + 1, 4))
+    cur = np.empty((n, elements + 1, 4))
+    vel = np.empty((n, elements + 1, 4))
+    for k in range(n):
+        p, t, dp, dt = _bent_rod(float(ini["alpha"][k]), float(ini["beta"][k]), float(l[k]), elements)
+        c, sn = math.cos(phi[k]), math.sin(phi[k])
+        R = np.array([[c, -sn], [sn, c]])
+        e = R[:, 0]
+        ref[k, :, :2] = root + s[:, None] * l[k] * e
+        ref[k, :, 2:] = e
+        cur[k, :, :2] = root + p @ R.T
+        cur[k, :, 2:] = t @ R.T
+        dp_rate = ini["dalpha"][k] * dp[0] + ini["dbeta"][k] * dp[1]
+        dt_rate = ini["dalpha"][k] * dt[0] + ini["dbeta"][k] * dt[1]
+        vel[k, :, :2] = root_vel + dphi[k] * p @ (R @ J).T + dp_rate @ R.T
+        vel[k, :, 2:] = dphi[k] * t @ (R @ J).T + dt_rate @ R.T
+        root, root_vel = cur[k, -1, :2].copy(), vel[k, -1, :2].copy()
+    return ref, cur - ref, vel
 
 
 @dataclass
@@ -127,6 +228,8 @@ class _Built:
     mbs: Any
     node_sensors: dict[tuple[int, int], tuple[int, int, int]]   # (rod, local node) -> (q, v, a)
     load_errors: list
+    nodes: list | None = None              # beam node numbers per rod
+    initial: tuple | None = None           # _initial_node_states: ref, offsets, velocities
 
 
 class ExudynModel(Model):
@@ -151,16 +254,34 @@ class ExudynModel(Model):
         Newton relative tolerance.
     newton_atol_per_EA : float in (0, 1e-6]
         Newton absolute tolerance per unit EA (absolute tolerance = this * EA, in N).
+    max_rotation_per_step : float in (0, pi] rad
+        Resolution bound: a run whose chords turn by more than this in one step (max |dphi_k|
+        x step) ends as STATUS_FAILED. Default 0.1 rad: 10 steps per radian, where a
+        second-order integrator's phase error on a rotation is about (|dphi| h)^2 / 12 = 1e-3
+        rad per radian turned; the paper example turns by < 1e-3 rad per step at the default
+        step. Beyond it the trajectory is not a resolved solution.
+
+    Any other keyword is refused with a ValueError listing these (``check_options``).
+    Divergence is detected during the run (``_Guard``): a non-finite state ends it as
+    STATUS_DIVERGED, kinetic energy above ``settings.blowup_factor`` x (E(0) + W+(t) + 1e-6 J)
+    as STATUS_BLOWUP, both at the time of detection with the output times before it kept.
     """
 
     name = "exudyn"
+    OPTIONS = tuple(DEFAULTS)
+    #: exudyn integrates with its own options: rodval's integrator settings do not apply.
+    USES_INTEGRATOR_SETTINGS = False
 
     def __init__(self, *, elements: int = DEFAULTS["elements"], step: float = DEFAULTS["step"],
                  EA: float = DEFAULTS["EA"], element: str = DEFAULTS["element"],
                  solver: str = DEFAULTS["solver"],
                  spectral_radius: float = DEFAULTS["spectral_radius"],
                  newton_rtol: float = DEFAULTS["newton_rtol"],
-                 newton_atol_per_EA: float = DEFAULTS["newton_atol_per_EA"]):
+                 newton_atol_per_EA: float = DEFAULTS["newton_atol_per_EA"],
+                 max_rotation_per_step: float = DEFAULTS["max_rotation_per_step"],
+                 **unknown):
+        if unknown:
+            raise ValueError(_unknown_options_message(unknown))
         self.elements = _positive("elements", elements, integer=True)
         self.step = _positive("step", step, upper=0.1)
         self.EA = _positive("EA", EA, upper=1e14)
@@ -176,6 +297,18 @@ class ExudynModel(Model):
         self.spectral_radius = float(spectral_radius)
         self.newton_rtol = _positive("newton_rtol", newton_rtol, upper=1e-2)
         self.newton_atol_per_EA = _positive("newton_atol_per_EA", newton_atol_per_EA, upper=1e-6)
+        self.max_rotation_per_step = _positive("max_rotation_per_step", max_rotation_per_step,
+                                               upper=math.pi)
+
+    @classmethod
+    def check_options(cls, options: dict[str, Any]) -> dict[str, Any]:
+        """Validate a dict of model options without running anything: the complete options
+        (defaults filled in), or ValueError naming an unknown key (and listing the allowed
+        ones) or a bad value."""
+        if not isinstance(options, dict):
+            raise ValueError(  # noqa: TRY004 - rodval reports every bad input as ValueError
+                f"exudyn model options must be a dict, got {type(options).__name__}")
+        return cls(**options).options()
 
     def options(self) -> dict[str, Any]:
         return {k: getattr(self, k) for k in DEFAULTS}
@@ -249,7 +382,7 @@ class ExudynModel(Model):
                        for v in (ovt.CoordinatesTotal, ovt.Coordinates_t, ovt.Coordinates_tt))
             for key in sorted(wanted)}
         mbs.Assemble()
-        return _Built(SC, mbs, node_sensors, load_errors)
+        return _Built(SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0))
 
     def _settings(self, t_end: float):
         import exudyn as exu
@@ -277,19 +410,46 @@ class ExudynModel(Model):
         return s
 
     # -- run -----------------------------------------------------------------------------------
+    @staticmethod
+    def check_settings(settings: IntegratorSettings | None) -> None:
+        """Refuse native integrator settings exudyn cannot honour: ValueError naming the first
+        field of ``NATIVE_INTEGRATOR_FIELDS`` that differs from ``IntegratorSettings()``.
+        (``blowup_factor`` is honoured: it sets the blow-up check.)"""
+        if settings is None:
+            return
+        default = IntegratorSettings()
+        for name in NATIVE_INTEGRATOR_FIELDS:
+            value = getattr(settings, name)
+            if value != getattr(default, name):
+                raise ValueError(
+                    f"the exudyn model cannot honour integrator setting {name}={value!r} "
+                    f"(default {getattr(default, name)!r}): exudyn's integrator is set by its own "
+                    f"options ({', '.join(DEFAULTS)}); leave {', '.join(NATIVE_INTEGRATOR_FIELDS)} "
+                    "at their defaults")
+
     def simulate(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
-        """Run the scene. ``settings`` (the native integrator settings) do not apply: the
-        exudyn integrator is set by this model's options, recorded in ``trajectory.settings``."""
+        """Run the scene. Of the native integrator ``settings`` only ``blowup_factor`` applies;
+        any other non-default field raises ValueError before any work (``check_settings``): the
+        exudyn integrator is set by this model's options, recorded in ``trajectory.settings``
+        with the steps actually taken."""
         import exudyn as exu
 
+        self.check_settings(settings)
+        factor = (settings or IntegratorSettings()).blowup_factor
         stats = SolverStats()
+        run_info: dict[str, Any] = {"blowup_factor": factor}
         try:
             built = self._build(scene)
             sim = self._settings(scene.t_end)
+            guard = _Guard(built, scene, self.elements, self.EA, factor, self.max_rotation_per_step)
         except Exception as exc:  # noqa: BLE001 - a failed build is data
             stats.status, stats.message = STATUS_ERROR, f"build failed: {type(exc).__name__}: {exc}"
-            return self._trajectory(scene, np.empty(0), {}, stats)
+            return self._trajectory(scene, np.empty(0), {}, stats, run_info)
+        ti = sim.timeIntegration
+        run_info.update(steps_planned=int(ti.numberOfSteps), step_used=float(ti.initialStepSize))
         solver = exu.MainSolverImplicitSecondOrder()
+        guard.solver = solver
+        built.mbs.SetPreStepUserFunction(guard.pre_step)
         if self.solver == "trapezoidal":
             sim.timeIntegration.generalizedAlpha.useNewmark = True
             sim.timeIntegration.generalizedAlpha.useIndex2Constraints = True
@@ -300,6 +460,8 @@ class ExudynModel(Model):
             ok = solver.SolveSystem(built.mbs, sim)
             if not ok:
                 stats.status, stats.message = STATUS_FAILED, _solver_message(solver, "solver failed")
+            elif guard.verdict is None:   # the last step's end state has had no pre-step check
+                guard.check(scene.t_end)
         except Exception as exc:  # noqa: BLE001 - exudyn errors come back as data
             stats.status = STATUS_ERROR
             cause = built.load_errors[0] if built.load_errors else exc
@@ -307,30 +469,44 @@ class ExudynModel(Model):
         finally:
             stats.wall_s = time.perf_counter() - start
             exu.config.printToConsole = console
-        stats.nsteps = int(solver.it.currentStepIndex)
+        stats.nsteps = max(int(solver.it.currentStepIndex) - 1, 0)   # the index ends one past
         stats.njev = int(solver.it.newtonJacobiCount)
         stats.nfev = int(solver.it.newtonStepsCount)
+        run_info.update(steps=stats.nsteps,
+                        min_step_used=guard.min_step if math.isfinite(guard.min_step) else None,
+                        max_rotation_per_step_seen=guard.max_rotation_seen)
         try:
             t_rec, records, diverged = self._records(built)
         except Exception as exc:  # noqa: BLE001
             stats.status, stats.message = STATUS_ERROR, f"reading sensors failed: {exc}"
-            return self._trajectory(scene, np.empty(0), {}, stats)
+            return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         stats.t_reached = float(t_rec[-1]) if t_rec.size else 0.0
+        keep_detected = True
+        if guard.verdict is not None and stats.status != STATUS_ERROR:
+            # the guard's verdict explains a solver failure that may follow it
+            stats.status, stats.message, t_detected, keep_detected = guard.verdict
+            stats.t_reached = min(stats.t_reached, t_detected) if t_rec.size else 0.0
         if stats.status == 0 and stats.t_reached < scene.t_end * (1 - 1e-9):
             stats.status, stats.message = STATUS_FAILED, "solver stopped before t_end"
-        if stats.status == STATUS_FAILED and diverged:
+        if stats.status == STATUS_FAILED and diverged and guard.verdict is None:
             stats.status = STATUS_DIVERGED
             stats.message = f"non-finite state after t = {stats.t_reached:.6g} s"
         if stats.status == 0:
             stats.message = "reached t_end"
         times = np.asarray(scene.times)
-        times = times[times <= stats.t_reached + 1e-9 * max(1.0, scene.t_end)] if t_rec.size else t_rec
+        tol = 1e-9 * max(1.0, scene.t_end)
+        if not t_rec.size:
+            times = t_rec
+        elif keep_detected:
+            times = times[times <= stats.t_reached + tol]
+        else:   # the state at the detection time is the bad one: keep the times before it
+            times = times[times < stats.t_reached - tol]
         try:
             observed = _observe(scene, self.elements, self.EA, times, t_rec, records) if times.size else {}
         except Exception as exc:  # noqa: BLE001
             stats.status, stats.message = STATUS_ERROR, f"observation failed: {type(exc).__name__}: {exc}"
-            return self._trajectory(scene, np.empty(0), {}, stats)
-        return self._trajectory(scene, times, observed, stats)
+            return self._trajectory(scene, np.empty(0), {}, stats, run_info)
+        return self._trajectory(scene, times, observed, stats, run_info)
 
     def _records(self, built: _Built):
         """Recorded times (s); per (rod, local node), arrays q, v, a (nt, 4) up to the first
@@ -355,12 +531,145 @@ class ExudynModel(Model):
         t = t[keep][:end]
         return t, {key: tuple(x[:end] for x in arrs) for key, arrs in out.items()}, bool(bad.size)
 
-    def _trajectory(self, scene, times, observed, stats) -> Trajectory:
+    def _trajectory(self, scene, times, observed, stats, run_info=None) -> Trajectory:
+        """``settings``: the integrator, every option, and what the run used (``run_info``:
+        steps_planned, step_used (s, the fixed step), steps (taken), min_step_used (s, smaller
+        than step_used only if Newton failures halved it), max_rotation_per_step_seen (rad),
+        blowup_factor)."""
         return Trajectory(model=self.name, scene_name=scene.name, times=times,
                           values={q: v for q, (v, _) in observed.items()},
                           k_index={q: k for q, (_, k) in observed.items()},
-                          stats=stats, settings={"integrator": f"exudyn {self.solver}",
-                                                 **self.options()})
+                          stats=stats,
+                          settings={"method": f"exudyn {self.solver}", "step": self.step,
+                                    **(run_info or {})},
+                          options=self.options())
+
+
+class _Guard:
+    """Divergence and resolution checks of one run, on every accepted step (exudyn's
+    PreStepUserFunction: called before each step with t = the end of the coming step, on the
+    state of the last accepted step, at t - step). A verdict stops the solver after the coming
+    step; ``verdict`` is then (status, message, time of the checked state, whether output times
+    at that time are kept).
+
+    * non-finite coordinates or velocities: STATUS_DIVERGED;
+    * kinetic energy T = v^T M v / 2 (consistent mass of the cubic elements plus the point
+      masses; the hinge data nodes carry no mass) above ``factor`` x (E(0) + W+(t) +
+      ENERGY_FLOOR_J), W+ the positive load work (trapezoid rule on the load power at the
+      checked states), E(0) the initial T + Pi (``_energies``): STATUS_BLOWUP;
+    * max_k |dphi_k| x step above ``max_rotation``: STATUS_FAILED (under-resolved)."""
+
+    def __init__(self, built: _Built, scene: Scene, E: int, EA: float, factor: float,
+                 max_rotation: float):
+        mbs, chain = built.mbs, scene.chain
+        ref, q0, v0 = built.initial
+        self.mbs, self.solver = mbs, None
+        self.factor, self.max_rotation = float(factor), float(max_rotation)
+        size = mbs.systemData.ODE2Size()
+        ltg = [[np.asarray(mbs.systemData.GetNodeLTGODE2(nd), int) for nd in rod] for rod in built.nodes]
+        self.ref = np.zeros(size)
+        for k, rod in enumerate(ltg):
+            for j, idx in enumerate(rod):
+                self.ref[idx] = ref[k, j]
+        self.M = np.zeros((size, size))   # dense: a 4 us product at n = 8, 2 elements/rod
+        for k in range(chain.n):
+            le = chain.l[k] / E
+            s = 0.5 * le * (_GAUSS_X + 1.0)
+            S = _hermite(s, le)[0]
+            Me = chain.m[k] * np.einsum("g,gi,gj->ij", 0.5 * le * _GAUSS_W, S, S)   # (4, 4)
+            for j in range(E):
+                a, b = ltg[k][j], ltg[k][j + 1]
+                dofs = np.array([a[:2], a[2:], b[:2], b[2:]])                       # (4, 2)
+                for c in range(2):
+                    self.M[np.ix_(dofs[:, c], dofs[:, c])] += Me
+            if chain.mu[k] > 0:
+                tip = ltg[k][E][:2]
+                self.M[tip, tip] += chain.mu[k]
+        # chord vectors d = A q + d_ref (rows: x, y of rod 1, 2, ...)
+        self.A = np.zeros((2 * chain.n, size))
+        for k in range(chain.n):
+            for c in range(2):
+                self.A[2 * k + c, ltg[k][E][c]] += 1.0
+                self.A[2 * k + c, ltg[k][0][c]] -= 1.0
+        self.d_ref = self.A @ self.ref
+        self.loads = [(f, ltg[f.node - 1][E][:2]) for f in scene.loads]
+        ini = scene.initial.resolve(chain.n)
+        at0 = {(k, j): ((ref + q0)[k, j][None], v0[k, j][None])
+               for k in range(chain.n) for j in range(E + 1)}
+        kin0, pot0 = _energies(scene, E, EA, at0, ini["phi"][None], ini["alpha"][None],
+                               ini["beta"][None])
+        self.E0 = float(kin0[0] + pot0[0])
+        self.w_plus, self.t_prev, self.p_prev = 0.0, 0.0, None
+        self.verdict: tuple | None = None
+        self.min_step, self.max_rotation_seen = math.inf, 0.0
+
+    def _power(self, t: float, v: np.ndarray) -> float:
+        p = 0.0
+        for f, idx in self.loads:
+            if f.active(t):
+                fx = f.fx(t) if f.fx is not None else 0.0
+                fy = f.fy(t) if f.fy is not None else 0.0
+                p += fx * v[idx[0]] + fy * v[idx[1]]
+        return p
+
+    def pre_step(self, mbs, t: float) -> bool:
+        h = float(self.solver.it.currentStepSize) if self.solver is not None else 0.0
+        if h > 0:
+            self.min_step = min(self.min_step, h)
+        return self.check(t - h, h)
+
+    def check(self, t: float, h: float = 0.0) -> bool:
+        """Check the current state, at time t (s), before a step h (s); False stops the run."""
+        if self.verdict is not None:
+            return False
+        try:
+            sd = self.mbs.systemData
+            q, v = sd.GetODE2Coordinates(), sd.GetODE2Coordinates_t()
+            if not math.isfinite(float(q @ q) + float(v @ v)):
+                self.verdict = (STATUS_DIVERGED, f"diverged: non-finite state at t = {t:.6g} s",
+                                t, False)
+                return False
+            if math.isfinite(self.factor):
+                p = self._power(t, v)
+                if not math.isfinite(p):
+                    self.verdict = (STATUS_ERROR, (f"a load is not finite at t = {t:.6g} s "
+                                                   f"(load power {p!r} W)"), t, False)
+                    return False
+                p = max(p, 0.0)
+                if self.p_prev is not None:
+                    self.w_plus += 0.5 * (t - self.t_prev) * (self.p_prev + p)
+                self.p_prev, self.t_prev = p, t
+                T = 0.5 * float(v @ self.M @ v)
+                budget = self.E0 + self.w_plus + ENERGY_FLOOR_J
+                if not T <= self.factor * budget:
+                    self.verdict = (STATUS_BLOWUP, (
+                        f"energy blow-up: kinetic energy {T:.4g} J > blowup_factor {self.factor:g} "
+                        f"x budget E(0) + W+ = {budget:.4g} J at t = {t:.6g} s"), t, False)
+                    return False
+            if h > 0:
+                d, dd = self.A @ q + self.d_ref, self.A @ v
+                dx, dy, ddx, ddy = d[0::2], d[1::2], dd[0::2], dd[1::2]
+                rate = np.abs(dx * ddy - dy * ddx) / (dx * dx + dy * dy)
+                rot = float(rate.max()) * h
+                self.max_rotation_seen = max(self.max_rotation_seen, rot)
+                if rot > self.max_rotation:
+                    k = int(rate.argmax()) + 1
+                    self.verdict = (STATUS_FAILED, (
+                        f"under-resolved: rod {k} turns by {rot:.3g} rad in one step of {h:.3g} s "
+                        f"(|dphi| = {rate.max():.4g} rad/s) at t = {t:.6g} s, above "
+                        f"max_rotation_per_step = {self.max_rotation:g} rad; reduce step"), t, True)
+                    return False
+        except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
+            self.verdict = (STATUS_ERROR, (f"divergence check failed at t = {t:.6g} s: "
+                                           f"{type(exc).__name__}: {exc}"), t, True)
+            return False
+        return True
+
+
+def _unknown_options_message(unknown: dict) -> str:
+    names = ", ".join(repr(k) for k in sorted(unknown))
+    return (f"unknown exudyn model option(s) {names}; allowed options: {', '.join(DEFAULTS)} "
+            f"(defaults {DEFAULTS})")
 
 
 def _revolutions(angle: float) -> float:

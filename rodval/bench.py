@@ -145,7 +145,7 @@ def work_precision(scene: Scene, models: list[str], methods: list[str], rtols: l
                     opts = {"kernel": kernel}
                 traj, wall = timed(scene, model, settings, repeats, **opts)
                 ref = refs.for_method(method) if native else ref_model
-                row = {"model": model, "method": method if native else traj.settings["solver"],
+                row = {"model": model, "method": method if native else traj.options["solver"],
                        "kernel": kernel, "rtol": knob if native else math.nan,
                        "atol": settings.atol if native else math.nan,
                        "step": math.nan if native else knob, **traj.stats.as_dict(),

@@ -54,7 +54,8 @@ def test_rigid_pendulum_period():
 @pytest.mark.parametrize("option, value", [
     ("elements", 0), ("elements", 1.5), ("step", 0.0), ("step", 1.0), ("EA", -1.0),
     ("element", "beam3d"), ("solver", "rk4"), ("spectral_radius", 1.5),
-    ("newton_rtol", 0.5), ("newton_atol_per_EA", 0.0)])
+    ("newton_rtol", 0.5), ("newton_atol_per_EA", 0.0), ("max_rotation_per_step", 0.0),
+    ("max_rotation_per_step", 4.0)])
 def test_bad_option_names_the_option(option, value):
     with pytest.raises(ValueError, match=option):
         ExudynModel(**{option: value})
