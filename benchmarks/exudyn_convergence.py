@@ -10,6 +10,7 @@ native run. Also compares the native ``published`` variant against the native pr
 
 writes ``convergence.csv`` and ``convergence.md`` in --out.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -18,9 +19,10 @@ import time
 
 import pandas as pd
 
-from rodval import TABLE1_TIMES, paper_scene, simulate
-from rodval.analysis.crosscheck import TABLE1_RODS as RODS, table1_gaps as errors
 from reference_models.exudyn_chain import DEFAULTS
+from rodval import TABLE1_TIMES, paper_scene, simulate
+from rodval.analysis.crosscheck import TABLE1_RODS as RODS
+from rodval.analysis.crosscheck import table1_gaps as errors
 
 SWEEPS = {
     "elements": [1, 2, 3, 4, 6, 8],
@@ -42,28 +44,53 @@ def main(argv=None) -> None:
     ref = simulate(scene, "full", rtol=1e-10, atol=1e-12)
     native_s = time.perf_counter() - t0
     published = simulate(scene, "full", rtol=1e-10, atol=1e-12, coefficients="published")
-    rows = [{"run": "native published", "option": "coefficients", "value": "published",
-             "status": published.stats.status, "wall_s": published.stats.wall_s,
-             **errors(published, ref)}]
+    rows = [
+        {
+            "run": "native published",
+            "option": "coefficients",
+            "value": "published",
+            "status": published.stats.status,
+            "wall_s": published.stats.wall_s,
+            **errors(published, ref),
+        }
+    ]
     default = simulate(scene, "exudyn")
-    rows += [{"run": f"exudyn defaults vs native {name}", "option": "-", "value": "-",
-              "status": default.stats.status, "wall_s": default.stats.wall_s, **errors(default, other)}
-             for name, other in (("printed", ref), ("published", published))]
+    rows += [
+        {
+            "run": f"exudyn defaults vs native {name}",
+            "option": "-",
+            "value": "-",
+            "status": default.stats.status,
+            "wall_s": default.stats.wall_s,
+            **errors(default, other),
+        }
+        for name, other in (("printed", ref), ("published", published))
+    ]
     for option, values in SWEEPS.items():
         for value in values[:2] if args.quick else values:
             tr = simulate(scene, "exudyn", **{option: value})
-            row = {"run": "exudyn", "option": option, "value": value, "status": tr.stats.status,
-                   "wall_s": tr.stats.wall_s, "newton_iterations": tr.stats.nfev}
+            row = {
+                "run": "exudyn",
+                "option": option,
+                "value": value,
+                "status": tr.stats.status,
+                "wall_s": tr.stats.wall_s,
+                "newton_iterations": tr.stats.nfev,
+            }
             row.update(errors(tr, ref) if tr.success else {"message": tr.stats.message})
             rows.append(row)
             print(row, flush=True)
     table = pd.DataFrame(rows)
     table.to_csv(args.out / "convergence.csv", index=False)
-    header = (f"# exudyn convergence on the paper example\n\nReference: native full model, printed "
-              f"coefficients, DOP853 rtol 1e-10 atol 1e-12 ({native_s:.2f} s). Defaults: {DEFAULTS}.\n"
-              f"Errors at t = {TABLE1_TIMES} s on rods {RODS}: phi, alpha, beta max abs (rad); dphi "
-              f"relative to the column's max |value|. One option varied at a time.\n\n")
-    (args.out / "convergence.md").write_text(header + table.to_markdown(index=False, floatfmt=".3g") + "\n")
+    header = (
+        f"# exudyn convergence on the paper example\n\nReference: native full model, printed "
+        f"coefficients, DOP853 rtol 1e-10 atol 1e-12 ({native_s:.2f} s). Defaults: {DEFAULTS}.\n"
+        f"Errors at t = {TABLE1_TIMES} s on rods {RODS}: phi, alpha, beta max abs (rad); dphi "
+        f"relative to the column's max |value|. One option varied at a time.\n\n"
+    )
+    (args.out / "convergence.md").write_text(
+        header + table.to_markdown(index=False, floatfmt=".3g") + "\n"
+    )
 
 
 if __name__ == "__main__":

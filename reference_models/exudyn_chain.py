@@ -31,14 +31,15 @@ length with unit slopes: unstretched at the nodes (``_bent_rod``). Velocities fo
 curve (dphi, dalpha, dbeta).
 
 Solver: exudyn's implicit generalized-alpha (or trapezoidal index-2) integrator with a fixed
-step (halved, down to step/64, only if Newton fails), sparse linear solver (EigenSparse), no solution files, no
-graphics and no console output. Newton's absolute tolerance is ``newton_atol_per_EA * EA``
+step (halved, down to step/64, only if Newton fails), sparse linear solver (EigenSparse), no
+solution files, no graphics and no console output. Newton's absolute tolerance is ``newton_atol_per_EA * EA``
 (N): the default absolute tolerance lies below the round-off of the stiff axial forces.
 rodval's native integrator settings are refused unless at their defaults (``check_settings``;
 ``blowup_factor`` applies). Before every step ``_Guard`` checks the state: non-finite
 (STATUS_DIVERGED), kinetic energy above blowup_factor x (E(0) + W+ + 1e-6 J) (STATUS_BLOWUP),
 rotation per step above ``max_rotation_per_step`` (STATUS_FAILED); a verdict stops the run.
 """
+
 from __future__ import annotations
 
 import math
@@ -51,7 +52,7 @@ import numpy as np
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
-from rodval.core.status import (STATUS_BLOWUP, STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED)
+from rodval.core.status import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED
 from rodval.core.trajectory import SolverStats, Trajectory
 
 ELEMENTS = ("cable2d",)
@@ -72,8 +73,15 @@ DEFAULTS: dict[str, Any] = {
 
 #: IntegratorSettings fields that belong to rodval's ODE integrators: exudyn cannot honour
 #: them (its integrator is set by this model's options), so any non-default value is refused.
-NATIVE_INTEGRATOR_FIELDS = ("method", "rtol", "atol", "max_step", "first_step", "max_evaluations",
-                            "max_wall_s")
+NATIVE_INTEGRATOR_FIELDS = (
+    "method",
+    "rtol",
+    "atol",
+    "max_step",
+    "first_step",
+    "max_evaluations",
+    "max_wall_s",
+)
 
 #: Absolute slack of the blow-up budget (J), as in the native runs' check (rodval.solvers.guard):
 #: a chain at rest without loads has E(0) = W+ = 0 and may pick up rounding-level motion.
@@ -83,8 +91,17 @@ _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(5)
 
 
 def _positive(name: str, value, *, upper: float = math.inf, integer: bool = False):
-    ok_type = isinstance(value, (int, np.integer)) if integer else isinstance(value, (int, float, np.number))
-    if isinstance(value, bool) or not ok_type or not (0 < value <= upper) or not math.isfinite(value):
+    ok_type = (
+        isinstance(value, (int, np.integer))
+        if integer
+        else isinstance(value, (int, float, np.number))
+    )
+    if (
+        isinstance(value, bool)
+        or not ok_type
+        or not (0 < value <= upper)
+        or not math.isfinite(value)
+    ):
         kind = "an integer >= 1" if integer else f"a number in (0, {upper:g}]"
         raise ValueError(f"{name} must be {kind}, got {value!r}")
     return int(value) if integer else float(value)
@@ -99,12 +116,27 @@ def _hermite(s: np.ndarray, le: float) -> tuple[np.ndarray, np.ndarray, np.ndarr
     """Cubic Hermite shape functions of an element of length le at local s (m):
     values, first and second s-derivatives, each (len(s), 4) for [r0, r0', r1, r1']."""
     x = s / le
-    S = np.stack([1 - 3 * x**2 + 2 * x**3, le * (x - 2 * x**2 + x**3),
-                  3 * x**2 - 2 * x**3, le * (-x**2 + x**3)], axis=-1)
-    dS = np.stack([(-6 * x + 6 * x**2) / le, 1 - 4 * x + 3 * x**2,
-                   (6 * x - 6 * x**2) / le, -2 * x + 3 * x**2], axis=-1)
-    ddS = np.stack([(-6 + 12 * x) / le**2, (-4 + 6 * x) / le,
-                    (6 - 12 * x) / le**2, (-2 + 6 * x) / le], axis=-1)
+    S = np.stack(
+        [
+            1 - 3 * x**2 + 2 * x**3,
+            le * (x - 2 * x**2 + x**3),
+            3 * x**2 - 2 * x**3,
+            le * (-(x**2) + x**3),
+        ],
+        axis=-1,
+    )
+    dS = np.stack(
+        [
+            (-6 * x + 6 * x**2) / le,
+            1 - 4 * x + 3 * x**2,
+            (6 * x - 6 * x**2) / le,
+            -2 * x + 3 * x**2,
+        ],
+        axis=-1,
+    )
+    ddS = np.stack(
+        [(-6 + 12 * x) / le**2, (-4 + 6 * x) / le, (6 - 12 * x) / le**2, (-2 + 6 * x) / le], axis=-1
+    )
     return S, dS, ddS
 
 
@@ -135,13 +167,15 @@ def _bent_rod(alpha: float, beta: float, l: float, elements: int):
     Returns positions p (E+1, 2), unit tangents t (E+1, 2), and their derivatives with
     respect to alpha and beta: dp (2, E+1, 2), dt (2, E+1, 2)."""
     if not (abs(alpha) < 0.5 * math.pi and abs(beta) < 0.5 * math.pi):
-        raise ValueError(f"initial alpha and beta must lie in (-pi/2, pi/2), got {alpha!r}, {beta!r}")
+        raise ValueError(
+            f"initial alpha and beta must lie in (-pi/2, pi/2), got {alpha!r}, {beta!r}"
+        )
     ta, tb = math.tan(alpha), math.tan(beta)
 
     def g(xi):
         return ta * (1 - xi) * (1 - 3 * xi) - tb * xi * (2 - 3 * xi)
 
-    def gp(xi):   # dg/dta, dg/dtb
+    def gp(xi):  # dg/dta, dg/dtb
         return np.stack([(1 - xi) * (1 - 3 * xi), -xi * (2 - 3 * xi)])
 
     def w(xi):
@@ -149,7 +183,7 @@ def _bent_rod(alpha: float, beta: float, l: float, elements: int):
 
     x1, w1 = _arc_rule(1.0)
     c = float(np.sum(w1 * w(x1)))
-    dc = np.sum(w1 * g(x1) * gp(x1) / w(x1), axis=-1)                   # (2,)
+    dc = np.sum(w1 * g(x1) * gp(x1) / w(x1), axis=-1)  # (2,)
     X = l / c
     dX = -l / c**2 * dc
     # arc-length positions of the beam nodes: int_0^xi w = (j / E) c, by Newton
@@ -162,10 +196,12 @@ def _bent_rod(alpha: float, beta: float, l: float, elements: int):
         if np.max(np.abs(step)) < 1e-15:
             break
     xi[0], xi[-1] = 0.0, 1.0
-    dA = np.stack([np.sum(wq * g(xq) * gp(xq) / w(xq), axis=-1) for xq, wq in map(_arc_rule, xi)], -1)
-    dxi = (frac * dc[:, None] - dA) / w(xi)                               # (2, E+1)
+    dA = np.stack(
+        [np.sum(wq * g(xq) * gp(xq) / w(xq), axis=-1) for xq, wq in map(_arc_rule, xi)], -1
+    )
+    dxi = (frac * dc[:, None] - dA) / w(xi)  # (2, E+1)
     dxi[:, 0] = dxi[:, -1] = 0.0
-    sig, tau = xi * (1 - xi) ** 2, -xi**2 * (1 - xi)
+    sig, tau = xi * (1 - xi) ** 2, -(xi**2) * (1 - xi)
     eta_hat = ta * sig + tb * tau
     gj, wj = g(xi), w(xi)
     dg_dxi = ta * (-4 + 6 * xi) + tb * (-2 + 6 * xi)
@@ -174,11 +210,12 @@ def _bent_rod(alpha: float, beta: float, l: float, elements: int):
     dp = np.empty((2, elements + 1, 2))
     dt = np.empty((2, elements + 1, 2))
     for i, (shape, dtan) in enumerate(((sig, 1.0 + ta**2), (tau, 1.0 + tb**2))):
-        dp_i = (dX[i] * np.stack([xi, eta_hat], -1)
-                + X * np.stack([dxi[i], gj * dxi[i] + shape], -1))        # per unit d(tan)
+        dp_i = dX[i] * np.stack([xi, eta_hat], -1) + X * np.stack(
+            [dxi[i], gj * dxi[i] + shape], -1
+        )  # per unit d(tan)
         dgj = gp(xi)[i] + dg_dxi * dxi[i]
         dt_i = np.stack([-gj / wj**3, 1.0 / wj**3], -1) * dgj[:, None]
-        dp[i], dt[i] = dp_i * dtan, dt_i * dtan                           # per unit angle
+        dp[i], dt[i] = dp_i * dtan, dt_i * dtan  # per unit angle
     return p, t, dp, dt
 
 
@@ -204,7 +241,9 @@ def _initial_node_states(scene: Scene, elements: int):
     cur = np.empty((n, elements + 1, 4))
     vel = np.empty((n, elements + 1, 4))
     for k in range(n):
-        p, t, dp, dt = _bent_rod(float(ini["alpha"][k]), float(ini["beta"][k]), float(l[k]), elements)
+        p, t, dp, dt = _bent_rod(
+            float(ini["alpha"][k]), float(ini["beta"][k]), float(l[k]), elements
+        )
         c, sn = math.cos(phi[k]), math.sin(phi[k])
         R = np.array([[c, -sn], [sn, c]])
         e = R[:, 0]
@@ -226,10 +265,10 @@ class _Built:
 
     SC: Any
     mbs: Any
-    node_sensors: dict[tuple[int, int], tuple[int, int, int]]   # (rod, local node) -> (q, v, a)
+    node_sensors: dict[tuple[int, int], tuple[int, int, int]]  # (rod, local node) -> (q, v, a)
     load_errors: list
-    nodes: list | None = None              # beam node numbers per rod
-    initial: tuple | None = None           # _initial_node_states: ref, offsets, velocities
+    nodes: list | None = None  # beam node numbers per rod
+    initial: tuple | None = None  # _initial_node_states: ref, offsets, velocities
 
 
 class ExudynModel(Model):
@@ -272,14 +311,20 @@ class ExudynModel(Model):
     #: exudyn integrates with its own options: rodval's integrator settings do not apply.
     USES_INTEGRATOR_SETTINGS = False
 
-    def __init__(self, *, elements: int = DEFAULTS["elements"], step: float = DEFAULTS["step"],
-                 EA: float = DEFAULTS["EA"], element: str = DEFAULTS["element"],
-                 solver: str = DEFAULTS["solver"],
-                 spectral_radius: float = DEFAULTS["spectral_radius"],
-                 newton_rtol: float = DEFAULTS["newton_rtol"],
-                 newton_atol_per_EA: float = DEFAULTS["newton_atol_per_EA"],
-                 max_rotation_per_step: float = DEFAULTS["max_rotation_per_step"],
-                 **unknown):
+    def __init__(
+        self,
+        *,
+        elements: int = DEFAULTS["elements"],
+        step: float = DEFAULTS["step"],
+        EA: float = DEFAULTS["EA"],
+        element: str = DEFAULTS["element"],
+        solver: str = DEFAULTS["solver"],
+        spectral_radius: float = DEFAULTS["spectral_radius"],
+        newton_rtol: float = DEFAULTS["newton_rtol"],
+        newton_atol_per_EA: float = DEFAULTS["newton_atol_per_EA"],
+        max_rotation_per_step: float = DEFAULTS["max_rotation_per_step"],
+        **unknown,
+    ):
         if unknown:
             raise ValueError(_unknown_options_message(unknown))
         self.elements = _positive("elements", elements, integer=True)
@@ -291,14 +336,18 @@ class ExudynModel(Model):
         if solver not in SOLVERS:
             raise ValueError(f"solver must be one of {SOLVERS}, got {solver!r}")
         self.solver = solver
-        if (isinstance(spectral_radius, bool) or not isinstance(spectral_radius, (int, float))
-                or not 0 <= spectral_radius <= 1):
+        if (
+            isinstance(spectral_radius, bool)
+            or not isinstance(spectral_radius, (int, float))
+            or not 0 <= spectral_radius <= 1
+        ):
             raise ValueError(f"spectral_radius must be a number in [0, 1], got {spectral_radius!r}")
         self.spectral_radius = float(spectral_radius)
         self.newton_rtol = _positive("newton_rtol", newton_rtol, upper=1e-2)
         self.newton_atol_per_EA = _positive("newton_atol_per_EA", newton_atol_per_EA, upper=1e-6)
-        self.max_rotation_per_step = _positive("max_rotation_per_step", max_rotation_per_step,
-                                               upper=math.pi)
+        self.max_rotation_per_step = _positive(
+            "max_rotation_per_step", max_rotation_per_step, upper=math.pi
+        )
 
     @classmethod
     def check_options(cls, options: dict[str, Any]) -> dict[str, Any]:
@@ -307,7 +356,8 @@ class ExudynModel(Model):
         ones) or a bad value."""
         if not isinstance(options, dict):
             raise ValueError(  # noqa: TRY004 - rodval reports every bad input as ValueError
-                f"exudyn model options must be a dict, got {type(options).__name__}")
+                f"exudyn model options must be a dict, got {type(options).__name__}"
+            )
         return cls(**options).options()
 
     def options(self) -> dict[str, Any]:
@@ -316,11 +366,20 @@ class ExudynModel(Model):
     # -- system ------------------------------------------------------------------------------
     def _build(self, scene: Scene) -> _Built:
         import exudyn as exu
-        from exudyn.itemInterface import (LoadForceVector, MarkerBodyPosition, MarkerBodyRigid,
-                                          MarkerNodePosition, NodeGenericData, NodePoint2DSlope1,
-                                          ObjectANCFCable2D, ObjectConnectorTorsionalSpringDamper,
-                                          ObjectGround, ObjectJointRevolute2D, ObjectMassPoint2D,
-                                          SensorNode)
+        from exudyn.itemInterface import (
+            LoadForceVector,
+            MarkerBodyPosition,
+            MarkerBodyRigid,
+            MarkerNodePosition,
+            NodeGenericData,
+            NodePoint2DSlope1,
+            ObjectANCFCable2D,
+            ObjectConnectorTorsionalSpringDamper,
+            ObjectGround,
+            ObjectJointRevolute2D,
+            ObjectMassPoint2D,
+            SensorNode,
+        )
 
         chain, E = scene.chain, self.elements
         SC = exu.SystemContainer()
@@ -329,15 +388,33 @@ class ExudynModel(Model):
         ref, q0, v0 = _initial_node_states(scene, E)
         nodes, elems = [], []
         for k in range(chain.n):
-            nodes.append([mbs.AddNode(NodePoint2DSlope1(referenceCoordinates=ref[k, j].tolist(),
-                                                        initialCoordinates=q0[k, j].tolist(),
-                                                        initialVelocities=v0[k, j].tolist()))
-                          for j in range(E + 1)])
+            nodes.append(
+                [
+                    mbs.AddNode(
+                        NodePoint2DSlope1(
+                            referenceCoordinates=ref[k, j].tolist(),
+                            initialCoordinates=q0[k, j].tolist(),
+                            initialVelocities=v0[k, j].tolist(),
+                        )
+                    )
+                    for j in range(E + 1)
+                ]
+            )
             le = float(chain.l[k]) / E
-            elems.append([mbs.AddObject(ObjectANCFCable2D(
-                nodeNumbers=[nodes[k][j], nodes[k][j + 1]], length=le,
-                massPerLength=float(chain.m[k]), bendingStiffness=float(chain.EI[k]),
-                axialStiffness=self.EA)) for j in range(E)])
+            elems.append(
+                [
+                    mbs.AddObject(
+                        ObjectANCFCable2D(
+                            nodeNumbers=[nodes[k][j], nodes[k][j + 1]],
+                            length=le,
+                            massPerLength=float(chain.m[k]),
+                            bendingStiffness=float(chain.EI[k]),
+                            axialStiffness=self.EA,
+                        )
+                    )
+                    for j in range(E)
+                ]
+            )
         # hinges: position joint + torsional spring-damper on the end tangents
         ini = scene.initial.resolve(chain.n)
         tangent_left = ini["phi"] + ini["alpha"]
@@ -349,26 +426,44 @@ class ExudynModel(Model):
                 angle0 = tangent_left[0]
             else:
                 pos0 = mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[k - 1][-1]))
-                rot0 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=elems[k - 1][-1],
-                                                     localPosition=[chain.l[k - 1] / E, 0, 0]))
+                rot0 = mbs.AddMarker(
+                    MarkerBodyRigid(
+                        bodyNumber=elems[k - 1][-1], localPosition=[chain.l[k - 1] / E, 0, 0]
+                    )
+                )
                 angle0 = tangent_left[k] - tangent_right[k - 1]
             pos1 = mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[k][0]))
             mbs.AddObject(ObjectJointRevolute2D(markerNumbers=[pos0, pos1]))
             if chain.kappa[k] > 0 or chain.nu[k] > 0:
-                rot1 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=elems[k][0], localPosition=[0, 0, 0]))
-                turns = mbs.AddNode(NodeGenericData(numberOfDataCoordinates=1,
-                                                    initialCoordinates=[_revolutions(angle0)]))
-                mbs.AddObject(ObjectConnectorTorsionalSpringDamper(
-                    markerNumbers=[rot0, rot1], nodeNumber=turns,
-                    stiffness=float(chain.kappa[k]), damping=float(chain.nu[k])))
+                rot1 = mbs.AddMarker(
+                    MarkerBodyRigid(bodyNumber=elems[k][0], localPosition=[0, 0, 0])
+                )
+                turns = mbs.AddNode(
+                    NodeGenericData(
+                        numberOfDataCoordinates=1, initialCoordinates=[_revolutions(angle0)]
+                    )
+                )
+                mbs.AddObject(
+                    ObjectConnectorTorsionalSpringDamper(
+                        markerNumbers=[rot0, rot1],
+                        nodeNumber=turns,
+                        stiffness=float(chain.kappa[k]),
+                        damping=float(chain.nu[k]),
+                    )
+                )
         for k in range(chain.n):
             if chain.mu[k] > 0:
                 mbs.AddObject(ObjectMassPoint2D(nodeNumber=nodes[k][-1], mass=float(chain.mu[k])))
         load_errors: list = []
         for f in scene.loads:
             marker = mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[f.node - 1][-1]))
-            mbs.AddLoad(LoadForceVector(markerNumber=marker, loadVector=[0, 0, 0],
-                                        loadVectorUserFunction=_load_function(f, load_errors)))
+            mbs.AddLoad(
+                LoadForceVector(
+                    markerNumber=marker,
+                    loadVector=[0, 0, 0],
+                    loadVectorUserFunction=_load_function(f, load_errors),
+                )
+            )
         # sensors on the beam nodes the outputs need
         wanted = set()
         if scene.wants("phi", "dphi", "alpha", "beta", "x", "y"):
@@ -377,10 +472,19 @@ class ExudynModel(Model):
             wanted |= {(k, j) for k in range(chain.n) for j in range(E + 1)}
         ovt = exu.OutputVariableType
         node_sensors = {
-            key: tuple(mbs.AddSensor(SensorNode(nodeNumber=nodes[key[0]][key[1]], storeInternal=True,
-                                                writeToFile=False, outputVariableType=v))
-                       for v in (ovt.CoordinatesTotal, ovt.Coordinates_t, ovt.Coordinates_tt))
-            for key in sorted(wanted)}
+            key: tuple(
+                mbs.AddSensor(
+                    SensorNode(
+                        nodeNumber=nodes[key[0]][key[1]],
+                        storeInternal=True,
+                        writeToFile=False,
+                        outputVariableType=v,
+                    )
+                )
+                for v in (ovt.CoordinatesTotal, ovt.Coordinates_t, ovt.Coordinates_tt)
+            )
+            for key in sorted(wanted)
+        }
         mbs.Assemble()
         return _Built(SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0))
 
@@ -395,7 +499,7 @@ class ExudynModel(Model):
         ti.initialStepSize = t_end / nsteps
         ti.automaticStepSize = False
         ti.adaptiveStep = True
-        ti.minimumStepSize = ti.initialStepSize / 64.0   # fail fast instead of crawling
+        ti.minimumStepSize = ti.initialStepSize / 64.0  # fail fast instead of crawling
         ti.verboseMode = 0
         ti.verboseModeFile = 0
         ti.newton.relativeTolerance = self.newton_rtol
@@ -425,7 +529,8 @@ class ExudynModel(Model):
                     f"the exudyn model cannot honour integrator setting {name}={value!r} "
                     f"(default {getattr(default, name)!r}): exudyn's integrator is set by its own "
                     f"options ({', '.join(DEFAULTS)}); leave {', '.join(NATIVE_INTEGRATOR_FIELDS)} "
-                    "at their defaults")
+                    "at their defaults"
+                )
 
     def simulate(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
         """Run the scene. Of the native integrator ``settings`` only ``blowup_factor`` applies;
@@ -459,8 +564,11 @@ class ExudynModel(Model):
         try:
             ok = solver.SolveSystem(built.mbs, sim)
             if not ok:
-                stats.status, stats.message = STATUS_FAILED, _solver_message(solver, "solver failed")
-            elif guard.verdict is None:   # the last step's end state has had no pre-step check
+                stats.status, stats.message = (
+                    STATUS_FAILED,
+                    _solver_message(solver, "solver failed"),
+                )
+            elif guard.verdict is None:  # the last step's end state has had no pre-step check
                 guard.check(scene.t_end)
         except Exception as exc:  # noqa: BLE001 - exudyn errors come back as data
             stats.status = STATUS_ERROR
@@ -469,12 +577,14 @@ class ExudynModel(Model):
         finally:
             stats.wall_s = time.perf_counter() - start
             exu.config.printToConsole = console
-        stats.nsteps = max(int(solver.it.currentStepIndex) - 1, 0)   # the index ends one past
+        stats.nsteps = max(int(solver.it.currentStepIndex) - 1, 0)  # the index ends one past
         stats.njev = int(solver.it.newtonJacobiCount)
         stats.nfev = int(solver.it.newtonStepsCount)
-        run_info.update(steps=stats.nsteps,
-                        min_step_used=guard.min_step if math.isfinite(guard.min_step) else None,
-                        max_rotation_per_step_seen=guard.max_rotation_seen)
+        run_info.update(
+            steps=stats.nsteps,
+            min_step_used=guard.min_step if math.isfinite(guard.min_step) else None,
+            max_rotation_per_step_seen=guard.max_rotation_seen,
+        )
         try:
             t_rec, records, diverged = self._records(built)
         except Exception as exc:  # noqa: BLE001
@@ -499,12 +609,17 @@ class ExudynModel(Model):
             times = t_rec
         elif keep_detected:
             times = times[times <= stats.t_reached + tol]
-        else:   # the state at the detection time is the bad one: keep the times before it
+        else:  # the state at the detection time is the bad one: keep the times before it
             times = times[times < stats.t_reached - tol]
         try:
-            observed = _observe(scene, self.elements, self.EA, times, t_rec, records) if times.size else {}
+            observed = (
+                _observe(scene, self.elements, self.EA, times, t_rec, records) if times.size else {}
+            )
         except Exception as exc:  # noqa: BLE001
-            stats.status, stats.message = STATUS_ERROR, f"observation failed: {type(exc).__name__}: {exc}"
+            stats.status, stats.message = (
+                STATUS_ERROR,
+                f"observation failed: {type(exc).__name__}: {exc}",
+            )
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         return self._trajectory(scene, times, observed, stats, run_info)
 
@@ -512,8 +627,10 @@ class ExudynModel(Model):
         """Recorded times (s); per (rod, local node), arrays q, v, a (nt, 4) up to the first
         non-finite record; whether a non-finite record was cut off."""
         mbs = built.mbs
-        data = {key: tuple(mbs.GetSensorStoredData(s) for s in ids)
-                for key, ids in built.node_sensors.items()}
+        data = {
+            key: tuple(mbs.GetSensorStoredData(s) for s in ids)
+            for key, ids in built.node_sensors.items()
+        }
         first = next(iter(data.values()))[0]
         if first.ndim != 2 or first.shape[0] == 0:
             return np.empty(0), {}, False
@@ -536,13 +653,16 @@ class ExudynModel(Model):
         steps_planned, step_used (s, the fixed step), steps (taken), min_step_used (s, smaller
         than step_used only if Newton failures halved it), max_rotation_per_step_seen (rad),
         blowup_factor)."""
-        return Trajectory(model=self.name, scene_name=scene.name, times=times,
-                          values={q: v for q, (v, _) in observed.items()},
-                          k_index={q: k for q, (_, k) in observed.items()},
-                          stats=stats,
-                          settings={"method": f"exudyn {self.solver}", "step": self.step,
-                                    **(run_info or {})},
-                          options=self.options())
+        return Trajectory(
+            model=self.name,
+            scene_name=scene.name,
+            times=times,
+            values={q: v for q, (v, _) in observed.items()},
+            k_index={q: k for q, (_, k) in observed.items()},
+            stats=stats,
+            settings={"method": f"exudyn {self.solver}", "step": self.step, **(run_info or {})},
+            options=self.options(),
+        )
 
 
 class _Guard:
@@ -559,27 +679,31 @@ class _Guard:
       checked states), E(0) the initial T + Pi (``_energies``): STATUS_BLOWUP;
     * max_k |dphi_k| x step above ``max_rotation``: STATUS_FAILED (under-resolved)."""
 
-    def __init__(self, built: _Built, scene: Scene, E: int, EA: float, factor: float,
-                 max_rotation: float):
+    def __init__(
+        self, built: _Built, scene: Scene, E: int, EA: float, factor: float, max_rotation: float
+    ):
         mbs, chain = built.mbs, scene.chain
         ref, q0, v0 = built.initial
         self.mbs, self.solver = mbs, None
         self.factor, self.max_rotation = float(factor), float(max_rotation)
         size = mbs.systemData.ODE2Size()
-        ltg = [[np.asarray(mbs.systemData.GetNodeLTGODE2(nd), int) for nd in rod] for rod in built.nodes]
+        ltg = [
+            [np.asarray(mbs.systemData.GetNodeLTGODE2(nd), int) for nd in rod]
+            for rod in built.nodes
+        ]
         self.ref = np.zeros(size)
         for k, rod in enumerate(ltg):
             for j, idx in enumerate(rod):
                 self.ref[idx] = ref[k, j]
-        self.M = np.zeros((size, size))   # dense: a 4 us product at n = 8, 2 elements/rod
+        self.M = np.zeros((size, size))  # dense: a 4 us product at n = 8, 2 elements/rod
         for k in range(chain.n):
             le = chain.l[k] / E
             s = 0.5 * le * (_GAUSS_X + 1.0)
             S = _hermite(s, le)[0]
-            Me = chain.m[k] * np.einsum("g,gi,gj->ij", 0.5 * le * _GAUSS_W, S, S)   # (4, 4)
+            Me = chain.m[k] * np.einsum("g,gi,gj->ij", 0.5 * le * _GAUSS_W, S, S)  # (4, 4)
             for j in range(E):
                 a, b = ltg[k][j], ltg[k][j + 1]
-                dofs = np.array([a[:2], a[2:], b[:2], b[2:]])                       # (4, 2)
+                dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
                 for c in range(2):
                     self.M[np.ix_(dofs[:, c], dofs[:, c])] += Me
             if chain.mu[k] > 0:
@@ -594,10 +718,14 @@ class _Guard:
         self.d_ref = self.A @ self.ref
         self.loads = [(f, ltg[f.node - 1][E][:2]) for f in scene.loads]
         ini = scene.initial.resolve(chain.n)
-        at0 = {(k, j): ((ref + q0)[k, j][None], v0[k, j][None])
-               for k in range(chain.n) for j in range(E + 1)}
-        kin0, pot0 = _energies(scene, E, EA, at0, ini["phi"][None], ini["alpha"][None],
-                               ini["beta"][None])
+        at0 = {
+            (k, j): ((ref + q0)[k, j][None], v0[k, j][None])
+            for k in range(chain.n)
+            for j in range(E + 1)
+        }
+        kin0, pot0 = _energies(
+            scene, E, EA, at0, ini["phi"][None], ini["alpha"][None], ini["beta"][None]
+        )
         self.E0 = float(kin0[0] + pot0[0])
         self.w_plus, self.t_prev, self.p_prev = 0.0, 0.0, None
         self.verdict: tuple | None = None
@@ -626,14 +754,22 @@ class _Guard:
             sd = self.mbs.systemData
             q, v = sd.GetODE2Coordinates(), sd.GetODE2Coordinates_t()
             if not math.isfinite(float(q @ q) + float(v @ v)):
-                self.verdict = (STATUS_DIVERGED, f"diverged: non-finite state at t = {t:.6g} s",
-                                t, False)
+                self.verdict = (
+                    STATUS_DIVERGED,
+                    f"diverged: non-finite state at t = {t:.6g} s",
+                    t,
+                    False,
+                )
                 return False
             if math.isfinite(self.factor):
                 p = self._power(t, v)
                 if not math.isfinite(p):
-                    self.verdict = (STATUS_ERROR, (f"a load is not finite at t = {t:.6g} s "
-                                                   f"(load power {p!r} W)"), t, False)
+                    self.verdict = (
+                        STATUS_ERROR,
+                        (f"a load is not finite at t = {t:.6g} s (load power {p!r} W)"),
+                        t,
+                        False,
+                    )
                     return False
                 p = max(p, 0.0)
                 if self.p_prev is not None:
@@ -642,9 +778,15 @@ class _Guard:
                 T = 0.5 * float(v @ self.M @ v)
                 budget = self.E0 + self.w_plus + ENERGY_FLOOR_J
                 if not T <= self.factor * budget:
-                    self.verdict = (STATUS_BLOWUP, (
-                        f"energy blow-up: kinetic energy {T:.4g} J > blowup_factor {self.factor:g} "
-                        f"x budget E(0) + W+ = {budget:.4g} J at t = {t:.6g} s"), t, False)
+                    self.verdict = (
+                        STATUS_BLOWUP,
+                        (
+                            f"energy blow-up: kinetic energy {T:.4g} J > blowup_factor {self.factor:g} "
+                            f"x budget E(0) + W+ = {budget:.4g} J at t = {t:.6g} s"
+                        ),
+                        t,
+                        False,
+                    )
                     return False
             if h > 0:
                 d, dd = self.A @ q + self.d_ref, self.A @ v
@@ -654,22 +796,34 @@ class _Guard:
                 self.max_rotation_seen = max(self.max_rotation_seen, rot)
                 if rot > self.max_rotation:
                     k = int(rate.argmax()) + 1
-                    self.verdict = (STATUS_FAILED, (
-                        f"under-resolved: rod {k} turns by {rot:.3g} rad in one step of {h:.3g} s "
-                        f"(|dphi| = {rate.max():.4g} rad/s) at t = {t:.6g} s, above "
-                        f"max_rotation_per_step = {self.max_rotation:g} rad; reduce step"), t, True)
+                    self.verdict = (
+                        STATUS_FAILED,
+                        (
+                            f"under-resolved: rod {k} turns by {rot:.3g} rad in one step of {h:.3g} s "
+                            f"(|dphi| = {rate.max():.4g} rad/s) at t = {t:.6g} s, above "
+                            f"max_rotation_per_step = {self.max_rotation:g} rad; reduce step"
+                        ),
+                        t,
+                        True,
+                    )
                     return False
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
-            self.verdict = (STATUS_ERROR, (f"divergence check failed at t = {t:.6g} s: "
-                                           f"{type(exc).__name__}: {exc}"), t, True)
+            self.verdict = (
+                STATUS_ERROR,
+                (f"divergence check failed at t = {t:.6g} s: {type(exc).__name__}: {exc}"),
+                t,
+                True,
+            )
             return False
         return True
 
 
 def _unknown_options_message(unknown: dict) -> str:
     names = ", ".join(repr(k) for k in sorted(unknown))
-    return (f"unknown exudyn model option(s) {names}; allowed options: {', '.join(DEFAULTS)} "
-            f"(defaults {DEFAULTS})")
+    return (
+        f"unknown exudyn model option(s) {names}; allowed options: {', '.join(DEFAULTS)} "
+        f"(defaults {DEFAULTS})"
+    )
 
 
 def _revolutions(angle: float) -> float:
@@ -719,8 +873,10 @@ def _observe(scene: Scene, E: int, EA: float, times: np.ndarray, t_rec: np.ndarr
     """The scene's quantities at ``times`` from recorded node states (see module docstring)."""
     n = scene.n
     rods = np.arange(1, n + 1)
-    at = {key: (_interpolate(times, t_rec, q, v), _interpolate(times, t_rec, v, a))
-          for key, (q, v, a) in records.items()}
+    at = {
+        key: (_interpolate(times, t_rec, q, v), _interpolate(times, t_rec, v, a))
+        for key, (q, v, a) in records.items()
+    }
     out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     if not scene.wants("phi", "dphi", "alpha", "beta", "x", "y", "energy"):
         return out
@@ -733,7 +889,7 @@ def _observe(scene: Scene, E: int, EA: float, times: np.ndarray, t_rec: np.ndarr
     phi0 = scene.initial.resolve(n)["phi"]
     phi_rec += 2 * np.pi * np.round((phi0 - phi_rec[0]) / (2 * np.pi))
     i = np.clip(np.searchsorted(t_rec, times, side="right") - 1, 0, t_rec.size - 1)
-    qL = np.stack([at[(k, 0)][0] for k in range(n)], 1)       # (nt, n, 4)
+    qL = np.stack([at[(k, 0)][0] for k in range(n)], 1)  # (nt, n, 4)
     qR = np.stack([at[(k, E)][0] for k in range(n)], 1)
     vL = np.stack([at[(k, 0)][1] for k in range(n)], 1)
     vR = np.stack([at[(k, E)][1] for k in range(n)], 1)
@@ -762,7 +918,9 @@ def _observe(scene: Scene, E: int, EA: float, times: np.ndarray, t_rec: np.ndarr
     return out
 
 
-def _energies(scene: Scene, E: int, EA: float, at: dict, phi, alpha, beta) -> tuple[np.ndarray, np.ndarray]:
+def _energies(
+    scene: Scene, E: int, EA: float, at: dict, phi, alpha, beta
+) -> tuple[np.ndarray, np.ndarray]:
     """Kinetic and potential energy (J) per output time: beam kinetic, bending (EI kappa^2/2),
     axial (EA eps^2/2, EA of the run), point masses and hinge springs (kappa D^2/2 with the
     continuous tangent angles phi + alpha, phi + beta)."""
@@ -777,7 +935,7 @@ def _energies(scene: Scene, E: int, EA: float, at: dict, phi, alpha, beta) -> tu
         for j in range(E):
             qa, va = at[(k, j)]
             qb, vb = at[(k, j + 1)]
-            Q = np.stack([qa[:, :2], qa[:, 2:], qb[:, :2], qb[:, 2:]], 1)     # (nt, 4, 2)
+            Q = np.stack([qa[:, :2], qa[:, 2:], qb[:, :2], qb[:, 2:]], 1)  # (nt, 4, 2)
             V = np.stack([va[:, :2], va[:, 2:], vb[:, :2], vb[:, 2:]], 1)
             r_t = np.einsum("gi,tic->tgc", S, V)
             r1 = np.einsum("gi,tic->tgc", dS, Q)

@@ -13,6 +13,7 @@ Conventions
   ``final_q`` = max_k |d(t_end)| / s, ``rms_q`` = RMS(d) / s, ``max_q`` = max |d| / s;
   ``scd`` = -log10 of the largest ``max_q``.
 """
+
 from __future__ import annotations
 
 import math
@@ -22,14 +23,14 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from rodval.solvers.driver import integrate
-from rodval.models import get_model
+from rodval.analysis.metrics import pareto_front, scaled_errors  # noqa: F401 - pareto_front: bench API
 from rodval.core.provenance import machine, package_versions
 from rodval.core.scene import Scene, paper_scene
 from rodval.core.settings import IntegratorSettings
-from rodval.models.registry import simulate
 from rodval.core.trajectory import Trajectory
-from rodval.analysis.metrics import pareto_front, scaled_errors  # noqa: F401 - pareto_front: bench API
+from rodval.models import get_model
+from rodval.models.registry import simulate
+from rodval.solvers.driver import integrate
 
 QUANTITIES = ("phi", "dphi", "alpha", "beta")
 DOP853_FAMILY = ("DOP853", "DOP853-numba")
@@ -47,8 +48,10 @@ def ladder(model: str, method: str, rtols) -> list[tuple[float, IntegratorSettin
     """(precision knob, settings, model options), loosest first: the tolerance ladder
     (atol = rtol / 100) for native models, the step ladder for fixed-step reference models."""
     if model in NATIVE:
-        return [(r, IntegratorSettings(method=method, rtol=r, atol=r * 1e-2), {})
-                for r in sorted(rtols, reverse=True)]
+        return [
+            (r, IntegratorSettings(method=method, rtol=r, atol=r * 1e-2), {})
+            for r in sorted(rtols, reverse=True)
+        ]
     return [(h, IntegratorSettings(), {"step": h}) for h in REFERENCE_MODEL_STEPS]
 
 
@@ -64,8 +67,9 @@ def reference_model_reference(scene: Scene, model: str) -> Trajectory:
 SLOW_RUN_S = 2.0
 
 
-def timed(scene: Scene, model: str, settings: IntegratorSettings, repeats: int = 3,
-          **options) -> tuple[Trajectory, float]:
+def timed(
+    scene: Scene, model: str, settings: IntegratorSettings, repeats: int = 3, **options
+) -> tuple[Trajectory, float]:
     """(trajectory, min wall time over ``repeats`` runs after a warm-up run) in s."""
     warm = simulate(scene, model, settings=settings, **options)
     count = 1 if warm.stats.wall_s > SLOW_RUN_S else repeats
@@ -88,7 +92,9 @@ def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str
             continue
         out.update({f"{k}_{q}": v for k, v in scaled_errors(traj[q], ref[q]).items()})
         worst = max(worst, out[f"max_{q}"])
-    out["scd"] = -math.log10(worst) if 0 < worst < math.inf else (math.inf if worst == 0 else math.nan)
+    out["scd"] = (
+        -math.log10(worst) if 0 < worst < math.inf else (math.inf if worst == 0 else math.nan)
+    )
     return out
 
 
@@ -96,17 +102,19 @@ def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str
 class References:
     """The two references of one (scene, model) and their mutual difference."""
 
-    dop: Trajectory      # for the DOP853 family
-    other: Trajectory    # for every other method
-    uncertainty: float   # max relative difference over phi, dphi
+    dop: Trajectory  # for the DOP853 family
+    other: Trajectory  # for every other method
+    uncertainty: float  # max relative difference over phi, dphi
 
     def for_method(self, method: str) -> Trajectory:
         return self.dop if method in DOP853_FAMILY else self.other
 
 
 def references(scene: Scene, model: str, **options) -> References:
-    runs = [simulate(scene, model, method=m, rtol=r, atol=a, **options)
-            for m, r, a in (REFERENCE_DOP, REFERENCE_OTHER)]
+    runs = [
+        simulate(scene, model, method=m, rtol=r, atol=a, **options)
+        for m, r, a in (REFERENCE_DOP, REFERENCE_OTHER)
+    ]
     for run in runs:
         if not run.success:
             raise RuntimeError(f"reference run of {model} failed: {run.stats.message}")
@@ -114,9 +122,17 @@ def references(scene: Scene, model: str, **options) -> References:
     return References(runs[0], runs[1], max(e["max_phi"], e["max_dphi"]))
 
 
-def work_precision(scene: Scene, models: list[str], methods: list[str], rtols: list[float], *,
-                   repeats: int = 3, budget_s: float = 20.0, baseline: bool = True,
-                   progress=print) -> tuple[pd.DataFrame, dict[str, float], list[str]]:
+def work_precision(
+    scene: Scene,
+    models: list[str],
+    methods: list[str],
+    rtols: list[float],
+    *,
+    repeats: int = 3,
+    budget_s: float = 20.0,
+    baseline: bool = True,
+    progress=print,
+) -> tuple[pd.DataFrame, dict[str, float], list[str]]:
     """One row per (model, method, kernel, rtol): cost and errors. For each model and method
     the ladder (loosest first) stops after a run slower than ``budget_s``. ``baseline`` adds
     scipy DOP853 with the numpy right-hand side (``kernel="numpy"``) for native models.
@@ -136,8 +152,10 @@ def work_precision(scene: Scene, models: list[str], methods: list[str], rtols: l
             variants = [(m, "numba") for m in methods] + ([("DOP853", "numpy")] if baseline else [])
         else:
             ref_model = reference_model_reference(scene, model)
-            notes.append(f"model {model}: step ladder {REFERENCE_MODEL_STEPS} s (its default "
-                         f"solver); reference = {REFERENCE_MODEL_REF}")
+            notes.append(
+                f"model {model}: step ladder {REFERENCE_MODEL_STEPS} s (its default "
+                f"solver); reference = {REFERENCE_MODEL_REF}"
+            )
             variants = [("default", "")]
         for method, kernel in variants:
             for knob, settings, opts in ladder(model, method, rtols):
@@ -145,21 +163,33 @@ def work_precision(scene: Scene, models: list[str], methods: list[str], rtols: l
                     opts = {"kernel": kernel}
                 traj, wall = timed(scene, model, settings, repeats, **opts)
                 ref = refs.for_method(method) if native else ref_model
-                row = {"model": model, "method": method if native else traj.options["solver"],
-                       "kernel": kernel, "rtol": knob if native else math.nan,
-                       "atol": settings.atol if native else math.nan,
-                       "step": math.nan if native else knob, **traj.stats.as_dict(),
-                       "reference": (f"{ref.settings['method']} rtol {ref.settings['rtol']:g}"
-                                     if native else f"{model} {REFERENCE_MODEL_REF}")}
-                row["wall_s"] = wall   # the minimum, not the last run's
+                row = {
+                    "model": model,
+                    "method": method if native else traj.options["solver"],
+                    "kernel": kernel,
+                    "rtol": knob if native else math.nan,
+                    "atol": settings.atol if native else math.nan,
+                    "step": math.nan if native else knob,
+                    **traj.stats.as_dict(),
+                    "reference": (
+                        f"{ref.settings['method']} rtol {ref.settings['rtol']:g}"
+                        if native
+                        else f"{model} {REFERENCE_MODEL_REF}"
+                    ),
+                }
+                row["wall_s"] = wall  # the minimum, not the last run's
                 row.update(errors(traj, ref))
                 rows.append(row)
-                progress(f"{model:8s} {row['method']:13s} {kernel:6s} "
-                         f"{'rtol' if native else 'step'} {knob:7.0e}  wall {wall * 1e3:9.2f} ms  "
-                         f"nfev {traj.stats.nfev:7d}  phi err {row.get('max_phi', math.nan):.2e}")
+                progress(
+                    f"{model:8s} {row['method']:13s} {kernel:6s} "
+                    f"{'rtol' if native else 'step'} {knob:7.0e}  wall {wall * 1e3:9.2f} ms  "
+                    f"nfev {traj.stats.nfev:7d}  phi err {row.get('max_phi', math.nan):.2e}"
+                )
                 if wall > budget_s:
-                    notes.append(f"{model} {method} {kernel}: ladder stopped after {knob:g} "
-                                 f"({wall:.1f} s > budget {budget_s:g} s)")
+                    notes.append(
+                        f"{model} {method} {kernel}: ladder stopped after {knob:g} "
+                        f"({wall:.1f} s > budget {budget_s:g} s)"
+                    )
                     break
     frame = pd.DataFrame(rows)
     return with_provenance(frame), uncertainty, notes
@@ -167,8 +197,10 @@ def work_precision(scene: Scene, models: list[str], methods: list[str], rtols: l
 
 def with_provenance(frame: pd.DataFrame) -> pd.DataFrame:
     """Machine and package versions as constant columns (so a CSV carries its own context)."""
-    info = {**{k: str(v) for k, v in machine().items()},
-            **{f"version_{k}": str(v) for k, v in package_versions().items()}}
+    info = {
+        **{k: str(v) for k, v in machine().items()},
+        **{f"version_{k}": str(v) for k, v in package_versions().items()},
+    }
     return frame.assign(**info)
 
 
@@ -179,8 +211,13 @@ def cheapest(frame: pd.DataFrame, quantity: str = "phi", tol: float = 1e-6) -> p
     return ok.loc[idx].sort_values(["model", "wall_s"])
 
 
-def baseline_ratios(scene: Scene, tol: float = 1e-6, rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
-                    repeats: int = 3, progress=print) -> pd.DataFrame:
+def baseline_ratios(
+    scene: Scene,
+    tol: float = 1e-6,
+    rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
+    repeats: int = 3,
+    progress=print,
+) -> pd.DataFrame:
     """Per native model: the loosest rtol at which the compiled DOP853 reaches phi error <= tol,
     then, side by side at that same tolerance, scipy DOP853 with the numba kernel and with
     the straightforward numpy kernel; speed-up = baseline wall / compiled wall."""
@@ -199,17 +236,30 @@ def baseline_ratios(scene: Scene, tol: float = 1e-6, rtols=(1e-5, 1e-6, 1e-7, 1e
             runs[f"DOP853/{kernel}"] = timed(scene, model, s, repeats, kernel=kernel)
         for name, (traj, w) in runs.items():
             method, kernel = name.split("/")
-            rows.append({"model": model, "method": method, "kernel": kernel, "rtol": rtol,
-                         "wall_s": w, "nfev": traj.stats.nfev,
-                         "max_phi": errors(traj, refs.dop)["max_phi"],
-                         "speedup_vs_numpy_DOP853": runs["DOP853/numpy"][1] / w})
+            rows.append(
+                {
+                    "model": model,
+                    "method": method,
+                    "kernel": kernel,
+                    "rtol": rtol,
+                    "wall_s": w,
+                    "nfev": traj.stats.nfev,
+                    "max_phi": errors(traj, refs.dop)["max_phi"],
+                    "speedup_vs_numpy_DOP853": runs["DOP853/numpy"][1] / w,
+                }
+            )
             progress(f"{model:8s} {name:20s} rtol {rtol:g}: {w * 1e3:9.2f} ms")
     return with_provenance(pd.DataFrame(rows))
 
 
-def per_eval_cost(n_values=(2, 4, 8, 16, 32, 64, 128, 256, 512), kernels=("numba", "numpy"),
-                  models=("full",), min_time: float = 0.05, repeats: int = 3,
-                  progress=print) -> pd.DataFrame:
+def per_eval_cost(
+    n_values=(2, 4, 8, 16, 32, 64, 128, 256, 512),
+    kernels=("numba", "numpy"),
+    models=("full",),
+    min_time: float = 0.05,
+    repeats: int = 3,
+    progress=print,
+) -> pd.DataFrame:
     """Seconds per right-hand-side evaluation (min over repeats of a timed loop) against n at
     a random state with the load active."""
     rows = []
@@ -266,30 +316,60 @@ def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
             runs = [integrate(system, undamped, settings, model=model) for _ in range(repeats + 1)]
             walls[forced] = (min(r.stats.wall_s for r in runs[1:]), runs[-1])
         same = np.max(np.abs(walls[True][1]["phi"] - walls[False][1]["phi"]))
-        rows.append(_skip_row("damping terms (all nu = 0)", model, walls[False][0], walls[True][0],
-                              f"max |phi difference| = {same:.1e}"))
+        rows.append(
+            _skip_row(
+                "damping terms (all nu = 0)",
+                model,
+                walls[False][0],
+                walls[True][0],
+                f"max |phi difference| = {same:.1e}",
+            )
+        )
     for model in ("reduced", "full"):
         for kernel in ("numba", "numpy"):
             system = get_model(model, kernel=kernel).system(paper_scene(8))
             y = np.random.default_rng(1).normal(scale=0.5, size=system.y0.size)
             cost = {t: min(_timeit(system, y, t) for _ in range(repeats)) for t in (1.5, 0.3)}
-            rows.append(_skip_row(f"load term past its support ({kernel} RHS, per eval)", model,
-                                  cost[1.5], cost[0.3], "t = 1.5 s (skipped) vs 0.3 s (evaluated)"))
+            rows.append(
+                _skip_row(
+                    f"load term past its support ({kernel} RHS, per eval)",
+                    model,
+                    cost[1.5],
+                    cost[0.3],
+                    "t = 1.5 s (skipped) vs 0.3 s (evaluated)",
+                )
+            )
     scipy_dop = IntegratorSettings("DOP853", rtol=1e-8, atol=1e-10)
     times = np.linspace(0, 2, 201)
     lean = paper_scene(8, times=times, outputs=("phi", "dphi"))
     full_out = paper_scene(8, times=times)
     w_lean = timed(lean, "reduced", scipy_dop, repeats)[1]
     w_full = timed(full_out, "reduced", scipy_dop, repeats)[1]
-    rows.append(_skip_row("gamma recovery (outputs phi, dphi only; 201 times)", "reduced",
-                          w_lean, w_full, "vs outputs phi, dphi, alpha, beta"))
+    rows.append(
+        _skip_row(
+            "gamma recovery (outputs phi, dphi only; 201 times)",
+            "reduced",
+            w_lean,
+            w_full,
+            "vs outputs phi, dphi, alpha, beta",
+        )
+    )
     few, fe = timed(paper_scene(8, times=(0.5, 1.0, 1.5, 2.0)), "reduced", scipy_dop, repeats)
     many, ma = timed(paper_scene(8, times=np.linspace(0, 2, 2001)), "reduced", scipy_dop, repeats)
-    rows.append(_skip_row("dense output only on steps with output times", "reduced", fe, ma,
-                          f"4 vs 2001 output times; nfev {few.stats.nfev} vs {many.stats.nfev}"))
+    rows.append(
+        _skip_row(
+            "dense output only on steps with output times",
+            "reduced",
+            fe,
+            ma,
+            f"4 vs 2001 output times; nfev {few.stats.nfev} vs {many.stats.nfev}",
+        )
+    )
     for r in rows:
-        progress(f"{r['skip']:60s} {r['model']:8s} {r['with_skip_s'] * 1e3:9.3f} ms vs "
-                 f"{r['without_skip_s'] * 1e3:9.3f} ms")
+        progress(
+            f"{r['skip']:60s} {r['model']:8s} {r['with_skip_s'] * 1e3:9.3f} ms vs "
+            f"{r['without_skip_s'] * 1e3:9.3f} ms"
+        )
     return with_provenance(pd.DataFrame(rows))
 
 
@@ -301,13 +381,24 @@ def _timeit(system, y, t, reps: int = 2000) -> float:
 
 
 def _skip_row(skip: str, model: str, with_skip: float, without: float, note: str) -> dict:
-    return {"skip": skip, "model": model, "with_skip_s": with_skip, "without_skip_s": without,
-            "saving": 1 - with_skip / without, "note": note}
+    return {
+        "skip": skip,
+        "model": model,
+        "with_skip_s": with_skip,
+        "without_skip_s": without,
+        "saving": 1 - with_skip / without,
+        "note": note,
+    }
 
 
-def speedup_vs_n(n_values=(2, 4, 8, 16, 32), tol: float = 1e-6,
-                 rtols=(1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10), repeats: int = 3,
-                 models=("full", "reduced", "exudyn"), progress=print) -> tuple[pd.DataFrame, list[str]]:
+def speedup_vs_n(
+    n_values=(2, 4, 8, 16, 32),
+    tol: float = 1e-6,
+    rtols=(1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
+    repeats: int = 3,
+    models=("full", "reduced", "exudyn"),
+    progress=print,
+) -> tuple[pd.DataFrame, list[str]]:
     """For each n and model: the cheapest rung of its precision ladder (``ladder``: compiled
     DOP853 tolerances for native models, the step for exudyn) with phi error <= tol against
     that model's own reference; then the full/reduced (and exudyn/native) wall-time ratios at
@@ -325,7 +416,9 @@ def speedup_vs_n(n_values=(2, 4, 8, 16, 32), tol: float = 1e-6,
         scene = paper_scene(n, times=np.linspace(0, 2, 21), outputs=("phi", "dphi"))
         for model in available:
             native = model in NATIVE
-            ref = references(scene, model).dop if native else reference_model_reference(scene, model)
+            ref = (
+                references(scene, model).dop if native else reference_model_reference(scene, model)
+            )
             method = "DOP853-numba" if native else "default"
             best = None
             for knob, settings, opts in ladder(model, method, rtols):
@@ -333,13 +426,21 @@ def speedup_vs_n(n_values=(2, 4, 8, 16, 32), tol: float = 1e-6,
                 if errors(traj, ref, ("phi",))["max_phi"] <= tol:
                     best = (knob, wall, traj.stats.nfev)
                     break
-            rows.append({"n": n, "model": model, "method": method,
-                         "rtol" if native else "step": best[0] if best else math.nan,
-                         "wall_s": best[1] if best else math.nan,
-                         "nfev": best[2] if best else math.nan})
+            rows.append(
+                {
+                    "n": n,
+                    "model": model,
+                    "method": method,
+                    "rtol" if native else "step": best[0] if best else math.nan,
+                    "wall_s": best[1] if best else math.nan,
+                    "nfev": best[2] if best else math.nan,
+                }
+            )
             knob = "rtol" if native else "step"
-            progress(f"n = {n:3d} {model:8s}: {rows[-1]['wall_s'] * 1e3:9.2f} ms at {knob} "
-                     f"{rows[-1][knob]:g}")
+            progress(
+                f"n = {n:3d} {model:8s}: {rows[-1]['wall_s'] * 1e3:9.2f} ms at {knob} "
+                f"{rows[-1][knob]:g}"
+            )
     frame = pd.DataFrame(rows)
     wide = frame.pivot(index="n", columns="model", values="wall_s")
     if {"full", "reduced"} <= set(wide):

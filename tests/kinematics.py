@@ -3,11 +3,12 @@
 Nothing here uses rodval.models: positions are computed from the definitions in model.md,
 velocities by central differences of positions, energies by Gauss-Legendre quadrature over s.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-GAUSS_S, GAUSS_W = np.polynomial.legendre.leggauss(8)   # exact for degree <= 15
+GAUSS_S, GAUSS_W = np.polynomial.legendre.leggauss(8)  # exact for degree <= 15
 
 
 def shape(s, l):
@@ -18,7 +19,7 @@ def shape(s, l):
 def points(q: np.ndarray, l: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Quadrature points of every rod (n, 8, 2), their weights (n, 8), and nodes (n, 2)."""
     n = l.size
-    phi, alpha, beta = q[:n], q[n:2 * n], q[2 * n:]
+    phi, alpha, beta = q[:n], q[n : 2 * n], q[2 * n :]
     e = np.stack([np.cos(phi), np.sin(phi)], axis=1)
     nrm = np.stack([-np.sin(phi), np.cos(phi)], axis=1)
     nodes = np.cumsum(l[:, None] * e, axis=0)
@@ -61,7 +62,7 @@ def convective(q, v, l, m, mu, h=1e-4):
         dq = np.zeros(N)
         dq[i] = h
         dM.append((mass_matrix(q + dq, l, m, mu) - mass_matrix(q - dq, l, m, mu)) / (2 * h))
-    dM = np.array(dM)                          # dM[l] = dM/dq_l
+    dM = np.array(dM)  # dM[l] = dM/dq_l
     term1 = np.einsum("lij,l,j->i", dM, v, v)
     term2 = 0.5 * np.einsum("ijk,j,k->i", dM, v, v)
     return term1 - term2
@@ -74,7 +75,7 @@ def node_positions(q, l):
 def rod_point(q, l, k, s):
     """Position of the point at arc parameter s (may be slightly outside [0, l]) of rod k."""
     n = l.size
-    phi, alpha, beta = q[:n], q[n:2 * n], q[2 * n:]
+    phi, alpha, beta = q[:n], q[n : 2 * n], q[2 * n :]
     root = np.array([np.sum(l[:k] * np.cos(phi[:k])), np.sum(l[:k] * np.sin(phi[:k]))])
     sig, tau = shape(s, l[k])
     eta = alpha[k] * sig + beta[k] * tau
@@ -97,12 +98,12 @@ def potential(q, l, EI, kappa):
     right = np.array([tangent_angle(q, l, k, l[k]) for k in range(n)])
     D = left - np.concatenate([[0.0], right[:-1]])
     energy = 0.5 * np.sum(kappa * D**2)
-    alpha, beta = q[n:2 * n], q[2 * n:]
+    alpha, beta = q[n : 2 * n], q[2 * n :]
     for k in range(n):
         s = 0.5 * l[k] * (GAUSS_S + 1.0)
         w = 0.5 * l[k] * GAUSS_W
         hs = 1e-3 * l[k]
-        eta = lambda x: np.dot([alpha[k], beta[k]], shape(x, l[k]))  # noqa: E731
+        eta = lambda x, k=k: np.dot([alpha[k], beta[k]], shape(x, l[k]))  # noqa: E731
         curv = (eta(s + hs) - 2 * eta(s) + eta(s - hs)) / hs**2
         energy += 0.5 * EI[k] * np.sum(w * curv**2)
     return energy
@@ -115,6 +116,7 @@ def hessian(f, x, h=1e-4):
     E = np.eye(N) * h
     for i in range(N):
         for j in range(i, N):
-            H[i, j] = H[j, i] = (f(x + E[i] + E[j]) - f(x + E[i] - E[j])
-                                 - f(x - E[i] + E[j]) + f(x - E[i] - E[j])) / (4 * h * h)
+            H[i, j] = H[j, i] = (
+                f(x + E[i] + E[j]) - f(x + E[i] - E[j]) - f(x - E[i] + E[j]) + f(x - E[i] - E[j])
+            ) / (4 * h * h)
     return H

@@ -1,4 +1,5 @@
 """Tiny study files for the study tests (n = 2-3, short horizons, cheap models)."""
+
 from pathlib import Path
 
 TINY = """
@@ -31,8 +32,14 @@ coefficients = "published"
 """
 
 
-def write_study(tmp: Path, name: str = "tiny.toml", *, reference: str = "reduced",
-                models: str = CHEAP_MODELS, grid: str = "scene.t_end = [0.1, 0.2]") -> Path:
+def write_study(
+    tmp: Path,
+    name: str = "tiny.toml",
+    *,
+    reference: str = "reduced",
+    models: str = CHEAP_MODELS,
+    grid: str = "scene.t_end = [0.1, 0.2]",
+) -> Path:
     path = tmp / name
     path.write_text(TINY.format(reference=reference, models=models, grid=grid))
     return path

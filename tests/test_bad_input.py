@@ -3,6 +3,7 @@
 Invalid scenes and scene files raise a ValueError naming the parameter, before any work;
 valid random chains give finite results or a reported failure, never an exception or NaN.
 """
+
 import math
 
 import numpy as np
@@ -17,8 +18,9 @@ FAST = settings(max_examples=30, deadline=None, suppress_health_check=[HealthChe
 
 non_finite = st.sampled_from([math.nan, math.inf, -math.inf])
 non_positive = st.one_of(st.floats(max_value=0.0, allow_nan=False), non_finite)
-negative = st.one_of(st.floats(max_value=-1e-300, allow_nan=False, allow_infinity=False),
-                     non_finite)
+negative = st.one_of(
+    st.floats(max_value=-1e-300, allow_nan=False, allow_infinity=False), non_finite
+)
 POSITIVE = ("l", "m", "EI")
 NON_NEGATIVE = ("mu", "kappa", "nu")
 
@@ -52,8 +54,21 @@ BASE = paper_scene(3)
 @st.composite
 def bad_scene_change(draw):
     """(field, change, expected word in the message)."""
-    kind = draw(st.sampled_from(["t_end", "times_empty", "times_unsorted", "times_negative",
-                                 "times_beyond", "times_nan", "outputs", "load_node", "initial"]))
+    kind = draw(
+        st.sampled_from(
+            [
+                "t_end",
+                "times_empty",
+                "times_unsorted",
+                "times_negative",
+                "times_beyond",
+                "times_nan",
+                "outputs",
+                "load_node",
+                "initial",
+            ]
+        )
+    )
     if kind == "t_end":
         return {"t_end": draw(non_positive)}, "t_end"
     if kind == "times_empty":
@@ -94,8 +109,22 @@ def test_load_node_below_one_is_named(node):
 @st.composite
 def bad_scene_file(draw):
     """(scene dict, word the message must contain)."""
-    kind = draw(st.sampled_from(["n", "t_end", "chain", "chain_type", "times", "outputs",
-                                 "loads", "load_type", "unknown", "initial"]))
+    kind = draw(
+        st.sampled_from(
+            [
+                "n",
+                "t_end",
+                "chain",
+                "chain_type",
+                "times",
+                "outputs",
+                "loads",
+                "load_type",
+                "unknown",
+                "initial",
+            ]
+        )
+    )
     if kind == "n":
         return {"n": draw(st.one_of(st.integers(max_value=0), st.floats(), st.text()))}, "'n'"
     if kind == "t_end":
@@ -113,11 +142,30 @@ def bad_scene_file(draw):
     if kind == "loads":
         return {"n": 3, "loads": [{"type": "pulse", "node": draw(st.integers(4, 50))}]}, "node"
     if kind == "load_type":
-        return {"loads": [{"type": draw(st.text(max_size=8).filter(
-            lambda s: s not in ("pulse", "constant")))}]}, "type"
+        return {
+            "loads": [
+                {"type": draw(st.text(max_size=8).filter(lambda s: s not in ("pulse", "constant")))}
+            ]
+        }, "type"
     if kind == "unknown":
-        key = draw(st.text(min_size=1, max_size=8).filter(lambda s: s not in (
-            "base", "name", "n", "t_end", "times", "outputs", "chain", "loads", "initial")))
+        key = draw(
+            st.text(min_size=1, max_size=8).filter(
+                lambda s: (
+                    s
+                    not in (
+                        "base",
+                        "name",
+                        "n",
+                        "t_end",
+                        "times",
+                        "outputs",
+                        "chain",
+                        "loads",
+                        "initial",
+                    )
+                )
+            )
+        )
         return {key: 1}, "unknown key"
     return {"n": 2, "initial": {"phi": [0.0, draw(non_finite)]}}, "initial phi"
 
@@ -132,20 +180,34 @@ def test_bad_scene_file_is_named(bad):
 
 
 def decades(lo, hi):
-    return st.floats(math.log10(lo), math.log10(hi)).map(lambda e: 10.0 ** e)
+    return st.floats(math.log10(lo), math.log10(hi)).map(lambda e: 10.0**e)
 
 
 @st.composite
 def valid_scene(draw):
     n = draw(st.integers(1, 16))
-    chain = Chain.uniform(n, l=draw(decades(0.1, 10)), m=draw(decades(0.1, 100)),
-                          EI=draw(decades(1e2, 1e8)), mu=draw(st.floats(0, 100)),
-                          kappa=draw(st.one_of(st.just(0.0), decades(1e-2, 1e6))),
-                          nu=draw(st.one_of(st.just(0.0), decades(1e-3, 10))))
-    load = pulse(draw(st.integers(1, n)), Xbar=draw(st.floats(-1e3, 1e3)),
-                 Ybar=draw(st.floats(-1e3, 1e3)), T=draw(st.floats(0.01, 0.1)))
-    return Scene(chain, loads=(load,), t_end=0.05, times=np.linspace(0, 0.05, 6),
-                 outputs=("phi", "alpha", "x", "energy"))
+    chain = Chain.uniform(
+        n,
+        l=draw(decades(0.1, 10)),
+        m=draw(decades(0.1, 100)),
+        EI=draw(decades(1e2, 1e8)),
+        mu=draw(st.floats(0, 100)),
+        kappa=draw(st.one_of(st.just(0.0), decades(1e-2, 1e6))),
+        nu=draw(st.one_of(st.just(0.0), decades(1e-3, 10))),
+    )
+    load = pulse(
+        draw(st.integers(1, n)),
+        Xbar=draw(st.floats(-1e3, 1e3)),
+        Ybar=draw(st.floats(-1e3, 1e3)),
+        T=draw(st.floats(0.01, 0.1)),
+    )
+    return Scene(
+        chain,
+        loads=(load,),
+        t_end=0.05,
+        times=np.linspace(0, 0.05, 6),
+        outputs=("phi", "alpha", "x", "energy"),
+    )
 
 
 def assert_finite_or_reported(tr):

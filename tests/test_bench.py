@@ -1,5 +1,6 @@
 """The benchmark helpers' pure parts and the bench CLI's input checks (no timing runs here;
 the benchmarks themselves run on demand, see benchmarks/run_all.sh)."""
+
 import numpy as np
 import pytest
 
@@ -13,7 +14,7 @@ def test_pareto_front_is_monotone_and_non_dominated():
     err[5] = np.nan
     f = bench.pareto_front(cost, err)
     assert np.all(np.diff(cost[f]) >= 0) and np.all(np.diff(err[f]) < 0)
-    for i in range(200):          # every finite point is dominated by (or on) the front
+    for i in range(200):  # every finite point is dominated by (or on) the front
         if np.isfinite(err[i]):
             assert np.any((cost[f] <= cost[i]) & (err[f] <= err[i]))
 
@@ -27,6 +28,7 @@ def test_fitted_exponent_recovers_a_power_law():
 
 def test_errors_are_relative_and_give_scd():
     from rodval import paper_scene, simulate
+
     sc = paper_scene(2, times=[0.5, 1.0], outputs=("phi",))
     ref = simulate(sc, "reduced", rtol=1e-10, atol=1e-12)
     loose = simulate(sc, "reduced", rtol=1e-3, atol=1e-5)
@@ -37,12 +39,15 @@ def test_errors_are_relative_and_give_scd():
     assert bench.errors(ref, ref, ("phi",))["max_phi"] == 0.0
 
 
-@pytest.mark.parametrize("argv", [
-    ["bench", "work-precision", "--out", "x", "--methods", "RK99"],
-    ["bench", "work-precision", "--out", "x", "--rtols", "1e-4,2"],
-    ["bench", "cost-n", "--out", "x", "--n-values", "0,4"],
-    ["bench", "skips", "--out", "x", "--repeats", "0"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["bench", "work-precision", "--out", "x", "--methods", "RK99"],
+        ["bench", "work-precision", "--out", "x", "--rtols", "1e-4,2"],
+        ["bench", "cost-n", "--out", "x", "--n-values", "0,4"],
+        ["bench", "skips", "--out", "x", "--repeats", "0"],
+    ],
+)
 def test_bench_cli_rejects_bad_options(argv, capsys):
     with pytest.raises(SystemExit) as exc:
         main(argv)

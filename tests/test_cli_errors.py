@@ -4,6 +4,7 @@ exit status 2, no traceback.
 Every case runs in-process through ``rodval.cli.main`` (fast); a few also run as
 ``python -m rodval`` in a subprocess, the way users meet them.
 """
+
 import os
 import subprocess
 import sys
@@ -18,8 +19,13 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.run([sys.executable, "-m", "rodval", *args], capture_output=True,
-                          text=True, env=env, timeout=120)
+    return subprocess.run(
+        [sys.executable, "-m", "rodval", *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -73,24 +79,31 @@ def test_bad_option_is_refused(options, words, tmp_path, capsys):
     assert not (tmp_path / "trajectory.csv").exists()
 
 
-@pytest.mark.parametrize("options, words", [CASES[0], CASES[8], CASES[12]],
-                         ids=["rtol", "times", "set"])
+@pytest.mark.parametrize(
+    "options, words", [CASES[0], CASES[8], CASES[12]], ids=["rtol", "times", "set"]
+)
 def test_python_m_rodval_refuses_without_traceback(options, words, tmp_path):
     assert_refused(run_cli("simulate", "paper", "--out", str(tmp_path), *options), words)
 
 
-@pytest.mark.parametrize("name, words", [
-    ("missing.toml", ["SCENE", "existing TOML file"]),
-    ("malformed.toml", ["malformed.toml", "malformed TOML"]),
-    ("zero_rods.toml", ["'n'", ">= 1"]),
-    ("unknown_key.toml", ["'rods'", "allowed"]),
-    ("negative_ei.toml", ["EI", "> 0"]),
-])
+@pytest.mark.parametrize(
+    "name, words",
+    [
+        ("missing.toml", ["SCENE", "existing TOML file"]),
+        ("malformed.toml", ["malformed.toml", "malformed TOML"]),
+        ("zero_rods.toml", ["'n'", ">= 1"]),
+        ("unknown_key.toml", ["'rods'", "allowed"]),
+        ("negative_ei.toml", ["EI", "> 0"]),
+    ],
+)
 def test_bad_scene_file_is_refused(bad_files, name, words, tmp_path, capsys):
-    assert_refused(run_main(capsys, "simulate", str(bad_files / name), "--out", str(tmp_path)),
-                   words)
+    assert_refused(
+        run_main(capsys, "simulate", str(bad_files / name), "--out", str(tmp_path)), words
+    )
 
 
 def test_python_m_rodval_refuses_a_malformed_scene_file(bad_files, tmp_path):
-    assert_refused(run_cli("simulate", str(bad_files / "malformed.toml"), "--out", str(tmp_path)),
-                   ["malformed TOML"])
+    assert_refused(
+        run_cli("simulate", str(bad_files / "malformed.toml"), "--out", str(tmp_path)),
+        ["malformed TOML"],
+    )

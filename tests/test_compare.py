@@ -1,4 +1,5 @@
 """Discrepancy metrics against closed forms, and the Trajectory round trips the study uses."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -8,21 +9,25 @@ from rodval.core.trajectory import SolverStats, Trajectory
 
 
 def _traj(values: dict, times, model="m") -> Trajectory:
-    return Trajectory(model=model, scene_name="s", times=np.asarray(times, float),
-                      values={q: np.asarray(v, float) for q, v in values.items()},
-                      k_index={q: np.arange(1, np.shape(v)[1] + 1) for q, v in values.items()},
-                      stats=SolverStats())
+    return Trajectory(
+        model=model,
+        scene_name="s",
+        times=np.asarray(times, float),
+        values={q: np.asarray(v, float) for q, v in values.items()},
+        k_index={q: np.arange(1, np.shape(v)[1] + 1) for q, v in values.items()},
+        stats=SolverStats(),
+    )
 
 
 def test_metrics_of_a_known_error():
     t = np.linspace(0.0, 1.0, 11)
-    ref = np.column_stack([np.cos(2 * np.pi * t), 10 * np.cos(2 * np.pi * t)])   # scales 1, 10
-    err = np.column_stack([0.01 * t, -0.05 * t ** 2])
+    ref = np.column_stack([np.cos(2 * np.pi * t), 10 * np.cos(2 * np.pi * t)])  # scales 1, 10
+    err = np.column_stack([0.01 * t, -0.05 * t**2])
     m = error_metrics(t, np.array([1, 2]), ref + err, ref)
     assert m["max_abs"] == pytest.approx(0.05)
     assert (m["k_at_max"], m["t_at_max"]) == (2, 1.0)
     assert m["final_abs"] == pytest.approx(0.05)
-    assert m["rms"] == pytest.approx(np.sqrt(np.mean(err ** 2)))
+    assert m["rms"] == pytest.approx(np.sqrt(np.mean(err**2)))
     # column 1: 0.01 / 1 = 0.01; column 2: 0.05 / 10 = 0.005 -> max_rel from column 1
     assert m["max_rel"] == pytest.approx(0.01)
 

@@ -1,12 +1,13 @@
 """Divergence detection: each failure mode stops the run with its own status."""
+
 import math
 
 import numpy as np
 
 from rodval import IntegratorSettings, paper_scene, simulate
-from rodval.solvers.guard import DivergenceGuard
+from rodval.core.status import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_STALLED
 from rodval.models.full import FullSystem
-from rodval.core.trajectory import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_STALLED
+from rodval.solvers.guard import DivergenceGuard
 
 SCENE = paper_scene(times=[0.5, 1.0, 1.5, 2.0])
 
@@ -15,8 +16,7 @@ def test_explicit_steps_far_above_the_bending_period_blow_up():
     # RK45 pinned at 10 ms steps (first_step = max_step; error control relaxed so it accepts
     # them) on the full model, whose bending period is ~2.3 ms: far outside RK45's stability
     # region, the energy explodes within the first steps.
-    settings = IntegratorSettings(method="RK45", rtol=0.9, atol=1e3, first_step=0.01,
-                                  max_step=0.01)
+    settings = IntegratorSettings(method="RK45", rtol=0.9, atol=1e3, first_step=0.01, max_step=0.01)
     tr = simulate(SCENE, "full", settings=settings)
     assert tr.stats.status == STATUS_BLOWUP
     assert "energy blow-up" in tr.stats.message
@@ -24,8 +24,7 @@ def test_explicit_steps_far_above_the_bending_period_blow_up():
 
 
 def test_same_steps_on_the_reduced_model_stay_bounded():
-    settings = IntegratorSettings(method="RK45", rtol=0.9, atol=1e3, first_step=0.01,
-                                  max_step=0.01)
+    settings = IntegratorSettings(method="RK45", rtol=0.9, atol=1e3, first_step=0.01, max_step=0.01)
     assert simulate(SCENE, "reduced", settings=settings).success
 
 

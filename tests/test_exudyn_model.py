@@ -1,5 +1,6 @@
 """The exudyn reference model: closed-form limits, option validation, and the CI comparison
 against the native full and reduced models."""
+
 from __future__ import annotations
 
 import math
@@ -39,8 +40,13 @@ def test_rigid_pendulum_period():
     period = 2 * math.pi / omega
     chain = Chain.uniform(1, l=l, m=m, EI=1e9, mu=mu, kappa=kappa, nu=0.0)
     times = np.arange(0.0, 2.2 * period, 1e-3)
-    scene = Scene(chain=chain, t_end=float(times[-1]), times=times, outputs=("phi",),
-                  initial=InitialState(phi=[0.01]))
+    scene = Scene(
+        chain=chain,
+        t_end=float(times[-1]),
+        times=times,
+        outputs=("phi",),
+        initial=InitialState(phi=[0.01]),
+    )
     tr = simulate(scene, "exudyn", elements=1, step=1e-3)
     assert tr.success, tr.stats.message
     phi = tr["phi"][:, 0]
@@ -51,11 +57,23 @@ def test_rigid_pendulum_period():
     assert np.abs(phi).max() == pytest.approx(0.01, rel=1e-2)
 
 
-@pytest.mark.parametrize("option, value", [
-    ("elements", 0), ("elements", 1.5), ("step", 0.0), ("step", 1.0), ("EA", -1.0),
-    ("element", "beam3d"), ("solver", "rk4"), ("spectral_radius", 1.5),
-    ("newton_rtol", 0.5), ("newton_atol_per_EA", 0.0), ("max_rotation_per_step", 0.0),
-    ("max_rotation_per_step", 4.0)])
+@pytest.mark.parametrize(
+    "option, value",
+    [
+        ("elements", 0),
+        ("elements", 1.5),
+        ("step", 0.0),
+        ("step", 1.0),
+        ("EA", -1.0),
+        ("element", "beam3d"),
+        ("solver", "rk4"),
+        ("spectral_radius", 1.5),
+        ("newton_rtol", 0.5),
+        ("newton_atol_per_EA", 0.0),
+        ("max_rotation_per_step", 0.0),
+        ("max_rotation_per_step", 4.0),
+    ],
+)
 def test_bad_option_names_the_option(option, value):
     with pytest.raises(ValueError, match=option):
         ExudynModel(**{option: value})
@@ -63,13 +81,26 @@ def test_bad_option_names_the_option(option, value):
 
 def test_outputs_labels_and_stats():
     """Exactly the requested quantities at the requested times, with the native k labels."""
-    scene = paper_scene(2, t_end=0.1, times=[0.0, 0.05, 0.1],
-                        outputs=("phi", "dphi", "alpha", "beta", "x", "y", "energy"))
+    scene = paper_scene(
+        2,
+        t_end=0.1,
+        times=[0.0, 0.05, 0.1],
+        outputs=("phi", "dphi", "alpha", "beta", "x", "y", "energy"),
+    )
     tr = simulate(scene, "exudyn", step=1e-3)
     assert tr.success, tr.stats.message
     assert np.array_equal(tr.times, scene.times)
-    assert set(tr.quantities) == {"phi", "dphi", "alpha", "beta", "x", "y",
-                                  "kinetic", "potential", "energy"}
+    assert set(tr.quantities) == {
+        "phi",
+        "dphi",
+        "alpha",
+        "beta",
+        "x",
+        "y",
+        "kinetic",
+        "potential",
+        "energy",
+    }
     assert tr.k_index["phi"].tolist() == [1, 2]
     assert tr.k_index["x"].tolist() == [0, 1, 2]
     assert tr.k_index["energy"].tolist() == [0]

@@ -2,6 +2,7 @@
 conserved without numerical damping, blow-ups and under-resolved runs are not reported as
 success, native integrator settings and unknown options are refused, and the run records what
 it used."""
+
 from __future__ import annotations
 
 import math
@@ -25,8 +26,13 @@ def one_rod(a: float, *, t_end: float, times, outputs=("energy",)) -> Scene:
     """One rod, pinned root with a hinge-0 spring kappa = 100 N m/rad, no tip mass, no damper,
     bent at alpha = -beta = a, at rest, no load."""
     chain = Chain.uniform(1, l=L, m=M, EI=EI, mu=0.0, kappa=KAPPA, nu=0.0)
-    return Scene(chain=chain, t_end=t_end, times=times, outputs=outputs,
-                 initial=InitialState(alpha=[a], beta=[-a]))
+    return Scene(
+        chain=chain,
+        t_end=t_end,
+        times=times,
+        outputs=outputs,
+        initial=InitialState(alpha=[a], beta=[-a]),
+    )
 
 
 @pytest.mark.parametrize("alpha, beta, elements", [(0.1, -0.1, 2), (0.05, 0.03, 3), (0.3, -0.2, 4)])
@@ -69,8 +75,10 @@ def test_bent_start_is_unstretched(a):
     native = simulate(scene, "full")
     closed = 0.5 * (4 * EI / L) * (a * a - a * a + a * a) + 0.5 * KAPPA * a * a
     pot_ex, pot_nat = ex["potential"][0, 0], native["potential"][0, 0]
-    print(f"a = {a}: potential at t = 0: exudyn {pot_ex:.6g} J, native {pot_nat:.6g} J, "
-          f"closed form {closed:.6g} J, relative gap {pot_ex / pot_nat - 1:.3g}")
+    print(
+        f"a = {a}: potential at t = 0: exudyn {pot_ex:.6g} J, native {pot_nat:.6g} J, "
+        f"closed form {closed:.6g} J, relative gap {pot_ex / pot_nat - 1:.3g}"
+    )
     assert pot_nat == pytest.approx(closed, rel=1e-12)
     assert pot_ex == pytest.approx(pot_nat, rel=1e-2)
     assert ex["kinetic"][0, 0] == pytest.approx(0.0, abs=1e-12)
@@ -120,11 +128,12 @@ def test_energy_blowup_is_detected_during_the_run():
     assert "energy blow-up" in tr.stats.message and "blowup_factor 100" in tr.stats.message
     assert 0 < tr.stats.t_reached < 0.9
     assert tr.times.size > 0 and np.all(tr.times < tr.stats.t_reached)
-    assert tr.times[-1] > tr.stats.t_reached - 0.01       # the output times before it are kept
-    assert tr.settings["steps"] < 0.95 * tr.settings["steps_planned"]   # stopped early
+    assert tr.times[-1] > tr.stats.t_reached - 0.01  # the output times before it are kept
+    assert tr.settings["steps"] < 0.95 * tr.settings["steps_planned"]  # stopped early
     # the budget follows the settings: a looser factor lets the run go on further
-    looser = simulate(scene, "exudyn", solver="trapezoidal",
-                      settings=IntegratorSettings(blowup_factor=1e12))
+    looser = simulate(
+        scene, "exudyn", solver="trapezoidal", settings=IntegratorSettings(blowup_factor=1e12)
+    )
     assert looser.stats.t_reached > tr.stats.t_reached
 
 
@@ -134,8 +143,13 @@ def test_under_resolved_rotation_is_a_failure():
     resolved run records its largest rotation per step."""
     chain = Chain.uniform(2)
     times = np.linspace(0.0, 0.1, 11)
-    scene = Scene(chain=chain, t_end=0.1, times=times, outputs=("phi", "dphi"),
-                  initial=InitialState(dphi=[1e6, 0.0]))
+    scene = Scene(
+        chain=chain,
+        t_end=0.1,
+        times=times,
+        outputs=("phi", "dphi"),
+        initial=InitialState(dphi=[1e6, 0.0]),
+    )
     tr = simulate(scene, "exudyn")
     print(tr.stats.message)
     assert tr.stats.status == STATUS_FAILED
@@ -147,17 +161,29 @@ def test_under_resolved_rotation_is_a_failure():
     assert 0.005 < ok.settings["max_rotation_per_step_seen"] < DEFAULTS["max_rotation_per_step"]
 
 
-@pytest.mark.parametrize("field, value", [("method", "RK45"), ("rtol", 1e-10), ("atol", 1e-12),
-                                          ("max_step", 1e-3), ("first_step", 1e-4)])
+@pytest.mark.parametrize(
+    "field, value",
+    [
+        ("method", "RK45"),
+        ("rtol", 1e-10),
+        ("atol", 1e-12),
+        ("max_step", 1e-3),
+        ("first_step", 1e-4),
+    ],
+)
 def test_native_integrator_settings_are_refused(monkeypatch, field, value):
     """Any native integrator field exudyn cannot honour raises before any work."""
+
     def no_build(*args, **kwargs):
         raise AssertionError("the model was built")
 
     monkeypatch.setattr(ExudynModel, "_build", no_build)
     scene = Scene(chain=Chain.uniform(1), t_end=0.01)
-    with pytest.raises(ValueError, match=f"{field}=.*exudyn's integrator is set by its own options "
-                                         r"\(elements, step, .*solver"):
+    with pytest.raises(
+        ValueError,
+        match=f"{field}=.*exudyn's integrator is set by its own options "
+        r"\(elements, step, .*solver",
+    ):
         ExudynModel().simulate(scene, IntegratorSettings(**{field: value}))
     with pytest.raises(ValueError, match=field):
         simulate(scene, "exudyn", **{field: value})
@@ -172,9 +198,11 @@ def test_default_settings_and_blowup_factor_are_accepted():
 
 def test_unknown_options_list_the_allowed_ones():
     allowed = "elements, step, EA, element, solver, spectral_radius, newton_rtol"
-    for call in (lambda: ExudynModel(stepsize=1e-3),
-                 lambda: ExudynModel.check_options({"stepsize": 1e-3, "step": 1e-3}),
-                 lambda: simulate(Scene(chain=Chain.uniform(1), t_end=0.01), "exudyn", stepsize=1e-3)):
+    for call in (
+        lambda: ExudynModel(stepsize=1e-3),
+        lambda: ExudynModel.check_options({"stepsize": 1e-3, "step": 1e-3}),
+        lambda: simulate(Scene(chain=Chain.uniform(1), t_end=0.01), "exudyn", stepsize=1e-3),
+    ):
         with pytest.raises(ValueError, match="unknown exudyn model option.*'stepsize'") as info:
             call()
         assert allowed in str(info.value) and "unexpected keyword" not in str(info.value)
@@ -205,14 +233,20 @@ def test_guard_verdicts_on_a_set_state():
     from reference_models.exudyn_chain import _Guard
     from rodval.core.status import STATUS_DIVERGED
 
-    scene = Scene(chain=Chain.uniform(2), t_end=1.0, outputs=("energy",),
-                  initial=InitialState(dphi=[0.5, -0.3], dalpha=[2.0, 1.0]))
+    scene = Scene(
+        chain=Chain.uniform(2),
+        t_end=1.0,
+        outputs=("energy",),
+        initial=InitialState(dphi=[0.5, -0.3], dalpha=[2.0, 1.0]),
+    )
     built = ExudynModel()._build(scene)
     guard = _Guard(built, scene, 2, 1e10, 100.0, 0.1)
     sd = built.mbs.systemData
     v0 = sd.GetODE2Coordinates_t()
     assert 0.5 * v0 @ guard.M @ v0 == pytest.approx(
-        simulate(scene.with_(t_end=1e-3, times=[0.0]), "exudyn", step=1e-4)["kinetic"][0, 0], rel=1e-12)
+        simulate(scene.with_(t_end=1e-3, times=[0.0]), "exudyn", step=1e-4)["kinetic"][0, 0],
+        rel=1e-12,
+    )
     assert guard.check(0.0, 1e-4) and guard.verdict is None
     sd.SetODE2Coordinates_t(1e4 * v0)
     assert not guard.check(0.1, 1e-6) and guard.verdict[0] == STATUS_BLOWUP

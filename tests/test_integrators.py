@@ -1,5 +1,6 @@
 """The compiled DOP853 loop against scipy's DOP853, Table 1 with the default kernels, and the
 method's input checks."""
+
 import math
 
 import numpy as np
@@ -42,8 +43,13 @@ def test_compiled_dop853_dense_output_matches_restart():
     base = paper_scene(3, t_end=1.3, times=[0.37, 0.81, 1.3])
     dense = simulate(base, "reduced", method="DOP853-numba", rtol=1e-11, atol=1e-13)
     for i, t in enumerate(base.times):
-        end = simulate(base.with_(t_end=float(t), times=[float(t)]), "reduced",
-                       method="DOP853-numba", rtol=1e-11, atol=1e-13)
+        end = simulate(
+            base.with_(t_end=float(t), times=[float(t)]),
+            "reduced",
+            method="DOP853-numba",
+            rtol=1e-11,
+            atol=1e-13,
+        )
         np.testing.assert_allclose(dense["phi"][i], end["phi"][0], rtol=0, atol=1e-8)
 
 
@@ -77,7 +83,8 @@ def test_compiled_failure_is_data():
     """A step-size collapse is reported with status, message and the time reached."""
     chain = Chain.uniform(2, kappa=0.0, nu=0.0)
     sc = Scene(chain=chain, t_end=1.0, times=[0.5, 1.0]).with_(
-        initial=__import__("rodval").scene.InitialState(dphi=[1e150, -1e150]))
+        initial=__import__("rodval").InitialState(dphi=[1e150, -1e150])
+    )
     tr = simulate(sc, "reduced", method="DOP853-numba", rtol=1e-6, atol=1e-8)
     assert not tr.success
     assert tr.stats.t_reached < 1.0 and tr.stats.message

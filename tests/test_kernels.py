@@ -1,16 +1,16 @@
 """The compiled (numba) kernels against the straightforward numpy right-hand sides, the load
 table against LoadSet, and the analytic Jacobians against central differences."""
+
 import math
 
 import numpy as np
 import pytest
 
 from rodval import paper_scene
-from rodval.core.loads import LoadSet, NodalForce, constant, pulse
-from rodval.models import kernels
+from rodval.core.loads import LoadSet, NodalForce, constant, load_sums, load_table, pulse
+from rodval.core.scene import Chain, Scene
 from rodval.models.full import FullSystem
 from rodval.models.reduced import ReducedSystem
-from rodval.core.scene import Chain, Scene
 
 SYSTEMS = {"full": (FullSystem, 6), "reduced": (ReducedSystem, 2)}
 
@@ -18,9 +18,14 @@ SYSTEMS = {"full": (FullSystem, 6), "reduced": (ReducedSystem, 2)}
 def scene(n: int, damped: bool, loaded: bool) -> Scene:
     """A non-uniform chain (so that no symmetry hides an index error)."""
     rng = np.random.default_rng(n)
-    chain = Chain(l=rng.uniform(0.5, 2.5, n), m=rng.uniform(1, 4, n), EI=rng.uniform(1e3, 1e5, n),
-                  mu=rng.uniform(0, 3, n), kappa=rng.uniform(0, 200, n),
-                  nu=rng.uniform(0.01, 0.5, n) if damped else 0.0)
+    chain = Chain(
+        l=rng.uniform(0.5, 2.5, n),
+        m=rng.uniform(1, 4, n),
+        EI=rng.uniform(1e3, 1e5, n),
+        mu=rng.uniform(0, 3, n),
+        kappa=rng.uniform(0, 200, n),
+        nu=rng.uniform(0.01, 0.5, n) if damped else 0.0,
+    )
     loads = (pulse(n), constant(1, X=30.0, Y=-20.0, t_on=0.2)) if loaded else ()
     return Scene(chain=chain, loads=loads, t_end=2.0)
 
@@ -36,7 +41,7 @@ def test_numba_rhs_matches_numpy(model, coefficients, n, damped, loaded):
     fast, ref = cls(sc, coefficients, "numba"), cls(sc, coefficients, "numpy")
     assert fast.damped == damped
     rng = np.random.default_rng(100 * n + damped)
-    for t in (0.3, 0.5, 1.7):            # inside both supports, at a kink, past the pulse
+    for t in (0.3, 0.5, 1.7):  # inside both supports, at a kink, past the pulse
         for _ in range(5):
             y = rng.normal(scale=1.5, size=width * n)
             a, b = fast.rhs(t, y), ref.rhs(t, y)
@@ -54,12 +59,18 @@ def test_structured_solve_at_large_n(coefficients):
 
 
 def test_load_table_matches_loadset():
-    loads = LoadSet((pulse(3, Xbar=-150.0, Ybar=1200.0, T=1.0), pulse(1, Xbar=10.0, Ybar=5.0, T=0.4),
-                     constant(2, X=7.0, Y=-3.0, t_on=0.25, t_off=1.2)), 4)
-    table = kernels.load_table(loads)
+    loads = LoadSet(
+        (
+            pulse(3, Xbar=-150.0, Ybar=1200.0, T=1.0),
+            pulse(1, Xbar=10.0, Ybar=5.0, T=0.4),
+            constant(2, X=7.0, Y=-3.0, t_on=0.25, t_off=1.2),
+        ),
+        4,
+    )
+    table = load_table(loads.loads)
     for t in np.concatenate([np.linspace(0, 2, 81), [0.2, 0.5, 1.0, 1.2]]):
         SX, SY = np.full(4, np.nan), np.full(4, np.nan)
-        active = kernels.load_sums(table, t, SX, SY)
+        active = load_sums(table, t, SX, SY)
         ref = loads.suffix_sums(t)
         assert active == (ref is not None)
         if ref is not None:
@@ -69,7 +80,7 @@ def test_load_table_matches_loadset():
 
 def test_callable_loads_have_no_table():
     loads = LoadSet((NodalForce(1, fx=math.sin),), 2)
-    assert kernels.load_table(loads) is None
+    assert load_table(loads.loads) is None
 
 
 @pytest.mark.parametrize("model", SYSTEMS)
@@ -83,11 +94,12 @@ def test_analytic_jacobian_matches_differences(model, coefficients, damped):
     t = 0.3
     J = system.jacobian(t, y)
     h = 1e-6
-    Jd = np.column_stack([(system.rhs(t, y + h * e) - system.rhs(t, y - h * e)) / (2 * h)
-                          for e in np.eye(y.size)])
+    Jd = np.column_stack(
+        [(system.rhs(t, y + h * e) - system.rhs(t, y - h * e)) / (2 * h) for e in np.eye(y.size)]
+    )
     np.testing.assert_allclose(J, Jd, rtol=0, atol=1e-7 * np.max(np.abs(Jd)))
     # and the Jacobian is not just the trivial [[0, I], [0, 0]] part
-    assert np.max(np.abs(J[width * n // 2:])) > 1.0
+    assert np.max(np.abs(J[width * n // 2 :])) > 1.0
 
 
 def test_kernel_option_is_validated():

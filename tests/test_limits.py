@@ -1,4 +1,5 @@
 """Closed-form limits: one rod (clamped, pinned), the rigid pendulum, stiff rods, energy."""
+
 import numpy as np
 import pytest
 
@@ -15,14 +16,14 @@ PINNED_EB = np.array([3.9266023120, 7.0685827897]) ** 2 * EB_SCALE
 def test_clamped_rod_first_mode_within_one_percent_above_euler_bernoulli():
     chain = Chain.uniform(1, l=L, m=M_LEN, EI=EI, mu=0.0, kappa=1e12, nu=0.0)
     w = natural_frequencies(chain)
-    assert np.all(w[:2] >= CLAMPED_EB)                    # Ritz upper bounds
-    assert w[0] / CLAMPED_EB[0] - 1 < 0.01                # 0.48 % for cubic Ritz (s^2, s^3)
+    assert np.all(w[:2] >= CLAMPED_EB)  # Ritz upper bounds
+    assert w[0] / CLAMPED_EB[0] - 1 < 0.01  # 0.48 % for cubic Ritz (s^2, s^3)
 
 
 def test_pinned_rod_frequencies_above_euler_bernoulli():
     chain = Chain.uniform(1, l=L, m=M_LEN, EI=EI, mu=0.0, kappa=0.0, nu=0.0)
     w = natural_frequencies(chain)
-    assert w[0] < 1e-6 * w[1]                             # rigid rotation about the pin
+    assert w[0] < 1e-6 * w[1]  # rigid rotation about the pin
     assert np.all(w[1:3] >= PINNED_EB)
 
 
@@ -41,8 +42,18 @@ def test_rigid_pendulum_period_in_time_domain():
     chain = Chain.uniform(1, l=L, m=M_LEN, EI=1e12, mu=mu, kappa=kappa, nu=0.0)
     period = 2 * np.pi / np.sqrt(kappa / (M_LEN * L**3 / 3 + mu * L**2))
     times = np.linspace(0, 3 * period, 3001)
-    tr = simulate(Scene(chain=chain, t_end=times[-1], times=times, outputs=("phi",),
-                        initial=InitialState(phi=amp)), "reduced", rtol=1e-11, atol=1e-16)
+    tr = simulate(
+        Scene(
+            chain=chain,
+            t_end=times[-1],
+            times=times,
+            outputs=("phi",),
+            initial=InitialState(phi=amp),
+        ),
+        "reduced",
+        rtol=1e-11,
+        atol=1e-16,
+    )
     phi = tr["phi"][:, 0]
     up = np.flatnonzero((phi[:-1] < 0) & (phi[1:] >= 0))  # upward zero crossings
     tc = times[up] - phi[up] * (times[up + 1] - times[up]) / (phi[up + 1] - phi[up])
@@ -54,8 +65,13 @@ def test_full_and_reduced_converge_as_bending_stiffness_grows():
     """max |phi_full - phi_reduced| falls like 1/EI (measured ratio ~10 per decade)."""
     gaps = []
     for ei in (1e4, 1e5, 1e6):
-        scene = Scene(chain=Chain.uniform(3, EI=ei), loads=(pulse(3),), t_end=1.0,
-                      times=np.linspace(0, 1, 51), outputs=("phi",))
+        scene = Scene(
+            chain=Chain.uniform(3, EI=ei),
+            loads=(pulse(3),),
+            t_end=1.0,
+            times=np.linspace(0, 1, 51),
+            outputs=("phi",),
+        )
         full = simulate(scene, "full", rtol=1e-10, atol=1e-12)
         red = simulate(scene, "reduced", rtol=1e-10, atol=1e-12)
         gaps.append(np.max(np.abs(full["phi"] - red["phi"])))

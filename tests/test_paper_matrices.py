@@ -1,19 +1,25 @@
 """The analytic blocks of the paper's models against independent kinematics (tests/kinematics.py)."""
+
+import kinematics as kin
 import numpy as np
 import pytest
 
 from rodval import Chain
 from rodval.models import paper_matrices as pm
 
-import kinematics as kin
-
 
 @pytest.fixture(params=[1, 2, 4])
 def chain(request):
     rng = np.random.default_rng(request.param)
     n = request.param
-    return Chain(l=rng.uniform(0.5, 3, n), m=rng.uniform(1, 5, n), EI=rng.uniform(1e3, 1e5, n),
-                 mu=rng.uniform(0, 4, n), kappa=rng.uniform(0, 200, n), nu=rng.uniform(0, 1, n))
+    return Chain(
+        l=rng.uniform(0.5, 3, n),
+        m=rng.uniform(1, 5, n),
+        EI=rng.uniform(1e3, 1e5, n),
+        mu=rng.uniform(0, 4, n),
+        kappa=rng.uniform(0, 200, n),
+        nu=rng.uniform(0, 1, n),
+    )
 
 
 def random_phi(n, seed=0):
@@ -58,7 +64,9 @@ def test_convective_terms_equal_lagrange_terms_of_kinetic_energy(chain):
     v = rng.normal(size=3 * n)
     h_kin = kin.convective(q, v, chain.l, chain.m, chain.mu)
     ckj, skj = pm.angle_differences(q[:n])
-    h_phi, h_gamma = pm.convective_terms(pm.chain_constants(chain), skj, v[:n], v[n:2 * n], v[2 * n:])
+    h_phi, h_gamma = pm.convective_terms(
+        pm.chain_constants(chain), skj, v[:n], v[n : 2 * n], v[2 * n :]
+    )
     h = np.concatenate([h_phi, h_gamma])
     scale = np.abs(kin.mass_matrix(q, chain.l, chain.m, chain.mu)).max() * np.sum(v**2)
     assert np.allclose(h, h_kin, rtol=1e-6, atol=1e-8 * scale)
@@ -69,12 +77,12 @@ def test_generalized_forces_equal_virtual_work_of_nodal_forces(chain):
     rng = np.random.default_rng(11)
     q = np.concatenate([random_phi(n, 5), rng.normal(scale=1e-2, size=2 * n)])
     X, Y = rng.normal(size=n), rng.normal(size=n)
-    _, Jn = kin.jacobians(q, chain.l)                     # d node / dq, (n, 2, 3n)
+    _, Jn = kin.jacobians(q, chain.l)  # d node / dq, (n, 2, 3n)
     Q_kin = np.einsum("k,ki->i", X, Jn[:, 0, :]) + np.einsum("k,ki->i", Y, Jn[:, 1, :])
     SX, SY = np.cumsum(X[::-1])[::-1], np.cumsum(Y[::-1])[::-1]
     Q = pm.generalized_forces(chain.l, q[:n], SX, SY)
     assert np.allclose(Q, Q_kin[:n], rtol=1e-8, atol=1e-8)
-    assert np.allclose(Q_kin[n:], 0.0, atol=1e-8)         # nodes do not move with bending
+    assert np.allclose(Q_kin[n:], 0.0, atol=1e-8)  # nodes do not move with bending
 
 
 def test_stiffness_matrix_is_hessian_of_potential_energy(chain):

@@ -1,20 +1,28 @@
 """Scene validation: every bad input names the parameter and the allowed range."""
+
 import math
 
 import numpy as np
 import pytest
 
-from rodval import Chain, InitialState, NodalForce, Scene, constant, paper_scene, pulse
+from rodval import Chain, InitialState, NodalForce, constant, paper_scene, pulse
 from rodval.core.scene_file import load_scene, scene_from_dict
 
 
-@pytest.mark.parametrize("field,value,match", [
-    ("l", 0.0, r"l \(rod length\) must be > 0"), ("m", -1.0, r"m \(mass per length\) must be > 0"),
-    ("EI", 0.0, r"EI \(bending stiffness\) must be > 0"), ("mu", -0.1, r"mu \(node mass\) must be >= 0"),
-    ("kappa", -1.0, r"kappa \(hinge stiffness\) must be >= 0"), ("nu", -1e-3, r"nu \(hinge damping\) must be >= 0"),
-    ("l", math.nan, r"l \(rod length\) must be finite"), ("EI", math.inf, r"EI .* must be finite"),
-    ("kappa", [1.0, 2.0], r"kappa .* length n = 3"),
-])
+@pytest.mark.parametrize(
+    "field,value,match",
+    [
+        ("l", 0.0, r"l \(rod length\) must be > 0"),
+        ("m", -1.0, r"m \(mass per length\) must be > 0"),
+        ("EI", 0.0, r"EI \(bending stiffness\) must be > 0"),
+        ("mu", -0.1, r"mu \(node mass\) must be >= 0"),
+        ("kappa", -1.0, r"kappa \(hinge stiffness\) must be >= 0"),
+        ("nu", -1e-3, r"nu \(hinge damping\) must be >= 0"),
+        ("l", math.nan, r"l \(rod length\) must be finite"),
+        ("EI", math.inf, r"EI .* must be finite"),
+        ("kappa", [1.0, 2.0], r"kappa .* length n = 3"),
+    ],
+)
 def test_chain_rejects_bad_values(field, value, match):
     with pytest.raises(ValueError, match=match):
         Chain.uniform(3, **{field: value})
@@ -26,15 +34,23 @@ def test_chain_rejects_bad_n(n):
         Chain.uniform(n)
 
 
-@pytest.mark.parametrize("changes,match", [
-    ({"t_end": 0.0}, r"t_end \(horizon\) must be finite and > 0"),
-    ({"t_end": -1.0}, r"t_end \(horizon\)"), ({"t_end": math.nan}, r"t_end \(horizon\)"),
-    ({"times": []}, r"times .* non-empty"), ({"times": [1.0, 0.5]}, r"times .* strictly increasing"),
-    ({"times": [0.5, 0.5]}, r"strictly increasing"), ({"times": [-0.1, 1.0]}, r"times .* \[0, t_end\]"),
-    ({"times": [1.0, 3.0]}, r"times .* \[0, t_end\]"), ({"outputs": ("phi", "psi")}, r"outputs must be"),
-    ({"outputs": ()}, r"outputs must be"), ({"loads": (pulse(9),)}, r"load node must be in 1..n"),
-    ({"initial": InitialState(phi=[0.0, 1.0])}, r"initial phi .* length n = 8"),
-])
+@pytest.mark.parametrize(
+    "changes,match",
+    [
+        ({"t_end": 0.0}, r"t_end \(horizon\) must be finite and > 0"),
+        ({"t_end": -1.0}, r"t_end \(horizon\)"),
+        ({"t_end": math.nan}, r"t_end \(horizon\)"),
+        ({"times": []}, r"times .* non-empty"),
+        ({"times": [1.0, 0.5]}, r"times .* strictly increasing"),
+        ({"times": [0.5, 0.5]}, r"strictly increasing"),
+        ({"times": [-0.1, 1.0]}, r"times .* \[0, t_end\]"),
+        ({"times": [1.0, 3.0]}, r"times .* \[0, t_end\]"),
+        ({"outputs": ("phi", "psi")}, r"outputs must be"),
+        ({"outputs": ()}, r"outputs must be"),
+        ({"loads": (pulse(9),)}, r"load node must be in 1..n"),
+        ({"initial": InitialState(phi=[0.0, 1.0])}, r"initial phi .* length n = 8"),
+    ],
+)
 def test_scene_rejects_bad_values(changes, match):
     with pytest.raises(ValueError, match=match):
         paper_scene().with_(**changes)
@@ -74,20 +90,29 @@ def test_chain_broadcasts_and_is_immutable():
 
 def test_scene_file_round_trip(tmp_path):
     path = tmp_path / "s.toml"
-    path.write_text('n = 3\nt_end = 0.5\ntimes = {num = 11}\noutputs = ["phi", "x"]\n'
-                    '[chain]\nEI = [1e4, 2e4, 3e4]\n[[loads]]\ntype = "pulse"\nnode = 3\nYbar = 10.0\n')
+    path.write_text(
+        'n = 3\nt_end = 0.5\ntimes = {num = 11}\noutputs = ["phi", "x"]\n'
+        '[chain]\nEI = [1e4, 2e4, 3e4]\n[[loads]]\ntype = "pulse"\nnode = 3\nYbar = 10.0\n'
+    )
     s = load_scene(path)
     assert s.n == 3 and s.t_end == 0.5 and s.times.size == 11 and s.outputs == ("phi", "x")
     assert s.chain.EI.tolist() == [1e4, 2e4, 3e4] and s.loads[0].params["Ybar"] == 10.0
 
 
-@pytest.mark.parametrize("d,match", [
-    ({"n": 3, "colour": 1}, r"unknown key 'colour'"), ({"chain": {"E": 1}}, r"\[chain\]: unknown key 'E'"),
-    ({"n": 0}, r"key 'n'"), ({"loads": [{"type": "gust", "node": 1}]}, r"load type must be one of"),
-    ({"loads": [{"type": "pulse", "node": 1, "Zbar": 1}]}, r"unexpected keyword"),
-    ({"times": {"num": 0}}, r"num must be >= 1"), ({"chain": {"l": -1.0}}, r"l \(rod length\)"),
-    ({"base": "lab"}, r"key 'base'"), ({"t_end": "long"}, r"key 't_end'"),
-])
+@pytest.mark.parametrize(
+    "d,match",
+    [
+        ({"n": 3, "colour": 1}, r"unknown key 'colour'"),
+        ({"chain": {"E": 1}}, r"\[chain\]: unknown key 'E'"),
+        ({"n": 0}, r"key 'n'"),
+        ({"loads": [{"type": "gust", "node": 1}]}, r"load type must be one of"),
+        ({"loads": [{"type": "pulse", "node": 1, "Zbar": 1}]}, r"unexpected keyword"),
+        ({"times": {"num": 0}}, r"num must be >= 1"),
+        ({"chain": {"l": -1.0}}, r"l \(rod length\)"),
+        ({"base": "lab"}, r"key 'base'"),
+        ({"t_end": "long"}, r"key 't_end'"),
+    ],
+)
 def test_scene_file_errors_name_file_and_key(d, match):
     with pytest.raises(ValueError, match=match) as info:
         scene_from_dict(d, where="f.toml")

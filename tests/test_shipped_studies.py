@@ -1,4 +1,5 @@
 """The shipped studies run to completion on the 2-core machine (slow: `pytest -m slow`)."""
+
 import subprocess
 import sys
 
@@ -12,8 +13,20 @@ pytestmark = pytest.mark.slow
 
 
 def run_study(name: str, out, *extra: str) -> None:
-    res = subprocess.run([sys.executable, "-m", "rodval", "study", f"studies/{name}.toml",
-                          "--out", str(out), *extra], capture_output=True, text=True)
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "rodval",
+            "study",
+            f"studies/{name}.toml",
+            "--out",
+            str(out),
+            *extra,
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert res.returncode == 0, res.stderr[-2000:]
 
 

@@ -1,4 +1,5 @@
 """The report: figures that are real images, GitHub pipe tables, rebuilt from the CSVs alone."""
+
 import re
 import shutil
 import subprocess
@@ -6,9 +7,9 @@ import sys
 
 import matplotlib.image as mpimg
 import pytest
+from study_helpers import write_study
 
 from rodval.study import load_study, run_study
-from study_helpers import write_study
 
 SEPARATOR = re.compile(r"^\|(\s*:?-+:?\s*\|)+$")
 
@@ -35,8 +36,14 @@ def _tables(markdown: str) -> list[list[str]]:
 def test_figures_exist_and_are_not_blank(study_dir):
     report = (study_dir / "report.md").read_text()
     linked = re.findall(r"\(figures/([^)]+\.png)\)", report)
-    names = {"discrepancy_vs_n.png", "discrepancy_vs_horizon.png", "runtime_vs_n.png",
-             "speedup_vs_n.png", "history_n2_t_end0.1.png", "configurations_n2_t_end0.1.png"}
+    names = {
+        "discrepancy_vs_n.png",
+        "discrepancy_vs_horizon.png",
+        "runtime_vs_n.png",
+        "speedup_vs_n.png",
+        "history_n2_t_end0.1.png",
+        "configurations_n2_t_end0.1.png",
+    }
     assert names <= set(linked)
     for name in linked:
         png = study_dir / "figures" / name
@@ -52,26 +59,29 @@ def test_markdown_tables_are_github_pipe_tables(study_dir):
         for table in tables:
             assert SEPARATOR.match(table[1]), (name, table[1])
             widths = {len(re.findall(r"(?<!\\)\|", row)) for row in table}
-            assert len(widths) == 1, (name, table[0])      # same number of cells in every row
+            assert len(widths) == 1, (name, table[0])  # same number of cells in every row
             assert len(table) >= 3
 
 
 def test_report_is_rebuilt_from_the_saved_tables_only(study_dir, tmp_path):
     copy = tmp_path / "copy"
     shutil.copytree(study_dir, copy)
-    shutil.rmtree(copy / "cases")                           # no case records, no study file
+    shutil.rmtree(copy / "cases")  # no case records, no study file
     (copy / "study.toml").unlink()
     shutil.rmtree(copy / "figures")
     (copy / "report.md").unlink()
-    res = subprocess.run([sys.executable, "-m", "rodval", "report", str(copy)],
-                         capture_output=True, text=True)
+    res = subprocess.run(
+        [sys.executable, "-m", "rodval", "report", str(copy)], capture_output=True, text=True
+    )
     assert res.returncode == 0, res.stderr
     assert (copy / "report.md").read_text() == (study_dir / "report.md").read_text()
-    assert sorted(p.name for p in (copy / "figures").iterdir()) == \
-        sorted(p.name for p in (study_dir / "figures").iterdir())
+    assert sorted(p.name for p in (copy / "figures").iterdir()) == sorted(
+        p.name for p in (study_dir / "figures").iterdir()
+    )
 
 
 def test_report_of_a_folder_without_tables_exits_2(tmp_path):
-    res = subprocess.run([sys.executable, "-m", "rodval", "report", str(tmp_path)],
-                         capture_output=True, text=True)
+    res = subprocess.run(
+        [sys.executable, "-m", "rodval", "report", str(tmp_path)], capture_output=True, text=True
+    )
     assert res.returncode == 2 and "not a study folder" in res.stderr

@@ -1,6 +1,6 @@
 """The study runner: resume after a kill, failure isolation, the dask backend."""
+
 import math
-import os
 import signal
 import subprocess
 import sys
@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from study_helpers import write_study
 
 from rodval.study import load_study, run_study
-from study_helpers import write_study
 
 TIMING = ["wall_s", "setup_s"]
 
@@ -24,21 +24,32 @@ def _assert_same_results(a: Path, b: Path) -> None:
     ta, tb = _tables(a), _tables(b)
     pd.testing.assert_frame_equal(ta["trajectories"], tb["trajectories"])
     pd.testing.assert_frame_equal(ta["discrepancies"], tb["discrepancies"])
-    pd.testing.assert_frame_equal(ta["runtime"].drop(columns=TIMING),
-                                  tb["runtime"].drop(columns=TIMING))
+    pd.testing.assert_frame_equal(
+        ta["runtime"].drop(columns=TIMING), tb["runtime"].drop(columns=TIMING)
+    )
 
 
 def _study_cmd(path: Path, out: Path, *extra: str) -> list[str]:
-    return [sys.executable, "-m", "rodval", "study", str(path), "--out", str(out),
-            "--no-progress", *extra]
+    return [
+        sys.executable,
+        "-m",
+        "rodval",
+        "study",
+        str(path),
+        "--out",
+        str(out),
+        "--no-progress",
+        *extra,
+    ]
 
 
 def test_killed_study_resumes_without_redoing_finished_cases(tmp_path):
-    path = write_study(tmp_path, grid="scene.t_end = [0.1, 0.2, 0.3, 0.4]")   # 8 cases
+    path = write_study(tmp_path, grid="scene.t_end = [0.1, 0.2, 0.3, 0.4]")  # 8 cases
     n_cases = len(load_study(path).cases)
     out = tmp_path / "killed"
-    proc = subprocess.Popen(_study_cmd(path, out, "--workers", "1"),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        _study_cmd(path, out, "--workers", "1"), stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
     deadline = time.monotonic() + 120
     while len(list((out / "cases").glob("*.json"))) < 2 and time.monotonic() < deadline:
         assert proc.poll() is None, "the study ended before it could be killed"
@@ -52,7 +63,7 @@ def test_killed_study_resumes_without_redoing_finished_cases(tmp_path):
     res = subprocess.run(_study_cmd(path, out, "--workers", "2"), capture_output=True, text=True)
     assert res.returncode == 0, res.stderr
     assert f"{n_cases - len(finished)} cases run, {len(finished)} reused" in res.stdout
-    assert all(p.stat().st_mtime_ns == m for p, m in finished.items())   # not recomputed
+    assert all(p.stat().st_mtime_ns == m for p, m in finished.items())  # not recomputed
     assert len(list((out / "cases").glob("*.json"))) == n_cases
     assert not list((out / "cases").glob(".*.tmp"))
     fresh = tmp_path / "fresh"
@@ -67,7 +78,9 @@ def test_failing_case_is_recorded_and_the_others_finish(tmp_path):
     grid = "scene.t_end = [0.05]\nmodels.full.max_step = [inf, 1e-8]"
     path = write_study(tmp_path, models=models, grid=grid)
     out = tmp_path / "out"
-    res = subprocess.run(_study_cmd(path, out, "--case-timeout", "20"), capture_output=True, text=True)
+    res = subprocess.run(
+        _study_cmd(path, out, "--case-timeout", "20"), capture_output=True, text=True
+    )
     assert res.returncode == 0, res.stderr
     rt = pd.read_csv(out / "runtime.csv")
     assert len(rt) == 4 * 2
@@ -80,7 +93,9 @@ def test_failing_case_is_recorded_and_the_others_finish(tmp_path):
     assert (rt[rt[axis] == 1e-8].query("model == 'reduced'")["status"] == "success").all()
     disc = pd.read_csv(out / "discrepancies.csv")
     ok = disc[disc[axis] == math.inf]
-    assert (ok["status"] == "ok").all() and not ok[["max_abs", "rms", "final_abs", "max_rel"]].isna().any().any()
+    assert (ok["status"] == "ok").all() and not ok[
+        ["max_abs", "rms", "final_abs", "max_rel"]
+    ].isna().any().any()
     failed = disc[disc[axis] == 1e-8]
     assert (failed["status"] == "model failed (timeout)").all() and failed["max_abs"].isna().all()
     assert set(disc["case"]) == set(rt["case"])
@@ -89,10 +104,17 @@ def test_failing_case_is_recorded_and_the_others_finish(tmp_path):
 def test_dask_backend_on_a_local_cluster_gives_the_same_tables(tmp_path):
     distributed = pytest.importorskip("distributed")
     spec = load_study(write_study(tmp_path, grid="scene.t_end = [0.1]"))
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                                  dashboard_address=None) as cluster:
-        res = run_study(spec, tmp_path / "dask", backend="dask",
-                        scheduler=cluster.scheduler_address, progress=False, report=False)
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+    ) as cluster:
+        res = run_study(
+            spec,
+            tmp_path / "dask",
+            backend="dask",
+            scheduler=cluster.scheduler_address,
+            progress=False,
+            report=False,
+        )
     assert sorted(res.ran) == sorted(c.id for c in spec.cases)
     run_study(spec, tmp_path / "procs", workers=2, progress=False, report=False)
     _assert_same_results(tmp_path / "dask", tmp_path / "procs")
@@ -100,8 +122,12 @@ def test_dask_backend_on_a_local_cluster_gives_the_same_tables(tmp_path):
 
 def test_bad_runner_arguments(tmp_path):
     spec = load_study(write_study(tmp_path))
-    for kwargs, word in (({"workers": 0}, "workers"), ({"case_timeout": -1.0}, "case_timeout"),
-                         ({"backend": "mpi"}, "backend"), ({"backend": "dask"}, "scheduler")):
+    for kwargs, word in (
+        ({"workers": 0}, "workers"),
+        ({"case_timeout": -1.0}, "case_timeout"),
+        ({"backend": "mpi"}, "backend"),
+        ({"backend": "dask"}, "scheduler"),
+    ):
         with pytest.raises(ValueError, match=word):
             run_study(spec, tmp_path / "x", **kwargs)
     assert not (tmp_path / "x").exists()

@@ -1,5 +1,5 @@
 """The published Table 1 (error = max_k |rodval - published| / max_k |published| per column)."""
-import numpy as np
+
 import pytest
 
 from rodval.analysis.reproduce import column_errors, compare_table1, run_paper_models
@@ -9,7 +9,9 @@ from rodval.analysis.reproduce import column_errors, compare_table1, run_paper_m
 def errors(request):
     table = compare_table1(run_paper_models(request.param))
     assert table["rodval"].notna().all()
-    return request.param, column_errors(table).set_index(["quantity", "formulation", "t"]).sort_index()["error"]
+    return request.param, column_errors(table).set_index(
+        ["quantity", "formulation", "t"]
+    ).sort_index()["error"]
 
 
 def test_table1(errors):
@@ -19,7 +21,7 @@ def test_table1(errors):
         for f in "PR":
             assert err.loc["phi", f].max() < 2e-3
             assert err.loc["dphi", f].max() < 2e-2
-        assert err.loc["alpha", "R"].min() > 0.1            # the published bending is not ours
+        assert err.loc["alpha", "R"].min() > 0.1  # the published bending is not ours
     else:
         for q in ("phi", "dphi", "alpha", "beta"):
             assert err.loc[q, "R"].max() < 1e-2, q

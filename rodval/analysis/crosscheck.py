@@ -5,30 +5,33 @@ trajectories of the same scene is, per quantity (``rodval.analysis.metrics.error
 phi, alpha, beta: ``max_abs`` (rad); dphi: ``max_rel``, the largest error of a rod divided by
 that rod's max |value| (dimensionless).
 """
+
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 
 from rodval.analysis.metrics import error_metrics
-from rodval.core.scene import TABLE1_TIMES, paper_scene
 from rodval.analysis.reproduce import REPRODUCTION_SETTINGS
-from rodval.models.registry import simulate
+from rodval.core.scene import TABLE1_TIMES, paper_scene
 from rodval.core.trajectory import Trajectory
+from rodval.models.registry import simulate
 
 TABLE1_RODS = (2, 4, 6, 8)
 #: Acceptance bounds of the independent model against the native full model (issue 3).
 ACCEPTANCE = {"phi": 1.5e-3, "dphi": 2e-2, "alpha": 2e-4, "beta": 2e-4}
 
 
-def table1_gaps(traj: Trajectory, reference: Trajectory,
-                rods: tuple[int, ...] = TABLE1_RODS) -> dict[str, float]:
+def table1_gaps(
+    traj: Trajectory, reference: Trajectory, rods: tuple[int, ...] = TABLE1_RODS
+) -> dict[str, float]:
     """Gaps of ``traj`` against ``reference`` on ``rods`` (see module docstring)."""
     cols = [int(np.flatnonzero(reference.k_index["phi"] == k)[0]) for k in rods]
     out = {}
     for q in ACCEPTANCE:
-        m = error_metrics(reference.times, np.asarray(rods), traj[q][:, cols],
-                          reference[q][:, cols])
+        m = error_metrics(
+            reference.times, np.asarray(rods), traj[q][:, cols], reference[q][:, cols]
+        )
         out[q] = m["max_rel"] if q == "dphi" else m["max_abs"]
     return out
 
@@ -37,18 +40,31 @@ def crosscheck_paper(**exudyn_options) -> tuple[pd.DataFrame, dict[str, Trajecto
     """Run exudyn and the native full model (printed and published) on the paper example;
     return the gap table (one row per comparison) and the trajectories."""
     scene = paper_scene(times=TABLE1_TIMES)
-    runs = {"exudyn": simulate(scene, "exudyn", **exudyn_options),
-            "full printed": simulate(scene, "full", settings=REPRODUCTION_SETTINGS),
-            "full published": simulate(scene, "full", settings=REPRODUCTION_SETTINGS,
-                                       coefficients="published")}
+    runs = {
+        "exudyn": simulate(scene, "exudyn", **exudyn_options),
+        "full printed": simulate(scene, "full", settings=REPRODUCTION_SETTINGS),
+        "full published": simulate(
+            scene, "full", settings=REPRODUCTION_SETTINGS, coefficients="published"
+        ),
+    }
     rows = []
-    for label, model in (("exudyn vs full printed", "exudyn"),
-                         ("exudyn vs full published", "exudyn"),
-                         ("full published vs full printed", "full published")):
+    for label, model in (
+        ("exudyn vs full printed", "exudyn"),
+        ("exudyn vs full published", "exudyn"),
+        ("full published vs full printed", "full published"),
+    ):
         ref = "full printed" if label.endswith("printed") else "full published"
         gaps = table1_gaps(runs[model], runs[ref]) if runs[model].success else {}
-        rows.append({"comparison": label, **gaps,
-                     "within_acceptance": bool(gaps) and all(gaps[q] <= ACCEPTANCE[q] for q in ACCEPTANCE),
-                     "status": runs[model].stats.message})
-    rows.append({"comparison": "acceptance bound", **ACCEPTANCE, "within_acceptance": None, "status": ""})
+        rows.append(
+            {
+                "comparison": label,
+                **gaps,
+                "within_acceptance": bool(gaps)
+                and all(gaps[q] <= ACCEPTANCE[q] for q in ACCEPTANCE),
+                "status": runs[model].stats.message,
+            }
+        )
+    rows.append(
+        {"comparison": "acceptance bound", **ACCEPTANCE, "within_acceptance": None, "status": ""}
+    )
     return pd.DataFrame(rows), runs

@@ -5,20 +5,22 @@ About phi = phi0, alpha = beta = 0, q' = 0 with no load and no damping, the conv
 reduced: M_r(phi0), K_r). Natural angular frequencies (rad/s) are the square roots of the
 generalized eigenvalues of (K, M), ascending; rigid-body (zero-stiffness) modes give 0.
 """
+
 from __future__ import annotations
 
 import numpy as np
 import scipy.linalg
 
+from rodval.core.scene import Chain, InitialState, Scene
 from rodval.models.full import FullSystem
 from rodval.models.reduced import ReducedSystem
-from rodval.core.scene import Chain, InitialState, Scene
 
 _SYSTEMS = {"full": FullSystem, "reduced": ReducedSystem}
 
 
-def linear_matrices(chain: Chain, model: str = "full", phi0=None,
-                    coefficients: str = "printed") -> tuple[np.ndarray, np.ndarray]:
+def linear_matrices(
+    chain: Chain, model: str = "full", phi0=None, coefficients: str = "printed"
+) -> tuple[np.ndarray, np.ndarray]:
     """(M, K) of the linearized model about phi0 (default: straight along x)."""
     if model not in _SYSTEMS:
         raise ValueError(f"model must be one of {tuple(_SYSTEMS)}, got {model!r}")
@@ -27,12 +29,14 @@ def linear_matrices(chain: Chain, model: str = "full", phi0=None,
     phi = system.initial["phi"]
     if model == "full":
         from rodval.models.paper_matrices import mass_matrix
+
         return mass_matrix(system.cc, phi), system.K
     return system.reduced_matrices(phi)[0], system.K_r
 
 
-def natural_frequencies(chain: Chain, model: str = "full", phi0=None,
-                        coefficients: str = "printed") -> np.ndarray:
+def natural_frequencies(
+    chain: Chain, model: str = "full", phi0=None, coefficients: str = "printed"
+) -> np.ndarray:
     """Natural angular frequencies (rad/s), ascending."""
     M, K = linear_matrices(chain, model, phi0, coefficients)
     lam = scipy.linalg.eigvals(K, M)

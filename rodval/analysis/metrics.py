@@ -20,14 +20,16 @@ group of entries divided by max |r| over the same group. The group is one choice
 output time across columns: Table 1 columns, where the group is the rods at one time) or
 ``"column"`` (each column across time: ``max_rel`` above and the cross-check's dphi gap).
 """
+
 from __future__ import annotations
 
 import math
-from typing import Iterable
+from collections.abc import Iterable
 
 import numpy as np
 import pandas as pd
 
+from rodval.core.scene import trajectory_quantities
 from rodval.core.status import STATUS_MESSAGES
 from rodval.core.trajectory import Trajectory
 
@@ -49,22 +51,30 @@ def relative_error(values: np.ndarray, reference: np.ndarray, scale: str = "all"
         return np.where(norm > 0, top / np.where(norm > 0, norm, 1.0), np.nan)
 
 
-def error_metrics(times: np.ndarray, k: np.ndarray, values: np.ndarray,
-                  reference: np.ndarray) -> dict[str, float]:
+def error_metrics(
+    times: np.ndarray, k: np.ndarray, values: np.ndarray, reference: np.ndarray
+) -> dict[str, float]:
     """The metrics of one quantity: ``values`` and ``reference`` (nt, nk) at ``times`` (nt,)
     with column labels ``k`` (nk,). See the module docstring for the definitions."""
     values = np.asarray(values, dtype=float)
     reference = np.asarray(reference, dtype=float)
     if values.shape != reference.shape or values.ndim != 2 or values.size == 0:
-        raise ValueError(f"values and reference must be equal non-empty (nt, nk) arrays, "
-                         f"got {values.shape} and {reference.shape}")
+        raise ValueError(
+            f"values and reference must be equal non-empty (nt, nk) arrays, "
+            f"got {values.shape} and {reference.shape}"
+        )
     err = np.abs(values - reference)
     i, j = np.unravel_index(int(np.argmax(err)), err.shape)
     per_column = relative_error(values, reference, "column")
     max_rel = float(np.nanmax(per_column)) if np.isfinite(per_column).any() else float("nan")
-    return {"max_abs": float(err[i, j]), "rms": float(np.sqrt(np.mean(err * err))),
-            "final_abs": float(err[-1].max()), "max_rel": max_rel,
-            "k_at_max": int(k[j]), "t_at_max": float(times[i])}
+    return {
+        "max_abs": float(err[i, j]),
+        "rms": float(np.sqrt(np.mean(err * err))),
+        "final_abs": float(err[-1].max()),
+        "max_rel": max_rel,
+        "k_at_max": int(k[j]),
+        "t_at_max": float(times[i]),
+    }
 
 
 def common_quantities(traj: Trajectory, reference: Trajectory) -> tuple[str, ...]:
@@ -75,17 +85,22 @@ def common_quantities(traj: Trajectory, reference: Trajectory) -> tuple[str, ...
 def check_comparable(traj: Trajectory, reference: Trajectory, quantities: Iterable[str]) -> None:
     """Raise ValueError unless both trajectories have the same times and k labels."""
     if traj.times.shape != reference.times.shape or not np.allclose(
-            traj.times, reference.times, rtol=0, atol=1e-12):
-        raise ValueError(f"trajectories {traj.model!r} and {reference.model!r} have different "
-                         f"output times ({traj.times.size} and {reference.times.size} times)")
+        traj.times, reference.times, rtol=0, atol=1e-12
+    ):
+        raise ValueError(
+            f"trajectories {traj.model!r} and {reference.model!r} have different "
+            f"output times ({traj.times.size} and {reference.times.size} times)"
+        )
     for q in quantities:
         if not np.array_equal(traj.k_index[q], reference.k_index[q]):
-            raise ValueError(f"quantity {q!r}: k labels differ between {traj.model!r} and "
-                             f"{reference.model!r}")
+            raise ValueError(
+                f"quantity {q!r}: k labels differ between {traj.model!r} and {reference.model!r}"
+            )
 
 
-def discrepancies(traj: Trajectory, reference: Trajectory,
-                  quantities: Iterable[str] | None = None) -> pd.DataFrame:
+def discrepancies(
+    traj: Trajectory, reference: Trajectory, quantities: Iterable[str] | None = None
+) -> pd.DataFrame:
     """One row per quantity: quantity, max_abs, rms, final_abs, max_rel, k_at_max, t_at_max.
 
     ``quantities`` defaults to those both trajectories hold; a quantity missing from either
@@ -96,8 +111,15 @@ def discrepancies(traj: Trajectory, reference: Trajectory,
     if missing:
         raise ValueError(f"quantities {missing} are not in both trajectories")
     check_comparable(traj, reference, qs)
-    rows = [{"quantity": q, **error_metrics(reference.times, reference.k_index[q],
-                                            traj.values[q], reference.values[q])} for q in qs]
+    rows = [
+        {
+            "quantity": q,
+            **error_metrics(
+                reference.times, reference.k_index[q], traj.values[q], reference.values[q]
+            ),
+        }
+        for q in qs
+    ]
     return pd.DataFrame(rows, columns=["quantity", *METRICS])
 
 
@@ -107,25 +129,21 @@ def scaled_errors(values: np.ndarray, reference: np.ndarray) -> dict[str, float]
     ``rms`` = RMS(e) / s, ``max`` = max |e| / s (= ``relative_error(..., "all")``)."""
     e = np.asarray(values, float) - np.asarray(reference, float)
     s = float(np.max(np.abs(reference)))
-    return {"final": float(np.max(np.abs(e[-1])) / s), "rms": float(np.sqrt(np.mean(e * e)) / s),
-            "max": float(relative_error(values, reference, "all"))}
+    return {
+        "final": float(np.max(np.abs(e[-1])) / s),
+        "rms": float(np.sqrt(np.mean(e * e)) / s),
+        "max": float(relative_error(values, reference, "all")),
+    }
 
 
-def expected_quantities(outputs: Iterable[str]) -> tuple[str, ...]:
-    """The trajectory quantities a scene's ``outputs`` produce ("energy" gives three)."""
-    out: list[str] = []
-    for q in outputs:
-        out.extend(("kinetic", "potential", "energy") if q == "energy" else (q,))
-    return tuple(out)
-
-
-def compare_runs(trajectories: dict[str, Trajectory], reference: str,
-                 outputs: Iterable[str]) -> list[dict]:
+def compare_runs(
+    trajectories: dict[str, Trajectory], reference: str, outputs: Iterable[str]
+) -> list[dict]:
     """Discrepancy rows of every trajectory against the one labelled ``reference``, one row
     per quantity (``discrepancies`` plus model, reference, status). When either run failed,
     the metrics are absent (NaN in tables) and ``status`` says which run failed."""
     ref = trajectories[reference]
-    quantities = ref.quantities if ref.success else expected_quantities(outputs)
+    quantities = ref.quantities if ref.success else trajectory_quantities(outputs)
     rows: list[dict] = []
     for label, traj in trajectories.items():
         if label == reference:
@@ -137,8 +155,10 @@ def compare_runs(trajectories: dict[str, Trajectory], reference: str,
             status = f"model failed ({STATUS_MESSAGES[traj.stats.status]})"
         else:
             try:
-                rows += [{**base, **r, "status": "ok"}
-                         for r in discrepancies(traj, ref, quantities).to_dict("records")]
+                rows += [
+                    {**base, **r, "status": "ok"}
+                    for r in discrepancies(traj, ref, quantities).to_dict("records")
+                ]
                 continue
             except ValueError as exc:
                 status = f"not comparable: {exc}"

@@ -3,19 +3,18 @@
 Error measure of a Table 1 column (one quantity, formulation and time):
 max over k of |rodval - published| divided by max over k of |published|.
 """
+
 from __future__ import annotations
 
 from importlib import resources
-from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from rodval.analysis.metrics import relative_error
 from rodval.core.scene import TABLE1_TIMES, paper_scene
 from rodval.core.settings import IntegratorSettings
-from rodval.models.registry import simulate
 from rodval.core.trajectory import Trajectory
+from rodval.models.registry import simulate
 
 #: Table 1 formulation letters: P = full ("полная"), R = reduced.
 FORMULATIONS = {"P": "full", "R": "reduced"}
@@ -30,13 +29,17 @@ def published_table1() -> pd.DataFrame:
         return pd.read_csv(fh)
 
 
-def run_paper_models(coefficients: str = "printed",
-                     settings: IntegratorSettings = REPRODUCTION_SETTINGS,
-                     outputs=("phi", "dphi", "alpha", "beta")) -> dict[str, Trajectory]:
+def run_paper_models(
+    coefficients: str = "printed",
+    settings: IntegratorSettings = REPRODUCTION_SETTINGS,
+    outputs=("phi", "dphi", "alpha", "beta"),
+) -> dict[str, Trajectory]:
     """Full and reduced models on the paper example at the Table 1 times."""
     scene = paper_scene(times=TABLE1_TIMES, outputs=outputs)
-    return {f: simulate(scene, model, settings=settings, coefficients=coefficients)
-            for f, model in FORMULATIONS.items()}
+    return {
+        f: simulate(scene, model, settings=settings, coefficients=coefficients)
+        for f, model in FORMULATIONS.items()
+    }
 
 
 def compare_table1(trajectories: dict[str, Trajectory]) -> pd.DataFrame:
@@ -66,8 +69,8 @@ def column_errors(table: pd.DataFrame) -> pd.DataFrame:
         ours = part.pivot(index="t", columns="k", values="rodval")
         pub = part.pivot(index="t", columns="k", values="published")
         err = relative_error(ours.to_numpy(float), pub.to_numpy(float), "time")
-        rows += [{"quantity": q, "formulation": f, "t": t, "error": float(e)}
-                 for t, e in zip(ours.index, err)]
+        rows += [
+            {"quantity": q, "formulation": f, "t": t, "error": float(e)}
+            for t, e in zip(ours.index, err)
+        ]
     return pd.DataFrame(rows, columns=["quantity", "formulation", "t", "error"])
-
-

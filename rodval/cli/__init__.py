@@ -1,5 +1,6 @@
 """The ``rodval`` command. Each subcommand lives in its own module exposing
 ``register(subparsers)``; bad options exit with status 2 and a one-line message."""
+
 from __future__ import annotations
 
 import argparse
@@ -32,15 +33,17 @@ def build_parser() -> argparse.ArgumentParser:
     parser = OneLineParser(
         prog="rodval",
         description="Cross-validate plane rod-chain models: the paper's full and reduced\n"
-                    "models against each other and an independent exudyn beam model.",
+        "models against each other and an independent exudyn beam model.",
         epilog="examples:\n"
-               "  rodval reproduce paper --out out/paper\n"
-               "  rodval simulate paper --model reduced --out out/paper-reduced\n"
-               "  rodval study studies/paper.toml --out out/paper\n"
-               "  rodval report out/paper\n"
-               "Run `rodval COMMAND --help` for the options of a command.",
-        formatter_class=argparse.RawDescriptionHelpFormatter)
+        "  rodval reproduce paper --out out/paper\n"
+        "  rodval simulate paper --model reduced --out out/paper-reduced\n"
+        "  rodval study studies/paper.toml --out out/paper\n"
+        "  rodval report out/paper\n"
+        "Run `rodval COMMAND --help` for the options of a command.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     from rodval import __version__
+
     parser.add_argument("--version", action="version", version=f"rodval {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in COMMANDS:

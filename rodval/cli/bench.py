@@ -1,6 +1,7 @@
 """rodval bench {work-precision, cost-n, skips, speedup} --out DIR: performance measurements
 (see ``rodval.bench``). Each writes a CSV (with machine and package versions), a markdown
 summary and, where it applies, plots into DIR."""
+
 from __future__ import annotations
 
 import argparse
@@ -13,10 +14,10 @@ import numpy as np
 import pandas as pd
 
 from rodval import bench
+from rodval.cli.options import positive_float
 from rodval.core.provenance import provenance
 from rodval.core.scene import paper_scene
 from rodval.core.settings import METHODS
-from rodval.cli.options import positive_float
 from rodval.report.figures import plot_work_precision
 from rodval.report.markdown import to_markdown
 
@@ -31,11 +32,14 @@ def _float_list(name: str):
             try:
                 v = float(part)
             except ValueError:
-                raise argparse.ArgumentTypeError(f"{name} must be comma-separated numbers, got {text!r}") from None
+                raise argparse.ArgumentTypeError(
+                    f"{name} must be comma-separated numbers, got {text!r}"
+                ) from None
             if not (0 < v < 1):
                 raise argparse.ArgumentTypeError(f"{name} values must be in (0, 1), got {v}")
             values.append(v)
         return values
+
     return parse
 
 
@@ -44,8 +48,11 @@ def _choice_list(name: str, allowed: tuple[str, ...]):
         values = [v.strip() for v in text.split(",") if v.strip()]
         bad = [v for v in values if v not in allowed]
         if bad or not values:
-            raise argparse.ArgumentTypeError(f"{name} must be a comma-separated subset of {allowed}, got {text!r}")
+            raise argparse.ArgumentTypeError(
+                f"{name} must be a comma-separated subset of {allowed}, got {text!r}"
+            )
         return values
+
     return parse
 
 
@@ -53,7 +60,9 @@ def _int_list(text: str) -> list[int]:
     try:
         values = [int(v) for v in text.split(",")]
     except ValueError:
-        raise argparse.ArgumentTypeError(f"--n-values must be comma-separated integers >= 1, got {text!r}") from None
+        raise argparse.ArgumentTypeError(
+            f"--n-values must be comma-separated integers >= 1, got {text!r}"
+        ) from None
     if any(v < 1 for v in values):
         raise argparse.ArgumentTypeError(f"--n-values must be integers >= 1, got {text!r}")
     return values
@@ -70,30 +79,49 @@ def _repeats(text: str) -> int:
 
 
 def register(sub) -> None:
-    p = sub.add_parser("bench", help="performance benchmarks (work-precision, cost vs n, ...)",
-                       description="Performance measurements on the paper example; see "
-                                   "docs/performance.md.")
+    p = sub.add_parser(
+        "bench",
+        help="performance benchmarks (work-precision, cost vs n, ...)",
+        description="Performance measurements on the paper example; see docs/performance.md.",
+    )
     bsub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
     wp = bsub.add_parser("work-precision", help="error against cost for every model and integrator")
     wp.add_argument("--n", type=int, default=8, help="number of rods (default 8)")
-    wp.add_argument("--models", type=_choice_list("--models", ("full", "reduced", "exudyn")),
-                    default=["reduced", "full", "exudyn"])
-    wp.add_argument("--methods", type=_choice_list("--methods", METHODS), default=list(DEFAULT_METHODS))
-    wp.add_argument("--rtols", type=_float_list("--rtols"), default=_float_list("--rtols")(DEFAULT_RTOLS),
-                    help=f"tolerance ladder (default {DEFAULT_RTOLS}; atol = rtol/100)")
-    wp.add_argument("--budget", type=positive_float("--budget"), default=20.0,
-                    help="stop a method's ladder after a run slower than this, s (default 20)")
+    wp.add_argument(
+        "--models",
+        type=_choice_list("--models", ("full", "reduced", "exudyn")),
+        default=["reduced", "full", "exudyn"],
+    )
+    wp.add_argument(
+        "--methods", type=_choice_list("--methods", METHODS), default=list(DEFAULT_METHODS)
+    )
+    wp.add_argument(
+        "--rtols",
+        type=_float_list("--rtols"),
+        default=_float_list("--rtols")(DEFAULT_RTOLS),
+        help=f"tolerance ladder (default {DEFAULT_RTOLS}; atol = rtol/100)",
+    )
+    wp.add_argument(
+        "--budget",
+        type=positive_float("--budget"),
+        default=20.0,
+        help="stop a method's ladder after a run slower than this, s (default 20)",
+    )
     wp.set_defaults(func=run_work_precision)
     cn = bsub.add_parser("cost-n", help="seconds per RHS evaluation against n, fitted exponent")
     cn.add_argument("--n-values", type=_int_list, default=[2, 4, 8, 16, 32, 64, 128, 256, 512])
     cn.set_defaults(func=run_cost_n)
     sk = bsub.add_parser("skips", help="cost with and without each skipped piece of work")
     sk.set_defaults(func=run_skips)
-    sp = bsub.add_parser("speedup", help="reduced vs full (and exudyn) at equal phi accuracy against n")
+    sp = bsub.add_parser(
+        "speedup", help="reduced vs full (and exudyn) at equal phi accuracy against n"
+    )
     sp.add_argument("--n-values", type=_int_list, default=[2, 4, 8, 16, 32])
     sp.set_defaults(func=run_speedup)
     for q in (wp, cn, sk, sp):
-        q.add_argument("--repeats", type=_repeats, default=3, help="timed runs after a warm-up (min is kept)")
+        q.add_argument(
+            "--repeats", type=_repeats, default=3, help="timed runs after a warm-up (min is kept)"
+        )
         q.add_argument("--out", required=True, type=Path, help="output folder")
 
 
@@ -115,29 +143,72 @@ def run_work_precision(args) -> int:
     if args.n < 1:
         raise ValueError(f"--n must be an integer >= 1, got {args.n}")
     scene = paper_scene(args.n, times=np.linspace(0, 2, 41))
-    frame, unc, notes = bench.work_precision(scene, args.models, args.methods, args.rtols,
-                                             repeats=args.repeats, budget_s=args.budget)
+    frame, unc, notes = bench.work_precision(
+        scene, args.models, args.methods, args.rtols, repeats=args.repeats, budget_s=args.budget
+    )
     args.out.mkdir(parents=True, exist_ok=True)
     plots = plot_work_precision(frame, args.out)
-    ratios = bench.baseline_ratios(paper_scene(args.n, times=np.linspace(0, 2, 41)),
-                                   repeats=args.repeats)
+    ratios = bench.baseline_ratios(
+        paper_scene(args.n, times=np.linspace(0, 2, 41)), repeats=args.repeats
+    )
     ratios.to_csv(args.out / "baseline_ratios.csv", index=False)
     best = bench.cheapest(frame)
-    cols = ["model", "method", "kernel", "rtol", "wall_s", "nfev", "njev", "nlu", "nsteps",
-            "max_phi", "rms_phi", "final_phi", "max_dphi", "max_alpha", "max_beta", "scd"]
-    body = ["Paper example, n = %d, 0..2 s, 41 output times. Errors: max relative over output "
-            "times (see rodval.bench)." % args.n, "",
-            "Reference uncertainty (max relative difference of the two references, phi/dphi): "
-            + ", ".join(f"{m}: {u:.1e}" for m, u in unc.items()), "",
-            "## Fastest run per integrator with phi error <= 1e-6", "",
-            _table(best, cols), "",
-            "## Side by side at equal tolerance: compiled DOP853 vs scipy DOP853 (numba and "
-            "numpy right-hand sides)", "",
-            _table(ratios, ["model", "method", "kernel", "rtol", "wall_s", "nfev", "max_phi",
-                            "speedup_vs_numpy_DOP853"]), "",
-            "## All runs", "", _table(frame, [c for c in cols if c in frame]), "",
-            "## Notes", "", *[f"- {n}" for n in notes or ["none"]], "",
-            "Plots: " + ", ".join(p.name for p in plots)]
+    cols = [
+        "model",
+        "method",
+        "kernel",
+        "rtol",
+        "wall_s",
+        "nfev",
+        "njev",
+        "nlu",
+        "nsteps",
+        "max_phi",
+        "rms_phi",
+        "final_phi",
+        "max_dphi",
+        "max_alpha",
+        "max_beta",
+        "scd",
+    ]
+    body = [
+        f"Paper example, n = {args.n}, 0..2 s, 41 output times. Errors: max relative over "
+        "output times (see rodval.bench).",
+        "",
+        "Reference uncertainty (max relative difference of the two references, phi/dphi): "
+        + ", ".join(f"{m}: {u:.1e}" for m, u in unc.items()),
+        "",
+        "## Fastest run per integrator with phi error <= 1e-6",
+        "",
+        _table(best, cols),
+        "",
+        "## Side by side at equal tolerance: compiled DOP853 vs scipy DOP853 (numba and "
+        "numpy right-hand sides)",
+        "",
+        _table(
+            ratios,
+            [
+                "model",
+                "method",
+                "kernel",
+                "rtol",
+                "wall_s",
+                "nfev",
+                "max_phi",
+                "speedup_vs_numpy_DOP853",
+            ],
+        ),
+        "",
+        "## All runs",
+        "",
+        _table(frame, [c for c in cols if c in frame]),
+        "",
+        "## Notes",
+        "",
+        *[f"- {n}" for n in notes or ["none"]],
+        "",
+        "Plots: " + ", ".join(p.name for p in plots),
+    ]
     _write(args.out, "work_precision", frame, "Work-precision", body)
     return 0
 
@@ -147,17 +218,29 @@ def run_cost_n(args) -> int:
     fits = []
     for (model, kernel), part in frame.groupby(["model", "kernel"]):
         n, c = part.n.to_numpy(), part.s_per_eval.to_numpy()
-        fits.append({"model": model, "kernel": kernel,
-                     "exponent (n >= 32)": bench.fitted_exponent(n, c, 32),
-                     "exponent (all n)": bench.fitted_exponent(n, c)})
-        print(f"{model} {kernel}: fitted exponent {fits[-1]['exponent (n >= 32)']:.2f} (n >= 32), "
-              f"{fits[-1]['exponent (all n)']:.2f} (all n)")
+        fits.append(
+            {
+                "model": model,
+                "kernel": kernel,
+                "exponent (n >= 32)": bench.fitted_exponent(n, c, 32),
+                "exponent (all n)": bench.fitted_exponent(n, c),
+            }
+        )
+        print(
+            f"{model} {kernel}: fitted exponent {fits[-1]['exponent (n >= 32)']:.2f} (n >= 32), "
+            f"{fits[-1]['exponent (all n)']:.2f} (all n)"
+        )
     wide = frame.pivot_table(index="n", columns=["model", "kernel"], values="s_per_eval")
     wide.columns = [f"{m}/{k} (us)" for m, k in wide.columns]
-    body = ["Seconds per right-hand-side evaluation, paper chain, load active, random state.", "",
-            (wide * 1e6).reset_index().to_markdown(index=False, floatfmt=".3g"), "",
-            "Fitted exponent of cost ~ n^p:", "",
-            pd.DataFrame(fits).to_markdown(index=False, floatfmt=".2f")]
+    body = [
+        "Seconds per right-hand-side evaluation, paper chain, load active, random state.",
+        "",
+        (wide * 1e6).reset_index().to_markdown(index=False, floatfmt=".3g"),
+        "",
+        "Fitted exponent of cost ~ n^p:",
+        "",
+        pd.DataFrame(fits).to_markdown(index=False, floatfmt=".2f"),
+    ]
     _write(args.out, "cost_n", frame, "Cost per evaluation against n", body)
     return 0
 
@@ -171,10 +254,18 @@ def run_skips(args) -> int:
 
 def run_speedup(args) -> int:
     frame, notes = bench.speedup_vs_n(args.n_values, repeats=args.repeats)
-    body = ["Fastest run with phi error <= 1e-6 against each model's own reference; wall "
-            "times in s.", "", frame[[c for c in frame if not c.startswith(("version_", "python",
-                                                                         "platform", "processor",
-                                                                         "cpu_count"))]]
-            .to_markdown(index=False, floatfmt=".3g"), "", *[f"- {n}" for n in notes]]
+    body = [
+        "Fastest run with phi error <= 1e-6 against each model's own reference; wall times in s.",
+        "",
+        frame[
+            [
+                c
+                for c in frame
+                if not c.startswith(("version_", "python", "platform", "processor", "cpu_count"))
+            ]
+        ].to_markdown(index=False, floatfmt=".3g"),
+        "",
+        *[f"- {n}" for n in notes],
+    ]
     _write(args.out, "speedup", frame, "Speed-up at equal phi accuracy against n", body)
     return 0

@@ -1,4 +1,5 @@
 """Option parsers shared by subcommands: each rejects bad values with a message naming them."""
+
 from __future__ import annotations
 
 import argparse
@@ -22,6 +23,7 @@ def positive_float(name: str, *, finite: bool = True, below: float = math.inf):
         if not (0 < v < below) or (finite and math.isinf(v)):
             raise argparse.ArgumentTypeError(f"{name} must be {allowed}, got {text!r}")
         return v
+
     return parse
 
 
@@ -30,10 +32,13 @@ def positive_int(name: str):
         try:
             v = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1, got {text!r}") from None
+            raise argparse.ArgumentTypeError(
+                f"{name} must be an integer >= 1, got {text!r}"
+            ) from None
         if v < 1:
             raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1, got {text!r}")
         return v
+
     return parse
 
 
@@ -42,7 +47,8 @@ def time_list(text: str) -> list[float]:
         values = [float(t) for t in text.split(",") if t.strip()]
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"--times must be comma-separated seconds like 0.5,1,2, got {text!r}") from None
+            f"--times must be comma-separated seconds like 0.5,1,2, got {text!r}"
+        ) from None
     if not values:
         raise argparse.ArgumentTypeError("--times must list at least one time")
     if any(v < 0 or not math.isfinite(v) for v in values):
@@ -71,28 +77,56 @@ def add_integrator_options(p: argparse.ArgumentParser) -> None:
     """--method, --rtol, --atol, --max-step, --max-evaluations, --max-wall with the defaults of
     ``rodval.core.settings.DEFAULTS`` (the same as the Python API and study files)."""
     d = DEFAULTS
-    p.add_argument("--method", default=d["method"], choices=METHODS,
-                   help="auto (default: the compiled DOP853 where the model and scene have a "
-                        "compiled form, scipy's DOP853 otherwise), a scipy solve_ivp method, or "
-                        "DOP853-numba (native models)")
-    p.add_argument("--rtol", type=positive_float("--rtol", below=1.0), default=d["rtol"],
-                   help=f"relative tolerance in (0, 1) (default {d['rtol']:g})")
-    p.add_argument("--atol", type=positive_float("--atol"), default=d["atol"],
-                   help=f"absolute tolerance > 0 (default {d['atol']:g})")
-    p.add_argument("--max-step", type=positive_float("--max-step", finite=False),
-                   default=d["max_step"], help="largest step, s (default unbounded)")
-    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"),
-                   default=d["max_evaluations"],
-                   help=f"right-hand-side evaluations a run may use (default {d['max_evaluations']})")
-    p.add_argument("--max-wall", type=positive_float("--max-wall", finite=False),
-                   default=d["max_wall_s"], help="wall-clock seconds a run may use (default: no limit)")
+    p.add_argument(
+        "--method",
+        default=d["method"],
+        choices=METHODS,
+        help="auto (default: the compiled DOP853 where the model and scene have a "
+        "compiled form, scipy's DOP853 otherwise), a scipy solve_ivp method, or "
+        "DOP853-numba (native models)",
+    )
+    p.add_argument(
+        "--rtol",
+        type=positive_float("--rtol", below=1.0),
+        default=d["rtol"],
+        help=f"relative tolerance in (0, 1) (default {d['rtol']:g})",
+    )
+    p.add_argument(
+        "--atol",
+        type=positive_float("--atol"),
+        default=d["atol"],
+        help=f"absolute tolerance > 0 (default {d['atol']:g})",
+    )
+    p.add_argument(
+        "--max-step",
+        type=positive_float("--max-step", finite=False),
+        default=d["max_step"],
+        help="largest step, s (default unbounded)",
+    )
+    p.add_argument(
+        "--max-evaluations",
+        type=positive_int("--max-evaluations"),
+        default=d["max_evaluations"],
+        help=f"right-hand-side evaluations a run may use (default {d['max_evaluations']})",
+    )
+    p.add_argument(
+        "--max-wall",
+        type=positive_float("--max-wall", finite=False),
+        default=d["max_wall_s"],
+        help="wall-clock seconds a run may use (default: no limit)",
+    )
 
 
 def integrator_settings(args: argparse.Namespace) -> dict:
     """The integrator settings the user gave on the command line (only those that differ
     from the defaults, so that a reference model with its own integrator is not handed
     settings nobody asked for)."""
-    given = {"method": args.method, "rtol": args.rtol, "atol": args.atol,
-             "max_step": args.max_step, "max_evaluations": args.max_evaluations,
-             "max_wall_s": args.max_wall}
+    given = {
+        "method": args.method,
+        "rtol": args.rtol,
+        "atol": args.atol,
+        "max_step": args.max_step,
+        "max_evaluations": args.max_evaluations,
+        "max_wall_s": args.max_wall,
+    }
     return {k: v for k, v in given.items() if v != DEFAULTS[k]}

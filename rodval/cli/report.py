@@ -1,13 +1,17 @@
 """rodval report DIR: rebuild DIR/report.md and DIR/figures/ from a study's saved tables."""
+
 from __future__ import annotations
 
 from pathlib import Path
 
 
 def register(sub) -> None:
-    p = sub.add_parser("report", help="rebuild a study's report from its saved tables",
-                       description="Rebuild DIR/report.md and DIR/figures/*.png from the CSV "
-                                   "tables a `rodval study` run saved in DIR; nothing is recomputed.")
+    p = sub.add_parser(
+        "report",
+        help="rebuild a study's report from its saved tables",
+        description="Rebuild DIR/report.md and DIR/figures/*.png from the CSV "
+        "tables a `rodval study` run saved in DIR; nothing is recomputed.",
+    )
     p.add_argument("dir", metavar="DIR", type=Path, help="output folder of `rodval study`")
     p.set_defaults(func=run)
 

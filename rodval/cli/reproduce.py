@@ -1,28 +1,45 @@
 """rodval reproduce paper --out DIR: the paper's Table 1 and Fig. 3, and the exudyn cross-check."""
+
 from __future__ import annotations
 
 import importlib.util
 from pathlib import Path
 
-from rodval.report.paper import crosscheck_markdown, reproduce_paper
 from rodval.cli import CliError
+from rodval.report.paper import crosscheck_markdown, reproduce_paper
 
 
 def register(sub) -> None:
-    p = sub.add_parser("reproduce", help="reproduce the paper's example (Table 1, Fig. 3, cross-check)",
-                       description="Run the paper's example with the full and reduced models and "
-                                   "write DIR/table1.csv, DIR/table1.md, DIR/configurations.png; "
-                                   "with exudyn installed, also cross-check against the independent "
-                                   "beam model (DIR/crosscheck.csv, DIR/crosscheck.md).")
+    p = sub.add_parser(
+        "reproduce",
+        help="reproduce the paper's example (Table 1, Fig. 3, cross-check)",
+        description="Run the paper's example with the full and reduced models and "
+        "write DIR/table1.csv, DIR/table1.md, DIR/configurations.png; "
+        "with exudyn installed, also cross-check against the independent "
+        "beam model (DIR/crosscheck.csv, DIR/crosscheck.md).",
+    )
     p.add_argument("target", choices=("paper",), help="what to reproduce")
     p.add_argument("--out", required=True, type=Path, help="output folder")
-    p.add_argument("--variant", choices=("printed", "published"), default="printed",
-                   help="coefficients: printed (from the kinematics, default) or published "
-                        "(the erratum that reproduces the paper's alpha/beta)")
-    p.add_argument("--cross-check", dest="cross_check", action="store_true", default=None,
-                   help="require the exudyn cross-check (default: run it when exudyn is installed)")
-    p.add_argument("--no-cross-check", dest="cross_check", action="store_false",
-                   help="skip the exudyn cross-check")
+    p.add_argument(
+        "--variant",
+        choices=("printed", "published"),
+        default="printed",
+        help="coefficients: printed (from the kinematics, default) or published "
+        "(the erratum that reproduces the paper's alpha/beta)",
+    )
+    p.add_argument(
+        "--cross-check",
+        dest="cross_check",
+        action="store_true",
+        default=None,
+        help="require the exudyn cross-check (default: run it when exudyn is installed)",
+    )
+    p.add_argument(
+        "--no-cross-check",
+        dest="cross_check",
+        action="store_false",
+        help="skip the exudyn cross-check",
+    )
     p.set_defaults(func=run)
 
 
@@ -31,10 +48,13 @@ def run(args) -> int:
     if args.cross_check and not have_exudyn:
         raise CliError("--cross-check needs exudyn: pip install 'rodval[exudyn]'")
     errors = reproduce_paper(args.out, args.variant)
-    wide = errors.pivot_table(index=["quantity", "formulation"], columns="t", values="error",
-                              sort=False)
-    print(f"Table 1 column errors (max_k |rodval - published| / max_k |published|), "
-          f"coefficients = {args.variant}:")
+    wide = errors.pivot_table(
+        index=["quantity", "formulation"], columns="t", values="error", sort=False
+    )
+    print(
+        f"Table 1 column errors (max_k |rodval - published| / max_k |published|), "
+        f"coefficients = {args.variant}:"
+    )
     print(wide.to_string(float_format=lambda v: f"{v:.2e}"))
     print(f"wrote {args.out}/table1.csv, table1.md, configurations.png")
     if args.cross_check is False or not have_exudyn:

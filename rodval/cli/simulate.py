@@ -3,6 +3,7 @@
 SCENE is 'paper', a TOML scene file, or the run.json of an earlier run (rerun exactly: the
 same resolved scene, model, options and integrator settings; options given here override).
 """
+
 from __future__ import annotations
 
 import json
@@ -10,34 +11,55 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from rodval.cli.options import (add_integrator_options, integrator_settings, key_value,
-                                positive_float, time_list)
+from rodval.cli.options import (
+    add_integrator_options,
+    integrator_settings,
+    key_value,
+    positive_float,
+    time_list,
+)
 from rodval.core.provenance import provenance
-from rodval.core.scene_file import (read_scene_document, scene_from_dict, scene_to_dict,
-                                    with_horizon)
+from rodval.core.scene_file import read_scene_document, scene_from_dict, scene_to_dict, with_horizon
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.models import REGISTRY, simulate
 from rodval.solvers.progress import progress_bar
 
 
 def register(sub) -> None:
-    p = sub.add_parser("simulate", help="run one scene with one model",
-                       description="Run SCENE ('paper', a TOML scene file, or the run.json of "
-                                   "an earlier run) with one model and write "
-                                   "DIR/trajectory.csv (t, quantity, k, value) and DIR/run.json "
-                                   "(the complete resolved scene, model, options, settings "
-                                   "and how the run ended).")
+    p = sub.add_parser(
+        "simulate",
+        help="run one scene with one model",
+        description="Run SCENE ('paper', a TOML scene file, or the run.json of "
+        "an earlier run) with one model and write "
+        "DIR/trajectory.csv (t, quantity, k, value) and DIR/run.json "
+        "(the complete resolved scene, model, options, settings "
+        "and how the run ended).",
+    )
     p.add_argument("scene", metavar="SCENE", help="'paper', a TOML scene file or a run.json")
-    p.add_argument("--model", choices=tuple(REGISTRY),
-                   help="model (default full; a run.json's own model)")
+    p.add_argument(
+        "--model", choices=tuple(REGISTRY), help="model (default full; a run.json's own model)"
+    )
     add_integrator_options(p)
-    p.add_argument("--t-end", type=positive_float("--t-end"),
-                   help="horizon, s (> 0); the scene's output times up to it are kept")
+    p.add_argument(
+        "--t-end",
+        type=positive_float("--t-end"),
+        help="horizon, s (> 0); the scene's output times up to it are kept",
+    )
     p.add_argument("--times", type=time_list, help="output times t1,t2,... (s), increasing")
-    p.add_argument("--coefficients", choices=("printed", "published"),
-                   help="coefficient variant of the native models (default printed)")
-    p.add_argument("--set", dest="options", type=key_value, action="append", default=[],
-                   metavar="KEY=VALUE", help="model option, e.g. elements=2 (repeatable)")
+    p.add_argument(
+        "--coefficients",
+        choices=("printed", "published"),
+        help="coefficient variant of the native models (default printed)",
+    )
+    p.add_argument(
+        "--set",
+        dest="options",
+        type=key_value,
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="model option, e.g. elements=2 (repeatable)",
+    )
     p.add_argument("--out", required=True, type=Path, help="output folder")
     p.set_defaults(func=run)
 
@@ -52,8 +74,11 @@ def _previous_run(path: Path) -> dict[str, Any] | None:
         rec = json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ValueError(f"{path}: not a readable run.json ({exc})") from None
-    missing = [k for k in ("scene", "model", "settings", "options") if not isinstance(rec, dict)
-               or k not in rec]
+    missing = [
+        k
+        for k in ("scene", "model", "settings", "options")
+        if not isinstance(rec, dict) or k not in rec
+    ]
     if missing:
         raise ValueError(f"{path}: not a run.json of rodval simulate (no {missing[0]!r})")
     return rec
@@ -64,11 +89,17 @@ def run(args) -> int:
     if previous is not None:
         doc, model = dict(previous["scene"]), args.model or previous["model"]
         settings_kw = {k: v for k, v in previous["settings"].items() if k in SETTING_NAMES}
-        settings_kw["method"] = previous["settings"].get("requested_method",
-                                                         settings_kw.get("method"))
+        settings_kw["method"] = previous["settings"].get(
+            "requested_method", settings_kw.get("method")
+        )
         options = dict(previous["options"]) if model == previous["model"] else {}
     else:
-        doc, model, settings_kw, options = read_scene_document(args.scene), args.model or "full", {}, {}
+        doc, model, settings_kw, options = (
+            read_scene_document(args.scene),
+            args.model or "full",
+            {},
+            {},
+        )
     where = str(args.scene)
     if args.t_end is not None:
         scene = with_horizon(doc, args.t_end, where)
@@ -84,11 +115,19 @@ def run(args) -> int:
         traj = simulate(scene, model, settings=IntegratorSettings(**settings_kw), **options)
     args.out.mkdir(parents=True, exist_ok=True)
     traj.to_frame().to_csv(args.out / "trajectory.csv", index=False)
-    record = {"scene": scene_to_dict(scene), "model": traj.model, "options": traj.options,
-              "settings": traj.settings, "stats": traj.stats.as_dict(), "events": traj.events,
-              "provenance": provenance()}
+    record = {
+        "scene": scene_to_dict(scene),
+        "model": traj.model,
+        "options": traj.options,
+        "settings": traj.settings,
+        "stats": traj.stats.as_dict(),
+        "events": traj.events,
+        "provenance": provenance(),
+    }
     (args.out / "run.json").write_text(json.dumps(record, indent=2, default=str))
-    print(f"{traj.model}: {traj.stats.message}, method {traj.settings.get('method')}, "
-          f"t_reached = {traj.stats.t_reached:g} s, nfev = {traj.stats.nfev}, "
-          f"wall = {traj.stats.wall_s:.3f} s -> {args.out}")
+    print(
+        f"{traj.model}: {traj.stats.message}, method {traj.settings.get('method')}, "
+        f"t_reached = {traj.stats.t_reached:g} s, nfev = {traj.stats.nfev}, "
+        f"wall = {traj.stats.wall_s:.3f} s -> {args.out}"
+    )
     return 0 if traj.success else 1

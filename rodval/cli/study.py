@@ -1,4 +1,5 @@
 """rodval study FILE --out DIR: run a study grid, write tables and the report."""
+
 from __future__ import annotations
 
 import argparse
@@ -11,24 +12,45 @@ from rodval.cli.options import positive_float, positive_int
 
 def register(sub) -> None:
     p = sub.add_parser(
-        "study", help="run a study (grid of scenes x models) and write tables and a report",
+        "study",
+        help="run a study (grid of scenes x models) and write tables and a report",
         description="Run every case of the study FILE (TOML, see studies/README.md) and write "
-                    "DIR/cases/*.json (one per finished case), DIR/{trajectories,discrepancies,"
-                    "runtime,cases}.csv with markdown versions, DIR/report.md and DIR/figures/. "
-                    "An interrupted study resumes where it stopped.")
+        "DIR/cases/*.json (one per finished case), DIR/{trajectories,discrepancies,"
+        "runtime,cases}.csv with markdown versions, DIR/report.md and DIR/figures/. "
+        "An interrupted study resumes where it stopped.",
+    )
     p.add_argument("file", metavar="FILE", type=Path, help="study file (TOML)")
     p.add_argument("--out", required=True, type=Path, metavar="DIR", help="output folder")
-    p.add_argument("--workers", type=positive_int("--workers"), metavar="N",
-                   help="cases run at once by the processes backend (default: all cores)")
-    p.add_argument("--case-timeout", type=positive_float("--case-timeout"), metavar="S",
-                   help="stop a case after S seconds and record its unfinished runs as 'timeout'")
-    p.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True,
-                   help="reuse the finished cases in DIR (default); --no-resume runs all again")
-    p.add_argument("--backend", choices=("processes", "dask"), default="processes",
-                   help="processes on this machine (default) or an existing dask.distributed cluster")
-    p.add_argument("--scheduler", metavar="ADDR", help="dask scheduler address, e.g. tcp://host:8786")
-    p.add_argument("--fresh", action="store_true",
-                   help="empty DIR first (needed when DIR holds another study)")
+    p.add_argument(
+        "--workers",
+        type=positive_int("--workers"),
+        metavar="N",
+        help="cases run at once by the processes backend (default: all cores)",
+    )
+    p.add_argument(
+        "--case-timeout",
+        type=positive_float("--case-timeout"),
+        metavar="S",
+        help="stop a case after S seconds and record its unfinished runs as 'timeout'",
+    )
+    p.add_argument(
+        "--resume",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="reuse the finished cases in DIR (default); --no-resume runs all again",
+    )
+    p.add_argument(
+        "--backend",
+        choices=("processes", "dask"),
+        default="processes",
+        help="processes on this machine (default) or an existing dask.distributed cluster",
+    )
+    p.add_argument(
+        "--scheduler", metavar="ADDR", help="dask scheduler address, e.g. tcp://host:8786"
+    )
+    p.add_argument(
+        "--fresh", action="store_true", help="empty DIR first (needed when DIR holds another study)"
+    )
     p.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     p.set_defaults(func=run)
 
@@ -42,17 +64,30 @@ def run(args) -> int:
         raise ValueError("--backend dask needs --scheduler ADDR")
     signal.signal(signal.SIGTERM, signal.default_int_handler)
     try:
-        res = run_study(spec, args.out, workers=args.workers, case_timeout=args.case_timeout,
-                        resume=args.resume, backend=args.backend, scheduler=args.scheduler,
-                        progress=args.progress, fresh=args.fresh)
+        res = run_study(
+            spec,
+            args.out,
+            workers=args.workers,
+            case_timeout=args.case_timeout,
+            resume=args.resume,
+            backend=args.backend,
+            scheduler=args.scheduler,
+            progress=args.progress,
+            fresh=args.fresh,
+        )
     except KeyboardInterrupt:
         store = StudyStore(args.out)
         done = sum(store.case_path(c.id).is_file() for c in spec.cases)
-        print(f"rodval study: interrupted; {done} of {len(spec.cases)} cases are in "
-              f"{args.out / 'cases'}; run the same command again to resume", file=sys.stderr)
+        print(
+            f"rodval study: interrupted; {done} of {len(spec.cases)} cases are in "
+            f"{args.out / 'cases'}; run the same command again to resume",
+            file=sys.stderr,
+        )
         return 130
     for warning in res.warnings:
         print(f"rodval study: warning: {warning}", file=sys.stderr)
-    print(f"{spec.name}: {len(res.ran)} cases run, {len(res.reused)} reused, "
-          f"{res.failed_runs} failed model runs, {res.wall_s:.1f} s -> {res.out / 'report.md'}")
+    print(
+        f"{spec.name}: {len(res.ran)} cases run, {len(res.reused)} reused, "
+        f"{res.failed_runs} failed model runs, {res.wall_s:.1f} s -> {res.out / 'report.md'}"
+    )
     return 0

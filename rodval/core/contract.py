@@ -4,6 +4,7 @@ Models are registered by name (``rodval.models.registry``); a run never raises f
 integration (the Trajectory's stats say how it ended), but a bad option or a setting the
 model cannot honour is a ValueError raised before any work.
 """
+
 from __future__ import annotations
 
 from abc import ABC, abstractmethod

@@ -14,15 +14,17 @@ Compiled load table: one row per (node, component, law piece), columns ``LOAD_CO
 node (0-based), component (0 = X, 1 = Y), law code, t0, t1 (s), right_closed (1: active on
 [t0, t1], 0: on [t0, t1)), p0, p1, p2 (the law's parameters, see ``LAW_*``).
 """
+
 from __future__ import annotations
 
 import csv
 import math
 import numbers
 from abc import ABC, abstractmethod
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -31,23 +33,23 @@ ForceLaw = Callable[[float], float]
 
 LOAD_COLUMNS = ("node", "component", "law", "t0", "t1", "right_closed", "p0", "p1", "p2")
 #: Compiled law codes: value(t) on the row's interval.
-LAW_CONSTANT = 0        # p0
-LAW_RAISED_COSINE = 1   # p0 (1/2 - 1/2 cos(p1 t))
-LAW_LINEAR = 2          # p0 + p1 (t - t0)
-LAW_HARMONIC = 3        # p0 sin(p1 t + p2)
+LAW_CONSTANT = 0  # p0
+LAW_RAISED_COSINE = 1  # p0 (1/2 - 1/2 cos(p1 t))
+LAW_LINEAR = 2  # p0 + p1 (t - t0)
+LAW_HARMONIC = 3  # p0 sin(p1 t + p2)
 
-Row = tuple[int, float, float, bool, float, float, float]   # law, t0, t1, closed, p0, p1, p2
+Row = tuple[int, float, float, bool, float, float, float]  # law, t0, t1, closed, p0, p1, p2
 
 
-def _real(where: str, value: Any, *, positive: bool = False) -> float:
-    """Types before values: a finite real number (not a bool, string or complex)."""
+def _real(where: str, value: Any, unit: str, *, positive: bool = False) -> float:
+    """Types before values: a finite real number (not a bool, string or complex), > 0 when
+    ``positive``; the message names the parameter, its allowed range and unit."""
+    allowed = f"a finite real number{' > 0' if positive else ''} ({unit})"
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{where} must be a real number, got {value!r}")
+        raise ValueError(f"{where} must be {allowed}, got {value!r}")
     v = float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"{where} must be finite, got {value!r}")
-    if positive and v <= 0:
-        raise ValueError(f"{where} must be > 0, got {value!r}")
+    if not math.isfinite(v) or (positive and v <= 0):
+        raise ValueError(f"{where} must be {allowed}, got {value!r}")
     return v
 
 
@@ -129,10 +131,21 @@ class PiecewiseLinear(Law):
         for i in range(self.t.size - 1):
             slope = (self.f[i + 1] - self.f[i]) / (self.t[i + 1] - self.t[i])
             closed = i == last and not self.hold
-            out.append((LAW_LINEAR, float(self.t[i]), float(self.t[i + 1]), closed,
-                        float(self.f[i]), float(slope), 0.0))
+            out.append(
+                (
+                    LAW_LINEAR,
+                    float(self.t[i]),
+                    float(self.t[i + 1]),
+                    closed,
+                    float(self.f[i]),
+                    float(slope),
+                    0.0,
+                )
+            )
         if self.hold:
-            out.append((LAW_CONSTANT, float(self.t[-1]), math.inf, True, float(self.f[-1]), 0.0, 0.0))
+            out.append(
+                (LAW_CONSTANT, float(self.t[-1]), math.inf, True, float(self.f[-1]), 0.0, 0.0)
+            )
         return out
 
 
@@ -174,13 +187,17 @@ class NodalForce:
             if f is not None and not callable(f):
                 raise ValueError(f"load {label} must be callable t -> float or None, got {f!r}")
         if not (isinstance(self.support, tuple) and len(self.support) == 2):
-            raise ValueError(f"load support must be a pair (t0, t1) of seconds, got {self.support!r}")
+            raise ValueError(
+                f"load support must be a pair (t0, t1) of seconds, got {self.support!r}"
+            )
         t0, t1 = (_real_or_inf("load support", v) for v in self.support)
         if not (math.isfinite(t0) and t0 >= 0 and t1 > t0):
             raise ValueError(f"load support must satisfy 0 <= t0 < t1, got {self.support}")
         for b in self.breakpoints:
             if _real_or_inf("load breakpoints", b) < 0 or not math.isfinite(b):
-                raise ValueError(f"load breakpoints must be finite and >= 0, got {self.breakpoints}")
+                raise ValueError(
+                    f"load breakpoints must be finite and >= 0, got {self.breakpoints}"
+                )
 
     def active(self, t: float) -> bool:
         return self.support[0] <= t <= self.support[1]
@@ -214,77 +231,119 @@ def pulse(node: int, Xbar: float = -150.0, Ybar: float = 1200.0, T: float = 1.0)
     Y(t) = Ybar (1/2 - 1/2 cos(2 pi t / T)) for 0 <= t <= T,   else 0.
     Both components are C1 at t = 0 but have kinks at T/2 (X) and T (Y).
     """
-    Xbar, Ybar = _real("pulse Xbar (N)", Xbar), _real("pulse Ybar (N)", Ybar)
-    T = _real("pulse T (s)", T, positive=True)
-    return NodalForce(node, RaisedCosine(Xbar, 4.0 * math.pi / T, 0.5 * T),
-                      RaisedCosine(Ybar, 2.0 * math.pi / T, T), support=(0.0, T),
-                      breakpoints=(0.5 * T, T), name="pulse",
-                      params={"Xbar": Xbar, "Ybar": Ybar, "T": T})
+    Xbar, Ybar = _real("pulse Xbar", Xbar, "N"), _real("pulse Ybar", Ybar, "N")
+    T = _real("pulse T", T, "s", positive=True)
+    return NodalForce(
+        node,
+        RaisedCosine(Xbar, 4.0 * math.pi / T, 0.5 * T),
+        RaisedCosine(Ybar, 2.0 * math.pi / T, T),
+        support=(0.0, T),
+        breakpoints=(0.5 * T, T),
+        name="pulse",
+        params={"Xbar": Xbar, "Ybar": Ybar, "T": T},
+    )
 
 
 def _switch_times(kind: str, t_on: Any, t_off: Any) -> tuple[float, float]:
-    t_on = _real(f"{kind} t_on (s)", t_on)
+    t_on = _real(f"{kind} t_on", t_on, "s")
     t_off = _real_or_inf(f"{kind} t_off (s)", t_off)
     if not (0 <= t_on < t_off):
         raise ValueError(f"{kind} load needs 0 <= t_on < t_off, got t_on = {t_on}, t_off = {t_off}")
     return t_on, t_off
 
 
-def constant(node: int, X: float = 0.0, Y: float = 0.0, t_on: float = 0.0,
-             t_off: float = math.inf) -> NodalForce:
+def constant(
+    node: int, X: float = 0.0, Y: float = 0.0, t_on: float = 0.0, t_off: float = math.inf
+) -> NodalForce:
     """A constant force (X, Y) in N switched on at ``t_on`` and off at ``t_off`` (s): a step
     load (t_on > 0) or a constant one."""
-    X, Y = _real("constant X (N)", X), _real("constant Y (N)", Y)
+    X, Y = _real("constant X", X, "N"), _real("constant Y", Y, "N")
     t_on, t_off = _switch_times("constant", t_on, t_off)
     bps = tuple(b for b in (t_on, t_off) if math.isfinite(b) and b > 0)
-    return NodalForce(node, Constant(X, t_on, t_off) if X else None,
-                      Constant(Y, t_on, t_off) if Y else None, support=(t_on, t_off),
-                      breakpoints=bps, name="constant",
-                      params={"X": X, "Y": Y, "t_on": t_on, "t_off": t_off})
+    return NodalForce(
+        node,
+        Constant(X, t_on, t_off) if X else None,
+        Constant(Y, t_on, t_off) if Y else None,
+        support=(t_on, t_off),
+        breakpoints=bps,
+        name="constant",
+        params={"X": X, "Y": Y, "t_on": t_on, "t_off": t_off},
+    )
 
 
-def ramp(node: int, X: float = 0.0, Y: float = 0.0, t_on: float = 0.0,
-         t_full: float = 1.0, t_off: float = math.inf) -> NodalForce:
+def ramp(
+    node: int,
+    X: float = 0.0,
+    Y: float = 0.0,
+    t_on: float = 0.0,
+    t_full: float = 1.0,
+    t_off: float = math.inf,
+) -> NodalForce:
     """A force rising linearly from 0 at ``t_on`` to (X, Y) N at ``t_full``, then held until
     ``t_off`` (s). Kinks at t_on and t_full, a jump at t_off."""
-    X, Y = _real("ramp X (N)", X), _real("ramp Y (N)", Y)
+    X, Y = _real("ramp X", X, "N"), _real("ramp Y", Y, "N")
     t_on, t_off = _switch_times("ramp", t_on, t_off)
-    t_full = _real("ramp t_full (s)", t_full)
+    t_full = _real("ramp t_full", t_full, "s")
     if not (t_on < t_full <= t_off):
-        raise ValueError(f"ramp load needs t_on < t_full <= t_off, got t_on = {t_on}, "
-                         f"t_full = {t_full}, t_off = {t_off}")
+        raise ValueError(
+            f"ramp load needs t_on < t_full <= t_off, got t_on = {t_on}, "
+            f"t_full = {t_full}, t_off = {t_off}"
+        )
     times = np.array([t_on, t_full])
 
     def law(v: float) -> PiecewiseLinear | None:
         return PiecewiseLinear(times, np.array([0.0, v]), hold=True) if v else None
 
     bps = tuple(b for b in (t_on, t_full, t_off) if math.isfinite(b) and b > 0)
-    return NodalForce(node, law(X), law(Y), support=(t_on, t_off), breakpoints=bps, name="ramp",
-                      params={"X": X, "Y": Y, "t_on": t_on, "t_full": t_full, "t_off": t_off})
+    return NodalForce(
+        node,
+        law(X),
+        law(Y),
+        support=(t_on, t_off),
+        breakpoints=bps,
+        name="ramp",
+        params={"X": X, "Y": Y, "t_on": t_on, "t_full": t_full, "t_off": t_off},
+    )
 
 
-def harmonic(node: int, X: float = 0.0, Y: float = 0.0, omega: float = 1.0,
-             phase: float = 0.0, t_on: float = 0.0, t_off: float = math.inf) -> NodalForce:
+def harmonic(
+    node: int,
+    X: float = 0.0,
+    Y: float = 0.0,
+    omega: float = 1.0,
+    phase: float = 0.0,
+    t_on: float = 0.0,
+    t_off: float = math.inf,
+) -> NodalForce:
     """A harmonic force (X, Y) sin(omega t + phase) in N, omega in rad/s, phase in rad, acting
     on [t_on, t_off] (s)."""
-    X, Y = _real("harmonic X (N)", X), _real("harmonic Y (N)", Y)
-    omega = _real("harmonic omega (rad/s)", omega, positive=True)
-    phase = _real("harmonic phase (rad)", phase)
+    X, Y = _real("harmonic X", X, "N"), _real("harmonic Y", Y, "N")
+    omega = _real("harmonic omega", omega, "rad/s", positive=True)
+    phase = _real("harmonic phase", phase, "rad")
     t_on, t_off = _switch_times("harmonic", t_on, t_off)
     bps = tuple(b for b in (t_on, t_off) if math.isfinite(b) and b > 0)
-    return NodalForce(node, Harmonic(X, omega, phase, t_on, t_off) if X else None,
-                      Harmonic(Y, omega, phase, t_on, t_off) if Y else None,
-                      support=(t_on, t_off), breakpoints=bps, name="harmonic",
-                      params={"X": X, "Y": Y, "omega": omega, "phase": phase, "t_on": t_on,
-                              "t_off": t_off})
+    return NodalForce(
+        node,
+        Harmonic(X, omega, phase, t_on, t_off) if X else None,
+        Harmonic(Y, omega, phase, t_on, t_off) if Y else None,
+        support=(t_on, t_off),
+        breakpoints=bps,
+        name="harmonic",
+        params={"X": X, "Y": Y, "omega": omega, "phase": phase, "t_on": t_on, "t_off": t_off},
+    )
 
 
 #: Largest number of samples of a tabulated force history.
 MAX_SAMPLES = 1_000_000
 
 
-def tabulated(node: int, t: Sequence[float] | None = None, X: Sequence[float] | None = None,
-              Y: Sequence[float] | None = None, file: str | Path | None = None) -> NodalForce:
+def tabulated(
+    node: int,
+    t: Sequence[float] | None = None,
+    X: Sequence[float] | None = None,
+    Y: Sequence[float] | None = None,
+    file: str | Path | None = None,
+) -> NodalForce:
     """A measured or specified force history: X(t), Y(t) in N linearly interpolated between
     samples at strictly increasing times t (s), zero outside [t_0, t_last]. Either arrays
     ``t`` with ``X`` and/or ``Y``, or ``file``: a CSV file with a header row naming the
@@ -301,20 +360,28 @@ def tabulated(node: int, t: Sequence[float] | None = None, X: Sequence[float] | 
         raise ValueError(f"tabulated t must have 2 to {MAX_SAMPLES} samples, got {tt.size}")
     if tt[0] < 0 or np.any(np.diff(tt) <= 0):
         raise ValueError("tabulated t must be >= 0 and strictly increasing")
-    laws, params = [], {"t": tt.tolist()}
+    laws: list[PiecewiseLinear | None] = []
+    params: dict[str, Any] = {"t": tt.tolist()}
     for label, v in (("X", X), ("Y", Y)):
         if v is None:
             laws.append(None)
             continue
         arr = _samples(f"tabulated {label} (N)", v)
         if arr.shape != tt.shape:
-            raise ValueError(f"tabulated {label} must have one value per time ({tt.size}), "
-                             f"got {arr.size}")
+            raise ValueError(
+                f"tabulated {label} must have one value per time ({tt.size}), got {arr.size}"
+            )
         laws.append(PiecewiseLinear(tt, arr))
         params[label] = arr.tolist()
-    return NodalForce(node, laws[0], laws[1], support=(float(tt[0]), float(tt[-1])),
-                      breakpoints=tuple(float(b) for b in tt if b > 0), name="tabulated",
-                      params=params)
+    return NodalForce(
+        node,
+        laws[0],
+        laws[1],
+        support=(float(tt[0]), float(tt[-1])),
+        breakpoints=tuple(float(b) for b in tt if b > 0),
+        name="tabulated",
+        params=params,
+    )
 
 
 def _samples(where: str, values: Any) -> np.ndarray:
@@ -350,8 +417,12 @@ def _read_history(path: Path) -> tuple[list[float], list[float] | None, list[flo
 
 #: Scene-file load types -> factory (the keys of each table are the factory's arguments).
 LOAD_FACTORIES: dict[str, Callable[..., NodalForce]] = {
-    "pulse": pulse, "constant": constant, "ramp": ramp, "harmonic": harmonic,
-    "tabulated": tabulated}
+    "pulse": pulse,
+    "constant": constant,
+    "ramp": ramp,
+    "harmonic": harmonic,
+    "tabulated": tabulated,
+}
 
 
 def load_table(loads: Sequence[NodalForce]) -> np.ndarray | None:
@@ -442,9 +513,12 @@ def _evaluate(law: ForceLaw, t: float, node: int, label: str) -> float:
     try:
         v = law(t)
     except Exception as exc:  # noqa: BLE001 - a user's callable: named, then reported as data
-        raise ValueError(f"load {label} at node {node} raised at t = {t:.6g} s: "
-                         f"{type(exc).__name__}: {exc}") from exc
+        raise ValueError(
+            f"load {label} at node {node} raised at t = {t:.6g} s: {type(exc).__name__}: {exc}"
+        ) from exc
     if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
-        raise ValueError(f"load {label} at node {node} must return a finite real number (N), "
-                         f"got {v!r} at t = {t:.6g} s")
+        raise ValueError(
+            f"load at node {node} is not finite at t = {t:.6g} s: {label} = {v!r} "
+            "(a load law must return a finite real number, N)"
+        )
     return float(v)

@@ -1,4 +1,5 @@
 """Where a result came from: package versions and the machine, recorded beside outputs."""
+
 from __future__ import annotations
 
 import os
@@ -19,9 +20,12 @@ def package_versions() -> dict[str, str | None]:
 
 
 def machine() -> dict[str, object]:
-    return {"python": platform.python_version(), "platform": platform.platform(),
-            "processor": platform.processor() or platform.machine(),
-            "cpu_count": os.cpu_count()}
+    return {
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "processor": platform.processor() or platform.machine(),
+        "cpu_count": os.cpu_count(),
+    }
 
 
 def provenance() -> dict[str, object]:

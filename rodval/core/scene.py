@@ -14,12 +14,14 @@ Conventions (used throughout rodval)
 * Units: m, kg, s, N, rad. ``m`` is mass per length (kg/m), ``EI`` in N m^2, ``kappa`` in
   N m/rad, ``nu`` in N m s/rad.
 """
+
 from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
-from typing import Iterable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -28,16 +30,42 @@ from rodval.core.loads import NodalForce
 #: Quantities a scene may ask for. "x"/"y" are node positions (k = 0..n); "energy" yields
 #: kinetic, potential and total energy (k = 0).
 QUANTITIES = ("phi", "dphi", "alpha", "beta", "x", "y", "energy")
-ENERGY_QUANTITIES = ("kinetic", "potential", "energy")
+#: Units of every trajectory quantity (the energy audit adds work, dissipated, residual).
+UNITS = {
+    "phi": "rad",
+    "dphi": "rad/s",
+    "alpha": "rad",
+    "beta": "rad",
+    "x": "m",
+    "y": "m",
+    "kinetic": "J",
+    "potential": "J",
+    "energy": "J",
+    "work": "J",
+    "dissipated": "J",
+    "energy_residual": "J",
+    "hinge_angle": "rad",
+    "hinge_moment": "N m",
+}
+
+
+def trajectory_quantities(outputs: Iterable[str]) -> tuple[str, ...]:
+    """The trajectory quantities a scene's ``outputs`` produce: "energy" yields kinetic,
+    potential and energy (J, k = 0); the others themselves."""
+    out: list[str] = []
+    for q in outputs:
+        out.extend(("kinetic", "potential", "energy") if q == "energy" else (q,))
+    return tuple(out)
 
 
 def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndarray:
     """A length-n float array from a scalar or sequence of real numbers; ``positive``: True
     for > 0, False for >= 0, None for any finite value."""
     raw = np.asarray(value) if not isinstance(value, (str, bytes, dict)) else np.asarray(None)
-    if raw.dtype.kind not in "iuf":          # strings, booleans, complex, objects: refused
-        raise ValueError(f"{name} must be a real number or a list of n = {n} real numbers, "
-                         f"got {value!r}")
+    if raw.dtype.kind not in "iuf":  # strings, booleans, complex, objects: refused
+        raise ValueError(
+            f"{name} must be a real number or a list of n = {n} real numbers, got {value!r}"
+        )
     arr = raw.astype(float)
     if arr.ndim == 0:
         arr = np.full(n, float(arr))
@@ -68,11 +96,11 @@ class Chain:
     nu: np.ndarray
 
     @classmethod
-    def uniform(cls, n: int, *, l=2.0, m=3.0, EI=1e5, mu=3.0, kappa=100.0, nu=0.01) -> "Chain":
+    def uniform(cls, n: int, *, l=2.0, m=3.0, EI=1e5, mu=3.0, kappa=100.0, nu=0.01) -> Chain:
         """Chain of n rods; each argument is a scalar or a length-n sequence."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
             raise ValueError(f"n (number of rods) must be an integer >= 1, got {n!r}")
-        return cls(l=l, m=m, EI=EI, mu=mu, kappa=kappa, nu=nu, _n=int(n))  # type: ignore[call-arg]
+        return cls(l=l, m=m, EI=EI, mu=mu, kappa=kappa, nu=nu, _n=int(n))
 
     def __init__(self, l, m, EI, mu, kappa, nu, _n: int | None = None):
         n = _n
@@ -96,7 +124,7 @@ class Chain:
     def as_dict(self) -> dict[str, list[float]]:
         return {k: getattr(self, k).tolist() for k in ("l", "m", "EI", "mu", "kappa", "nu")}
 
-    def with_(self, **changes) -> "Chain":
+    def with_(self, **changes) -> Chain:
         """A copy with some fields replaced (scalars broadcast)."""
         d = {k: getattr(self, k) for k in ("l", "m", "EI", "mu", "kappa", "nu")}
         d.update(changes)
@@ -105,10 +133,13 @@ class Chain:
     def __eq__(self, other) -> bool:
         return isinstance(other, Chain) and all(
             np.array_equal(getattr(self, k), getattr(other, k))
-            for k in ("l", "m", "EI", "mu", "kappa", "nu"))
+            for k in ("l", "m", "EI", "mu", "kappa", "nu")
+        )
 
     def __hash__(self):  # pragma: no cover - frozen dataclass with arrays
-        return hash(tuple(getattr(self, k).tobytes() for k in ("l", "m", "EI", "mu", "kappa", "nu")))
+        return hash(
+            tuple(getattr(self, k).tobytes() for k in ("l", "m", "EI", "mu", "kappa", "nu"))
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -184,7 +215,9 @@ class Scene:
     chain: Chain
     loads: tuple[NodalForce, ...] = ()
     t_end: float = 2.0
-    times: np.ndarray | None = None
+    #: Output times (s): a sequence or None (the default grid) on input; always a read-only
+    #: float array after construction.
+    times: Any = None
     outputs: tuple[str, ...] = ("phi", "dphi", "alpha", "beta")
     initial: InitialState = field(default_factory=InitialState)
     name: str = "scene"
@@ -200,8 +233,9 @@ class Scene:
             raise ValueError(f"t_end (horizon) must be finite and > 0 s, got {self.t_end!r}")
         object.__setattr__(self, "t_end", t_end)
         if isinstance(self.loads, (str, bytes, dict)) or not isinstance(self.loads, Iterable):
-            raise ValueError(f"loads must be a sequence of NodalForce (e.g. () for none), "
-                             f"got {self.loads!r}")
+            raise ValueError(
+                f"loads must be a sequence of NodalForce (e.g. () for none), got {self.loads!r}"
+            )
         loads = tuple(self.loads)
         for f in loads:
             if not isinstance(f, NodalForce):
@@ -209,7 +243,11 @@ class Scene:
             if f.node > n:
                 raise ValueError(f"load node must be in 1..n = 1..{n}, got {f.node}")
         object.__setattr__(self, "loads", loads)
-        times = output_times(0.0, t_end, DEFAULT_NUM_TIMES) if self.times is None else _times_array(self.times)
+        times = (
+            output_times(0.0, t_end, DEFAULT_NUM_TIMES)
+            if self.times is None
+            else _times_array(self.times)
+        )
         if times.ndim != 1 or times.size == 0:
             raise ValueError("times (output times) must be a non-empty 1-D sequence of seconds")
         if not np.all(np.isfinite(times)):
@@ -217,15 +255,19 @@ class Scene:
         if np.any(np.diff(times) <= 0):
             raise ValueError("times (output times) must be strictly increasing")
         if times[0] < 0 or times[-1] > t_end * (1 + 1e-12):
-            raise ValueError(f"times (output times) must lie in [0, t_end] = [0, {t_end}], "
-                             f"got [{times[0]}, {times[-1]}]")
+            raise ValueError(
+                f"times (output times) must lie in [0, t_end] = [0, {t_end}], "
+                f"got [{times[0]}, {times[-1]}]"
+            )
         times = times.copy()
         times.setflags(write=False)
         object.__setattr__(self, "times", times)
         outputs = (self.outputs,) if isinstance(self.outputs, str) else tuple(self.outputs)
         bad = [q for q in outputs if q not in QUANTITIES]
         if bad or not outputs:
-            raise ValueError(f"outputs must be a non-empty subset of {QUANTITIES}, got {list(outputs)}")
+            raise ValueError(
+                f"outputs must be a non-empty subset of {QUANTITIES}, got {list(outputs)}"
+            )
         object.__setattr__(self, "outputs", tuple(dict.fromkeys(outputs)))
         if not isinstance(self.initial, InitialState):
             raise ValueError("initial must be a rodval.InitialState")
@@ -241,7 +283,7 @@ class Scene:
         bps = {b for f in self.loads for b in f.breakpoints if 0 < b < self.t_end}
         return np.array(sorted(bps))
 
-    def with_(self, **changes) -> "Scene":
+    def with_(self, **changes) -> Scene:
         """A copy with fields replaced (validated again)."""
         return replace(self, **changes)
 
@@ -249,9 +291,15 @@ class Scene:
         return any(q in self.outputs for q in quantities)
 
 
-def paper_scene(n: int = 8, *, t_end: float = 2.0, times: Iterable[float] | None = None,
-                outputs: Iterable[str] = ("phi", "dphi", "alpha", "beta"),
-                load_node: int | None = None, **chain_overrides: Mapping) -> Scene:
+def paper_scene(
+    n: int = 8,
+    *,
+    t_end: float = 2.0,
+    times: Iterable[float] | None = None,
+    outputs: Iterable[str] = ("phi", "dphi", "alpha", "beta"),
+    load_node: int | None = None,
+    **chain_overrides: Mapping,
+) -> Scene:
     """The example of the paper (section 3): n uniform rods, the pulse at the last node.
 
     l = 2 m, m = 3 kg/m, mu = 3 kg, EI = 1e5 N m^2, kappa = 100 N m/rad, nu = 0.01 N m s/rad,
@@ -261,9 +309,14 @@ def paper_scene(n: int = 8, *, t_end: float = 2.0, times: Iterable[float] | None
 
     chain = Chain.uniform(n, **chain_overrides)
     node = n if load_node is None else load_node
-    return Scene(chain=chain, loads=(pulse(node),), t_end=t_end,
-                 times=None if times is None else np.asarray(list(times), float),
-                 outputs=tuple(outputs), name=f"paper-n{n}")
+    return Scene(
+        chain=chain,
+        loads=(pulse(node),),
+        t_end=t_end,
+        times=None if times is None else np.asarray(list(times), float),
+        outputs=tuple(outputs),
+        name=f"paper-n{n}",
+    )
 
 
 #: Output times of the paper's Table 1 and Fig. 3 (s).

@@ -24,6 +24,7 @@ Format (every key optional except where noted)::
     [initial]                 # scalars or lists of length n (rad, rad/s)
     phi = 0.0
 """
+
 from __future__ import annotations
 
 import inspect
@@ -34,8 +35,16 @@ from typing import Any
 import numpy as np
 
 from rodval.core.loads import LOAD_FACTORIES
-from rodval.core.scene import (DEFAULT_NUM_TIMES, MAX_TIMES, QUANTITIES, Chain, InitialState,
-                               Scene, output_times, paper_scene)
+from rodval.core.scene import (
+    DEFAULT_NUM_TIMES,
+    MAX_TIMES,
+    QUANTITIES,
+    Chain,
+    InitialState,
+    Scene,
+    output_times,
+    paper_scene,
+)
 
 BASES = ("paper",)
 TOP_KEYS = {"base", "name", "n", "t_end", "times", "outputs", "chain", "loads", "initial"}
@@ -49,7 +58,9 @@ def _check_keys(d: dict, allowed: set[str], where: str) -> None:
         raise ValueError(f"{where}: expected a table, got {type(d).__name__}")
     unknown = sorted(set(d) - allowed)
     if unknown:
-        raise ValueError(f"{where}: unknown key {unknown[0]!r} (allowed: {', '.join(sorted(allowed))})")
+        raise ValueError(
+            f"{where}: unknown key {unknown[0]!r} (allowed: {', '.join(sorted(allowed))})"
+        )
 
 
 def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
@@ -59,10 +70,11 @@ def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
         _check_keys(value, TIMES_KEYS, f"{where} key 'times'")
         num = value.get("num", DEFAULT_NUM_TIMES)
         if isinstance(num, bool) or not isinstance(num, int):
-            raise ValueError(f"{where} key 'times.num': must be an integer in [1, {MAX_TIMES}], "
-                             f"got {num!r}")
+            raise ValueError(
+                f"{where} key 'times': num must be an integer >= 1 and <= {MAX_TIMES}, got {num!r}"
+            )
         if not 1 <= num <= MAX_TIMES:
-            raise ValueError(f"{where} key 'times.num': must be in [1, {MAX_TIMES}], got {num}")
+            raise ValueError(f"{where} key 'times': num must be >= 1 and <= {MAX_TIMES}, got {num}")
         for key in ("start", "stop"):
             v = value.get(key)
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
@@ -72,9 +84,13 @@ def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
         if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value):
             raise ValueError(f"{where} key 'times': must be a list of numbers (s), got {value!r}")
         if len(value) > MAX_TIMES:
-            raise ValueError(f"{where} key 'times': at most {MAX_TIMES} output times, got {len(value)}")
+            raise ValueError(
+                f"{where} key 'times': at most {MAX_TIMES} output times, got {len(value)}"
+            )
         return np.array([float(v) for v in value])
-    raise ValueError(f"{where} key 'times': must be a list of seconds or a table {{start, stop, num}}")
+    raise ValueError(
+        f"{where} key 'times': must be a list of seconds or a table {{start, stop, num}}"
+    )
 
 
 def _load(spec: dict, n: int, where: str):
@@ -82,7 +98,9 @@ def _load(spec: dict, n: int, where: str):
         raise ValueError(f"{where}: each load needs a 'type' (one of {', '.join(LOAD_FACTORIES)})")
     kind = spec["type"]
     if kind not in LOAD_FACTORIES:
-        raise ValueError(f"{where}: load type must be one of {', '.join(LOAD_FACTORIES)}, got {kind!r}")
+        raise ValueError(
+            f"{where}: load type must be one of {', '.join(LOAD_FACTORIES)}, got {kind!r}"
+        )
     args = {k: v for k, v in spec.items() if k != "type"}
     if args.get("node") == "last":
         args["node"] = n
@@ -90,8 +108,10 @@ def _load(spec: dict, n: int, where: str):
     allowed = [p for p in inspect.signature(factory).parameters]
     unknown = sorted(set(args) - set(allowed))
     if unknown:
-        raise ValueError(f"{where}: load {kind!r} has no key {unknown[0]!r} "
-                         f"(allowed: {', '.join(allowed)})")
+        raise ValueError(
+            f"{where}: unexpected keyword {unknown[0]!r} for load {kind!r} "
+            f"(allowed: {', '.join(allowed)})"
+        )
     if "node" not in args:
         raise ValueError(f"{where}: load {kind!r} needs 'node' (1..n or \"last\")")
     return factory(**args)
@@ -116,21 +136,30 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
         scene = paper_scene(n, t_end=float(t_end))
         chain_spec = d.get("chain", {})
         _check_keys(chain_spec, CHAIN_KEYS, f"{where} [chain]")
-        chain = Chain(**{**scene.chain.as_dict(), **chain_spec}, _n=n) if chain_spec else scene.chain
+        chain = (
+            Chain(**{**scene.chain.as_dict(), **chain_spec}, _n=n) if chain_spec else scene.chain
+        )
         loads = scene.loads
         if "loads" in d:
             if not isinstance(d["loads"], list):
                 raise ValueError("key 'loads' must be an array of tables [[loads]]")
-            loads = tuple(_load(s, n, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"]))
+            loads = tuple(
+                _load(s, n, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"])
+            )
         init_spec = d.get("initial", {})
         _check_keys(init_spec, INITIAL_KEYS, f"{where} [initial]")
         outputs = d.get("outputs", scene.outputs)
         if isinstance(outputs, str) or not isinstance(outputs, (list, tuple)):
             raise ValueError(f"key 'outputs' must be a list from {QUANTITIES}, got {outputs!r}")
-        return Scene(chain=chain, loads=loads, t_end=float(t_end),
-                     times=_times(d.get("times"), float(t_end), where),
-                     outputs=tuple(outputs), initial=InitialState(**init_spec),
-                     name=str(d.get("name", scene.name)))
+        return Scene(
+            chain=chain,
+            loads=loads,
+            t_end=float(t_end),
+            times=_times(d.get("times"), float(t_end), where),
+            outputs=tuple(outputs),
+            initial=InitialState(**init_spec),
+            name=str(d.get("name", scene.name)),
+        )
     except ValueError as exc:
         msg = str(exc)
         raise ValueError(msg if msg.startswith(where) else f"{where}: {msg}") from None
@@ -165,8 +194,10 @@ def with_horizon(doc: dict[str, Any], t_end: float, where: str) -> Scene:
     scene = scene_from_dict(doc, where=where)
     keep = scene.times[scene.times <= t_end]
     if keep.size == 0:
-        raise ValueError(f"{where}: --t-end {t_end:g} s leaves none of the scene's output times "
-                         f"(the first is {scene.times[0]:g} s); give --times as well")
+        raise ValueError(
+            f"{where}: --t-end {t_end:g} s leaves none of the scene's output times "
+            f"(the first is {scene.times[0]:g} s); give --times as well"
+        )
     return scene.with_(t_end=t_end, times=keep)
 
 
@@ -176,8 +207,13 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     scene from it, bit for bit. A load that is a plain Python callable has no such form: it
     is recorded as ``{"type": "callable", "node": k}``, which ``scene_from_dict`` refuses."""
     init = scene.initial.resolve(scene.n)
-    return {"name": scene.name, "n": scene.n, "t_end": scene.t_end,
-            "times": [float(t) for t in scene.times], "outputs": list(scene.outputs),
-            "chain": scene.chain.as_dict(),
-            "loads": [{"type": f.name, "node": f.node, **f.params} for f in scene.loads],
-            "initial": {k: v.tolist() for k, v in init.items()}}
+    return {
+        "name": scene.name,
+        "n": scene.n,
+        "t_end": scene.t_end,
+        "times": [float(t) for t in scene.times],
+        "outputs": list(scene.outputs),
+        "chain": scene.chain.as_dict(),
+        "loads": [{"type": f.name, "node": f.node, **f.params} for f in scene.loads],
+        "initial": {k: v.tolist() for k, v in init.items()},
+    }

@@ -3,6 +3,7 @@
 This module is the one source of defaults for the Python API, the CLI and study files
 (``DEFAULTS``): every surface builds an ``IntegratorSettings`` and never repeats a value.
 """
+
 from __future__ import annotations
 
 import math
@@ -65,11 +66,17 @@ class IntegratorSettings:
     def __post_init__(self) -> None:
         if not isinstance(self.method, str) or self.method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
-        for name in ("rtol", "atol", "max_step", "max_wall_s", "blowup_factor",
-                     "min_step_fraction"):
+        for name in (
+            "rtol",
+            "atol",
+            "max_step",
+            "max_wall_s",
+            "blowup_factor",
+            "min_step_fraction",
+        ):
             _number(name, getattr(self, name))
         if not (0 < self.rtol < 1):
-            raise ValueError(f"rtol must be in (0, 1), got {self.rtol!r}")
+            raise ValueError(f"rtol must be a number > 0 and < 1, got {self.rtol!r}")
         if not (0 < self.atol < math.inf):
             raise ValueError(f"atol must be a finite number > 0, got {self.atol!r}")
         for name in ("max_step", "max_wall_s"):
@@ -78,10 +85,13 @@ class IntegratorSettings:
         if self.first_step is not None:
             _number("first_step", self.first_step)
             if not (0 < self.first_step < math.inf):
-                raise ValueError(f"first_step must be a finite number > 0 or None, "
-                                 f"got {self.first_step!r}")
+                raise ValueError(
+                    f"first_step must be a finite number > 0 or None, got {self.first_step!r}"
+                )
         if not (self.blowup_factor > 1):
-            raise ValueError(f"blowup_factor must be > 1 (inf disables), got {self.blowup_factor!r}")
+            raise ValueError(
+                f"blowup_factor must be > 1 (inf disables), got {self.blowup_factor!r}"
+            )
         if not (0 <= self.min_step_fraction < 1):
             raise ValueError(f"min_step_fraction must be in [0, 1), got {self.min_step_fraction!r}")
         for name in ("stall_steps", "max_evaluations"):

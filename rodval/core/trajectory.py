@@ -1,4 +1,5 @@
 """What a simulation returns: requested quantities at requested times, and how the run ended."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -7,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from rodval.core.status import STATUS_SUCCESS
+
 
 @dataclass
 class SolverStats:
@@ -30,10 +32,18 @@ class SolverStats:
         return self.status == STATUS_SUCCESS
 
     def as_dict(self) -> dict:
-        return {"status": self.status, "success": self.success, "message": self.message,
-                "t_reached": self.t_reached, "nfev": self.nfev, "njev": self.njev,
-                "nlu": self.nlu, "nsteps": self.nsteps, "wall_s": self.wall_s,
-                "energy_residual": self.energy_residual}
+        return {
+            "status": self.status,
+            "success": self.success,
+            "message": self.message,
+            "t_reached": self.t_reached,
+            "nfev": self.nfev,
+            "njev": self.njev,
+            "nlu": self.nlu,
+            "nsteps": self.nsteps,
+            "wall_s": self.wall_s,
+            "energy_residual": self.energy_residual,
+        }
 
 
 @dataclass
@@ -80,26 +90,40 @@ class Trajectory:
 
     def to_dict(self) -> dict:
         """Plain JSON-ready form (lists and numbers); inverse of ``from_dict``."""
-        return {"model": self.model, "scene_name": self.scene_name, "times": self.times.tolist(),
-                "values": {q: v.tolist() for q, v in self.values.items()},
-                "k_index": {q: k.tolist() for q, k in self.k_index.items()},
-                "stats": self.stats.as_dict(), "settings": self.settings,
-                "options": self.options, "events": self.events}
+        return {
+            "model": self.model,
+            "scene_name": self.scene_name,
+            "times": self.times.tolist(),
+            "values": {q: v.tolist() for q, v in self.values.items()},
+            "k_index": {q: k.tolist() for q, k in self.k_index.items()},
+            "stats": self.stats.as_dict(),
+            "settings": self.settings,
+            "options": self.options,
+            "events": self.events,
+        }
 
     @classmethod
-    def from_dict(cls, d: dict) -> "Trajectory":
+    def from_dict(cls, d: dict) -> Trajectory:
         times = np.asarray(d["times"], dtype=float)
         stats = {k: v for k, v in d["stats"].items() if k != "success"}
         k_index = {q: np.asarray(k, dtype=int) for q, k in d["k_index"].items()}
-        return cls(model=d["model"], scene_name=d["scene_name"], times=times,
-                   values={q: np.asarray(v, dtype=float).reshape(times.size, k_index[q].size)
-                           for q, v in d["values"].items()},
-                   k_index=k_index,
-                   stats=SolverStats(**stats), settings=dict(d.get("settings", {})),
-                   options=dict(d.get("options", {})), events=list(d.get("events", [])))
+        return cls(
+            model=d["model"],
+            scene_name=d["scene_name"],
+            times=times,
+            values={
+                q: np.asarray(v, dtype=float).reshape(times.size, k_index[q].size)
+                for q, v in d["values"].items()
+            },
+            k_index=k_index,
+            stats=SolverStats(**stats),
+            settings=dict(d.get("settings", {})),
+            options=dict(d.get("options", {})),
+            events=list(d.get("events", [])),
+        )
 
     @classmethod
-    def from_frame(cls, frame: pd.DataFrame, model: str, scene_name: str = "scene") -> "Trajectory":
+    def from_frame(cls, frame: pd.DataFrame, model: str, scene_name: str = "scene") -> Trajectory:
         """Inverse of ``to_frame`` (columns t, quantity, k, value; every (t, k) of a quantity
         present). The stats are not in the frame: they are left at their defaults."""
         times = np.unique(frame["t"].to_numpy(float))
@@ -110,17 +134,30 @@ class Trajectory:
                 raise ValueError(f"frame of quantity {q!r} does not cover every (t, k)")
             values[q] = wide.to_numpy(float)
             k_index[q] = wide.columns.to_numpy(int)
-        return cls(model=model, scene_name=scene_name, times=times, values=values,
-                   k_index=k_index, stats=SolverStats())
+        return cls(
+            model=model,
+            scene_name=scene_name,
+            times=times,
+            values=values,
+            k_index=k_index,
+            stats=SolverStats(),
+        )
 
     def to_frame(self) -> pd.DataFrame:
         """Tidy table with columns t, quantity, k, value."""
         parts = []
         for q, arr in self.values.items():
             nt, nk = arr.shape
-            parts.append(pd.DataFrame({
-                "t": np.repeat(self.times, nk), "quantity": q,
-                "k": np.tile(self.k_index[q], nt), "value": arr.ravel()}))
+            parts.append(
+                pd.DataFrame(
+                    {
+                        "t": np.repeat(self.times, nk),
+                        "quantity": q,
+                        "k": np.tile(self.k_index[q], nt),
+                        "value": arr.ravel(),
+                    }
+                )
+            )
         if not parts:
             return pd.DataFrame(columns=["t", "quantity", "k", "value"])
         return pd.concat(parts, ignore_index=True)

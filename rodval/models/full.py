@@ -4,25 +4,33 @@ State y = [q; q'] (6n). M(phi) q'' = [Q; 0; 0] - h - C q' - K q, see ``paper_mat
 ``numpy_rhs`` is the straightforward dense form; the default compiled kernel
 (``kernels.full_accel``) computes the same in O(n).
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 from rodval.core.scene import Scene
 from rodval.models import kernels
-from rodval.models.paper_matrices import angle_differences, angle_jacobian, assemble_mass, convective_terms
+from rodval.models.paper_matrices import (
+    angle_differences,
+    angle_jacobian,
+    assemble_mass,
+    convective_terms,
+)
 from rodval.models.paper_system import PaperModel, PaperSystem
 
 
 class FullSystem(PaperSystem):
     accel_kernel = staticmethod(kernels.full_accel)
     compiled_rhs = staticmethod(kernels.full_rhs)
+    compiled_mechanics = staticmethod(kernels.full_mechanics)
 
     def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
         super().__init__(scene, coefficients, kernel)
         i = self.initial
-        self.y0 = np.concatenate([i["phi"], i["alpha"], i["beta"],
-                                  i["dphi"], i["dalpha"], i["dbeta"]])
+        self.y0 = np.concatenate(
+            [i["phi"], i["alpha"], i["beta"], i["dphi"], i["dalpha"], i["dbeta"]]
+        )
         self.use_kernel()
 
     def kernel_constants(self):
@@ -31,7 +39,7 @@ class FullSystem(PaperSystem):
     def forces(self, t: float, q: np.ndarray, v: np.ndarray, skj: np.ndarray) -> np.ndarray:
         """Right-hand side f = [Q; 0; 0] - h - C q' - K q of M q'' = f (3n)."""
         n = self.n
-        h_phi, h_gamma = convective_terms(self.cc, skj, v[:n], v[n:2 * n], v[2 * n:])
+        h_phi, h_gamma = convective_terms(self.cc, skj, v[:n], v[n : 2 * n], v[2 * n :])
         f = -(self.K @ q)
         if self.damped:
             f -= self.C @ v
@@ -44,7 +52,7 @@ class FullSystem(PaperSystem):
 
     def numpy_rhs(self, t, y):
         n = self.n
-        q, v = y[:3 * n], y[3 * n:]
+        q, v = y[: 3 * n], y[3 * n :]
         ckj, skj = angle_differences(q[:n])
         f = self.forces(t, q, v, skj)
         return np.concatenate([v, np.linalg.solve(assemble_mass(self.cc, ckj), f)])
@@ -52,21 +60,31 @@ class FullSystem(PaperSystem):
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         """Analytic Jacobian df/dy (6n, 6n): [[0, I], [M^-1 (df/dq - dM/dphi q''), M^-1 df/dq']]."""
         n, cc = self.n, self.cc
-        q, v = y[:3 * n], y[3 * n:]
-        phi, dphi, dgam = q[:n], v[:n], v[n:2 * n] - v[2 * n:]
+        q, v = y[: 3 * n], y[3 * n :]
+        phi, dphi, dgam = q[:n], v[:n], v[n : 2 * n] - v[2 * n :]
         ckj, skj = angle_differences(phi)
         M = assemble_mass(cc, ckj)
         a = np.linalg.solve(M, self.forces(t, q, v, skj))
         Wt = cc.w_upper.T
         w2, u = dphi * dphi, dphi * dgam
         # d(M q'')/dphi at fixed q'' (only the angle-dependent blocks; d cos = -sin)
-        dM_a = np.vstack([angle_jacobian(cc.pp_scale, -skj, a[:n])
-                          + angle_jacobian(cc.w_upper, -skj, a[n:2 * n] - a[2 * n:]),
-                          angle_jacobian(Wt, -skj, a[:n]), -angle_jacobian(Wt, -skj, a[:n])])
+        dM_a = np.vstack(
+            [
+                angle_jacobian(cc.pp_scale, -skj, a[:n])
+                + angle_jacobian(cc.w_upper, -skj, a[n : 2 * n] - a[2 * n :]),
+                angle_jacobian(Wt, -skj, a[:n]),
+                -angle_jacobian(Wt, -skj, a[:n]),
+            ]
+        )
         # dh/dphi at fixed rates (d sin = cos); h_alpha = -G_pa^T w2 = (W^T o s_jk) w2
         dh_alpha = angle_jacobian(Wt, ckj, w2)
-        dh = np.vstack([angle_jacobian(cc.pp_scale, ckj, w2) + 2 * angle_jacobian(cc.w_upper, ckj, u),
-                        dh_alpha, -dh_alpha])
+        dh = np.vstack(
+            [
+                angle_jacobian(cc.pp_scale, ckj, w2) + 2 * angle_jacobian(cc.w_upper, ckj, u),
+                dh_alpha,
+                -dh_alpha,
+            ]
+        )
         dfdq = -self.K.copy()
         dfdq[:, :n] -= dh + dM_a
         sums = self.loads.suffix_sums(t)
@@ -76,30 +94,30 @@ class FullSystem(PaperSystem):
         G_pp, G_pa = cc.pp_scale * skj, cc.w_upper * skj
         dhdv = np.zeros((3 * n, 3 * n))
         dhdv[:n, :n] = 2 * G_pp * dphi + 2 * G_pa * dgam
-        dhdv[:n, n:2 * n] = 2 * G_pa * dphi
-        dhdv[:n, 2 * n:] = -2 * G_pa * dphi
-        dhdv[n:2 * n, :n] = -2 * G_pa.T * dphi
-        dhdv[2 * n:, :n] = 2 * G_pa.T * dphi
+        dhdv[:n, n : 2 * n] = 2 * G_pa * dphi
+        dhdv[:n, 2 * n :] = -2 * G_pa * dphi
+        dhdv[n : 2 * n, :n] = -2 * G_pa.T * dphi
+        dhdv[2 * n :, :n] = 2 * G_pa.T * dphi
         dfdv = -dhdv - self.C if self.damped else -dhdv
         J = np.zeros((6 * n, 6 * n))
-        J[:3 * n, 3 * n:] = np.eye(3 * n)
-        J[3 * n:] = np.linalg.solve(M, np.hstack([dfdq, dfdv]))
+        J[: 3 * n, 3 * n :] = np.eye(3 * n)
+        J[3 * n :] = np.linalg.solve(M, np.hstack([dfdq, dfdv]))
         return J
 
     def generalized_rates(self, y):
-        return y[3 * self.n:]
+        return y[3 * self.n :]
 
     def energy_budget(self, t, y):
-        q = y[:3 * self.n]
+        q = y[: 3 * self.n]
         return self.kinetic_energy(t, y) + 0.5 * float(q @ self.K @ q)
 
     def rigid(self, Y):
         n = self.n
-        return Y[:, :n], Y[:, 3 * n:4 * n]
+        return Y[:, :n], Y[:, 3 * n : 4 * n]
 
     def bending(self, times, Y):
         n = self.n
-        return Y[:, n:2 * n], Y[:, 2 * n:3 * n], Y[:, 4 * n:5 * n], Y[:, 5 * n:]
+        return Y[:, n : 2 * n], Y[:, 2 * n : 3 * n], Y[:, 4 * n : 5 * n], Y[:, 5 * n :]
 
 
 class FullModel(PaperModel):

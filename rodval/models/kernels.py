@@ -26,9 +26,8 @@ load table, ``rodval.core.loads.load_sums``). Parameters are packed into plain a
 ``V`` (rows of length-n vectors, layout ``V_*`` below), ``Mt`` (stack of n x n matrices of the
 reduced model, layout ``M_*``; empty for the full model), ``S = [damped]``.
 """
-from __future__ import annotations
 
-import math
+from __future__ import annotations
 
 import numpy as np
 from numba import njit
@@ -44,10 +43,16 @@ V_PA, V_PB, V_AP, V_BP, V_AA, V_AB, V_EPS, V_PI, V_RHO, V_TAU = range(7, 17)
 M_PDIFF, M_PDIAG, M_KR, M_CR = range(4)
 
 
-
 def _rows(cc, chain) -> list[np.ndarray]:
-    return [cc.l, cc.outer_mass, cc.pp_diag, chain.m * chain.l**2 / 12.0, chain.kappa,
-            chain.nu, 4.0 * chain.EI / chain.l]
+    return [
+        cc.l,
+        cc.outer_mass,
+        cc.pp_diag,
+        chain.m * chain.l**2 / 12.0,
+        chain.kappa,
+        chain.nu,
+        4.0 * chain.EI / chain.l,
+    ]
 
 
 def full_constants(cc, chain) -> np.ndarray:
@@ -59,10 +64,22 @@ def full_constants(cc, chain) -> np.ndarray:
     eps = 2.0 / (aa - ab)
     pi = (cc.pa_diag - cc.pb_diag) / (aa - ab)
     rho = (cc.ap_diag - cc.bp_diag) / (aa - ab)
-    tau = (cc.pa_diag * (aa * cc.ap_diag - ab * cc.bp_diag)
-           + cc.pb_diag * (aa * cc.bp_diag - ab * cc.ap_diag)) / det
-    rows = _rows(cc, chain) + [cc.pa_diag, cc.pb_diag, cc.ap_diag, cc.bp_diag, aa, ab,
-                               np.broadcast_to(eps, aa.shape), pi, rho, tau]
+    tau = (
+        cc.pa_diag * (aa * cc.ap_diag - ab * cc.bp_diag)
+        + cc.pb_diag * (aa * cc.bp_diag - ab * cc.ap_diag)
+    ) / det
+    rows = _rows(cc, chain) + [
+        cc.pa_diag,
+        cc.pb_diag,
+        cc.ap_diag,
+        cc.bp_diag,
+        aa,
+        ab,
+        np.broadcast_to(eps, aa.shape),
+        pi,
+        rho,
+        tau,
+    ]
     return np.ascontiguousarray(np.vstack(rows), dtype=np.float64)
 
 
@@ -96,13 +113,13 @@ def _gpp_times(V, c, s, x, out):
     l, outer = V[V_L], V[V_OUTER]
     pc = 0.0
     ps = 0.0
-    for k in range(n):                       # j < k: weight M_k
+    for k in range(n):  # j < k: weight M_k
         out[k] -= l[k] * outer[k] * (s[k] * pc - c[k] * ps)
         pc += l[k] * c[k] * x[k]
         ps += l[k] * s[k] * x[k]
     sc = 0.0
     ss = 0.0
-    for k in range(n - 1, -1, -1):           # j > k: weight M_j
+    for k in range(n - 1, -1, -1):  # j > k: weight M_j
         out[k] -= l[k] * (s[k] * sc - c[k] * ss)
         sc += outer[k] * l[k] * c[k] * x[k]
         ss += outer[k] * l[k] * s[k] * x[k]
@@ -153,7 +170,7 @@ def _schur_solve(V, c, s, r, x):
     d = np.empty(n)
     scc = 0.0
     scs = 0.0
-    sss = 0.0                               # sum_{j>k} w_j^2 eps_j (c c, c s, s s)_j
+    sss = 0.0  # sum_{j>k} w_j^2 eps_j (c c, c s, s s)_j
     for k in range(n - 1, -1, -1):
         g0 = c[k] * scc + s[k] * scs
         g1 = c[k] * scs + s[k] * sss
@@ -210,9 +227,9 @@ def full_accel(V, Mt, y, has_load, SX, SY, damped, out):
     [Q; 0; 0] - h - C q' - K q. SX, SY are the load suffix sums (N), used when ``has_load``.
     O(n) time and memory (``Mt`` is unused)."""
     n = V.shape[1]
-    q, v = y[:3 * n], y[3 * n:]
-    phi, alpha, beta = q[:n], q[n:2 * n], q[2 * n:]
-    dphi, dalpha, dbeta = v[:n], v[n:2 * n], v[2 * n:]
+    q, v = y[: 3 * n], y[3 * n :]
+    phi, alpha, beta = q[:n], q[n : 2 * n], q[2 * n :]
+    dphi, dalpha, dbeta = v[:n], v[n : 2 * n], v[2 * n :]
     c = np.cos(phi)
     s = np.sin(phi)
     fp = np.zeros(n)
@@ -229,9 +246,9 @@ def full_accel(V, Mt, y, has_load, SX, SY, damped, out):
         fa[k] = -fa[k]
         fb[k] = -fb[k]
     w2 = dphi * dphi
-    _gpp_times(V, c, s, w2, fp)                                  # - G_pp phi'^2
+    _gpp_times(V, c, s, w2, fp)  # - G_pp phi'^2
     _upper_times(V, c, s, dphi * (dalpha - dbeta), False, fp, -2.0)  # - 2 G_pa (...)
-    _upper_t_times(V, c, s, w2, False, fa, 1.0)                  # - h_alpha = + G_pa^T w2
+    _upper_t_times(V, c, s, w2, False, fa, 1.0)  # - h_alpha = + G_pa^T w2
     _upper_t_times(V, c, s, w2, False, fb, -1.0)
     if has_load:
         l = V[V_L]
@@ -330,3 +347,66 @@ def reduced_rhs(t, y, P, S, M, L, out):
     SY = np.empty(n)
     has_load = load_sums(L, t, SX, SY)
     reduced_accel(P, M, y, has_load, SX, SY, S[0] != 0.0, out[half:])
+
+
+@njit(cache=True)
+def _mpp_quadratic(V, c, s, x):
+    """x^T M_pp x (kg m^2/s^2 for rates x), O(n): M_pp[k,j] = l_k l_j M_max(k,j) c_kj off the
+    diagonal, c_kj = c_k c_j + s_k s_j by prefix sums."""
+    n = c.shape[0]
+    l, outer, d = V[V_L], V[V_OUTER], V[V_PPDIAG]
+    total = 0.0
+    pc = 0.0
+    ps = 0.0
+    for k in range(n):
+        total += d[k] * x[k] * x[k] + 2.0 * l[k] * outer[k] * x[k] * (c[k] * pc + s[k] * ps)
+        pc += l[k] * c[k] * x[k]
+        ps += l[k] * s[k] * x[k]
+    return total
+
+
+@njit(cache=True)
+def _load_power(V, c, s, dphi, L, t):
+    """P_ext = Q . phi' (W) with Q_k = l_k (c_k SY_k - s_k SX_k); 0 when no load acts."""
+    n = c.shape[0]
+    SX = np.empty(n)
+    SY = np.empty(n)
+    if not load_sums(L, t, SX, SY):
+        return 0.0
+    l = V[V_L]
+    p = 0.0
+    for k in range(n):
+        p += l[k] * (c[k] * SY[k] - s[k] * SX[k]) * dphi[k]
+    return p
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def full_mechanics(t, y, P, S, M, L, out):
+    """(T, P_ext) of the full model: T = 1/2 q'^T M q' with the kinematic (printed, symmetric)
+    mass matrix, O(n)."""
+    n = P.shape[1]
+    phi, dphi = y[:n], y[3 * n : 4 * n]
+    va, vb = y[4 * n : 5 * n], y[5 * n :]
+    c = np.cos(phi)
+    s = np.sin(phi)
+    u = np.zeros(n)
+    _upper_times(P, c, s, va - vb, True, u, 1.0)  # U (alpha' - beta')
+    aa, ab = P[V_AA], P[V_AB]
+    T = _mpp_quadratic(P, c, s, dphi)
+    for k in range(n):
+        T += 2.0 * dphi[k] * (u[k] + P[V_PA, k] * va[k] + P[V_PB, k] * vb[k])
+        T += aa[k] * (va[k] * va[k] + vb[k] * vb[k]) + 2.0 * ab[k] * va[k] * vb[k]
+    out[0] = 0.5 * T
+    out[1] = _load_power(P, c, s, dphi, L, t)
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def reduced_mechanics(t, y, P, S, M, L, out):
+    """(T, P_ext) of the reduced model: T = 1/2 phi'^T M_pp phi' (its bending rates are
+    dropped), O(n)."""
+    n = P.shape[1]
+    phi, dphi = y[:n], y[n:]
+    c = np.cos(phi)
+    s = np.sin(phi)
+    out[0] = 0.5 * _mpp_quadratic(P, c, s, dphi)
+    out[1] = _load_power(P, c, s, dphi, L, t)

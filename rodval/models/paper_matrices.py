@@ -30,6 +30,7 @@ m l^3/60, M_bp diagonal -m l^3/40) while the phi rows keep m l^3/30, -m l^3/20. 
 non-symmetric matrix reproduces the alpha/beta values published in the paper's Table 1 and is
 kept only to document that erratum (see model.md).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -47,17 +48,16 @@ class ChainConstants:
 
     n: int
     l: np.ndarray
-    outer_mass: np.ndarray          # M_k (kg)
-    pp_scale: np.ndarray            # l_k l_j M_max(k,j), (n, n)
-    pp_diag: np.ndarray             # diagonal of M_pp (kg m^2)
-    w_upper: np.ndarray             # w_j l_k for k < j, else 0 (kg m^2), (n, n)
-    pa_diag: np.ndarray             # m l^3/30 in phi rows
-    pb_diag: np.ndarray             # -m l^3/20 in phi rows
-    ap_diag: np.ndarray             # bending-row diagonal coupling (variant dependent)
+    outer_mass: np.ndarray  # M_k (kg)
+    pp_scale: np.ndarray  # l_k l_j M_max(k,j), (n, n)
+    pp_diag: np.ndarray  # diagonal of M_pp (kg m^2)
+    w_upper: np.ndarray  # w_j l_k for k < j, else 0 (kg m^2), (n, n)
+    pa_diag: np.ndarray  # m l^3/30 in phi rows
+    pb_diag: np.ndarray  # -m l^3/20 in phi rows
+    ap_diag: np.ndarray  # bending-row diagonal coupling (variant dependent)
     bp_diag: np.ndarray
-    aa_diag: np.ndarray             # m l^3/105
-    ab_diag: np.ndarray             # -m l^3/140
-    variant: str
+    aa_diag: np.ndarray  # m l^3/105
+    ab_diag: np.ndarray  # -m l^3/140
 
 
 def chain_constants(chain: Chain, variant: str = "printed") -> ChainConstants:
@@ -73,14 +73,23 @@ def chain_constants(chain: Chain, variant: str = "printed") -> ChainConstants:
     pp_scale = np.outer(l, l) * outer[kmax]
     pp_diag = l**2 * (outer - rod_mass / 2.0) + m * l**3 / 3.0
     w = m * l**2 / 12.0
-    w_upper = np.triu(np.outer(l, w), k=1)          # [k, j] = l_k w_j for k < j
+    w_upper = np.triu(np.outer(l, w), k=1)  # [k, j] = l_k w_j for k < j
     ml3 = m * l**3
     half = 0.5 if variant == "published" else 1.0
     return ChainConstants(
-        n=n, l=l, outer_mass=outer, pp_scale=pp_scale, pp_diag=pp_diag, w_upper=w_upper,
-        pa_diag=ml3 / 30.0, pb_diag=-ml3 / 20.0,
-        ap_diag=half * ml3 / 30.0, bp_diag=-half * ml3 / 20.0,
-        aa_diag=ml3 / 105.0, ab_diag=-ml3 / 140.0, variant=variant)
+        n=n,
+        l=l,
+        outer_mass=outer,
+        pp_scale=pp_scale,
+        pp_diag=pp_diag,
+        w_upper=w_upper,
+        pa_diag=ml3 / 30.0,
+        pb_diag=-ml3 / 20.0,
+        ap_diag=half * ml3 / 30.0,
+        bp_diag=-half * ml3 / 20.0,
+        aa_diag=ml3 / 105.0,
+        ab_diag=-ml3 / 140.0,
+    )
 
 
 def angle_differences(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -119,9 +128,13 @@ def assemble_mass(cc: ChainConstants, ckj: np.ndarray) -> np.ndarray:
     return M
 
 
-def convective_terms(cc: ChainConstants, skj: np.ndarray, dphi: np.ndarray,
-                     dalpha: np.ndarray | None = None, dbeta: np.ndarray | None = None
-                     ) -> tuple[np.ndarray, np.ndarray]:
+def convective_terms(
+    cc: ChainConstants,
+    skj: np.ndarray,
+    dphi: np.ndarray,
+    dalpha: np.ndarray | None = None,
+    dbeta: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Convective vector h = (h_phi, h_gamma) with h_gamma = [h_alpha; h_beta], from
     precomputed s_kj = sin(phi_k - phi_j).
 
@@ -133,7 +146,7 @@ def convective_terms(cc: ChainConstants, skj: np.ndarray, dphi: np.ndarray,
     h_phi = G_pp @ w2
     if dalpha is not None:
         h_phi += 2.0 * (G_pa @ (dphi * (dalpha - dbeta)))
-    h_alpha = -(G_pa.T @ w2)          # G_ap[k,j] = w_k l_j s_kj (k > j) = -G_pa[j,k]
+    h_alpha = -(G_pa.T @ w2)  # G_ap[k,j] = w_k l_j s_kj (k > j) = -G_pa[j,k]
     return h_phi, np.concatenate([h_alpha, -h_alpha])
 
 
@@ -180,7 +193,9 @@ def damping_matrix(chain: Chain) -> np.ndarray:
     return A.T @ (chain.nu[:, None] * A)
 
 
-def generalized_forces(l: np.ndarray, phi: np.ndarray, SX: np.ndarray, SY: np.ndarray) -> np.ndarray:
+def generalized_forces(
+    l: np.ndarray, phi: np.ndarray, SX: np.ndarray, SY: np.ndarray
+) -> np.ndarray:
     """Q_k = l_k (cos phi_k SY_k - sin phi_k SX_k), SX_k = sum_{j>=k} X_j (N m)."""
     return l * (np.cos(phi) * SY - np.sin(phi) * SX)
 
@@ -191,7 +206,3 @@ def node_positions(l: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarr
     y = np.cumsum(l * np.sin(phi), axis=-1)
     zero = np.zeros(phi.shape[:-1] + (1,))
     return np.concatenate([zero, x], axis=-1), np.concatenate([zero, y], axis=-1)
-
-
-
-

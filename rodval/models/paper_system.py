@@ -1,4 +1,5 @@
 """What the full and reduced models share: scene constants, loads and the observation map."""
+
 from __future__ import annotations
 
 from typing import Any
@@ -7,12 +8,19 @@ import numpy as np
 
 from rodval.core.loads import LoadSet, load_table
 from rodval.core.scene import Scene
-from rodval.models import kernels
+from rodval.models.paper_matrices import (
+    VARIANTS,
+    angle_differences,
+    assemble_mass,
+    chain_constants,
+    damping_matrix,
+    generalized_forces,
+    hinge_matrix,
+    node_positions,
+    stiffness_matrix,
+)
 from rodval.solvers.ode_model import OdeModel
 from rodval.solvers.system import CompiledForm, OdeSystem
-from rodval.models.paper_matrices import (VARIANTS, angle_differences, assemble_mass, chain_constants, damping_matrix,
-                             generalized_forces, hinge_matrix, node_positions, stiffness_matrix)
-
 
 #: Right-hand-side implementations: "numba" (compiled, structured; default) or "numpy"
 #: (the straightforward dense reference).
@@ -29,6 +37,7 @@ class PaperSystem(OdeSystem):
     #: kernels.*_accel(V, Mt, y, has_load, SX, SY, damped, out) and the RHS_TYPE function.
     accel_kernel: Any
     compiled_rhs: Any
+    compiled_mechanics: Any
 
     def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
         if kernel not in KERNELS:
@@ -84,8 +93,15 @@ class PaperSystem(OdeSystem):
         table = load_table(self.scene.loads)
         if table is None:
             return None
-        return CompiledForm(self.compiled_rhs, self.V, self._flags, self.Mt, table,
-                            name=type(self).__name__)
+        return CompiledForm(
+            self.compiled_rhs,
+            self.V,
+            self._flags,
+            self.Mt,
+            table,
+            mechanics=self.compiled_mechanics,
+            name=type(self).__name__,
+        )
 
     def generalized_force(self, t: float, phi: np.ndarray) -> np.ndarray | None:
         """Q(phi, t) (N m) on the phi coordinates, or None when no load acts at t."""

@@ -11,6 +11,7 @@ Substituting gamma into the phi rows (with P = K_pg B^-1, constant):
 gamma is recovered from the first line only at output times, and only if alpha/beta (or the
 energy) are asked for. State y = [phi; phi'] (2n).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -24,6 +25,7 @@ from rodval.models.paper_system import PaperModel, PaperSystem
 class ReducedSystem(PaperSystem):
     accel_kernel = staticmethod(kernels.reduced_accel)
     compiled_rhs = staticmethod(kernels.reduced_rhs)
+    compiled_mechanics = staticmethod(kernels.reduced_mechanics)
 
     def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
         super().__init__(scene, coefficients, kernel)
@@ -32,8 +34,8 @@ class ReducedSystem(PaperSystem):
         K, C = self.K, self.C
         self.B = K[g, g]
         self.B_inv = np.linalg.inv(self.B)
-        P = K[p, g] @ self.B_inv                      # K_pg B^-1, (n, 2n)
-        self.P_diff = P[:, :n] - P[:, n:]             # P_a - P_b
+        P = K[p, g] @ self.B_inv  # K_pg B^-1, (n, 2n)
+        self.P_diff = P[:, :n] - P[:, n:]  # P_a - P_b
         self.P_a, self.P_b = P[:, :n], P[:, n:]
         self.K_r = K[p, p] - P @ K[g, p]
         self.C_r = C[p, p] - P @ C[g, p]
@@ -44,8 +46,9 @@ class ReducedSystem(PaperSystem):
 
     def kernel_constants(self):
         P_diag = self.P_a * self.cc.ap_diag + self.P_b * self.cc.bp_diag
-        return kernels.reduced_constants(self.cc, self.scene.chain, self.P_diff, P_diag,
-                                         self.K_r, self.C_r)
+        return kernels.reduced_constants(
+            self.cc, self.scene.chain, self.P_diff, P_diag, self.K_r, self.C_r
+        )
 
     def reduced_matrices(self, phi: np.ndarray):
         """M_r(phi), G_r(phi) and the bending-row blocks M_gp, G_gp (for recovery)."""
@@ -102,13 +105,14 @@ class ReducedSystem(PaperSystem):
         """gamma = [alpha; beta] (rad) at one time from the algebraic bending rows."""
         n, cc = self.n, self.cc
         phi, dphi = y[:n], y[n:]
-        M_r, G_r, U, G_pa = self.reduced_matrices(phi)      # once: phi'' and gamma share them
+        M_r, G_r, U, G_pa = self.reduced_matrices(phi)  # once: phi'' and gamma share them
         ddphi = np.linalg.solve(M_r, self.forces(t, phi, dphi, G_r))
         w2 = dphi * dphi
         Ut_dd = U.T @ ddphi
         GT_w2 = G_pa.T @ w2
-        r = np.concatenate([Ut_dd + cc.ap_diag * ddphi - GT_w2,
-                            -Ut_dd + cc.bp_diag * ddphi + GT_w2])
+        r = np.concatenate(
+            [Ut_dd + cc.ap_diag * ddphi - GT_w2, -Ut_dd + cc.bp_diag * ddphi + GT_w2]
+        )
         r += self.K_gp @ phi
         if self.damped:
             r += self.C_gp @ dphi
@@ -123,7 +127,7 @@ class ReducedSystem(PaperSystem):
     def energy_budget(self, t, y):
         """T + 1/2 phi^T K_r phi: K_r is the Schur complement of B in K, so this is Pi at the
         quasi-static bending gamma = -B^-1 K_gp phi (exact when phi'' = phi' = 0)."""
-        phi = y[:self.n]
+        phi = y[: self.n]
         return self.kinetic_energy(t, y) + 0.5 * float(phi @ self.K_r @ phi)
 
     def rigid(self, Y):

@@ -3,6 +3,7 @@
 Native models: ``full``, ``reduced``; reference models (``reference_models``) are imported by
 name only when asked for, so the models layer does not depend on them.
 """
+
 from __future__ import annotations
 
 import importlib
@@ -44,13 +45,19 @@ def get_model(name: str | Model, **options: Any) -> Model:
     allowed = tuple(getattr(cls, "OPTIONS", ()))
     unknown = sorted(set(options) - set(allowed))
     if unknown:
-        raise ValueError(f"model {name!r} has no option {unknown[0]!r} "
-                         f"(allowed: {', '.join(allowed) or 'none'})")
+        raise ValueError(
+            f"unknown {name} model option {unknown[0]!r} (allowed: {', '.join(allowed) or 'none'})"
+        )
     return cls(**options)
 
 
-def simulate(scene: Scene, model: str | Model = "full", *,
-             settings: IntegratorSettings | None = None, **keywords: Any) -> Trajectory:
+def simulate(
+    scene: Scene,
+    model: str | Model = "full",
+    *,
+    settings: IntegratorSettings | None = None,
+    **keywords: Any,
+) -> Trajectory:
     """Simulate ``scene`` with ``model`` ("full", "reduced", "exudyn" or a Model instance).
 
     Integrator settings are given either as keywords (``method``: "auto" (default), any
@@ -66,9 +73,12 @@ def simulate(scene: Scene, model: str | Model = "full", *,
     if settings is None:
         settings = IntegratorSettings(**integ)
     elif not isinstance(settings, IntegratorSettings):
-        raise ValueError(f"settings must be a rodval.IntegratorSettings or None, "
-                         f"got {type(settings).__name__}")
+        raise ValueError(
+            f"settings must be a rodval.IntegratorSettings or None, got {type(settings).__name__}"
+        )
     elif integ:
-        raise ValueError(f"give integrator settings either as settings= or as keywords, not "
-                         f"both (got settings= and {', '.join(sorted(integ))})")
+        raise ValueError(
+            f"give integrator settings either as settings= or as keywords, not "
+            f"both (got settings= and {', '.join(sorted(integ))})"
+        )
     return get_model(model, **options).simulate(scene, settings)

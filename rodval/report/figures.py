@@ -4,10 +4,12 @@ run time and speed-up against a grid parameter) and work-precision plots.
 Figures are drawn on ``matplotlib.figure.Figure`` objects and saved as PNG directly, without
 pyplot: no GUI backend is ever selected, whatever the machine, and nothing happens at import.
 """
+
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -15,6 +17,7 @@ from matplotlib import colormaps, ticker
 from matplotlib.figure import Figure
 
 from rodval.analysis.metrics import pareto_front
+from rodval.core.scene import UNITS
 from rodval.core.trajectory import Trajectory
 
 
@@ -23,6 +26,7 @@ def _figure(nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
     figsize = kw.pop("figsize", None)
     fig = Figure(figsize=figsize)
     return fig, fig.subplots(nrows, ncols, **kw)
+
 
 LINESTYLES = ("-", "--", ":", "-.")
 
@@ -35,8 +39,10 @@ def chain_nodes(traj: Trajectory, t: float, l: np.ndarray) -> tuple[np.ndarray, 
     if "x" in traj.values and "y" in traj.values:
         return traj.values["x"][i], traj.values["y"][i]
     phi = traj.values["phi"][i]
-    return (np.concatenate([[0.0], np.cumsum(l * np.cos(phi))]),
-            np.concatenate([[0.0], np.cumsum(l * np.sin(phi))]))
+    return (
+        np.concatenate([[0.0], np.cumsum(l * np.cos(phi))]),
+        np.concatenate([[0.0], np.cumsum(l * np.sin(phi))]),
+    )
 
 
 def _min_height(ax, ratio: float) -> None:
@@ -49,8 +55,13 @@ def _min_height(ax, ratio: float) -> None:
         ax.set_ylim(mid - need / 2, mid + need / 2)
 
 
-def plot_configurations(trajectories: Mapping[str, Trajectory], times: Sequence[float],
-                        l: np.ndarray, path: Path | str, title: str = "") -> Path:
+def plot_configurations(
+    trajectories: Mapping[str, Trajectory],
+    times: Sequence[float],
+    l: np.ndarray,
+    path: Path | str,
+    title: str = "",
+) -> Path:
     """Chain configurations at ``times`` (one colour per time), one line style per model.
 
     Like Fig. 3 of the paper: the chord polygon through the nodes, root at the origin.
@@ -62,16 +73,19 @@ def plot_configurations(trajectories: Mapping[str, Trajectory], times: Sequence[
             if not np.any(np.abs(traj.times - t) < 1e-9):
                 continue  # a failed run may not have reached t
             x, y = chain_nodes(traj, t, l)
-            ax.plot(x, y, ls, color=c, marker="o", ms=3,
-                    label=f"{label}, t = {t:.4g} s")
+            ax.plot(x, y, ls, color=c, marker="o", ms=3, label=f"{label}, t = {t:.4g} s")
     ax.plot([0], [0], "k^", ms=10)
     _min_height(ax, 0.3)
     ax.set_aspect("equal")
     ax.set_xlabel("x, m")
     ax.set_ylabel("y, m")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, ncol=1 + len(trajectories) * len(times) // 12,
-              loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    ax.legend(
+        fontsize=7,
+        ncol=1 + len(trajectories) * len(times) // 12,
+        loc="upper left",
+        bbox_to_anchor=(1.02, 1.0),
+    )
     if title:
         ax.set_title(title)
     path = Path(path)
@@ -82,21 +96,29 @@ def plot_configurations(trajectories: Mapping[str, Trajectory], times: Sequence[
 def model_styles(labels: Sequence[str]) -> dict[str, dict]:
     """One colour and line style per model label, the same in every figure of a report."""
     colours = colormaps["tab10"].colors
-    return {lab: {"color": colours[i % len(colours)], "ls": LINESTYLES[i % len(LINESTYLES)]}
-            for i, lab in enumerate(labels)}
+    return {
+        lab: {"color": colours[i % len(colours)], "ls": LINESTYLES[i % len(LINESTYLES)]}
+        for i, lab in enumerate(labels)
+    }
 
 
-QUANTITY_UNITS = {"phi": "rad", "dphi": "rad/s", "alpha": "rad", "beta": "rad", "x": "m",
-                  "y": "m", "kinetic": "J", "potential": "J", "energy": "J"}
-
-
-def plot_time_histories(trajectories: Mapping[str, Trajectory], quantities: Sequence[str],
-                        rods: Sequence[int], path: Path | str, title: str = "") -> Path:
+def plot_time_histories(
+    trajectories: Mapping[str, Trajectory],
+    quantities: Sequence[str],
+    rods: Sequence[int],
+    path: Path | str,
+    title: str = "",
+) -> Path:
     """Time histories of ``quantities`` (rows) for rods ``rods`` (columns), every model
     overlaid; a model that lacks a quantity or rod (or failed early) draws what it has."""
     styles = model_styles(list(trajectories))
-    fig, axes = _figure(len(quantities), len(rods), figsize=(4.2 * len(rods), 2.4 * len(quantities)),
-                             sharex=True, squeeze=False)
+    fig, axes = _figure(
+        len(quantities),
+        len(rods),
+        figsize=(4.2 * len(rods), 2.4 * len(quantities)),
+        sharex=True,
+        squeeze=False,
+    )
     for r, q in enumerate(quantities):
         for c, k in enumerate(rods):
             ax = axes[r, c]
@@ -105,7 +127,7 @@ def plot_time_histories(trajectories: Mapping[str, Trajectory], quantities: Sequ
                     continue
                 j = int(np.flatnonzero(traj.k_index[q] == k)[0])
                 ax.plot(traj.times, traj.values[q][:, j], label=label, lw=1.2, **styles[label])
-            ax.set_ylabel(f"{q}_{k}, {QUANTITY_UNITS.get(q, '')}")
+            ax.set_ylabel(f"{q}_{k}, {UNITS.get(q, '')}")
             ax.grid(alpha=0.3)
             if r == len(quantities) - 1:
                 ax.set_xlabel("t, s")
@@ -119,19 +141,29 @@ def plot_time_histories(trajectories: Mapping[str, Trajectory], quantities: Sequ
 
 
 def _label(model: str, others: Sequence[str], key: tuple) -> str:
-    parts = [f"{o}={v:g}" if isinstance(v, (int, float, np.number)) else f"{o}={v}"
-             for o, v in zip(others, key)]
+    parts = [
+        f"{o}={v:g}" if isinstance(v, (int, float, np.number)) else f"{o}={v}"
+        for o, v in zip(others, key)
+    ]
     return ", ".join([model, *parts])
 
 
-def _lines(ax, df: pd.DataFrame, x: str, y: str, others: Sequence[str], styles: dict,
-           logx: bool, logy: bool = True) -> None:
+def _lines(
+    ax,
+    df: pd.DataFrame,
+    x: str,
+    y: str,
+    others: Sequence[str],
+    styles: dict,
+    logx: bool,
+    logy: bool = True,
+) -> None:
     """One line per model and combination of ``others``; log scales where the data allow."""
     markers = "os^dvP*X"
     df = df[np.isfinite(df[y]) & (df[y] > 0 if logy else True)]
     if logx and (df[x] > 0).all() and not df.empty:
         ax.set_xscale("log")
-        ax.set_xticks(sorted(df[x].unique()))           # label the grid values themselves
+        ax.set_xticks(sorted(df[x].unique()))  # label the grid values themselves
         ax.xaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
         ax.xaxis.set_minor_locator(ticker.NullLocator())
     if logy and not df.empty:
@@ -141,9 +173,16 @@ def _lines(ax, df: pd.DataFrame, x: str, y: str, others: Sequence[str], styles: 
         for i, (key, sub) in enumerate(groups):
             key = key if isinstance(key, tuple) else (key,)
             sub = sub.sort_values(x)
-            ax.plot(sub[x], sub[y], marker=markers[i % len(markers)], ms=4, lw=1,
-                    color=styles[model]["color"], ls=styles[model]["ls"],
-                    label=_label(str(model), others, key))
+            ax.plot(
+                sub[x],
+                sub[y],
+                marker=markers[i % len(markers)],
+                ms=4,
+                lw=1,
+                color=styles[model]["color"],
+                ls=styles[model]["ls"],
+                label=_label(str(model), others, key),
+            )
 
 
 def _finish(fig, axes, path: Path, title: str) -> Path:
@@ -154,8 +193,15 @@ def _finish(fig, axes, path: Path, title: str) -> Path:
     return path
 
 
-def plot_discrepancy_vs(disc: pd.DataFrame, x: str, others: Sequence[str], models: Sequence[str],
-                        path: Path, metric: str = "max_abs", logx: bool = False) -> Path:
+def plot_discrepancy_vs(
+    disc: pd.DataFrame,
+    x: str,
+    others: Sequence[str],
+    models: Sequence[str],
+    path: Path,
+    metric: str = "max_abs",
+    logx: bool = False,
+) -> Path:
     """``metric`` of every compared quantity against ``x`` (log y); rows with status "ok" only."""
     ok = disc[disc["status"] == "ok"]
     quantities = list(dict.fromkeys(ok["quantity"]))
@@ -163,20 +209,26 @@ def plot_discrepancy_vs(disc: pd.DataFrame, x: str, others: Sequence[str], model
     nrow = max(1, -(-len(quantities) // ncol))
     fig, axes = _figure(nrow, ncol, figsize=(5.2 * ncol, 3.3 * nrow), squeeze=False)
     axes = axes.ravel()
-    for ax in axes[len(quantities):]:
+    for ax in axes[len(quantities) :]:
         ax.set_visible(False)
     styles = model_styles(models)
     for ax, q in zip(axes, quantities):
         _lines(ax, ok[ok["quantity"] == q], x, metric, others, styles, logx)
-        ax.set_title(f"{q}, {QUANTITY_UNITS.get(q, '')}")
+        ax.set_title(f"{q}, {UNITS.get(q, '')}")
         ax.set_xlabel(x)
         ax.set_ylabel(metric)
         ax.grid(alpha=0.3, which="both")
     return _finish(fig, axes, path, f"Discrepancy ({metric}) against {x}")
 
 
-def plot_runtime_vs(runtime: pd.DataFrame, x: str, others: Sequence[str], models: Sequence[str],
-                    path: Path, logx: bool = True) -> Path:
+def plot_runtime_vs(
+    runtime: pd.DataFrame,
+    x: str,
+    others: Sequence[str],
+    models: Sequence[str],
+    path: Path,
+    logx: bool = True,
+) -> Path:
     """Integration wall time of successful runs against ``x`` (log-log)."""
     ok = runtime[runtime["status"] == "success"]
     fig, ax = _figure(figsize=(6.5, 4.5))
@@ -195,12 +247,21 @@ def speedups(runtime: pd.DataFrame, reference: str, params: Sequence[str]) -> pd
     if reference not in wide.columns:
         return pd.DataFrame(columns=["case", *params, "model", "speedup"])
     ratio = (1.0 / wide.drop(columns=reference)).mul(wide[reference], axis=0)
-    long = ratio.reset_index().melt(id_vars=["case", *params], var_name="model", value_name="speedup")
+    long = ratio.reset_index().melt(
+        id_vars=["case", *params], var_name="model", value_name="speedup"
+    )
     return long.dropna(subset=["speedup"])
 
 
-def plot_speedup_vs(speed: pd.DataFrame, x: str, others: Sequence[str], models: Sequence[str],
-                    reference: str, path: Path, logx: bool = True) -> Path:
+def plot_speedup_vs(
+    speed: pd.DataFrame,
+    x: str,
+    others: Sequence[str],
+    models: Sequence[str],
+    reference: str,
+    path: Path,
+    logx: bool = True,
+) -> Path:
     fig, ax = _figure(figsize=(6.5, 4.5))
     _lines(ax, speed, x, "speedup", others, model_styles(models), logx)
     ax.axhline(1.0, color="k", lw=0.8)
@@ -210,15 +271,18 @@ def plot_speedup_vs(speed: pd.DataFrame, x: str, others: Sequence[str], models: 
     return _finish(fig, [ax], path, f"Speed-up relative to {reference} against {x}")
 
 
-def plot_work_precision(frame: pd.DataFrame, out_dir: Path,
-                        quantities: Sequence[str] = ("phi", "dphi", "alpha", "beta")) -> list[Path]:
+def plot_work_precision(
+    frame: pd.DataFrame, out_dir: Path, quantities: Sequence[str] = ("phi", "dphi", "alpha", "beta")
+) -> list[Path]:
     """One figure per model and x axis (wall, nfev): error against cost per quantity, one
     line per method/kernel, and the monotone front over all of them. Returns the paths."""
     paths = []
     for model, part in frame.groupby("model"):
         native = model in ("full", "reduced")
-        for xcol, xlabel in (("wall_s", "wall time (s)"),
-                             ("nfev", "RHS evaluations" if native else "Newton iterations")):
+        for xcol, xlabel in (
+            ("wall_s", "wall time (s)"),
+            ("nfev", "RHS evaluations" if native else "Newton iterations"),
+        ):
             qs = [q for q in quantities if f"max_{q}" in part and part[f"max_{q}"].notna().any()]
             fig, axes = _figure(1, len(qs), figsize=(4.2 * len(qs), 3.8), squeeze=False)
             for ax, q in zip(axes[0], qs):

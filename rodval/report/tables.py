@@ -4,6 +4,7 @@ checked reading of the CSV files, and the Table-1-like sample of values at repor
 The tables themselves are written by ``rodval.study.tables``; this module is what a reader of
 a study folder needs (the report, ``rodval report``), so it lies below the study layer.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -14,9 +15,34 @@ import pandas as pd
 from rodval.analysis.metrics import METRICS
 
 TABLES = ("cases", "trajectories", "discrepancies", "runtime")
-FIXED = ("case", "n", "horizon", "model", "reference", "quantity", "method", "rtol", "atol",
-         "max_step", "step", "wall_s", "setup_s", "nfev", "njev", "nlu", "nsteps", "t_reached",
-         "status", "message", "t", "k", "value", "l", "fingerprint", *METRICS)
+FIXED = (
+    "case",
+    "n",
+    "horizon",
+    "model",
+    "reference",
+    "quantity",
+    "method",
+    "rtol",
+    "atol",
+    "max_step",
+    "step",
+    "wall_s",
+    "setup_s",
+    "nfev",
+    "njev",
+    "nlu",
+    "nsteps",
+    "t_reached",
+    "status",
+    "message",
+    "t",
+    "k",
+    "value",
+    "l",
+    "fingerprint",
+    *METRICS,
+)
 #: Columns each table must have for the report (a grid axis adds more).
 REQUIRED = {
     "cases": ("case", "n", "horizon", "l"),
@@ -44,18 +70,27 @@ def read_tables(out: Path) -> dict[str, pd.DataFrame]:
     for name in TABLES:
         path = out / f"{name}.csv"
         if not path.is_file():
-            raise ValueError(f"{out} is not a complete study folder: {path.name} is missing "
-                             "(run `rodval study FILE --out DIR` first)")
+            raise ValueError(
+                f"{out} is not a complete study folder: {path.name} is missing "
+                "(run `rodval study FILE --out DIR` first)"
+            )
         try:
             df = pd.read_csv(path)
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError,
-                ValueError) as exc:
-            raise ValueError(f"{path}: not a readable CSV table ({type(exc).__name__}: "
-                             f"{str(exc).splitlines()[0] if str(exc) else ''})") from None
+        except (
+            pd.errors.ParserError,
+            pd.errors.EmptyDataError,
+            UnicodeDecodeError,
+            ValueError,
+        ) as exc:
+            raise ValueError(
+                f"{path}: not a readable CSV table ({type(exc).__name__}: "
+                f"{str(exc).splitlines()[0] if str(exc) else ''})"
+            ) from None
         missing = [c for c in REQUIRED[name] if c not in df.columns]
         if missing:
-            raise ValueError(f"{path}: column {missing[0]!r} is missing "
-                             f"(needed: {', '.join(REQUIRED[name])})")
+            raise ValueError(
+                f"{path}: column {missing[0]!r} is missing (needed: {', '.join(REQUIRED[name])})"
+            )
         tables[name] = df
     cases = set(tables["cases"]["case"])
     for name in ("runtime", "discrepancies"):
@@ -65,7 +100,9 @@ def read_tables(out: Path) -> dict[str, pd.DataFrame]:
     return tables
 
 
-def trajectory_samples(traj: pd.DataFrame, meta: dict[str, Any], cases: pd.DataFrame) -> pd.DataFrame:
+def trajectory_samples(
+    traj: pd.DataFrame, meta: dict[str, Any], cases: pd.DataFrame
+) -> pd.DataFrame:
     """The report cases' values at the report times (nearest output time) for the report rods
     and quantities, one column per model: a small table like the paper's Table 1."""
     rep = meta["report"]
@@ -76,13 +113,20 @@ def trajectory_samples(traj: pd.DataFrame, meta: dict[str, Any], cases: pd.DataF
             continue
         horizon = float(cases.loc[cases["case"] == cid, "horizon"].iloc[0])
         n = int(cases.loc[cases["case"] == cid, "n"].iloc[0])
-        rods = sorted({n if r == "last" else int(r) for r in rep["rods"] if r == "last" or int(r) <= n})
+        rods = sorted(
+            {n if r == "last" else int(r) for r in rep["rods"] if r == "last" or int(r) <= n}
+        )
         want = rep["times"] or [horizon * f for f in (0.25, 0.5, 0.75, 1.0)]
         out_times = sub["t"].unique()
-        snapped = sorted({float(out_times[abs(out_times - t).argmin()]) for t in want if t <= horizon})
-        pick = sub[sub["t"].isin(snapped) & sub["k"].isin(rods) & sub["quantity"].isin(rep["quantities"])]
-        wide = pick.pivot_table(index=["quantity", "k", "t"], columns="model", values="value",
-                                sort=False).reset_index()
+        snapped = sorted(
+            {float(out_times[abs(out_times - t).argmin()]) for t in want if t <= horizon}
+        )
+        pick = sub[
+            sub["t"].isin(snapped) & sub["k"].isin(rods) & sub["quantity"].isin(rep["quantities"])
+        ]
+        wide = pick.pivot_table(
+            index=["quantity", "k", "t"], columns="model", values="value", sort=False
+        ).reset_index()
         wide.insert(0, "case", cid)
         parts.append(wide)
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()

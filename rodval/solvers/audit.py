@@ -11,9 +11,10 @@ the step's dense output (``GAUSS_NODES`` nodes, exact for polynomials of degree
 not changed by the audit: the integrator's step selection sees the same state as without it.
 An exact balance gives R(t) = 0; what each model leaves in R is in docs/stability.md.
 """
+
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -71,12 +72,16 @@ def balance(E: np.ndarray, E0: float, W: np.ndarray, D: np.ndarray) -> tuple[np.
     return R, float(np.max(np.abs(R)) / scale) if scale > 0 else 0.0
 
 
-def audit_quantities(E: np.ndarray, E0: float, ledger: PowerLedger
-                     ) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], float]:
+def audit_quantities(
+    E: np.ndarray, E0: float, ledger: PowerLedger
+) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], float]:
     """The audit's trajectory quantities (name -> (values (nt, 1), k labels [0])) and the
     scalar residual, from the observed energy E at the output times."""
     W, D = ledger.series()
     R, scalar = balance(E, E0, W, D)
     k = np.zeros(1, dtype=int)
-    return {"work": (W[:, None], k), "dissipated": (D[:, None], k),
-            "energy_residual": (R[:, None], k)}, scalar
+    return {
+        "work": (W[:, None], k),
+        "dissipated": (D[:, None], k),
+        "energy_residual": (R[:, None], k),
+    }, scalar

@@ -3,34 +3,80 @@
 They take a system's ``CompiledForm`` (its own jitted right-hand side and arrays) and import
 no model. ``run_compiled`` is called by the driver (``rodval.solvers.driver``).
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
-from rodval.core.status import STATUS_BUDGET, STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED
+from rodval.core.status import (
+    STATUS_BLOWUP,
+    STATUS_BUDGET,
+    STATUS_DIVERGED,
+    STATUS_ERROR,
+    STATUS_FAILED,
+    STATUS_STALLED,
+)
 from rodval.core.trajectory import SolverStats
 from rodval.solvers import dop853
+from rodval.solvers.guard import ENERGY_FLOOR_J
 from rodval.solvers.system import CompiledForm
 
 RHS_TYPE = dop853.RHS_TYPE
 RHS_SIGNATURE = dop853.RHS_SIGNATURE
 
-_CODES = {dop853.STEP_TOO_SMALL: (STATUS_FAILED, "Required step size is less than spacing between numbers."),
-          dop853.NON_FINITE: (STATUS_DIVERGED, "diverged: non-finite state"),
-          dop853.BUDGET: (STATUS_BUDGET, "evaluation budget exhausted: max_evaluations")}
+_CODES = {
+    dop853.STEP_TOO_SMALL: (
+        STATUS_FAILED,
+        "Required step size is less than spacing between numbers.",
+    ),
+    dop853.NON_FINITE: (STATUS_DIVERGED, "diverged: non-finite state"),
+    dop853.BUDGET: (STATUS_BUDGET, "evaluation budget exhausted: max_evaluations"),
+    dop853.BLOWUP: (
+        STATUS_BLOWUP,
+        "energy blow-up: kinetic energy > blowup_factor x budget E(0) + W+",
+    ),
+    dop853.STALLED: (
+        STATUS_STALLED,
+        "step size collapse: stall_steps consecutive steps shorter than min_step_fraction x t_end",
+    ),
+}
 
 
-def run_compiled(form: CompiledForm, y0: np.ndarray, edges: np.ndarray, scene: Scene,
-                 settings: IntegratorSettings, Y: np.ndarray, stats: SolverStats) -> int:
+def run_compiled(
+    form: CompiledForm,
+    y0: np.ndarray,
+    edges: np.ndarray,
+    scene: Scene,
+    settings: IntegratorSettings,
+    energy0: float,
+    Y: np.ndarray,
+    stats: SolverStats,
+) -> int:
     """Integrate over [edges[0], edges[-1]] restarting at each interior edge (the scene's
     breakpoints), writing states at the output times into Y; fills ``stats`` (status,
-    message, t_reached, nfev, nsteps) and returns the number of output times reached."""
+    message, t_reached, nfev, nsteps) and returns the number of output times reached.
+    The divergence guard runs inside the loop, with the verdicts of ``rodval.solvers.guard``
+    (``energy0``: the budget's E(0), J)."""
+    guard = np.array(
+        [settings.min_step_fraction * scene.t_end, settings.blowup_factor, energy0, ENERGY_FLOOR_J]
+    )
     try:
         n_out, nfev, nsteps, code, t = dop853.integrate_compiled(
-            form, y0, edges, np.asarray(scene.times, float), settings.rtol, settings.atol,
-            settings.max_step, settings.first_step, settings.max_evaluations, Y)
+            form,
+            y0,
+            edges,
+            np.asarray(scene.times, float),
+            settings.rtol,
+            settings.atol,
+            settings.max_step,
+            settings.first_step,
+            settings.max_evaluations,
+            guard,
+            settings.stall_steps,
+            Y,
+        )
     except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
         stats.status, stats.message = STATUS_ERROR, f"{type(exc).__name__}: {exc}"
         return 0

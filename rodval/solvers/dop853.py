@@ -11,6 +11,7 @@ imports no model and is compiled (and cached on disk) once for every model.
 Cost: 12 right-hand-side evaluations per accepted step (+3 on steps holding output times), and
 O(N) work per stage combination.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -33,7 +34,7 @@ _E5 = np.ascontiguousarray(dc.E5)
 _D = np.ascontiguousarray(dc.D)
 
 #: Return codes of ``run``.
-OK, STEP_TOO_SMALL, NON_FINITE, BUDGET = 0, 1, 2, 3
+OK, STEP_TOO_SMALL, NON_FINITE, BUDGET, BLOWUP, STALLED = 0, 1, 2, 3, 4, 5
 
 SAFETY, MIN_FACTOR, MAX_FACTOR, ERROR_EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
 
@@ -62,16 +63,69 @@ def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, tm
 
 
 _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64, types.float64))(
-    RHS_TYPE, _F2, _F1, _F3, _F2, _F1, _F1, _F1, types.float64, types.float64, types.float64,
-    types.float64, types.int64, _F2, _F1, _F1, _F1, _F1, _F2, _F2)
+    RHS_TYPE,
+    RHS_TYPE,
+    types.boolean,
+    _F2,
+    _F1,
+    _F3,
+    _F2,
+    _F1,
+    _F1,
+    _F1,
+    types.float64,
+    types.float64,
+    types.float64,
+    types.float64,
+    types.int64,
+    _F1,
+    types.int64,
+    _F2,
+    _F1,
+    _F1,
+    _F1,
+    _F1,
+    _F2,
+    _F2,
+)
 
 
 @njit(_RUN_SIGNATURE, cache=True)
-def run(rhs, P, S, M, L, y0, edges, times, rtol, atol, max_step, first_step, max_nfev,
-        A, B, C, E3, E5, D, Y):
+def run(
+    rhs,
+    mechanics,
+    guarded,
+    P,
+    S,
+    M,
+    L,
+    y0,
+    edges,
+    times,
+    rtol,
+    atol,
+    max_step,
+    first_step,
+    max_nfev,
+    guard,
+    stall_steps,
+    A,
+    B,
+    C,
+    E3,
+    E5,
+    D,
+    Y,
+):
     """Integrate from edges[0] to edges[-1], restarting at each interior edge (breakpoint),
     writing the state at ``times`` into Y. ``first_step`` <= 0 selects it automatically; the
     run stops with ``BUDGET`` once ``max_nfev`` evaluations are used.
+
+    The divergence guard of ``rodval.solvers.guard`` after every accepted step: ``STALLED``
+    after ``stall_steps`` consecutive steps shorter than guard[0] (s); when ``guarded``,
+    ``mechanics(t, y, ...)`` writes (T, P_ext) and the run stops with ``BLOWUP`` when
+    T > guard[1] (blow-up factor) x (guard[2] (E(0)) + W+ + guard[3] (floor, J)), W+ the
+    positive load work by the trapezoid rule on P_ext at step ends.
 
     Returns (number of output times written, nfev, accepted steps, code, t reached).
     """
@@ -86,7 +140,14 @@ def run(rhs, P, S, M, L, y0, edges, times, rtol, atol, max_step, first_step, max
     n_out = 0
     nfev = 0
     nsteps = 0
+    n_short = 0
+    mech = np.zeros(2)
+    w_plus = 0.0
+    p_prev = 0.0
     t = edges[0]
+    if guarded:
+        mechanics(t, y, P, S, M, L, mech)
+        p_prev = max(mech[1], 0.0)
     while n_out < nt and times[n_out] <= t:
         Y[n_out] = y
         n_out += 1
@@ -98,8 +159,9 @@ def run(rhs, P, S, M, L, y0, edges, times, rtol, atol, max_step, first_step, max
         if first_step > 0:
             h_abs = min(first_step, t_bound - t)
         else:
-            h_abs = _initial_step(rhs, P, S, M, L, t, y, K[0], t_bound, rtol, atol,
-                                  max_step, tmp, f1)
+            h_abs = _initial_step(
+                rhs, P, S, M, L, t, y, K[0], t_bound, rtol, atol, max_step, tmp, f1
+            )
             nfev += 1
         while t < t_bound:
             min_step = 10.0 * (np.nextafter(t, np.inf) - t)
@@ -144,16 +206,28 @@ def run(rhs, P, S, M, L, y0, edges, times, rtol, atol, max_step, first_step, max
                 if not np.isfinite(err):
                     return n_out, nfev, nsteps, NON_FINITE, t
                 if err < 1.0:
-                    factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** ERROR_EXPONENT)
+                    factor = (
+                        MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
+                    )
                     if rejected:
                         factor = min(1.0, factor)
                     h_abs *= factor
                     break
-                h_abs *= max(MIN_FACTOR, SAFETY * err ** ERROR_EXPONENT)
+                h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
                 rejected = True
             nsteps += 1
             if not np.all(np.isfinite(y_new)):
                 return n_out, nfev, nsteps, NON_FINITE, t
+            n_short = n_short + 1 if h < guard[0] else 0
+            if n_short >= stall_steps:
+                return n_out, nfev, nsteps, STALLED, t
+            if guarded:
+                mechanics(t_new, y_new, P, S, M, L, mech)
+                p = max(mech[1], 0.0)
+                w_plus += 0.5 * h * (p_prev + p)
+                p_prev = p
+                if not mech[0] <= guard[1] * (guard[2] + w_plus + guard[3]):
+                    return n_out, nfev, nsteps, BLOWUP, t
             if n_out < nt and times[n_out] <= t_new:
                 # dense output: three extra stages, then the 7th-order interpolant
                 for s in range(N_STAGES + 1, 16):
@@ -185,12 +259,48 @@ def run(rhs, P, S, M, L, y0, edges, times, rtol, atol, max_step, first_step, max
     return n_out, nfev, nsteps, OK, t
 
 
-def integrate_compiled(form, y0: np.ndarray, edges: np.ndarray, times: np.ndarray, rtol: float,
-                       atol: float, max_step: float, first_step: float | None,
-                       max_nfev: int, Y: np.ndarray) -> tuple[int, int, int, int, float]:
-    """Run ``run`` on a CompiledForm with scipy's DOP853 coefficients (see ``run``)."""
+def integrate_compiled(
+    form,
+    y0: np.ndarray,
+    edges: np.ndarray,
+    times: np.ndarray,
+    rtol: float,
+    atol: float,
+    max_step: float,
+    first_step: float | None,
+    max_nfev: int,
+    guard: np.ndarray,
+    stall_steps: int,
+    Y: np.ndarray,
+) -> tuple[int, int, int, int, float]:
+    """Run ``run`` on a CompiledForm with scipy's DOP853 coefficients (see ``run``; without
+    ``form.mechanics`` or with guard[1] = inf there is no blow-up check)."""
+    guarded = form.mechanics is not None and bool(np.isfinite(guard[1]))
+    mechanics = form.mechanics if form.mechanics is not None else form.rhs
     n_out, nfev, nsteps, code, t = run(
-        form.rhs, form.P, form.S, form.M, form.L, np.array(y0, float), np.array(edges, float),
-        np.array(times, float), rtol, atol, max_step, -1.0 if first_step is None else first_step,
-        max_nfev, _A, _B, _C, _E3, _E5, _D, Y)
+        form.rhs,
+        mechanics,
+        guarded,
+        form.P,
+        form.S,
+        form.M,
+        form.L,
+        np.array(y0, float),
+        np.array(edges, float),
+        np.array(times, float),
+        rtol,
+        atol,
+        max_step,
+        -1.0 if first_step is None else first_step,
+        max_nfev,
+        np.asarray(guard, float),
+        stall_steps,
+        _A,
+        _B,
+        _C,
+        _E3,
+        _E5,
+        _D,
+        Y,
+    )
     return int(n_out), int(nfev), int(nsteps), int(code), float(t)

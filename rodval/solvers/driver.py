@@ -18,6 +18,7 @@ Dense output is formed only on steps that contain output times, events, or when 
 for "energy". A failure ends the run early with a status, a message and the time reached; the
 output times reached so far are kept.
 """
+
 from __future__ import annotations
 
 import time
@@ -28,8 +29,13 @@ from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
 from rodval.core.scene import Scene
 from rodval.core.settings import AUTO, COMPILED_METHODS, IntegratorSettings
-from rodval.core.status import (STATUS_BUDGET, STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED,
-                                STATUS_WALL)
+from rodval.core.status import (
+    STATUS_BUDGET,
+    STATUS_DIVERGED,
+    STATUS_ERROR,
+    STATUS_FAILED,
+    STATUS_WALL,
+)
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.solvers.audit import PowerLedger, audit_quantities
 from rodval.solvers.events import EventMonitor
@@ -37,8 +43,14 @@ from rodval.solvers.guard import DivergenceGuard
 from rodval.solvers.progress import report
 from rodval.solvers.system import OdeSystem
 
-_SOLVERS = {"RK23": RK23, "RK45": RK45, "DOP853": DOP853, "Radau": Radau, "BDF": BDF,
-            "LSODA": LSODA}
+_SOLVERS = {
+    "RK23": RK23,
+    "RK45": RK45,
+    "DOP853": DOP853,
+    "Radau": Radau,
+    "BDF": BDF,
+    "LSODA": LSODA,
+}
 
 
 class _Stop(Exception):
@@ -60,15 +72,22 @@ def choose_method(system: OdeSystem, scene: Scene, settings: IntegratorSettings)
         return "DOP853"
     if settings.compiled:
         if system.compiled() is None:
-            raise ValueError(f"method {settings.method!r} needs a system with a compiled form "
-                             "(native models with kernel='numba' and loads built from rodval's "
-                             "load laws, not plain callables); use a scipy method or 'auto'")
+            raise ValueError(
+                f"method {settings.method!r} needs a system with a compiled form "
+                "(native models with kernel='numba' and loads built from rodval's "
+                "load laws: pulse/constant/ramp/harmonic/tabulated, not plain "
+                "callables); use a scipy method or 'auto'"
+            )
         if audit:
-            raise ValueError(f"method {settings.method!r} runs in one compiled loop and cannot "
-                             "audit energy; use a scipy method or 'auto' for 'energy' outputs")
+            raise ValueError(
+                f"method {settings.method!r} runs in one compiled loop and cannot "
+                "audit energy; use a scipy method or 'auto' for 'energy' outputs"
+            )
         if events:
-            raise ValueError(f"method {settings.method!r} cannot handle this scene's events; "
-                             "use a scipy method or 'auto'")
+            raise ValueError(
+                f"method {settings.method!r} cannot handle this scene's events; "
+                "use a scipy method or 'auto'"
+            )
     return settings.method
 
 
@@ -90,20 +109,28 @@ class _Outputs:
     def upto(self, t: float) -> np.ndarray:
         """The output times not yet written that are <= t."""
         end = int(np.searchsorted(self.times, t, side="right"))
-        return self.times[self.n:end]
+        return self.times[self.n : end]
 
     def write(self, values: np.ndarray) -> None:
         """values (k, N) for the next k output times."""
-        self.Y[self.n:self.n + len(values)] = values
+        self.Y[self.n : self.n + len(values)] = values
         self.n += len(values)
 
 
 class _ScipyRun:
     """One run on a scipy OdeSolver with evaluation and wall budgets, events, guard and audit."""
 
-    def __init__(self, system: OdeSystem, scene: Scene, settings: IntegratorSettings,
-                 method: str, stats: SolverStats, out: _Outputs, ledger: PowerLedger | None,
-                 guard: DivergenceGuard):
+    def __init__(
+        self,
+        system: OdeSystem,
+        scene: Scene,
+        settings: IntegratorSettings,
+        method: str,
+        stats: SolverStats,
+        out: _Outputs,
+        ledger: PowerLedger | None,
+        guard: DivergenceGuard,
+    ):
         self.system, self.scene, self.settings = system, scene, settings
         self.cls = _SOLVERS[method]
         self.stats, self.out, self.ledger, self.guard = stats, out, ledger, guard
@@ -120,14 +147,21 @@ class _ScipyRun:
     def fun(self, t: float, y: np.ndarray) -> np.ndarray:
         self.nfev += 1
         if self.nfev > self.settings.max_evaluations:
-            raise _Stop(STATUS_BUDGET, f"evaluation budget exhausted: max_evaluations = "
-                                       f"{self.settings.max_evaluations} used (t = {t:.6g} s)")
+            raise _Stop(
+                STATUS_BUDGET,
+                f"evaluation budget exhausted: max_evaluations = "
+                f"{self.settings.max_evaluations} used (t = {t:.6g} s)",
+            )
         if time.perf_counter() > self.deadline:
-            raise _Stop(STATUS_WALL, f"wall-clock budget exhausted: max_wall_s = "
-                                     f"{self.settings.max_wall_s:g} s used (t = {t:.6g} s)")
+            raise _Stop(
+                STATUS_WALL,
+                f"wall-clock budget exhausted: max_wall_s = "
+                f"{self.settings.max_wall_s:g} s used (t = {t:.6g} s)",
+            )
         if not np.all(np.isfinite(y)):
-            raise _Stop(STATUS_DIVERGED, f"diverged: non-finite state in a step attempt at "
-                                         f"t = {t:.6g} s")
+            raise _Stop(
+                STATUS_DIVERGED, f"diverged: non-finite state in a step attempt at t = {t:.6g} s"
+            )
         try:
             f = self.system.rhs(t, y)
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
@@ -148,13 +182,15 @@ class _ScipyRun:
                     return t_now
         return t_now
 
-    def _segment(self, y: np.ndarray, a: float, b: float,
-                 events: EventMonitor) -> tuple[np.ndarray, float, float]:
+    def _segment(
+        self, y: np.ndarray, a: float, b: float, events: EventMonitor
+    ) -> tuple[np.ndarray, float, float]:
         """Step from a towards b; returns (state, time reached, where to restart): b at the
         segment's end, the event time after a jump."""
         s = self.settings
-        solver = self.cls(self.fun, a, y, b, rtol=s.rtol, atol=s.atol, max_step=s.max_step,
-                          **self.extra)
+        solver = self.cls(
+            self.fun, a, y, b, rtol=s.rtol, atol=s.atol, max_step=s.max_step, **self.extra
+        )
         t_now = a
         try:
             while solver.status == "running":
@@ -168,8 +204,11 @@ class _ScipyRun:
                     self.stats.status, self.stats.message = verdict
                     break
                 t0, t1 = solver.t_old, solver.t
-                hit = events.first_crossing(t0, t1, solver.y, solver.dense_output()) \
-                    if events.active else None
+                hit = (
+                    events.first_crossing(t0, t1, solver.y, solver.dense_output())
+                    if events.active
+                    else None
+                )
                 t_end = hit[1] if hit else t1
                 pending = self.out.upto(t_end)
                 if pending.size or self.ledger or hit:
@@ -200,8 +239,14 @@ class _ScipyRun:
         self.stats.nlu += int(solver.nlu)
 
 
-def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
-              model: str, options: dict | None = None) -> Trajectory:
+def integrate(
+    system: OdeSystem,
+    scene: Scene,
+    settings: IntegratorSettings,
+    *,
+    model: str,
+    options: dict | None = None,
+) -> Trajectory:
     """Integrate ``system`` over [0, scene.t_end] and observe it at ``scene.times``.
 
     Never raises for a failed run: status, message and time reached are in ``stats``; a bad
@@ -213,7 +258,7 @@ def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
         ran["requested_method"] = AUTO
     form = system.compiled() if method in COMPILED_METHODS else None
     if form is not None:
-        from rodval.solvers.compiled import run_compiled   # loads the compiled loop once
+        from rodval.solvers.compiled import run_compiled  # loads the compiled loop once
     times = np.asarray(scene.times)
     out = _Outputs(times, system.y0.size)
     stats = SolverStats()
@@ -232,7 +277,8 @@ def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
             for _ in at_zero:
                 ledger.record()
         if form is not None:
-            out.n = run_compiled(form, y, edges, scene, settings, out.Y, stats)
+            energy0 = system.energy_budget(0.0, y) if system.has_energy else 0.0
+            out.n = run_compiled(form, y, edges, scene, settings, energy0, out.Y, stats)
             t_now = stats.t_reached
         else:
             scipy_run = _ScipyRun(system, scene, settings, method, stats, out, ledger, guard)
@@ -243,19 +289,29 @@ def integrate(system: OdeSystem, scene: Scene, settings: IntegratorSettings, *,
     stats.t_reached = float(t_now)
     if stats.status == 0:
         stats.message = "reached t_end"
-    reached = times[:out.n]
+    reached = times[: out.n]
     try:
-        observed = system.observe(reached, out.Y[:out.n]) if out.n else {}
+        observed = system.observe(reached, out.Y[: out.n]) if out.n else {}
         if ledger and out.n:
             audited, stats.energy_residual = audit_quantities(
-                observed["energy"][0][:, 0], system.energy(0.0, system.y0), ledger)
+                observed["energy"][0][:, 0], system.energy(0.0, system.y0), ledger
+            )
             observed.update(audited)
     except Exception as exc:  # noqa: BLE001
         observed = {}
-        stats.status, stats.message = STATUS_ERROR, f"observation failed: {type(exc).__name__}: {exc}"
+        stats.status, stats.message = (
+            STATUS_ERROR,
+            f"observation failed: {type(exc).__name__}: {exc}",
+        )
     stats.wall_s = time.perf_counter() - start
-    return Trajectory(model=model, scene_name=scene.name, times=reached,
-                      values={q: v for q, (v, _) in observed.items()},
-                      k_index={q: k for q, (_, k) in observed.items()},
-                      stats=stats, settings=ran, options=dict(options or {}),
-                      events=events)
+    return Trajectory(
+        model=model,
+        scene_name=scene.name,
+        times=reached,
+        values={q: v for q, (v, _) in observed.items()},
+        k_index={q: k for q, (_, k) in observed.items()},
+        stats=stats,
+        settings=ran,
+        options=dict(options or {}),
+        events=events,
+    )

@@ -7,9 +7,10 @@ g_i = 0 does not fire again at once). When several events cross in one step, the
 located one is taken; the step is cut there and the integrator restarts after the jump.
 Location: Brent's method on g_i(t, dense(t)), to ``time_tolerance(t)``.
 """
+
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import brentq
@@ -50,8 +51,9 @@ class EventMonitor:
     def active(self) -> bool:
         return bool(self.specs)
 
-    def first_crossing(self, t0: float, t1: float, y1: np.ndarray,
-                       dense: Dense) -> tuple[int, float] | None:
+    def first_crossing(
+        self, t0: float, t1: float, y1: np.ndarray, dense: Dense
+    ) -> tuple[int, float] | None:
         """(event index, located time) of the earliest crossing in (t0, t1], or None; updates
         the stored values to the step end when there is none."""
         new = [float(e.g(t1, y1)) for e in self.specs]
@@ -62,8 +64,13 @@ class EventMonitor:
             if g1 == 0.0:
                 t_root = t1
             else:
-                t_root = brentq(lambda s, g=e.g: g(s, dense(s)), t0, t1,
-                                xtol=time_tolerance(t1), rtol=4 * np.finfo(float).eps)
+                t_root = brentq(
+                    lambda s, g=e.g: g(s, dense(s)),
+                    t0,
+                    t1,
+                    xtol=time_tolerance(t1),
+                    rtol=4 * np.finfo(float).eps,
+                )
             if found is None or t_root < found[1]:
                 found = (i, t_root)
         if found is None:

@@ -16,6 +16,7 @@ The energy check needs the system's energy capability (``OdeSystem.has_energy``)
 costs one kinetic-energy evaluation per step: a mass-matrix product, no linear solve, and no
 bending recovery in the reduced model (its bending angles stay computed at output times only).
 """
+
 from __future__ import annotations
 
 import math
@@ -34,8 +35,9 @@ ENERGY_FLOOR_J = 1e-6
 class DivergenceGuard:
     """Per-step checks of one run; ``check`` returns (status, message) or None."""
 
-    def __init__(self, system: OdeSystem, settings: IntegratorSettings, t_end: float,
-                 y0: np.ndarray):
+    def __init__(
+        self, system: OdeSystem, settings: IntegratorSettings, t_end: float, y0: np.ndarray
+    ):
         self.h_min = settings.min_step_fraction * t_end
         self.stall_steps = settings.stall_steps
         self.n_short = 0
@@ -59,19 +61,24 @@ class DivergenceGuard:
             return STATUS_STALLED, (
                 f"step size collapse: {self.n_short} consecutive steps shorter than "
                 f"min_step_fraction x t_end = {self.h_min:.3g} s (last {t1 - t0:.3g} s) "
-                f"at t = {t1:.6g} s")
+                f"at t = {t1:.6g} s"
+            )
         if self.system is None:
             return None
         try:
             p = self._positive_power(t1, y)
             E = self.system.kinetic_energy(t1, y)
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
-            return STATUS_ERROR, f"energy check failed at t = {t1:.6g} s: {type(exc).__name__}: {exc}"
+            return (
+                STATUS_ERROR,
+                f"energy check failed at t = {t1:.6g} s: {type(exc).__name__}: {exc}",
+            )
         self.w_plus += 0.5 * (t1 - t0) * (self.p_prev + p)
         self.p_prev = p
         budget = self.E0 + self.w_plus + ENERGY_FLOOR_J
         if not E <= self.factor * budget:
             return STATUS_BLOWUP, (
                 f"energy blow-up: kinetic energy {E:.4g} J > blowup_factor {self.factor:g} x budget "
-                f"E(0) + W+ = {budget:.4g} J at t = {t1:.6g} s")
+                f"E(0) + W+ = {budget:.4g} J at t = {t1:.6g} s"
+            )
         return None

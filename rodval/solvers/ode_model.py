@@ -1,4 +1,5 @@
 """A model that is an ODE system integrated by rodval's driver."""
+
 from __future__ import annotations
 
 import time
@@ -30,10 +31,19 @@ class OdeModel(Model):
         try:
             system = self.system(scene)
         except Exception as exc:  # noqa: BLE001 - failures are data
-            stats = SolverStats(status=STATUS_ERROR,
-                                message=f"model set-up failed: {type(exc).__name__}: {exc}",
-                                wall_s=time.perf_counter() - start)
-            return Trajectory(model=self.name, scene_name=scene.name, times=np.zeros(0),
-                              values={}, k_index={}, stats=stats,
-                              settings=settings.as_dict(), options=self.options())
+            stats = SolverStats(
+                status=STATUS_ERROR,
+                message=f"model set-up failed: {type(exc).__name__}: {exc}",
+                wall_s=time.perf_counter() - start,
+            )
+            return Trajectory(
+                model=self.name,
+                scene_name=scene.name,
+                times=np.zeros(0),
+                values={},
+                k_index={},
+                stats=stats,
+                settings=settings.as_dict(),
+                options=self.options(),
+            )
         return integrate(system, scene, settings, model=self.name, options=self.options())

@@ -4,15 +4,17 @@ the reporter set for the current context (none by default, so library calls prin
 ``progress_bar`` is the CLI's reporter: a tqdm bar over [0, t_end] s on stderr that appears
 only when the run lasts more than ``delay`` seconds and only on a terminal.
 """
+
 from __future__ import annotations
 
 import contextvars
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Callable, Iterator
 
 Reporter = Callable[[float], None]
-_reporter: contextvars.ContextVar[Reporter | None] = contextvars.ContextVar("rodval_progress",
-                                                                            default=None)
+_reporter: contextvars.ContextVar[Reporter | None] = contextvars.ContextVar(
+    "rodval_progress", default=None
+)
 
 
 def report(t: float) -> None:
@@ -30,8 +32,13 @@ def progress_bar(t_end: float, *, enabled: bool, delay: float = 2.0) -> Iterator
         return
     from tqdm import tqdm
 
-    bar = tqdm(total=t_end, unit="s", delay=delay, leave=False,
-               bar_format="{l_bar}{bar}| t = {n:.4g} / {total:.4g} s [{elapsed}]")
+    bar = tqdm(
+        total=t_end,
+        unit="s",
+        delay=delay,
+        leave=False,
+        bar_format="{l_bar}{bar}| t = {n:.4g} / {total:.4g} s [{elapsed}]",
+    )
 
     def update(t: float) -> None:
         bar.update(max(t - bar.n, 0.0))

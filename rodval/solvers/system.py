@@ -15,11 +15,13 @@ method with the same (t, y) signature:
 
 The solvers layer imports no model: models implement this contract.
 """
+
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -36,6 +38,10 @@ class CompiledForm:
     hold is the model's business: ``P`` (rows of per-rod constants, float64 2-D), ``S``
     (scalars, float64 1-D), ``M`` (dense matrices, float64 3-D, may be empty), ``L`` (the load
     table, ``rodval.core.loads.load_table``). The integrator passes them through untouched.
+
+    ``mechanics`` (optional, same type): writes (T, P_ext) — kinetic energy (J) and power of
+    the loads (W) — into a length-2 ``out``, for the divergence guard inside the loop; None
+    disables the energy blow-up check.
     """
 
     rhs: Any
@@ -43,15 +49,26 @@ class CompiledForm:
     S: np.ndarray
     M: np.ndarray
     L: np.ndarray
+    mechanics: Any = None
     name: str = ""
 
     def __post_init__(self) -> None:
-        for label, arr, ndim in (("P", self.P, 2), ("S", self.S, 1), ("M", self.M, 3),
-                                 ("L", self.L, 2)):
-            if not (isinstance(arr, np.ndarray) and arr.dtype == np.float64 and arr.ndim == ndim
-                    and arr.flags.c_contiguous):
-                raise TypeError(f"CompiledForm.{label} must be a C-contiguous float64 array "
-                                f"with {ndim} dimensions")
+        for label, arr, ndim in (
+            ("P", self.P, 2),
+            ("S", self.S, 1),
+            ("M", self.M, 3),
+            ("L", self.L, 2),
+        ):
+            if not (
+                isinstance(arr, np.ndarray)
+                and arr.dtype == np.float64
+                and arr.ndim == ndim
+                and arr.flags.c_contiguous
+            ):
+                raise TypeError(
+                    f"CompiledForm.{label} must be a C-contiguous float64 array "
+                    f"with {ndim} dimensions"
+                )
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,7 @@ by ``timeout`` or ``worker crashed`` (conditions of the run, not of the case). A
 incomplete record is named in a warning and recomputed. The pipeline knows nothing of the
 physics: comparisons come from ``rodval.analysis.metrics``.
 """
+
 from __future__ import annotations
 
 import time
@@ -30,11 +31,19 @@ RETRIED = (STATUS_TIMEOUT, STATUS_CRASHED)
 
 def study_meta(spec: StudySpec) -> dict[str, Any]:
     """The study's description saved beside the tables (the report reads it)."""
-    return {"name": spec.name, "description": spec.description, "source": spec.source,
-            "reference": spec.reference, "models": [m.as_dict() for m in spec.models],
-            "axes": spec.axes, "labels": spec.labels, "report": spec.report.as_dict(),
-            "cases": [{"id": c.id, "params": c.params, "fingerprint": c.fingerprint}
-                      for c in spec.cases]}
+    return {
+        "name": spec.name,
+        "description": spec.description,
+        "source": spec.source,
+        "reference": spec.reference,
+        "models": [m.as_dict() for m in spec.models],
+        "axes": spec.axes,
+        "labels": spec.labels,
+        "report": spec.report.as_dict(),
+        "cases": [
+            {"id": c.id, "params": c.params, "fingerprint": c.fingerprint} for c in spec.cases
+        ],
+    }
 
 
 def case_record(case: Case, runs: list[dict[str, Any]]) -> CaseRecord:
@@ -43,9 +52,15 @@ def case_record(case: Case, runs: list[dict[str, Any]]) -> CaseRecord:
     order = {m.label: i for i, m in enumerate(case.models)}
     typed = sorted((RunRecord.from_dict(r) for r in runs), key=lambda r: order[r.label])
     trajs: dict[str, Trajectory] = {r.label: r.trajectory for r in typed}
-    return CaseRecord(case=case.id, fingerprint=case.fingerprint, params=case.params,
-                      scene=scene_to_dict(case.scene), reference=case.reference, runs=typed,
-                      discrepancies=compare_runs(trajs, case.reference, case.scene.outputs))
+    return CaseRecord(
+        case=case.id,
+        fingerprint=case.fingerprint,
+        params=case.params,
+        scene=scene_to_dict(case.scene),
+        reference=case.reference,
+        runs=typed,
+        discrepancies=compare_runs(trajs, case.reference, case.scene.outputs),
+    )
 
 
 def _reusable(store: StudyStore, case: Case, warnings: list[str]) -> bool:
@@ -75,10 +90,19 @@ class StudyRun:
     warnings: list[str] = field(default_factory=list)
 
 
-def run_study(spec: StudySpec, out: str | Path, *, workers: int | None = None,
-              case_timeout: float | None = None, resume: bool = True,
-              backend: str = "processes", scheduler: str | None = None,
-              progress: bool = True, report: bool = True, fresh: bool = False) -> StudyRun:
+def run_study(
+    spec: StudySpec,
+    out: str | Path,
+    *,
+    workers: int | None = None,
+    case_timeout: float | None = None,
+    resume: bool = True,
+    backend: str = "processes",
+    scheduler: str | None = None,
+    progress: bool = True,
+    report: bool = True,
+    fresh: bool = False,
+) -> StudyRun:
     """Run the cases of ``spec`` not yet on disk in ``out``, then write tables and report.
 
     workers: parallel cases for the processes backend (default: all cores).
@@ -108,8 +132,9 @@ def run_study(spec: StudySpec, out: str | Path, *, workers: int | None = None,
         write_text_atomic(store.out / "study.toml", spec.text)
         reused = [c.id for c in spec.cases if resume and _reusable(store, c, warnings)]
         # Longest first (rods x horizon as the cost guess) so that no big case starts last.
-        todo = sorted((c for c in spec.cases if c.id not in reused),
-                      key=lambda c: -c.scene.n * c.scene.t_end)
+        todo = sorted(
+            (c for c in spec.cases if c.id not in reused), key=lambda c: -c.scene.n * c.scene.t_end
+        )
         by_id = {c.id: c for c in todo}
         failed = 0
         bar = tqdm(total=len(todo), desc=spec.name, unit="case", disable=not progress or not todo)
@@ -139,5 +164,11 @@ def run_study(spec: StudySpec, out: str | Path, *, workers: int | None = None,
             from rodval.report.study_report import build_report
 
             build_report(store.out)
-    return StudyRun(out=store.out, ran=[c.id for c in todo], reused=reused, failed_runs=failed,
-                    wall_s=time.perf_counter() - start, warnings=warnings)
+    return StudyRun(
+        out=store.out,
+        ran=[c.id for c in todo],
+        reused=reused,
+        failed_runs=failed,
+        wall_s=time.perf_counter() - start,
+        warnings=warnings,
+    )

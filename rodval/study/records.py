@@ -9,6 +9,7 @@ fields): ``read_case`` verifies both, so a damaged, edited or incomplete file is
 
 This module is the one reader of case files; tables, resume and reports go through it.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -39,13 +40,19 @@ class RunRecord:
     trajectory: Trajectory
 
     def to_dict(self) -> dict[str, Any]:
-        return {"label": self.label, "setup_s": self.setup_s,
-                "trajectory": self.trajectory.to_dict()}
+        return {
+            "label": self.label,
+            "setup_s": self.setup_s,
+            "trajectory": self.trajectory.to_dict(),
+        }
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> RunRecord:
-        return cls(label=str(d["label"]), setup_s=float(d["setup_s"]),
-                   trajectory=Trajectory.from_dict(d["trajectory"]))
+        return cls(
+            label=str(d["label"]),
+            setup_s=float(d["setup_s"]),
+            trajectory=Trajectory.from_dict(d["trajectory"]),
+        )
 
     @property
     def status(self) -> int:
@@ -77,9 +84,16 @@ class CaseRecord:
         return list(self.scene["chain"]["l"])
 
     def body(self) -> dict[str, Any]:
-        return {"schema": SCHEMA, "case": self.case, "fingerprint": self.fingerprint,
-                "params": self.params, "scene": self.scene, "reference": self.reference,
-                "runs": [r.to_dict() for r in self.runs], "discrepancies": self.discrepancies}
+        return {
+            "schema": SCHEMA,
+            "case": self.case,
+            "fingerprint": self.fingerprint,
+            "params": self.params,
+            "scene": self.scene,
+            "reference": self.reference,
+            "runs": [r.to_dict() for r in self.runs],
+            "discrepancies": self.discrepancies,
+        }
 
     def to_json(self) -> str:
         body = self.body()
@@ -94,8 +108,9 @@ def _json_default(value: Any) -> Any:
 
 def _canonical(body: dict[str, Any]) -> str:
     # the same text the file was checked with: round-trip through JSON first (floats, inf)
-    return json.dumps(json.loads(json.dumps(body, default=_json_default)), sort_keys=True,
-                      separators=(",", ":"))
+    return json.dumps(
+        json.loads(json.dumps(body, default=_json_default)), sort_keys=True, separators=(",", ":")
+    )
 
 
 def checksum(body: dict[str, Any]) -> str:
@@ -109,22 +124,32 @@ def read_case(path: Path, *, labels: list[str] | None = None) -> CaseRecord:
     try:
         doc = json.loads(Path(path).read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise DamagedRecord(f"{path}: unreadable case record ({type(exc).__name__}: {exc})") from None
+        raise DamagedRecord(
+            f"{path}: unreadable case record ({type(exc).__name__}: {exc})"
+        ) from None
     if not isinstance(doc, dict):
-        raise DamagedRecord(f"{path}: a case record must be a JSON object, got {type(doc).__name__}")
+        raise DamagedRecord(
+            f"{path}: a case record must be a JSON object, got {type(doc).__name__}"
+        )
     if doc.get("schema") != SCHEMA:
         raise DamagedRecord(f"{path}: case record schema {doc.get('schema')!r}, expected {SCHEMA}")
     body = {k: v for k, v in doc.items() if k != "checksum"}
     if doc.get("checksum") != checksum(body):
         raise DamagedRecord(f"{path}: checksum mismatch (the file was edited or damaged)")
     try:
-        rec = CaseRecord(case=str(doc["case"]), fingerprint=str(doc["fingerprint"]),
-                         params=dict(doc["params"]), scene=dict(doc["scene"]),
-                         reference=str(doc["reference"]),
-                         runs=[RunRecord.from_dict(r) for r in doc["runs"]],
-                         discrepancies=list(doc["discrepancies"]))
+        rec = CaseRecord(
+            case=str(doc["case"]),
+            fingerprint=str(doc["fingerprint"]),
+            params=dict(doc["params"]),
+            scene=dict(doc["scene"]),
+            reference=str(doc["reference"]),
+            runs=[RunRecord.from_dict(r) for r in doc["runs"]],
+            discrepancies=list(doc["discrepancies"]),
+        )
     except (KeyError, TypeError, ValueError) as exc:
-        raise DamagedRecord(f"{path}: malformed case record ({type(exc).__name__}: {exc})") from None
+        raise DamagedRecord(
+            f"{path}: malformed case record ({type(exc).__name__}: {exc})"
+        ) from None
     if labels is not None:
         have = [r.label for r in rec.runs]
         missing = [lab for lab in labels if lab not in have]
@@ -133,6 +158,7 @@ def read_case(path: Path, *, labels: list[str] | None = None) -> CaseRecord:
     for run in rec.runs:
         for q, v in run.trajectory.values.items():
             if run.trajectory.success and not all(math.isfinite(x) for x in v.ravel()):
-                raise DamagedRecord(f"{path}: run {run.label!r} reports success with "
-                                    f"non-finite values of {q!r}")
+                raise DamagedRecord(
+                    f"{path}: run {run.label!r} reports success with non-finite values of {q!r}"
+                )
     return rec

@@ -7,6 +7,7 @@ only that worker, which is replaced; its unfinished runs are recorded with statu
 or ``worker crashed``. On dask, every dask worker process keeps its own warm workers (one per
 thread), so the same isolation and warm-up hold there.
 """
+
 from __future__ import annotations
 
 import json
@@ -17,8 +18,9 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor, as_completed
-from typing import Any, Callable
+from typing import Any
 
 from rodval.core.status import STATUS_CRASHED, STATUS_TIMEOUT
 from rodval.study.worker import failed_run
@@ -33,8 +35,9 @@ def complete_runs(payload: Payload, runs: list[dict], status: int, message: str)
     """``runs`` plus a failed run (``status``, ``message``) for each model not in them."""
     done = {r["label"] for r in runs}
     name = payload["scene"].get("name", payload["case"])
-    return runs + [failed_run(m, name, status, message)
-                   for m in payload["models"] if m["label"] not in done]
+    return runs + [
+        failed_run(m, name, status, message) for m in payload["models"] if m["label"] not in done
+    ]
 
 
 class WarmWorker:
@@ -52,9 +55,14 @@ class WarmWorker:
         self.lines = queue.Queue()
         self.stderr.seek(0)
         self.stderr.truncate()
-        self.proc = subprocess.Popen([sys.executable, "-m", "rodval.study.worker"],
-                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                     stderr=self.stderr, text=True, bufsize=1)
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "rodval.study.worker"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self.stderr,
+            text=True,
+            bufsize=1,
+        )
         threading.Thread(target=self._read, args=(self.proc, self.lines), daemon=True).start()
         with WarmWorker._live_lock:
             WarmWorker._live.add(self)
@@ -64,7 +72,7 @@ class WarmWorker:
         assert proc.stdout is not None
         for line in proc.stdout:
             lines.put(line)
-        lines.put(None)                        # end of output: the process has exited
+        lines.put(None)  # end of output: the process has exited
 
     def kill(self) -> None:
         if self.proc is not None:
@@ -85,7 +93,7 @@ class WarmWorker:
         if self.proc is None or self.proc.poll() is not None:
             self.kill()
             self._start()
-            if self._next(None) is None:         # the "ready" line (imports done)
+            if self._next(None) is None:  # the "ready" line (imports done)
                 message = self._crash_message()
                 self.kill()
                 return complete_runs(payload, [], STATUS_CRASHED, message)
@@ -104,8 +112,9 @@ class WarmWorker:
                 line = self._next(deadline)
             except queue.Empty:
                 self.kill()
-                return complete_runs(payload, runs, STATUS_TIMEOUT,
-                                     f"case exceeded its time limit of {timeout:g} s")
+                return complete_runs(
+                    payload, runs, STATUS_TIMEOUT, f"case exceeded its time limit of {timeout:g} s"
+                )
             if line is None:
                 message = self._crash_message()
                 self.kill()
@@ -144,8 +153,7 @@ def run_case_warm(payload: Payload, timeout: float | None = None) -> list[dict[s
     return worker.run(payload, timeout)
 
 
-def run_processes(payloads: list[Payload], done: Done, workers: int,
-                  timeout: float | None) -> None:
+def run_processes(payloads: list[Payload], done: Done, workers: int, timeout: float | None) -> None:
     """Run the cases on ``workers`` warm worker processes, calling ``done`` as each ends."""
     pool: queue.Queue[WarmWorker] = queue.Queue()
     for _ in range(min(workers, max(len(payloads), 1))):
@@ -172,8 +180,7 @@ def run_processes(payloads: list[Payload], done: Done, workers: int,
         pool.get().kill()
 
 
-def run_dask(payloads: list[Payload], done: Done, scheduler: str,
-             timeout: float | None) -> None:
+def run_dask(payloads: list[Payload], done: Done, scheduler: str, timeout: float | None) -> None:
     """Run the cases on the dask.distributed cluster at ``scheduler``."""
     from dask.distributed import Client
     from dask.distributed import as_completed as dask_completed
@@ -186,8 +193,9 @@ def run_dask(payloads: list[Payload], done: Done, scheduler: str,
             try:
                 runs = fut.result()
             except Exception as exc:  # noqa: BLE001 - the task itself failed
-                runs = complete_runs(payload, [], STATUS_CRASHED,
-                                     f"dask task failed: {type(exc).__name__}: {exc}")
+                runs = complete_runs(
+                    payload, [], STATUS_CRASHED, f"dask task failed: {type(exc).__name__}: {exc}"
+                )
             done(payload, runs)
 
 

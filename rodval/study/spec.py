@@ -11,6 +11,7 @@ axis values (``n=8,t_end=2``), so it stays the same when other axes or values ar
 
 Every error is a ValueError naming the file and the key, raised before any work.
 """
+
 from __future__ import annotations
 
 import copy
@@ -20,14 +21,14 @@ import json
 import math
 import re
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from rodval.models import REGISTRY, get_model, model_class
 from rodval.core.scene import QUANTITIES, Scene
 from rodval.core.scene_file import scene_from_dict
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
+from rodval.models import REGISTRY, get_model, model_class
 
 TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report"}
 STUDY_KEYS = {"name", "description", "reference"}
@@ -47,8 +48,12 @@ class ModelSpec:
     settings: IntegratorSettings
 
     def as_dict(self) -> dict[str, Any]:
-        return {"label": self.label, "model": self.model, "options": self.options,
-                "settings": self.settings.as_dict()}
+        return {
+            "label": self.label,
+            "model": self.model,
+            "options": self.options,
+            "settings": self.settings.as_dict(),
+        }
 
 
 @dataclass(frozen=True)
@@ -56,8 +61,8 @@ class Case:
     """One scene (the base scene after the grid's overrides) run by every model of the study."""
 
     id: str
-    params: dict[str, Any]            # axis label -> value
-    scene_dict: dict[str, Any]        # the [scene] table of this case (scene_file format)
+    params: dict[str, Any]  # axis label -> value
+    scene_dict: dict[str, Any]  # the [scene] table of this case (scene_file format)
     scene: Scene
     models: tuple[ModelSpec, ...]
     reference: str
@@ -66,15 +71,25 @@ class Case:
     @property
     def fingerprint(self) -> str:
         """Hash of everything that determines the case's results (scene, models, reference)."""
-        text = json.dumps({"scene": self.scene_dict, "reference": self.reference,
-                           "models": [m.as_dict() for m in self.models]},
-                          sort_keys=True, default=repr)
+        text = json.dumps(
+            {
+                "scene": self.scene_dict,
+                "reference": self.reference,
+                "models": [m.as_dict() for m in self.models],
+            },
+            sort_keys=True,
+            default=repr,
+        )
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
     def payload(self) -> dict[str, Any]:
         """What a worker needs to run the case (plain JSON)."""
-        return {"case": self.id, "where": self.where, "scene": self.scene_dict,
-                "models": [m.as_dict() for m in self.models]}
+        return {
+            "case": self.id,
+            "where": self.where,
+            "scene": self.scene_dict,
+            "models": [m.as_dict() for m in self.models],
+        }
 
 
 @dataclass(frozen=True)
@@ -88,21 +103,24 @@ class ReportSpec:
     times: tuple[float, ...] | None = None
 
     def as_dict(self) -> dict[str, Any]:
-        return {"cases": list(self.cases), "rods": list(self.rods),
-                "quantities": list(self.quantities),
-                "times": None if self.times is None else list(self.times)}
+        return {
+            "cases": list(self.cases),
+            "rods": list(self.rods),
+            "quantities": list(self.quantities),
+            "times": None if self.times is None else list(self.times),
+        }
 
 
 @dataclass(frozen=True)
 class StudySpec:
     name: str
     description: str
-    source: str                       # file name used in messages
-    text: str                         # the TOML text, copied beside the results
+    source: str  # file name used in messages
+    text: str  # the TOML text, copied beside the results
     reference: str
     models: tuple[ModelSpec, ...]
-    axes: dict[str, list[Any]]        # grid path -> values
-    labels: dict[str, str]            # grid path -> short label used in case ids and tables
+    axes: dict[str, list[Any]]  # grid path -> values
+    labels: dict[str, str]  # grid path -> short label used in case ids and tables
     cases: tuple[Case, ...]
     report: ReportSpec
 
@@ -153,8 +171,11 @@ def _format_value(v: Any) -> str:
         return "inf" if math.isinf(v) else f"{v:.12g}"
     if isinstance(v, dict):
         kind = v.get("type", "")
-        return f"{kind}(" + ",".join(f"{k}={_format_value(x)}" for k, x in v.items()
-                                     if k != "type") + ")"
+        return (
+            f"{kind}("
+            + ",".join(f"{k}={_format_value(x)}" for k, x in v.items() if k != "type")
+            + ")"
+        )
     if isinstance(v, list):
         return "+".join(_format_value(x) for x in v)
     return re.sub(r"[^A-Za-z0-9._+-]", "-", str(v))
@@ -178,8 +199,11 @@ def _model_specs(doc: dict, where: str) -> tuple[ModelSpec, ...]:
     _check_keys(integ, INTEGRATOR_KEYS, where, "integrator")
     models = doc.get("models")
     if not isinstance(models, dict) or not models:
-        raise _err(where, "models", "at least one [models.LABEL] table is required "
-                                    f"(model names: {', '.join(REGISTRY)})")
+        raise _err(
+            where,
+            "models",
+            f"at least one [models.LABEL] table is required (model names: {', '.join(REGISTRY)})",
+        )
     specs = []
     for label, table in models.items():
         key = f"models.{label}"
@@ -187,15 +211,21 @@ def _model_specs(doc: dict, where: str) -> tuple[ModelSpec, ...]:
             raise _err(where, key, "must be a table")
         name = table.get("model", label)
         if name not in REGISTRY:
-            raise _err(where, f"{key}.model" if "model" in table else key,
-                       f"model must be one of {', '.join(REGISTRY)}, got {name!r}")
+            raise _err(
+                where,
+                f"{key}.model" if "model" in table else key,
+                f"model must be one of {', '.join(REGISTRY)}, got {name!r}",
+            )
         own = {k: v for k, v in table.items() if k in INTEGRATOR_KEYS}
         if not _uses_rodval_integrator(name):
             if own:
-                raise _err(where, f"{key}.{sorted(own)[0]}",
-                           f"model {name!r} integrates with its own options, not rodval's "
-                           "integrator settings (see its options, e.g. step, solver)")
-            settings_kw = {}        # [integrator] applies to the models rodval integrates
+                raise _err(
+                    where,
+                    f"{key}.{sorted(own)[0]}",
+                    f"model {name!r} integrates with its own options, not rodval's "
+                    "integrator settings (see its options, e.g. step, solver)",
+                )
+            settings_kw = {}  # [integrator] applies to the models rodval integrates
         else:
             settings_kw = {**integ, **own}
         try:
@@ -237,42 +267,77 @@ def _report_spec(table: Any, case_ids: list[str], where: str) -> ReportSpec:
     _check_keys(table, REPORT_KEYS, where, "report")
     cases = table.get("cases", case_ids[:1])
     if not isinstance(cases, list) or any(c not in case_ids for c in cases):
-        raise _err(where, "report.cases", f"must be a list of case ids from {case_ids}, got {cases!r}")
+        raise _err(
+            where, "report.cases", f"must be a list of case ids from {case_ids}, got {cases!r}"
+        )
     rods = table.get("rods", [1, "last"])
-    if not isinstance(rods, list) or not rods or any(
+    if (
+        not isinstance(rods, list)
+        or not rods
+        or any(
             not (r == "last" or (isinstance(r, int) and not isinstance(r, bool) and r >= 1))
-            for r in rods):
-        raise _err(where, "report.rods", f"must be a list of rod numbers >= 1 or \"last\", got {rods!r}")
+            for r in rods
+        )
+    ):
+        raise _err(
+            where, "report.rods", f'must be a list of rod numbers >= 1 or "last", got {rods!r}'
+        )
     quantities = table.get("quantities", ["phi", "dphi", "alpha", "beta"])
-    if not isinstance(quantities, list) or not quantities or any(q not in QUANTITIES for q in quantities):
-        raise _err(where, "report.quantities", f"must be a list from {QUANTITIES}, got {quantities!r}")
+    if (
+        not isinstance(quantities, list)
+        or not quantities
+        or any(q not in QUANTITIES for q in quantities)
+    ):
+        raise _err(
+            where, "report.quantities", f"must be a list from {QUANTITIES}, got {quantities!r}"
+        )
     times = table.get("times")
-    if times is not None and (not isinstance(times, list) or not times or any(
+    if times is not None and (
+        not isinstance(times, list)
+        or not times
+        or any(
             isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t < 0
-            for t in times)):
+            for t in times
+        )
+    ):
         raise _err(where, "report.times", f"must be a list of times >= 0 s, got {times!r}")
-    return ReportSpec(cases=tuple(cases), rods=tuple(rods), quantities=tuple(quantities),
-                      times=None if times is None else tuple(float(t) for t in times))
+    return ReportSpec(
+        cases=tuple(cases),
+        rods=tuple(rods),
+        quantities=tuple(quantities),
+        times=None if times is None else tuple(float(t) for t in times),
+    )
 
 
 def _grid_axes(grid: Any, doc: dict, where: str) -> dict[str, list[Any]]:
     if grid is None:
         return {}
     if not isinstance(grid, dict):
-        raise _err(where, "grid", "must be a table of dotted keys -> lists of values, "
-                                  "or an array of such tables ([[grid]])")
+        raise _err(
+            where,
+            "grid",
+            "must be a table of dotted keys -> lists of values, "
+            "or an array of such tables ([[grid]])",
+        )
     axes = _flatten(grid)
     for path, values in axes.items():
         key = f"grid.{path}"
         root, *rest = path.split(".")
         if root not in GRID_ROOTS or not rest:
-            raise _err(where, key, f"must be a path into {', '.join(GRID_ROOTS)} "
-                                   "(e.g. scene.n, scene.chain.EI, integrator.rtol, models.full.method)")
+            raise _err(
+                where,
+                key,
+                f"must be a path into {', '.join(GRID_ROOTS)} "
+                "(e.g. scene.n, scene.chain.EI, integrator.rtol, models.full.method)",
+            )
         if root == "integrator" and (len(rest) != 1 or rest[0] not in INTEGRATOR_KEYS):
             raise _err(where, key, f"integrator keys are {', '.join(sorted(INTEGRATOR_KEYS))}")
         if root == "models" and (len(rest) != 2 or rest[0] not in doc.get("models", {})):
-            raise _err(where, key, f"must be models.LABEL.KEY with LABEL one of "
-                                   f"{', '.join(doc.get('models', {}))}")
+            raise _err(
+                where,
+                key,
+                f"must be models.LABEL.KEY with LABEL one of {', '.join(doc.get('models', {}))}",
+            )
         if not isinstance(values, list) or not values:
             raise _err(where, key, f"must be a non-empty list of values, got {values!r}")
         if len({json.dumps(v, sort_keys=True) for v in values}) != len(values):
@@ -290,9 +355,15 @@ def _build_case(doc: dict, combo: dict[str, Any], labels: dict[str, str], where:
     scene_dict.setdefault("name", cid)
     scene = scene_from_dict(scene_dict, where=f"{case_where} [scene]")
     models = _model_specs(case_doc, case_where)
-    return Case(id=cid, params={labels[p]: v for p, v in combo.items()}, scene_dict=scene_dict,
-                scene=scene, models=models, reference=case_doc["study"]["reference"],
-                where=case_where)
+    return Case(
+        id=cid,
+        params={labels[p]: v for p, v in combo.items()},
+        scene_dict=scene_dict,
+        scene=scene,
+        models=models,
+        reference=case_doc["study"]["reference"],
+        where=case_where,
+    )
 
 
 def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpec:
@@ -304,30 +375,48 @@ def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpe
     labels_m = [m.label for m in models]
     reference = study.get("reference", labels_m[0])
     if reference not in labels_m:
-        raise _err(where, "study.reference", f"must be one of the model labels {labels_m}, "
-                                             f"got {reference!r}")
+        raise _err(
+            where,
+            "study.reference",
+            f"must be one of the model labels {labels_m}, got {reference!r}",
+        )
     study["reference"] = reference
     if "scene" in doc and not isinstance(doc["scene"], dict):
         raise _err(where, "scene", "must be a table")
     grid = doc.get("grid")
     grids = [_grid_axes(g, doc, where) for g in (grid if isinstance(grid, list) else [grid])]
     axes: dict[str, list[Any]] = {}
-    for sub in grids:           # [[grid]]: the union of several grids' cartesian products
+    for sub in grids:  # [[grid]]: the union of several grids' cartesian products
         for path, values in sub.items():
             axes.setdefault(path, [])
             axes[path] += [v for v in values if v not in axes[path]]
     labels = _axis_labels(list(axes))
-    cases = tuple(_build_case(doc, dict(zip(sub, combo)), labels, where)
-                  for sub in grids for combo in itertools.product(*sub.values()))
+    cases = tuple(
+        _build_case(doc, dict(zip(sub, combo)), labels, where)
+        for sub in grids
+        for combo in itertools.product(*sub.values())
+    )
     ids = [c.id for c in cases]
     if len(set(ids)) != len(ids):
-        raise _err(where, "grid", "two cases format to the same id; use values that differ "
-                                  "in their first 12 significant digits")
+        raise _err(
+            where,
+            "grid",
+            "two cases format to the same id; use values that differ "
+            "in their first 12 significant digits",
+        )
     report = _report_spec(doc.get("report"), ids, where)
-    return StudySpec(name=str(study.get("name", Path(where).stem)),
-                     description=str(study.get("description", "")), source=where, text=text,
-                     reference=reference, models=models, axes=axes, labels=labels,
-                     cases=cases, report=report)
+    return StudySpec(
+        name=str(study.get("name", Path(where).stem)),
+        description=str(study.get("description", "")),
+        source=where,
+        text=text,
+        reference=reference,
+        models=models,
+        axes=axes,
+        labels=labels,
+        cases=cases,
+        report=report,
+    )
 
 
 def load_study(path: str | Path) -> StudySpec:

@@ -14,6 +14,7 @@ and ``figures/``.
 * Case file names are bounded (``MAX_NAME``) whatever the grid: a readable prefix of the case
   id and a hash of the full id; the full parameters live in the record.
 """
+
 from __future__ import annotations
 
 import fcntl
@@ -22,9 +23,10 @@ import json
 import os
 import re
 import shutil
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 #: Longest case file name (characters, with ".json"): well below every file system's 255.
 MAX_NAME = 120
@@ -41,7 +43,7 @@ def case_file_name(case_id: str) -> str:
     if safe == case_id and len(safe) + 5 <= MAX_NAME:
         return f"{safe}.json"
     digest = hashlib.sha256(case_id.encode()).hexdigest()[:16]
-    return f"{safe[:MAX_NAME - 5 - 17]}~{digest}.json"
+    return f"{safe[: MAX_NAME - 5 - 17]}~{digest}.json"
 
 
 def write_text_atomic(path: Path, text: str) -> None:
@@ -90,8 +92,10 @@ class StudyStore:
             except BlockingIOError:
                 fh.seek(0)
                 holder = fh.read().strip() or "another process"
-                raise FolderBusy(f"{self.out} is in use by another rodval study (pid "
-                                 f"{holder}); wait for it to finish or use another --out") from None
+                raise FolderBusy(
+                    f"{self.out} is in use by another rodval study (pid "
+                    f"{holder}); wait for it to finish or use another --out"
+                ) from None
             fh.seek(0)
             fh.truncate()
             fh.write(str(os.getpid()))
@@ -107,7 +111,8 @@ class StudyStore:
         if old is not None and not fresh and not same_study(old, meta):
             raise ValueError(
                 f"{self.out} holds another study ({old.get('name')!r} from "
-                f"{old.get('source')!r}); use another --out, or --fresh to start over there")
+                f"{old.get('source')!r}); use another --out, or --fresh to start over there"
+            )
         if fresh:
             for item in self.out.iterdir():
                 if item.name == ".lock":
@@ -121,5 +126,6 @@ def same_study(a: dict[str, Any], b: dict[str, Any]) -> bool:
     """Whether two study descriptions are of the same study: same name, models and reference
     (its grid may grow: new cases are added, finished ones reused)."""
     keys = ("name", "reference", "models")
-    return all(json.dumps(a.get(k), sort_keys=True) == json.dumps(b.get(k), sort_keys=True)
-               for k in keys)
+    return all(
+        json.dumps(a.get(k), sort_keys=True) == json.dumps(b.get(k), sort_keys=True) for k in keys
+    )

@@ -10,6 +10,7 @@
 
 ``provenance.json`` (machine and package versions) and ``study.json`` lie beside them.
 """
+
 from __future__ import annotations
 
 import json
@@ -27,15 +28,22 @@ from rodval.study.spec import StudySpec
 from rodval.study.store import StudyStore
 
 
-
 def _case_columns(rec: CaseRecord, axes: dict[str, str]) -> dict[str, Any]:
-    return {"case": rec.case, "n": rec.n, "horizon": rec.t_end,
-            **{col: rec.params.get(label) for label, col in axes.items()}}
+    return {
+        "case": rec.case,
+        "n": rec.n,
+        "horizon": rec.t_end,
+        **{col: rec.params.get(label) for label, col in axes.items()},
+    }
 
 
 def cases_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFrame:
-    return pd.DataFrame([{**_case_columns(r, axes), "l": json.dumps(r.lengths),
-                          "fingerprint": r.fingerprint} for r in records])
+    return pd.DataFrame(
+        [
+            {**_case_columns(r, axes), "l": json.dumps(r.lengths), "fingerprint": r.fingerprint}
+            for r in records
+        ]
+    )
 
 
 def trajectories_table(records: list[CaseRecord]) -> pd.DataFrame:
@@ -52,8 +60,11 @@ def trajectories_table(records: list[CaseRecord]) -> pd.DataFrame:
 
 def discrepancies_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFrame:
     rows = [{**_case_columns(rec, axes), **row} for rec in records for row in rec.discrepancies]
-    cols = [*_case_columns(records[0], axes), "model", "reference", "quantity", *METRICS, "status"] \
-        if records else []
+    cols = (
+        [*_case_columns(records[0], axes), "model", "reference", "quantity", *METRICS, "status"]
+        if records
+        else []
+    )
     return pd.DataFrame(rows).reindex(columns=cols)
 
 
@@ -62,14 +73,27 @@ def runtime_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFra
     for rec in records:
         for run in rec.runs:
             st, se = run.trajectory.stats, run.trajectory.settings
-            rows.append({**_case_columns(rec, axes), "model": run.label,
-                         "method": se.get("method"), "rtol": se.get("rtol"),
-                         "atol": se.get("atol"), "max_step": se.get("max_step"),
-                         "step": se.get("step"),
-                         "wall_s": st.wall_s, "setup_s": run.setup_s, "nfev": st.nfev,
-                         "njev": st.njev, "nlu": st.nlu, "nsteps": st.nsteps,
-                         "t_reached": st.t_reached, "energy_residual": st.energy_residual,
-                         "status": STATUS_MESSAGES[st.status], "message": st.message})
+            rows.append(
+                {
+                    **_case_columns(rec, axes),
+                    "model": run.label,
+                    "method": se.get("method"),
+                    "rtol": se.get("rtol"),
+                    "atol": se.get("atol"),
+                    "max_step": se.get("max_step"),
+                    "step": se.get("step"),
+                    "wall_s": st.wall_s,
+                    "setup_s": run.setup_s,
+                    "nfev": st.nfev,
+                    "njev": st.njev,
+                    "nlu": st.nlu,
+                    "nsteps": st.nsteps,
+                    "t_reached": st.t_reached,
+                    "energy_residual": st.energy_residual,
+                    "status": STATUS_MESSAGES[st.status],
+                    "message": st.message,
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -79,7 +103,9 @@ def load_records(out: Path, case_ids: list[str], labels: list[str]) -> list[Case
     for cid in case_ids:
         path = store.case_path(cid)
         if not path.is_file():
-            raise ValueError(f"case {cid!r} has no result in {path.parent}; run the study to finish it")
+            raise ValueError(
+                f"case {cid!r} has no result in {path.parent}; run the study to finish it"
+            )
         try:
             records.append(read_case(path, labels=labels))
         except DamagedRecord as exc:
@@ -98,9 +124,12 @@ def build_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd
     labels = [m["label"] for m in meta["models"]]
     records = load_records(out, ids, labels)
     axes = axis_columns(meta)
-    return {"cases": cases_table(records, axes), "trajectories": trajectories_table(records),
-            "discrepancies": discrepancies_table(records, axes),
-            "runtime": runtime_table(records, axes)}
+    return {
+        "cases": cases_table(records, axes),
+        "trajectories": trajectories_table(records),
+        "discrepancies": discrepancies_table(records, axes),
+        "runtime": runtime_table(records, axes),
+    }
 
 
 def write_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd.DataFrame]:
@@ -114,5 +143,6 @@ def write_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd
     (out / "discrepancies.md").write_text(to_markdown(tables["discrepancies"]))
     (out / "runtime.md").write_text(to_markdown(tables["runtime"]))
     (out / "trajectories.md").write_text(
-        to_markdown(trajectory_samples(tables["trajectories"], meta, tables["cases"]), ".6g"))
+        to_markdown(trajectory_samples(tables["trajectories"], meta, tables["cases"]), ".6g")
+    )
     return tables

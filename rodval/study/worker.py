@@ -7,12 +7,14 @@ finishes and a final ``{"done": CASE}`` line. The parent (``rodval.study.schedul
 at a case's time limit or when it crashes and starts a fresh one; the runs it had finished
 are kept.
 """
+
 from __future__ import annotations
 
 import json
 import sys
 import time
-from typing import Any, Iterator
+from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 
@@ -25,9 +27,16 @@ from rodval.models import get_model
 
 def failed_run(model: dict, scene_name: str, status: int, message: str) -> dict[str, Any]:
     """A run record for a model that produced nothing (error before integration, timeout...)."""
-    traj = Trajectory(model=model["model"], scene_name=scene_name, times=np.zeros(0), values={},
-                      k_index={}, stats=SolverStats(status=status, message=message),
-                      settings=dict(model["settings"]), options=dict(model["options"]))
+    traj = Trajectory(
+        model=model["model"],
+        scene_name=scene_name,
+        times=np.zeros(0),
+        values={},
+        k_index={},
+        stats=SolverStats(status=status, message=message),
+        settings=dict(model["settings"]),
+        options=dict(model["options"]),
+    )
     return {"label": model["label"], "setup_s": 0.0, "trajectory": traj.to_dict()}
 
 
@@ -47,8 +56,11 @@ def iter_case(payload: dict[str, Any]) -> Iterator[dict[str, Any]]:
             yield failed_run(model, scene.name, STATUS_ERROR, f"{type(exc).__name__}: {exc}")
             continue
         total = time.perf_counter() - start
-        yield {"label": model["label"], "setup_s": max(total - traj.stats.wall_s, 0.0),
-               "trajectory": traj.to_dict()}
+        yield {
+            "label": model["label"],
+            "setup_s": max(total - traj.stats.wall_s, 0.0),
+            "trajectory": traj.to_dict(),
+        }
 
 
 def warm_up() -> None:
