@@ -85,7 +85,9 @@ def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndar
 class Chain:
     """Physical data of a plane chain of n rods (see module docstring for conventions).
 
-    Scalars are broadcast to all rods/nodes/hinges.
+    Scalars are broadcast to all rods/nodes/hinges. ``rest_angle[i]`` (rad) is the angle at
+    which hinge i's spring is relaxed: its moment is kappa_i (D_i - rest_angle_i), so a chain
+    that starts away from its rest angles (stowed) is pre-stressed.
     """
 
     l: np.ndarray
@@ -94,18 +96,24 @@ class Chain:
     mu: np.ndarray
     kappa: np.ndarray
     nu: np.ndarray
+    rest_angle: np.ndarray
+
+    #: The per-rod / per-hinge arrays, in order.
+    FIELDS = ("l", "m", "EI", "mu", "kappa", "nu", "rest_angle")
 
     @classmethod
-    def uniform(cls, n: int, *, l=2.0, m=3.0, EI=1e5, mu=3.0, kappa=100.0, nu=0.01) -> Chain:
+    def uniform(
+        cls, n: int, *, l=2.0, m=3.0, EI=1e5, mu=3.0, kappa=100.0, nu=0.01, rest_angle=0.0
+    ) -> Chain:
         """Chain of n rods; each argument is a scalar or a length-n sequence."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
             raise ValueError(f"n (number of rods) must be an integer >= 1, got {n!r}")
-        return cls(l=l, m=m, EI=EI, mu=mu, kappa=kappa, nu=nu, _n=int(n))
+        return cls(l=l, m=m, EI=EI, mu=mu, kappa=kappa, nu=nu, rest_angle=rest_angle, _n=int(n))
 
-    def __init__(self, l, m, EI, mu, kappa, nu, _n: int | None = None):
+    def __init__(self, l, m, EI, mu, kappa, nu, rest_angle=0.0, _n: int | None = None):
         n = _n
         if n is None:
-            sizes = [np.size(v) for v in (l, m, EI, mu, kappa, nu) if np.ndim(v) > 0]
+            sizes = [np.size(v) for v in (l, m, EI, mu, kappa, nu, rest_angle) if np.ndim(v) > 0]
             n = sizes[0] if sizes else 1
         if n < 1:
             raise ValueError(f"n (number of rods) must be >= 1, got {n}")
@@ -116,30 +124,32 @@ class Chain:
         set_(self, "mu", _as_rod_array("mu (node mass)", mu, n, positive=False))
         set_(self, "kappa", _as_rod_array("kappa (hinge stiffness)", kappa, n, positive=False))
         set_(self, "nu", _as_rod_array("nu (hinge damping)", nu, n, positive=False))
+        set_(
+            self,
+            "rest_angle",
+            _as_rod_array("rest_angle (hinge rest angle, rad)", rest_angle, n, positive=None),
+        )
 
     @property
     def n(self) -> int:
         return self.l.shape[0]
 
     def as_dict(self) -> dict[str, list[float]]:
-        return {k: getattr(self, k).tolist() for k in ("l", "m", "EI", "mu", "kappa", "nu")}
+        return {k: getattr(self, k).tolist() for k in self.FIELDS}
 
     def with_(self, **changes) -> Chain:
         """A copy with some fields replaced (scalars broadcast)."""
-        d = {k: getattr(self, k) for k in ("l", "m", "EI", "mu", "kappa", "nu")}
+        d = {k: getattr(self, k) for k in self.FIELDS}
         d.update(changes)
         return Chain(**d, _n=self.n)
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Chain) and all(
-            np.array_equal(getattr(self, k), getattr(other, k))
-            for k in ("l", "m", "EI", "mu", "kappa", "nu")
+            np.array_equal(getattr(self, k), getattr(other, k)) for k in self.FIELDS
         )
 
     def __hash__(self):  # pragma: no cover - frozen dataclass with arrays
-        return hash(
-            tuple(getattr(self, k).tobytes() for k in ("l", "m", "EI", "mu", "kappa", "nu"))
-        )
+        return hash(tuple(getattr(self, k).tobytes() for k in self.FIELDS))
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,6 +175,84 @@ class InitialState:
                 continue
             out[key] = _as_rod_array(f"initial {key}", v, n, positive=None)
         return out
+
+
+def hinge_angles(phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """Hinge angles D_k (rad), k = 0..n-1: D_k = (phi_{k+1} + alpha_{k+1}) - (phi_k + beta_k),
+    phi_0 = beta_0 = 0 (hinge 0 measures rod 1's root tangent from the x axis). Arrays may
+    carry leading axes (..., n)."""
+    left = np.concatenate([np.zeros(phi.shape[:-1] + (1,)), (phi + beta)[..., :-1]], axis=-1)
+    return (phi + alpha) - left
+
+
+def _index(name: str, value, n: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ValueError(
+            f"{name} must be an integer hinge index in 0..n-1 = 0..{n - 1}, got {value!r}"
+        )
+    if not 0 <= value < n:
+        raise ValueError(f"{name} must be in 0..n-1 = 0..{n - 1}, got {value}")
+    return int(value)
+
+
+def _finite(name: str, value, unit: str, *, positive: bool | None = None) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite real number ({unit}), got {value!r}")
+    if positive is True and value <= 0:
+        raise ValueError(f"{name} must be > 0 ({unit}), got {value!r}")
+    if positive is False and value < 0:
+        raise ValueError(f"{name} must be >= 0 ({unit}), got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class Latch:
+    """A latch on hinge ``hinge`` (0..n-1): the hinge locks when its angle D reaches
+    ``angle`` (rad) moving in ``direction`` (+1: D increasing, -1: decreasing; None: towards
+    the angle from the initial state). At the lock the hinge's relative rate drops to zero
+    (a plastic impact) and D stays at ``angle`` afterwards."""
+
+    hinge: int
+    angle: float
+    direction: int | None = None
+
+    def __post_init__(self) -> None:
+        if (
+            isinstance(self.hinge, bool)
+            or not isinstance(self.hinge, numbers.Integral)
+            or self.hinge < 0
+        ):
+            raise ValueError(f"latch hinge must be an integer >= 0, got {self.hinge!r}")
+        _finite("latch angle", self.angle, "rad")
+        if self.direction not in (None, 1, -1) or isinstance(self.direction, bool):
+            raise ValueError(f"latch direction must be +1, -1 or None, got {self.direction!r}")
+
+
+@dataclass(frozen=True)
+class Stop:
+    """A limit stop on hinge ``hinge``: a one-sided spring-damper acting beyond ``angle``
+    (rad) on the ``side`` "upper" (D > angle) or "lower" (D < angle), with moment
+    -stiffness (D - angle) - damping dD/dt there (N m; stiffness > 0 in N m/rad, damping >= 0
+    in N m s/rad)."""
+
+    hinge: int
+    angle: float
+    side: str = "upper"
+    stiffness: float = 1e4
+    damping: float = 0.0
+
+    def __post_init__(self) -> None:
+        if (
+            isinstance(self.hinge, bool)
+            or not isinstance(self.hinge, numbers.Integral)
+            or self.hinge < 0
+        ):
+            raise ValueError(f"stop hinge must be an integer >= 0, got {self.hinge!r}")
+        _finite("stop angle", self.angle, "rad")
+        if self.side not in ("upper", "lower"):
+            raise ValueError(f"stop side must be 'upper' or 'lower', got {self.side!r}")
+        _finite("stop stiffness", self.stiffness, "N m/rad", positive=True)
+        _finite("stop damping", self.damping, "N m s/rad", positive=False)
 
 
 #: Output times when a scene gives none, and the most a scene may ask for.
@@ -209,6 +297,10 @@ class Scene:
     outputs : iterable of str
         Quantities to compute, from ``QUANTITIES``. Nothing else is computed.
     initial : InitialState
+    latches : sequence of Latch
+        Hinges that lock at an angle (at most one latch per hinge).
+    stops : sequence of Stop
+        One-sided limit stops in the hinges.
     name : str
     """
 
@@ -221,6 +313,8 @@ class Scene:
     outputs: tuple[str, ...] = ("phi", "dphi", "alpha", "beta")
     initial: InitialState = field(default_factory=InitialState)
     name: str = "scene"
+    latches: tuple[Latch, ...] = ()
+    stops: tuple[Stop, ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.chain, Chain):
@@ -271,11 +365,41 @@ class Scene:
         object.__setattr__(self, "outputs", tuple(dict.fromkeys(outputs)))
         if not isinstance(self.initial, InitialState):
             raise ValueError("initial must be a rodval.InitialState")
-        self.initial.resolve(n)  # validate now, before any work
+        init = self.initial.resolve(n)  # validate now, before any work
+        for label, cls in (("latches", Latch), ("stops", Stop)):
+            items = getattr(self, label)
+            if isinstance(items, (str, bytes, dict)) or not isinstance(items, Iterable):
+                raise ValueError(f"{label} must be a sequence of rodval.{cls.__name__}")
+            items = tuple(items)
+            for item in items:
+                if not isinstance(item, cls):
+                    raise ValueError(
+                        f"{label} must be rodval.{cls.__name__} objects, got {type(item).__name__}"
+                    )
+                _index(f"{label[:-1] if label == 'stops' else 'latch'} hinge", item.hinge, n)
+            object.__setattr__(self, label, items)
+        hinges = [latch.hinge for latch in self.latches]
+        if len(set(hinges)) != len(hinges):
+            raise ValueError(f"at most one latch per hinge, got hinges {hinges}")
+        D0 = hinge_angles(init["phi"], init["alpha"], init["beta"])
+        for latch in self.latches:
+            d0 = D0[latch.hinge]
+            side = np.sign(latch.angle - d0)
+            if side == 0 or (latch.direction is not None and side != latch.direction):
+                raise ValueError(
+                    f"latch on hinge {latch.hinge}: the hinge starts at D = {d0:.6g} rad, at or "
+                    f"beyond its latch angle {latch.angle:.6g} rad"
+                    + (f" in direction {latch.direction:+d}" if latch.direction else "")
+                )
 
     @property
     def n(self) -> int:
         return self.chain.n
+
+    def initial_hinge_angles(self) -> np.ndarray:
+        """D_k at t = 0 (rad), k = 0..n-1."""
+        init = self.initial.resolve(self.n)
+        return hinge_angles(init["phi"], init["alpha"], init["beta"])
 
     @property
     def breakpoints(self) -> np.ndarray:

@@ -27,6 +27,7 @@ Format (every key optional except where noted)::
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import tomllib
 from pathlib import Path
@@ -41,14 +42,30 @@ from rodval.core.scene import (
     QUANTITIES,
     Chain,
     InitialState,
+    Latch,
     Scene,
+    Stop,
     output_times,
     paper_scene,
 )
 
 BASES = ("paper",)
-TOP_KEYS = {"base", "name", "n", "t_end", "times", "outputs", "chain", "loads", "initial"}
-CHAIN_KEYS = {"l", "m", "EI", "mu", "kappa", "nu"}
+TOP_KEYS = {
+    "base",
+    "name",
+    "n",
+    "t_end",
+    "times",
+    "outputs",
+    "chain",
+    "loads",
+    "initial",
+    "latches",
+    "stops",
+}
+LATCH_KEYS = ("hinge", "angle", "direction")
+STOP_KEYS = ("hinge", "angle", "side", "stiffness", "damping")
+CHAIN_KEYS = set(Chain.FIELDS)
 INITIAL_KEYS = {"phi", "dphi", "alpha", "beta", "dalpha", "dbeta"}
 TIMES_KEYS = {"start", "stop", "num"}
 
@@ -117,6 +134,22 @@ def _load(spec: dict, n: int, where: str):
     return factory(**args)
 
 
+def _table_items(d: dict, key: str, cls: type, keys: tuple[str, ...], where: str) -> list:
+    """``[[latches]]`` / ``[[stops]]`` tables as Latch / Stop objects."""
+    items = d.get(key, [])
+    if not isinstance(items, list):
+        raise ValueError(f"key '{key}' must be an array of tables [[{key}]]")
+    out = []
+    for i, spec in enumerate(items):
+        place = f"{where} [[{key}]] #{i + 1}"
+        _check_keys(spec, set(keys), place)
+        try:
+            out.append(cls(**spec))
+        except TypeError as exc:
+            raise ValueError(f"{place}: {exc}") from None
+    return out
+
+
 def scene_from_dict(d: dict, where: str = "scene") -> Scene:
     """Build and validate a Scene from the dict form (see module docstring).
 
@@ -151,9 +184,13 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
         outputs = d.get("outputs", scene.outputs)
         if isinstance(outputs, str) or not isinstance(outputs, (list, tuple)):
             raise ValueError(f"key 'outputs' must be a list from {QUANTITIES}, got {outputs!r}")
+        latches = tuple(_table_items(d, "latches", Latch, LATCH_KEYS, where))
+        stops = tuple(_table_items(d, "stops", Stop, STOP_KEYS, where))
         return Scene(
             chain=chain,
             loads=loads,
+            latches=latches,
+            stops=stops,
             t_end=float(t_end),
             times=_times(d.get("times"), float(t_end), where),
             outputs=tuple(outputs),
@@ -216,4 +253,6 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "chain": scene.chain.as_dict(),
         "loads": [{"type": f.name, "node": f.node, **f.params} for f in scene.loads],
         "initial": {k: v.tolist() for k, v in init.items()},
+        "latches": [dataclasses.asdict(latch) for latch in scene.latches],
+        "stops": [dataclasses.asdict(stop) for stop in scene.stops],
     }
