@@ -50,11 +50,14 @@ recovery is the same routine.
 """
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 from numba import njit
 
 from .kernels import (V_KAPPA, V_KB, V_L, V_NU, V_OUTER, V_PPDIAG, V_W, _gpp_times,
                       _hinge_forces, _upper_t_times)
+from .paper_matrices import VARIANTS
 
 # Rows of Cst: the first rows are laid out like kernels.V (so that the kernels' O(n) helpers
 # read them), then the bending-row diagonals and the equilibration scales.
@@ -77,20 +80,25 @@ W = 2 * KL + KU + 1
 
 
 @njit(cache=True, inline="always")
-def _put(A, Cst, i, j, v):
-    """A[i, j] = R_i v C_j in row-relative band storage (column j at offset j - i + KL)."""
-    A[i, j - i + KL] = v * Cst[C_RSCALE + i % NB, i // NB] * Cst[C_CSCALE + j % NB, j // NB]
+def _put(A, i, j, v):
+    """A[i, j] = v in row-relative band storage (row i keeps column j at offset j - i + KL)."""
+    A[i, j - i + KL] = v
 
 
 @njit(cache=True)
 def _fill_rod(Cst, k, c, s, A):
     """Write the 7 equation rows of rod k (rows 7k .. 7k+6) into the band storage ``A``,
-    equilibrated; c, s = cos, sin of phi. The rows are zeroed first."""
+    equilibrated (entry (i, j) times row scale R_i and column scale C_j); c, s = cos, sin of
+    phi. The rows are zeroed first."""
     n = Cst.shape[1]
     r0 = NB * k
     for i in range(r0, r0 + NB):
         for o in range(W):
             A[i, o] = 0.0
+    R = Cst[C_RSCALE:C_RSCALE + NB, k]           # this rod's row scales
+    Ch = Cst[C_CSCALE:C_CSCALE + NB, k]          # column scales: this rod, previous, next
+    Cp = Cst[C_CSCALE:C_CSCALE + NB, k - 1] if k > 0 else Ch
+    Cn = Cst[C_CSCALE:C_CSCALE + NB, k + 1] if k + 1 < n else Ch
     l, outer, w = Cst[V_L, k], Cst[V_OUTER, k], Cst[V_W, k]
     kap, kb = Cst[V_KAPPA, k], Cst[V_KB, k]
     kap_next = Cst[V_KAPPA, k + 1] if k + 1 < n else 0.0
@@ -99,87 +107,95 @@ def _fill_rod(Cst, k, c, s, A):
     prev = here - NB
     nxt = here + NB
     # prefix sums: P_k - P_{k-1} - l_{k-1} e_{k-1} x_{k-1} = 0
-    _put(A, Cst, r0 + E_PX, here + U_PX, 1.0)
-    _put(A, Cst, r0 + E_PY, here + U_PY, 1.0)
+    rx, ry = R[E_PX], R[E_PY]
+    _put(A, r0 + E_PX, here + U_PX, rx * Ch[U_PX])
+    _put(A, r0 + E_PY, here + U_PY, ry * Ch[U_PY])
     if k > 0:
         lp = Cst[V_L, k - 1]
-        _put(A, Cst, r0 + E_PX, prev + U_PX, -1.0)
-        _put(A, Cst, r0 + E_PY, prev + U_PY, -1.0)
-        _put(A, Cst, r0 + E_PX, prev + U_X, -lp * c[k - 1])
-        _put(A, Cst, r0 + E_PY, prev + U_X, -lp * s[k - 1])
+        _put(A, r0 + E_PX, prev + U_PX, -rx * Cp[U_PX])
+        _put(A, r0 + E_PY, prev + U_PY, -ry * Cp[U_PY])
+        _put(A, r0 + E_PX, prev + U_X, -rx * lp * c[k - 1] * Cp[U_X])
+        _put(A, r0 + E_PY, prev + U_X, -ry * lp * s[k - 1] * Cp[U_X])
     # alpha row: w e.P + ap x + kappa_k (alpha_k - beta_{k-1}) + kb (alpha + beta/2)
     row = r0 + E_AL
-    _put(A, Cst, row, here + U_PX, w * ck)
-    _put(A, Cst, row, here + U_PY, w * sk)
-    _put(A, Cst, row, here + U_X, Cst[C_AP, k])
-    _put(A, Cst, row, here + U_A, kap + kb)
-    _put(A, Cst, row, here + U_B, 0.5 * kb)
+    r = R[E_AL]
+    _put(A, row, here + U_PX, r * w * ck * Ch[U_PX])
+    _put(A, row, here + U_PY, r * w * sk * Ch[U_PY])
+    _put(A, row, here + U_X, r * Cst[C_AP, k] * Ch[U_X])
+    _put(A, row, here + U_A, r * (kap + kb) * Ch[U_A])
+    _put(A, row, here + U_B, r * 0.5 * kb * Ch[U_B])
     if k > 0:
-        _put(A, Cst, row, prev + U_B, -kap)
+        _put(A, row, prev + U_B, -r * kap * Cp[U_B])
     # phi row: pp x + l M e.P + l e.S_{k+1} + (K_pg gamma)_k
     row = r0 + E_PHI
-    _put(A, Cst, row, here + U_X, Cst[V_PPDIAG, k])
-    _put(A, Cst, row, here + U_PX, l * outer * ck)
-    _put(A, Cst, row, here + U_PY, l * outer * sk)
-    _put(A, Cst, row, here + U_A, kap)
-    _put(A, Cst, row, here + U_B, kap_next)
+    r = R[E_PHI]
+    _put(A, row, here + U_X, r * Cst[V_PPDIAG, k] * Ch[U_X])
+    _put(A, row, here + U_PX, r * l * outer * ck * Ch[U_PX])
+    _put(A, row, here + U_PY, r * l * outer * sk * Ch[U_PY])
+    _put(A, row, here + U_A, r * kap * Ch[U_A])
+    _put(A, row, here + U_B, r * kap_next * Ch[U_B])
     if k > 0:
-        _put(A, Cst, row, prev + U_B, -kap)
+        _put(A, row, prev + U_B, -r * kap * Cp[U_B])
     if k + 1 < n:
-        _put(A, Cst, row, nxt + U_SX, l * ck)
-        _put(A, Cst, row, nxt + U_SY, l * sk)
-        _put(A, Cst, row, nxt + U_A, -kap_next)
+        _put(A, row, nxt + U_SX, r * l * ck * Cn[U_SX])
+        _put(A, row, nxt + U_SY, r * l * sk * Cn[U_SY])
+        _put(A, row, nxt + U_A, -r * kap_next * Cn[U_A])
     # suffix sums: S_k - S_{k+1} - M_k l_k e_k x_k = 0
-    _put(A, Cst, r0 + E_SX, here + U_SX, 1.0)
-    _put(A, Cst, r0 + E_SY, here + U_SY, 1.0)
-    _put(A, Cst, r0 + E_SX, here + U_X, -outer * l * ck)
-    _put(A, Cst, r0 + E_SY, here + U_X, -outer * l * sk)
+    rx, ry = R[E_SX], R[E_SY]
+    _put(A, r0 + E_SX, here + U_SX, rx * Ch[U_SX])
+    _put(A, r0 + E_SY, here + U_SY, ry * Ch[U_SY])
+    _put(A, r0 + E_SX, here + U_X, -rx * outer * l * ck * Ch[U_X])
+    _put(A, r0 + E_SY, here + U_X, -ry * outer * l * sk * Ch[U_X])
     if k + 1 < n:
-        _put(A, Cst, r0 + E_SX, nxt + U_SX, -1.0)
-        _put(A, Cst, r0 + E_SY, nxt + U_SY, -1.0)
+        _put(A, r0 + E_SX, nxt + U_SX, -rx * Cn[U_SX])
+        _put(A, r0 + E_SY, nxt + U_SY, -ry * Cn[U_SY])
     # beta row: -w e.P + bp x + kappa_{k+1} (beta_k - alpha_{k+1}) + kb (alpha/2 + beta)
     row = r0 + E_BE
-    _put(A, Cst, row, here + U_PX, -w * ck)
-    _put(A, Cst, row, here + U_PY, -w * sk)
-    _put(A, Cst, row, here + U_X, Cst[C_BP, k])
-    _put(A, Cst, row, here + U_A, 0.5 * kb)
-    _put(A, Cst, row, here + U_B, kb + kap_next)
+    r = R[E_BE]
+    _put(A, row, here + U_PX, -r * w * ck * Ch[U_PX])
+    _put(A, row, here + U_PY, -r * w * sk * Ch[U_PY])
+    _put(A, row, here + U_X, r * Cst[C_BP, k] * Ch[U_X])
+    _put(A, row, here + U_A, r * 0.5 * kb * Ch[U_A])
+    _put(A, row, here + U_B, r * (kb + kap_next) * Ch[U_B])
     if k + 1 < n:
-        _put(A, Cst, row, nxt + U_A, -kap_next)
+        _put(A, row, nxt + U_A, -r * kap_next * Cn[U_A])
 
 
 @njit(cache=True)
-def _eliminate(A, b, j, N):
+def _eliminate(A, b, j):
     """One column of banded Gaussian elimination with partial pivoting: pivot for column j
-    among rows j .. j+KL, swap, and eliminate below; the right-hand side b follows."""
-    last = min(N - 1, j + KL)
-    p = j
+    among rows j .. j+KL, swap, and eliminate below; the right-hand side b follows. A and b
+    carry KL zero rows of padding past the last equation, so that all loops have fixed trip
+    counts (row j + r keeps column c at offset c - j - r + KL)."""
+    p = 0
     big = abs(A[j, KL])
-    for i in range(j + 1, last + 1):
-        v = abs(A[i, j - i + KL])
+    for r in range(1, KL + 1):
+        v = abs(A[j + r, KL - r])
         if v > big:
             big = v
-            p = i
-    if p != j:
-        for col in range(j, min(N - 1, j + KL + KU) + 1):
-            t = A[j, col - j + KL]
-            A[j, col - j + KL] = A[p, col - p + KL]
-            A[p, col - p + KL] = t
-        t = b[j]
-        b[j] = b[p]
-        b[p] = t
-    piv = A[j, KL]
-    if piv == 0.0:
+            p = r
+    if big == 0.0:
         return False
-    cmax = min(N - 1, j + KL + KU)
-    for i in range(j + 1, last + 1):
-        f = A[i, j - i + KL] / piv
+    if p != 0:
+        q = j + p
+        for o in range(KL, W):
+            t = A[j, o]
+            A[j, o] = A[q, o - p]
+            A[q, o - p] = t
+        t = b[j]
+        b[j] = b[q]
+        b[q] = t
+    piv = A[j, KL]
+    bj = b[j]
+    for r in range(1, KL + 1):
+        i = j + r
+        f = A[i, KL - r]
         if f != 0.0:
-            A[i, j - i + KL] = 0.0
-            d = KL - i
-            for col in range(j + 1, cmax + 1):
-                A[i, col + d] -= f * A[j, col - j + KL]
-            b[i] -= f * b[j]
+            f /= piv
+            A[i, KL - r] = 0.0
+            for o in range(KL + 1, W):
+                A[i, o - r] -= f * A[j, o]
+            b[i] -= f * bj
     return True
 
 
@@ -228,16 +244,17 @@ def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out
     N = NB * n
     c = np.cos(phi)
     s = np.sin(phi)
-    b = np.empty(N)
+    b = np.zeros(N + KL + KU)          # padded: see _eliminate and the back substitution
     _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b)
-    A = np.empty((N, W))
+    A = np.empty((N + KL, W))
+    A[N:] = 0.0
     _fill_rod(Cst, 0, c, s, A)
     ok = True
     for k in range(n):
         if k + 1 < n:
             _fill_rod(Cst, k + 1, c, s, A)   # rows 7k+7.. are reached from column 7k+3 on
         for j in range(NB * k, NB * k + NB):
-            if not _eliminate(A, b, j, N):
+            if not _eliminate(A, b, j):
                 ok = False
                 break
         if not ok:
@@ -249,9 +266,8 @@ def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out
     # back substitution with U (KL + KU super-diagonals), then undo the column scaling
     for i in range(N - 1, -1, -1):
         acc = b[i]
-        d = KL - i
-        for col in range(i + 1, min(N - 1, i + KL + KU) + 1):
-            acc -= A[i, col + d] * b[col]
+        for o in range(KL + 1, W):               # columns i+1 .. i+KL+KU (b is padded)
+            acc -= A[i, o] * b[i + o - KL]
         b[i] = acc / A[i, KL]
     for k in range(n):
         r0 = NB * k
@@ -312,15 +328,33 @@ def _ruiz(T, rs, cs, sweeps):
                     T[i, o] *= fr / np.sqrt(cmax[j])
 
 
-def banded_constants(cc, chain) -> np.ndarray:
+def _rod_constants(chain, variant: str) -> SimpleNamespace:
+    """The per-rod fields of paper_matrices.chain_constants (same formulas) in O(n) memory:
+    chain_constants also builds two n x n arrays, which a long chain cannot afford."""
+    if variant not in VARIANTS:
+        raise ValueError(f"coefficients must be one of {VARIANTS}, got {variant!r}")
+    l, m, mu = chain.l, chain.m, chain.mu
+    rod_mass = m * l
+    outer = np.cumsum((mu + rod_mass)[::-1])[::-1] - rod_mass / 2.0
+    ml3 = m * l**3
+    half = 0.5 if variant == "published" else 1.0
+    return SimpleNamespace(l=l, outer_mass=outer,
+                           pp_diag=l**2 * (outer - rod_mass / 2.0) + ml3 / 3.0,
+                           ap_diag=half * ml3 / 30.0, bp_diag=-half * ml3 / 20.0)
+
+
+def banded_constants(cc, chain, variant: str = "printed") -> np.ndarray:
     """Every angle-independent per-rod constant of ``reduced_solve`` as a float64 array
-    (N_CST, n); ``cc = paper_matrices.chain_constants(chain, variant)``. O(n).
+    (N_CST, n); ``cc = paper_matrices.chain_constants(chain, variant)``, or None to compute
+    the per-rod constants here for ``variant`` (O(n) memory; chain_constants is O(n^2)). O(n).
 
     Rows: the kernels.V layout (l (m), outer mass M_k (kg), M_pp diagonal (kg m^2),
     w = m l^2/12 (kg m), kappa (N m/rad), nu (N m s/rad), 4 EI/l (N m)), then the bending-row
     diagonals ap, bp (kg m^2; the only difference between the "printed" and "published"
     variants), then 7 row and 7 column equilibration scales (powers of two, per rod)."""
     n = chain.n
+    if cc is None:
+        cc = _rod_constants(chain, variant)
     Cst = np.zeros((N_CST, n))
     Cst[V_L] = cc.l
     Cst[V_OUTER] = cc.outer_mass
