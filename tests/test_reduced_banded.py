@@ -177,3 +177,22 @@ def test_accel_wrapper_and_band_structure():
     for i in range(rb.NB * n):
         cols = i - rb.KL + np.flatnonzero(T[i])
         assert cols.min() >= 0 and cols.max() < rb.NB * n
+
+
+@pytest.mark.parametrize("n", [1, 2, 9])
+def test_work_array_variant(n):
+    """reduced_solve_work gives reduced_solve's result bit for bit, whatever the work array
+    held before (here NaN, and a second call reusing it)."""
+    sc = make_scene(n, True, True)
+    Cst = rb.banded_constants(None, sc.chain, "published")
+    rng = np.random.default_rng(4)
+    SX, SY = rng.normal(size=n), rng.normal(size=n)
+    work = np.full(rb.work_size(n) + 3, np.nan)
+    for _ in range(2):
+        phi, dphi = rng.normal(size=n), rng.normal(size=n)
+        a = np.empty(n), np.empty(2 * n)
+        b = np.empty(n), np.empty(2 * n)
+        assert rb.reduced_solve(Cst, phi, dphi, True, SX, SY, True, *a)
+        assert rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, *b, work)
+        np.testing.assert_array_equal(a[0], b[0])
+        np.testing.assert_array_equal(a[1], b[1])

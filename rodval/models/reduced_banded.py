@@ -77,24 +77,28 @@ E_PX, E_PY, E_AL, E_PHI, E_SX, E_SY, E_BE = range(NB)
 KL, KU = 4, 6
 #: band storage width: row i keeps columns i - KL .. i + KL + KU (room for pivoting fill)
 W = 2 * KL + KU + 1
+#: rows of the ring of active rows (a power of two > rows alive at once, 2 NB + KL)
+RING = 16
+RMASK = RING - 1
 
 
 @njit(cache=True, inline="always")
-def _put(A, i, j, v):
-    """A[i, j] = v in row-relative band storage (row i keeps column j at offset j - i + KL)."""
-    A[i, j - i + KL] = v
+def _put(A, mask, i, j, v):
+    """A[i, j] = v in row-relative band storage: row i lives in A[i & mask] (mask = -1: all
+    rows; mask = RING - 1: a ring of rows) and keeps column j at offset j - i + KL."""
+    A[i & mask, j - i + KL] = v
 
 
 @njit(cache=True)
-def _fill_rod(Cst, k, c, s, A):
+def _fill_rod(Cst, k, c, s, A, mask):
     """Write the 7 equation rows of rod k (rows 7k .. 7k+6) into the band storage ``A``,
     equilibrated (entry (i, j) times row scale R_i and column scale C_j); c, s = cos, sin of
-    phi. The rows are zeroed first."""
+    phi. The rows are zeroed first; row i is stored in A[i & mask] (see _put)."""
     n = Cst.shape[1]
     r0 = NB * k
     for i in range(r0, r0 + NB):
         for o in range(W):
-            A[i, o] = 0.0
+            A[i & mask, o] = 0.0
     R = Cst[C_RSCALE:C_RSCALE + NB, k]           # this rod's row scales
     Ch = Cst[C_CSCALE:C_CSCALE + NB, k]          # column scales: this rod, previous, next
     Cp = Cst[C_CSCALE:C_CSCALE + NB, k - 1] if k > 0 else Ch
@@ -108,94 +112,98 @@ def _fill_rod(Cst, k, c, s, A):
     nxt = here + NB
     # prefix sums: P_k - P_{k-1} - l_{k-1} e_{k-1} x_{k-1} = 0
     rx, ry = R[E_PX], R[E_PY]
-    _put(A, r0 + E_PX, here + U_PX, rx * Ch[U_PX])
-    _put(A, r0 + E_PY, here + U_PY, ry * Ch[U_PY])
+    _put(A, mask, r0 + E_PX, here + U_PX, rx * Ch[U_PX])
+    _put(A, mask, r0 + E_PY, here + U_PY, ry * Ch[U_PY])
     if k > 0:
         lp = Cst[V_L, k - 1]
-        _put(A, r0 + E_PX, prev + U_PX, -rx * Cp[U_PX])
-        _put(A, r0 + E_PY, prev + U_PY, -ry * Cp[U_PY])
-        _put(A, r0 + E_PX, prev + U_X, -rx * lp * c[k - 1] * Cp[U_X])
-        _put(A, r0 + E_PY, prev + U_X, -ry * lp * s[k - 1] * Cp[U_X])
+        _put(A, mask, r0 + E_PX, prev + U_PX, -rx * Cp[U_PX])
+        _put(A, mask, r0 + E_PY, prev + U_PY, -ry * Cp[U_PY])
+        _put(A, mask, r0 + E_PX, prev + U_X, -rx * lp * c[k - 1] * Cp[U_X])
+        _put(A, mask, r0 + E_PY, prev + U_X, -ry * lp * s[k - 1] * Cp[U_X])
     # alpha row: w e.P + ap x + kappa_k (alpha_k - beta_{k-1}) + kb (alpha + beta/2)
     row = r0 + E_AL
     r = R[E_AL]
-    _put(A, row, here + U_PX, r * w * ck * Ch[U_PX])
-    _put(A, row, here + U_PY, r * w * sk * Ch[U_PY])
-    _put(A, row, here + U_X, r * Cst[C_AP, k] * Ch[U_X])
-    _put(A, row, here + U_A, r * (kap + kb) * Ch[U_A])
-    _put(A, row, here + U_B, r * 0.5 * kb * Ch[U_B])
+    _put(A, mask, row, here + U_PX, r * w * ck * Ch[U_PX])
+    _put(A, mask, row, here + U_PY, r * w * sk * Ch[U_PY])
+    _put(A, mask, row, here + U_X, r * Cst[C_AP, k] * Ch[U_X])
+    _put(A, mask, row, here + U_A, r * (kap + kb) * Ch[U_A])
+    _put(A, mask, row, here + U_B, r * 0.5 * kb * Ch[U_B])
     if k > 0:
-        _put(A, row, prev + U_B, -r * kap * Cp[U_B])
+        _put(A, mask, row, prev + U_B, -r * kap * Cp[U_B])
     # phi row: pp x + l M e.P + l e.S_{k+1} + (K_pg gamma)_k
     row = r0 + E_PHI
     r = R[E_PHI]
-    _put(A, row, here + U_X, r * Cst[V_PPDIAG, k] * Ch[U_X])
-    _put(A, row, here + U_PX, r * l * outer * ck * Ch[U_PX])
-    _put(A, row, here + U_PY, r * l * outer * sk * Ch[U_PY])
-    _put(A, row, here + U_A, r * kap * Ch[U_A])
-    _put(A, row, here + U_B, r * kap_next * Ch[U_B])
+    _put(A, mask, row, here + U_X, r * Cst[V_PPDIAG, k] * Ch[U_X])
+    _put(A, mask, row, here + U_PX, r * l * outer * ck * Ch[U_PX])
+    _put(A, mask, row, here + U_PY, r * l * outer * sk * Ch[U_PY])
+    _put(A, mask, row, here + U_A, r * kap * Ch[U_A])
+    _put(A, mask, row, here + U_B, r * kap_next * Ch[U_B])
     if k > 0:
-        _put(A, row, prev + U_B, -r * kap * Cp[U_B])
+        _put(A, mask, row, prev + U_B, -r * kap * Cp[U_B])
     if k + 1 < n:
-        _put(A, row, nxt + U_SX, r * l * ck * Cn[U_SX])
-        _put(A, row, nxt + U_SY, r * l * sk * Cn[U_SY])
-        _put(A, row, nxt + U_A, -r * kap_next * Cn[U_A])
+        _put(A, mask, row, nxt + U_SX, r * l * ck * Cn[U_SX])
+        _put(A, mask, row, nxt + U_SY, r * l * sk * Cn[U_SY])
+        _put(A, mask, row, nxt + U_A, -r * kap_next * Cn[U_A])
     # suffix sums: S_k - S_{k+1} - M_k l_k e_k x_k = 0
     rx, ry = R[E_SX], R[E_SY]
-    _put(A, r0 + E_SX, here + U_SX, rx * Ch[U_SX])
-    _put(A, r0 + E_SY, here + U_SY, ry * Ch[U_SY])
-    _put(A, r0 + E_SX, here + U_X, -rx * outer * l * ck * Ch[U_X])
-    _put(A, r0 + E_SY, here + U_X, -ry * outer * l * sk * Ch[U_X])
+    _put(A, mask, r0 + E_SX, here + U_SX, rx * Ch[U_SX])
+    _put(A, mask, r0 + E_SY, here + U_SY, ry * Ch[U_SY])
+    _put(A, mask, r0 + E_SX, here + U_X, -rx * outer * l * ck * Ch[U_X])
+    _put(A, mask, r0 + E_SY, here + U_X, -ry * outer * l * sk * Ch[U_X])
     if k + 1 < n:
-        _put(A, r0 + E_SX, nxt + U_SX, -rx * Cn[U_SX])
-        _put(A, r0 + E_SY, nxt + U_SY, -ry * Cn[U_SY])
+        _put(A, mask, r0 + E_SX, nxt + U_SX, -rx * Cn[U_SX])
+        _put(A, mask, r0 + E_SY, nxt + U_SY, -ry * Cn[U_SY])
     # beta row: -w e.P + bp x + kappa_{k+1} (beta_k - alpha_{k+1}) + kb (alpha/2 + beta)
     row = r0 + E_BE
     r = R[E_BE]
-    _put(A, row, here + U_PX, -r * w * ck * Ch[U_PX])
-    _put(A, row, here + U_PY, -r * w * sk * Ch[U_PY])
-    _put(A, row, here + U_X, r * Cst[C_BP, k] * Ch[U_X])
-    _put(A, row, here + U_A, r * 0.5 * kb * Ch[U_A])
-    _put(A, row, here + U_B, r * (kb + kap_next) * Ch[U_B])
+    _put(A, mask, row, here + U_PX, -r * w * ck * Ch[U_PX])
+    _put(A, mask, row, here + U_PY, -r * w * sk * Ch[U_PY])
+    _put(A, mask, row, here + U_X, r * Cst[C_BP, k] * Ch[U_X])
+    _put(A, mask, row, here + U_A, r * 0.5 * kb * Ch[U_A])
+    _put(A, mask, row, here + U_B, r * (kb + kap_next) * Ch[U_B])
     if k + 1 < n:
-        _put(A, row, nxt + U_A, -r * kap_next * Cn[U_A])
+        _put(A, mask, row, nxt + U_A, -r * kap_next * Cn[U_A])
 
 
 @njit(cache=True)
-def _eliminate(A, b, j):
-    """One column of banded Gaussian elimination with partial pivoting: pivot for column j
-    among rows j .. j+KL, swap, and eliminate below; the right-hand side b follows. A and b
-    carry KL zero rows of padding past the last equation, so that all loops have fixed trip
-    counts (row j + r keeps column c at offset c - j - r + KL)."""
+def _eliminate(A, b, j, U):
+    """Column j of banded Gaussian elimination with partial pivoting: pivot among rows
+    j .. j+KL, swap, eliminate below (the right-hand side b follows), and move the finished
+    row j (diagonal and KL + KU super-diagonals) to U[j]. Active rows live in the ring A
+    (row i in A[i & RMASK], column c at offset c - i + KL); past the last equation the ring
+    holds KL zero rows, so that all loops have fixed trip counts."""
     p = 0
-    big = abs(A[j, KL])
+    big = abs(A[j & RMASK, KL])
     for r in range(1, KL + 1):
-        v = abs(A[j + r, KL - r])
+        v = abs(A[(j + r) & RMASK, KL - r])
         if v > big:
             big = v
             p = r
     if big == 0.0:
         return False
+    rj = j & RMASK
     if p != 0:
-        q = j + p
+        rq = (j + p) & RMASK
         for o in range(KL, W):
-            t = A[j, o]
-            A[j, o] = A[q, o - p]
-            A[q, o - p] = t
+            t = A[rj, o]
+            A[rj, o] = A[rq, o - p]
+            A[rq, o - p] = t
         t = b[j]
-        b[j] = b[q]
-        b[q] = t
-    piv = A[j, KL]
+        b[j] = b[j + p]
+        b[j + p] = t
+    piv = A[rj, KL]
     bj = b[j]
     for r in range(1, KL + 1):
-        i = j + r
-        f = A[i, KL - r]
+        ri = (j + r) & RMASK
+        f = A[ri, KL - r]
         if f != 0.0:
             f /= piv
-            A[i, KL - r] = 0.0
+            A[ri, KL - r] = 0.0
             for o in range(KL + 1, W):
-                A[i, o - r] -= f * A[j, o]
-            b[i] -= f * bj
+                A[ri, o - r] -= f * A[rj, o]
+            b[j + r] -= f * bj
+    for o in range(KL, W):
+        U[j, o - KL] = A[rj, o]
     return True
 
 
@@ -241,20 +249,43 @@ def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out
     hinge dampers. O(n) time and memory per evaluation. Returns False if a pivot is exactly
     zero (singular system; outputs then hold NaN)."""
     n = phi.shape[0]
+    work = np.empty(work_size(n))
+    return reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out,
+                              work)
+
+
+@njit(cache=True)
+def work_size(n):
+    """Length of the float64 work array of ``reduced_solve_work`` for n rods: the U factor
+    (7n x 11) and the right-hand side (7n + 10)."""
+    return NB * n * (KL + KU + 1) + NB * n + KL + KU
+
+
+@njit(cache=True)
+def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work):
+    """``reduced_solve`` with a caller-provided float64 work array of length >= work_size(n)
+    (a caller that evaluates many times, such as an integrator, allocates it once: for long
+    chains the fresh allocation's page faults cost about as much as the solve)."""
+    n = phi.shape[0]
     N = NB * n
     c = np.cos(phi)
     s = np.sin(phi)
-    b = np.zeros(N + KL + KU)          # padded: see _eliminate and the back substitution
+    U = work[:N * (KL + KU + 1)].reshape((N, KL + KU + 1))
+    b = work[N * (KL + KU + 1):N * (KL + KU + 1) + N + KL + KU]
+    b[N:] = 0.0                         # padding: see _eliminate and the back substitution
     _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b)
-    A = np.empty((N + KL, W))
-    A[N:] = 0.0
-    _fill_rod(Cst, 0, c, s, A)
+    A = np.empty((RING, W))             # the active rows
+    _fill_rod(Cst, 0, c, s, A, RMASK)
     ok = True
     for k in range(n):
-        if k + 1 < n:
-            _fill_rod(Cst, k + 1, c, s, A)   # rows 7k+7.. are reached from column 7k+3 on
+        if k + 1 < n:                   # rows 7k+7.. are reached from column 7k+3 on
+            _fill_rod(Cst, k + 1, c, s, A, RMASK)
+        else:                           # KL zero rows past the last equation
+            for i in range(N, N + KL):
+                for o in range(W):
+                    A[i & RMASK, o] = 0.0
         for j in range(NB * k, NB * k + NB):
-            if not _eliminate(A, b, j):
+            if not _eliminate(A, b, j, U):
                 ok = False
                 break
         if not ok:
@@ -266,9 +297,9 @@ def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out
     # back substitution with U (KL + KU super-diagonals), then undo the column scaling
     for i in range(N - 1, -1, -1):
         acc = b[i]
-        for o in range(KL + 1, W):               # columns i+1 .. i+KL+KU (b is padded)
-            acc -= A[i, o] * b[i + o - KL]
-        b[i] = acc / A[i, KL]
+        for o in range(1, KL + KU + 1):          # columns i+1 .. i+KL+KU (b is padded)
+            acc -= U[i, o] * b[i + o]
+        b[i] = acc / U[i, 0]
     for k in range(n):
         r0 = NB * k
         ddphi_out[k] = b[r0 + U_X] * Cst[C_CSCALE + U_X, k]
@@ -293,7 +324,7 @@ def _magnitudes(Cst):
     one = np.ones(n)
     A = np.empty((NB * n, W))
     for k in range(n):
-        _fill_rod(Cst, k, one, one, A)
+        _fill_rod(Cst, k, one, one, A, -1)
     return np.abs(A)
 
 
