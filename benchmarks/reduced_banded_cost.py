@@ -1,6 +1,7 @@
 """Cost of one reduced-model right-hand side: the O(n) banded solve
 (rodval.models.reduced_banded.reduced_accel_banded) against the dense kernels.reduced_accel
-(O(n^2) assembly + O(n^3) solve, timed for n <= 512).
+(O(n^2) assembly + O(n^3) solve, timed for n <= 512). "+work": reduced_solve_work with a
+work array allocated once (what a compiled integrator would do), phi'' and gamma.
 
 Seconds per evaluation = min over repeats of (timed loop time / evaluations in the loop), at a
 random state (phi ~ 1 rad, phi' ~ 1 rad/s), damped, with a load active. Prints a table and
@@ -19,7 +20,7 @@ from rodval.models import kernels
 from rodval.models import reduced_banded as rb
 from rodval.scene import Chain
 
-SIZES = (64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384, 32768, 65536, 100000)
+SIZES = (8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384, 32768, 65536, 100000)
 DENSE_MAX = 512
 
 
@@ -63,8 +64,8 @@ def main() -> None:
     args = ap.parse_args()
     min_time, repeats = (0.05, 3) if args.quick else (0.2, 5)
     rows = []
-    print(f"{'n':>7} {'banded s/eval':>14} {'us/eval':>10} {'ns/rod':>8} {'dense s/eval':>13} "
-          f"{'dense/banded':>12}")
+    print(f"{'n':>7} {'banded s/eval':>14} {'us/eval':>10} {'ns/rod':>8} {'+work s/eval':>13} "
+          f"{'dense s/eval':>13} {'dense/banded':>12}")
     for n in SIZES:
         ch = chain(n)
         Cst = rb.banded_constants(None, ch, "printed")
@@ -75,6 +76,10 @@ def main() -> None:
         out = np.empty(n)
         t_b = seconds_per_call(
             lambda: rb.reduced_accel_banded(Cst, phi, dphi, True, SX, SY, True, out),
+            min_time, repeats)
+        work, gamma, dd = np.empty(rb.work_size(n)), np.empty(2 * n), np.empty(n)
+        t_w = seconds_per_call(
+            lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma, work),
             min_time, repeats)
         t_d = None
         if n <= DENSE_MAX:
@@ -87,8 +92,11 @@ def main() -> None:
             assert err < 1e-9, f"banded and dense kernels disagree at n = {n}: {err:.1e}"
         rows.append((n, t_b))
         dense = f"{t_d:13.3e} {t_d / t_b:12.1f}" if t_d is not None else f"{'-':>13} {'-':>12}"
-        print(f"{n:7d} {t_b:14.3e} {t_b * 1e6:10.1f} {t_b / n * 1e9:8.0f} {dense}", flush=True)
+        print(f"{n:7d} {t_b:14.3e} {t_b * 1e6:10.1f} {t_b / n * 1e9:8.0f} {t_w:13.3e} {dense}",
+              flush=True)
     ns, ts = np.array(rows).T
+    fit = ns >= 64                     # the small chains only show the dense kernel's range
+    ns, ts = ns[fit], ts[fit]
     slope = np.polyfit(np.log(ns), np.log(ts), 1)[0]
     big = ns >= 1024
     slope_big = np.polyfit(np.log(ns[big]), np.log(ts[big]), 1)[0]

@@ -208,14 +208,19 @@ def _eliminate(A, b, j, U):
 
 
 @njit(cache=True)
-def _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b):
+def _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b, vec):
     """The equilibrated right-hand side of the banded system into b (7n):
-    r_p = Q - G_pp phi'^2 - C_pp phi' - K_pp phi, r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi)."""
+    r_p = Q - G_pp phi'^2 - C_pp phi' - K_pp phi, r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi).
+    ``vec``: scratch of 5n."""
     n = phi.shape[0]
-    fp = np.zeros(n)
-    fa = np.zeros(n)
-    fb = np.zeros(n)
-    zero = np.zeros(n)
+    vec[:4 * n] = 0.0
+    fp = vec[:n]
+    fa = vec[n:2 * n]
+    fb = vec[2 * n:3 * n]
+    zero = vec[3 * n:4 * n]
+    w2 = vec[4 * n:5 * n]
+    for k in range(n):
+        w2[k] = dphi[k] * dphi[k]
     _hinge_forces(Cst, phi, zero, zero, V_KAPPA, fp, fa, fb)       # K_qp phi
     if damped:
         _hinge_forces(Cst, dphi, zero, zero, V_NU, fp, fa, fb)     # C_qp phi'
@@ -223,7 +228,6 @@ def _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b):
         fp[k] = -fp[k]
         fa[k] = -fa[k]
         fb[k] = -fb[k]
-    w2 = dphi * dphi
     _gpp_times(Cst, c, s, w2, fp)                  # - G_pp phi'^2
     _upper_t_times(Cst, c, s, w2, False, fa, 1.0)  # - G_ap phi'^2 = + G_pa^T phi'^2
     _upper_t_times(Cst, c, s, w2, False, fb, -1.0)  # - G_bp phi'^2 = - G_pa^T phi'^2
@@ -248,8 +252,7 @@ def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out
     load suffix sums (N, see kernels.load_sums), used when ``has_load``; ``damped`` adds the
     hinge dampers. O(n) time and memory per evaluation. Returns False if a pivot is exactly
     zero (singular system; outputs then hold NaN)."""
-    n = phi.shape[0]
-    work = np.empty(work_size(n))
+    work = np.empty(work_size(phi.shape[0]))
     return reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out,
                               work)
 
@@ -257,8 +260,8 @@ def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out
 @njit(cache=True)
 def work_size(n):
     """Length of the float64 work array of ``reduced_solve_work`` for n rods: the U factor
-    (7n x 11) and the right-hand side (7n + 10)."""
-    return NB * n * (KL + KU + 1) + NB * n + KL + KU
+    (7n x 11), the right-hand side (7n + 10), the ring of active rows and 7n scratch."""
+    return NB * n * (KL + KU + 1) + NB * n + KL + KU + RING * W + 7 * n
 
 
 @njit(cache=True)
@@ -268,13 +271,19 @@ def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamm
     chains the fresh allocation's page faults cost about as much as the solve)."""
     n = phi.shape[0]
     N = NB * n
-    c = np.cos(phi)
-    s = np.sin(phi)
-    U = work[:N * (KL + KU + 1)].reshape((N, KL + KU + 1))
-    b = work[N * (KL + KU + 1):N * (KL + KU + 1) + N + KL + KU]
+    o1 = N * (KL + KU + 1)
+    o2 = o1 + N + KL + KU
+    o3 = o2 + RING * W
+    U = work[:o1].reshape((N, KL + KU + 1))
+    b = work[o1:o2]
+    A = work[o2:o3].reshape((RING, W))  # the active rows
+    c = work[o3:o3 + n]
+    s = work[o3 + n:o3 + 2 * n]
+    for k in range(n):
+        c[k] = np.cos(phi[k])
+        s[k] = np.sin(phi[k])
     b[N:] = 0.0                         # padding: see _eliminate and the back substitution
-    _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b)
-    A = np.empty((RING, W))             # the active rows
+    _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b, work[o3 + 2 * n:o3 + 7 * n])
     _fill_rod(Cst, 0, c, s, A, RMASK)
     ok = True
     for k in range(n):
@@ -312,8 +321,10 @@ def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamm
 def reduced_accel_banded(Cst, phi, dphi, has_load, SX, SY, damped, out):
     """phi'' of the reduced model into ``out`` (the argument list of kernels.reduced_accel
     with ``Cst`` in place of (V, Mt)); O(n) time and memory."""
-    gamma = np.empty(2 * phi.shape[0])
-    reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, out, gamma)
+    n = phi.shape[0]
+    size = work_size(n)
+    work = np.empty(size + 2 * n)
+    reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, out, work[size:], work[:size])
 
 
 @njit(cache=True)
