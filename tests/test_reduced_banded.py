@@ -1,5 +1,6 @@
-"""The O(n) banded reduced-model solve (rodval.models.reduced_banded) against the dense numpy
-reference (ReducedSystem with kernel="numpy": numpy_rhs for phi'', recover_bending for gamma)."""
+"""The O(n) reduced-model solves (rodval.models.reduced_banded: the tip-to-root sweep and the
+banded LU) against the dense numpy reference (ReducedSystem with kernel="numpy": numpy_rhs for
+phi'', recover_bending for gamma)."""
 import numpy as np
 import pytest
 
@@ -26,9 +27,12 @@ def make_scene(n: int, damped: bool, loaded: bool, seed: int = 0, kappa=None, mu
                  initial=InitialState(phi=rng.normal(size=n)))
 
 
-def banded(ref: ReducedSystem, t: float, phi: np.ndarray, dphi: np.ndarray):
+METHODS = (rb.METHOD_SWEEP, rb.METHOD_BAND)
+
+
+def banded(ref: ReducedSystem, t: float, phi: np.ndarray, dphi: np.ndarray, method: int):
     Cst = rb.banded_constants(ref.cc, ref.scene.chain)
-    return rb.bending_at(Cst, phi, dphi, ref.loads.suffix_sums(t), ref.damped)
+    return rb.bending_at(Cst, phi, dphi, ref.loads.suffix_sums(t), ref.damped, method)
 
 
 def assert_close(a, b):
@@ -43,9 +47,11 @@ def check_scene(sc: Scene, coefficients: str, seed: int, times=TIMES, states: in
         for _ in range(states):
             phi, dphi = rng.normal(size=n), rng.normal(size=n)    # ~1 rad, ~1 rad/s
             y = np.concatenate([phi, dphi])
-            ddphi, gamma = banded(ref, t, phi, dphi)
-            assert_close(ddphi, ref.numpy_rhs(t, y)[n:])
-            assert_close(gamma, ref.recover_bending(t, y))
+            want_ddphi, want_gamma = ref.numpy_rhs(t, y)[n:], ref.recover_bending(t, y)
+            for method in METHODS:
+                ddphi, gamma = banded(ref, t, phi, dphi, method)
+                assert_close(ddphi, want_ddphi)
+                assert_close(gamma, want_gamma)
 
 
 @pytest.mark.parametrize("coefficients", ["printed", "published"])
@@ -84,9 +90,10 @@ def test_undamped_flag_ignores_nu(coefficients):
     ref.damped = False
     rng = np.random.default_rng(3)
     phi, dphi = rng.normal(size=6), rng.normal(size=6)
-    ddphi, gamma = banded(ref, 0.3, phi, dphi)
-    assert_close(ddphi, ref.numpy_rhs(0.3, np.concatenate([phi, dphi]))[6:])
-    assert_close(gamma, ref.recover_bending(0.3, np.concatenate([phi, dphi])))
+    for method in METHODS:
+        ddphi, gamma = banded(ref, 0.3, phi, dphi, method)
+        assert_close(ddphi, ref.numpy_rhs(0.3, np.concatenate([phi, dphi]))[6:])
+        assert_close(gamma, ref.recover_bending(0.3, np.concatenate([phi, dphi])))
 
 
 def refined_solution(ref: ReducedSystem, t, phi, dphi):
@@ -138,10 +145,11 @@ def test_stiff_hinges_and_wide_parameters(coefficients):
     ref = ReducedSystem(sc, coefficients, "numpy")
     for _ in range(3):
         phi, dphi = rng.normal(size=n), rng.normal(size=n)
-        ddphi, gamma = banded(ref, 0.3, phi, dphi)
         x, g = refined_solution(ref, 0.3, phi, dphi)
-        np.testing.assert_allclose(ddphi, x, rtol=0, atol=1e-10 * np.max(np.abs(x)))
-        np.testing.assert_allclose(gamma, g, rtol=0, atol=1e-10 * np.max(np.abs(g)))
+        for method in METHODS:
+            ddphi, gamma = banded(ref, 0.3, phi, dphi, method)
+            np.testing.assert_allclose(ddphi, x, rtol=0, atol=1e-10 * np.max(np.abs(x)))
+            np.testing.assert_allclose(gamma, g, rtol=0, atol=1e-10 * np.max(np.abs(g)))
 
 
 @pytest.mark.parametrize("coefficients", ["printed", "published"])
@@ -156,7 +164,8 @@ def test_constants_without_chain_constants(coefficients):
 
 
 def test_accel_wrapper_and_band_structure():
-    """reduced_accel_banded writes reduced_solve's phi''; every coefficient of the assembled
+    """reduced_accel_banded writes reduced_solve's phi'' (the sweep: METHOD_AUTO with a
+    regular system); every coefficient of the assembled
     matrix lies inside the declared band (KL, KU); scales are powers of two."""
     n = 12
     sc = make_scene(n, True, True)
@@ -167,7 +176,7 @@ def test_accel_wrapper_and_band_structure():
     SX, SY = ref.loads.suffix_sums(0.3)
     out = np.empty(n)
     rb.reduced_accel_banded(Cst, phi, dphi, True, SX, SY, True, out)
-    ddphi, _ = rb.bending_at(Cst, phi, dphi, (SX, SY), True)
+    ddphi, _ = rb.bending_at(Cst, phi, dphi, (SX, SY), True, rb.METHOD_SWEEP)
     np.testing.assert_array_equal(out, ddphi)
     assert_close(out, ref.numpy_rhs(0.3, np.concatenate([phi, dphi]))[n:])
     scales = Cst[rb.C_RSCALE:]
@@ -179,8 +188,9 @@ def test_accel_wrapper_and_band_structure():
         assert cols.min() >= 0 and cols.max() < rb.NB * n
 
 
+@pytest.mark.parametrize("method", [rb.METHOD_AUTO, rb.METHOD_SWEEP, rb.METHOD_BAND])
 @pytest.mark.parametrize("n", [1, 2, 9])
-def test_work_array_variant(n):
+def test_work_array_variant(n, method):
     """reduced_solve_work gives reduced_solve's result bit for bit, whatever the work array
     held before (here NaN, and a second call reusing it)."""
     sc = make_scene(n, True, True)
@@ -192,7 +202,30 @@ def test_work_array_variant(n):
         phi, dphi = rng.normal(size=n), rng.normal(size=n)
         a = np.empty(n), np.empty(2 * n)
         b = np.empty(n), np.empty(2 * n)
-        assert rb.reduced_solve(Cst, phi, dphi, True, SX, SY, True, *a)
-        assert rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, *b, work)
+        assert rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, *a,
+                                     np.empty(rb.work_size(n)), method)
+        assert rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, *b, work, method)
         np.testing.assert_array_equal(a[0], b[0])
         np.testing.assert_array_equal(a[1], b[1])
+        if method == rb.METHOD_AUTO:
+            assert rb.reduced_solve(Cst, phi, dphi, True, SX, SY, True, *b)
+            np.testing.assert_array_equal(a[0], b[0])
+            np.testing.assert_array_equal(a[1], b[1])
+
+
+@pytest.mark.parametrize("coefficients", ["printed", "published"])
+def test_sweep_and_band_agree_on_a_long_chain(coefficients):
+    """The two O(n) methods are independent eliminations: they agree at n = 3000, where the
+    dense reference would be slow."""
+    n = 3000
+    rng = np.random.default_rng(8)
+    chain = Chain(l=rng.uniform(0.5, 2.5, n), m=rng.uniform(1, 4, n), EI=rng.uniform(1e3, 1e5, n),
+                  mu=rng.uniform(0, 3, n), kappa=np.where(rng.random(n) < 0.2, 0.0, 100.0),
+                  nu=0.05)
+    Cst = rb.banded_constants(None, chain, coefficients)
+    phi, dphi = rng.normal(size=n), rng.normal(size=n)
+    SX, SY = np.cumsum(rng.normal(size=n)[::-1])[::-1], np.cumsum(rng.normal(size=n)[::-1])[::-1]
+    a = rb.bending_at(Cst, phi, dphi, (SX, SY), True, rb.METHOD_SWEEP)
+    b = rb.bending_at(Cst, phi, dphi, (SX, SY), True, rb.METHOD_BAND)
+    for u, v in zip(a, b):
+        np.testing.assert_allclose(u, v, rtol=0, atol=1e-9 * np.max(np.abs(v)))

@@ -1,5 +1,10 @@
 """The reduced model's right-hand side and bending recovery in O(n) time and memory.
 
+API: ``banded_constants`` (once per chain), ``reduced_solve`` (phi'' and gamma at a state),
+``reduced_solve_work`` (the same with a reusable work array and a method choice),
+``reduced_accel_banded`` (phi'' only, the argument list of kernels.reduced_accel with Cst in
+place of (V, Mt)), ``bending_at`` (Python convenience).
+
 The dense route (``kernels.reduced_accel``, ``ReducedSystem.recover_bending``) eliminates the
 bending angles first, M_r = M_pp - K_pg B^-1 M_gp, which is a dense n x n matrix (O(n^2) to
 assemble, O(n^3) to solve). Here the elimination is not done: the *unreduced* algebraic system
@@ -27,6 +32,22 @@ per-rod blocks (4 EI_k / l_k) [[1, 1/2], [1/2, 1]]:
     (B gamma)_alpha_k = kappa_k (alpha_k - beta_{k-1}) + kb_k (alpha_k + beta_k / 2)
     (B gamma)_beta_k  = kappa_{k+1} (beta_k - alpha_{k+1}) + kb_k (alpha_k / 2 + beta_k)
 
+Two O(n) eliminations of this system are implemented; ``reduced_solve`` uses the sweep and
+falls back to the banded LU if the sweep meets an exactly zero local pivot (METHOD_AUTO).
+
+Sweep (tip to root, then root to tip; the default, about 6x faster). The rods k..n-1 interact
+with the rods before them only through z_k = (P_k, beta_{k-1}) (3 numbers; beta_{-1} = 0).
+Going from the tip (S_n = 0, kappa_n = 0) to the root, each rod's three rows (phi, alpha,
+beta) are written in its own unknowns u_k = (x_k, alpha_k, beta_k), with the tail relation of
+rod k+1, S_{k+1} = F z_{k+1} + f and alpha_{k+1} = G . z_{k+1} + g, and z_{k+1} =
+(P_k + l_k e_k x_k, beta_k) substituted; that 3 x 3 system (all rows in N m) is solved by
+Gaussian elimination with partial pivoting for u_k = T_k z_k + t_k, and S_k = S_{k+1} +
+M_k l_k e_k x_k gives rod k's tail relation. Then z_0 = 0 and u_k, z_{k+1} follow rod by rod.
+This is block elimination of the banded system below in the order tip to root (like the
+articulated-body algorithm of multibody dynamics); each local 3 x 3 matrix is the Schur
+complement of the sub-chain k..n-1, itself a chain of the same model.
+
+Banded LU (METHOD_BAND; Gaussian elimination with partial pivoting over the whole band).
 Unknowns, 7 per rod, ordered rod by rod as (S_k,x  S_k,y  alpha_k  P_k,x  P_k,y  x_k  beta_k);
 equations per rod in the row order
 
@@ -44,9 +65,9 @@ computed once in ``banded_constants``), which changes no value in exact arithmet
 the pivot choice independent of units. Its determinant is +-det(B) det(M_r), so the
 banded system is regular exactly when the dense reduced one is.
 
-Cost: O(n) time and memory per evaluation (about 7n x 15 doubles of band storage and ~600 n
-flops), no n x n array anywhere. phi'' and gamma come out of the same solve, so the bending
-recovery is the same routine.
+Cost: O(n) time and memory per evaluation, no n x n array anywhere: the sweep ~250 flops and
+19 doubles per rod, the banded LU ~800 flops and ~90 doubles per rod (U factor 7n x 11). phi''
+and gamma come out of the same solve, so the bending recovery is the same routine.
 """
 from __future__ import annotations
 
@@ -208,10 +229,10 @@ def _eliminate(A, b, j, U):
 
 
 @njit(cache=True)
-def _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b, vec):
-    """The equilibrated right-hand side of the banded system into b (7n):
-    r_p = Q - G_pp phi'^2 - C_pp phi' - K_pp phi, r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi).
-    ``vec``: scratch of 5n."""
+def _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec):
+    """Right-hand sides (N m) into vec (scratch of 5n): vec[:n] = r_p = Q - G_pp phi'^2
+    - C_pp phi' - K_pp phi, vec[n:2n] = r_alpha, vec[2n:3n] = r_beta, with
+    r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi) (C only when ``damped``)."""
     n = phi.shape[0]
     vec[:4 * n] = 0.0
     fp = vec[:n]
@@ -235,6 +256,14 @@ def _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b, vec):
         l = Cst[V_L]
         for k in range(n):
             fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
+
+
+@njit(cache=True)
+def _solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
+    """The banded LU with partial pivoting (module docstring) of the 7n x 7n system. U (7n x
+    11), b (7n + 10), A (RING x W): work storage. False if a pivot column is exactly zero."""
+    n = c.shape[0]
+    N = NB * n
     for k in range(n):
         r0 = NB * k
         for e in range(NB):
@@ -242,50 +271,8 @@ def _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b, vec):
         b[r0 + E_AL] = fa[k] * Cst[C_RSCALE + E_AL, k]
         b[r0 + E_PHI] = fp[k] * Cst[C_RSCALE + E_PHI, k]
         b[r0 + E_BE] = fb[k] * Cst[C_RSCALE + E_BE, k]
-
-
-@njit(cache=True)
-def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out):
-    """phi'' (rad/s^2, n) into ``ddphi_out`` and gamma = [alpha; beta] (rad, 2n) into
-    ``gamma_out`` of the reduced model at state (phi, phi'), by one banded LU solve of the
-    unreduced system (module docstring). ``Cst`` from ``banded_constants``; SX, SY are the
-    load suffix sums (N, see kernels.load_sums), used when ``has_load``; ``damped`` adds the
-    hinge dampers. O(n) time and memory per evaluation. Returns False if a pivot is exactly
-    zero (singular system; outputs then hold NaN)."""
-    work = np.empty(work_size(phi.shape[0]))
-    return reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out,
-                              work)
-
-
-@njit(cache=True)
-def work_size(n):
-    """Length of the float64 work array of ``reduced_solve_work`` for n rods: the U factor
-    (7n x 11), the right-hand side (7n + 10), the ring of active rows and 7n scratch."""
-    return NB * n * (KL + KU + 1) + NB * n + KL + KU + RING * W + 7 * n
-
-
-@njit(cache=True)
-def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work):
-    """``reduced_solve`` with a caller-provided float64 work array of length >= work_size(n)
-    (a caller that evaluates many times, such as an integrator, allocates it once: for long
-    chains the fresh allocation's page faults cost about as much as the solve)."""
-    n = phi.shape[0]
-    N = NB * n
-    o1 = N * (KL + KU + 1)
-    o2 = o1 + N + KL + KU
-    o3 = o2 + RING * W
-    U = work[:o1].reshape((N, KL + KU + 1))
-    b = work[o1:o2]
-    A = work[o2:o3].reshape((RING, W))  # the active rows
-    c = work[o3:o3 + n]
-    s = work[o3 + n:o3 + 2 * n]
-    for k in range(n):
-        c[k] = np.cos(phi[k])
-        s[k] = np.sin(phi[k])
     b[N:] = 0.0                         # padding: see _eliminate and the back substitution
-    _rhs(Cst, phi, dphi, c, s, has_load, SX, SY, damped, b, work[o3 + 2 * n:o3 + 7 * n])
     _fill_rod(Cst, 0, c, s, A, RMASK)
-    ok = True
     for k in range(n):
         if k + 1 < n:                   # rows 7k+7.. are reached from column 7k+3 on
             _fill_rod(Cst, k + 1, c, s, A, RMASK)
@@ -295,14 +282,7 @@ def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamm
                     A[i & RMASK, o] = 0.0
         for j in range(NB * k, NB * k + NB):
             if not _eliminate(A, b, j, U):
-                ok = False
-                break
-        if not ok:
-            break
-    if not ok:
-        ddphi_out[:] = np.nan
-        gamma_out[:] = np.nan
-        return False
+                return False
     # back substitution with U (KL + KU super-diagonals), then undo the column scaling
     for i in range(N - 1, -1, -1):
         acc = b[i]
@@ -318,13 +298,183 @@ def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamm
 
 
 @njit(cache=True)
+def _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
+    """The tip-to-root elimination (module docstring, "sweep"). T (n x 3 x 4): work storage
+    for u_k = T_k[:, :3] z_k + T_k[:, 3]. False if a local pivot is zero or a result is not
+    finite."""
+    n = c.shape[0]
+    F = np.zeros((2, 4))        # tail relation of rod k+1: S_{k+1} = F[:, :3] z_{k+1} + F[:, 3]
+    G = np.zeros(4)             #                           alpha_{k+1} = G[:3] . z_{k+1} + G[3]
+    L = np.empty((3, 3))
+    R = np.empty((3, 4))
+    for k in range(n - 1, -1, -1):
+        l, M, w = Cst[V_L, k], Cst[V_OUTER, k], Cst[V_W, k]
+        kap, kb = Cst[V_KAPPA, k], Cst[V_KB, k]
+        kapn = Cst[V_KAPPA, k + 1] if k + 1 < n else 0.0
+        ex, ey = c[k], s[k]
+        Fe0 = F[0, 0] * ex + F[0, 1] * ey           # F_P e
+        Fe1 = F[1, 0] * ex + F[1, 1] * ey
+        FTe0 = F[0, 0] * ex + F[1, 0] * ey          # F_P^T e
+        FTe1 = F[0, 1] * ex + F[1, 1] * ey
+        eFe = ex * Fe0 + ey * Fe1
+        eFb = ex * F[0, 2] + ey * F[1, 2]
+        ef = ex * F[0, 3] + ey * F[1, 3]
+        Ge = G[0] * ex + G[1] * ey
+        # L u = R [P; beta_{k-1}; 1], u = (x_k, alpha_k, beta_k): the phi, alpha, beta rows
+        # of rod k with S_{k+1}, alpha_{k+1} from the tail relation, z_{k+1} = (P_k + l e x_k,
+        # beta_k)
+        L[0, 0] = Cst[V_PPDIAG, k] + l * l * eFe - kapn * l * Ge
+        L[0, 1] = kap
+        L[0, 2] = l * eFb + kapn * (1.0 - G[2])
+        R[0, 0] = kapn * G[0] - l * (M * ex + FTe0)
+        R[0, 1] = kapn * G[1] - l * (M * ey + FTe1)
+        R[0, 2] = kap
+        R[0, 3] = fp[k] - l * ef + kapn * G[3]
+        L[1, 0] = Cst[C_AP, k]
+        L[1, 1] = kap + kb
+        L[1, 2] = 0.5 * kb
+        R[1, 0] = -w * ex
+        R[1, 1] = -w * ey
+        R[1, 2] = kap
+        R[1, 3] = fa[k]
+        L[2, 0] = Cst[C_BP, k] - kapn * l * Ge
+        L[2, 1] = 0.5 * kb
+        L[2, 2] = kb + kapn * (1.0 - G[2])
+        R[2, 0] = w * ex + kapn * G[0]
+        R[2, 1] = w * ey + kapn * G[1]
+        R[2, 2] = 0.0
+        R[2, 3] = fb[k] + kapn * G[3]
+        # T_k = L^-1 R: 3 x 3 Gaussian elimination with partial pivoting (rows all in N m)
+        for j in range(3):
+            p = j
+            big = abs(L[j, j])
+            for i in range(j + 1, 3):
+                if abs(L[i, j]) > big:
+                    big = abs(L[i, j])
+                    p = i
+            if big == 0.0:
+                return False
+            if p != j:
+                for q in range(3):
+                    t = L[j, q]
+                    L[j, q] = L[p, q]
+                    L[p, q] = t
+                for q in range(4):
+                    t = R[j, q]
+                    R[j, q] = R[p, q]
+                    R[p, q] = t
+            for i in range(j + 1, 3):
+                f = L[i, j] / L[j, j]
+                for q in range(j + 1, 3):
+                    L[i, q] -= f * L[j, q]
+                for q in range(4):
+                    R[i, q] -= f * R[j, q]
+        for j in range(2, -1, -1):
+            for q in range(4):
+                acc = R[j, q]
+                for i in range(j + 1, 3):
+                    acc -= L[j, i] * T[k, i, q]
+                T[k, j, q] = acc / L[j, j]
+        # tail relation of rod k: S_k = S_{k+1} + M l e x_k
+        #   = [F_P | 0 | f] + F_b (x) T_k[2] + (l F_P e + M l e) (x) T_k[0]
+        v0 = l * (Fe0 + M * ex)
+        v1 = l * (Fe1 + M * ey)
+        Fb0 = F[0, 2]
+        Fb1 = F[1, 2]
+        F[0, 2] = 0.0
+        F[1, 2] = 0.0
+        for q in range(4):
+            F[0, q] += Fb0 * T[k, 2, q] + v0 * T[k, 0, q]
+            F[1, q] += Fb1 * T[k, 2, q] + v1 * T[k, 0, q]
+            G[q] = T[k, 1, q]
+    # root to tip: z_0 = 0, u_k = T_k [z_k; 1], z_{k+1} = (P_k + l_k e_k x_k, beta_k)
+    P0 = 0.0
+    P1 = 0.0
+    bprev = 0.0
+    for k in range(n):
+        x = T[k, 0, 0] * P0 + T[k, 0, 1] * P1 + T[k, 0, 2] * bprev + T[k, 0, 3]
+        a = T[k, 1, 0] * P0 + T[k, 1, 1] * P1 + T[k, 1, 2] * bprev + T[k, 1, 3]
+        bb = T[k, 2, 0] * P0 + T[k, 2, 1] * P1 + T[k, 2, 2] * bprev + T[k, 2, 3]
+        if not (np.isfinite(x) and np.isfinite(a) and np.isfinite(bb)):
+            return False
+        ddphi_out[k] = x
+        gamma_out[k] = a
+        gamma_out[n + k] = bb
+        l = Cst[V_L, k]
+        P0 += l * c[k] * x
+        P1 += l * s[k] * x
+        bprev = bb
+    return True
+
+
+#: ``method`` of reduced_solve_work
+METHOD_AUTO, METHOD_BAND, METHOD_SWEEP = 0, 1, 2
+
+
+@njit(cache=True)
+def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out):
+    """phi'' (rad/s^2, n) into ``ddphi_out`` and gamma = [alpha; beta] (rad, 2n) into
+    ``gamma_out`` of the reduced model at state (phi, phi') (module docstring: the sweep, with
+    the banded LU as fallback). ``Cst`` from ``banded_constants``; SX, SY are the load suffix
+    sums (N, see kernels.load_sums), used when ``has_load``; ``damped`` adds the hinge
+    dampers. O(n) time and memory per evaluation. Returns False if the system is singular
+    (outputs then hold NaN)."""
+    work = np.empty(work_size(phi.shape[0]))
+    return reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out,
+                              work, METHOD_AUTO)
+
+
+@njit(cache=True)
+def work_size(n):
+    """Length of the float64 work array of ``reduced_solve_work`` for n rods: 7n scratch,
+    then the larger of the sweep's T (12n) and the banded LU's U (7n x 11), right-hand side
+    (7n + 10) and ring of active rows."""
+    return 7 * n + max(12 * n, NB * n * (KL + KU + 1) + NB * n + KL + KU + RING * W)
+
+
+@njit(cache=True)
+def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work,
+                       method):
+    """``reduced_solve`` with a caller-provided float64 work array of length >= work_size(n)
+    (a caller that evaluates many times, such as an integrator, allocates it once) and a
+    ``method``: METHOD_AUTO (the sweep; the banded LU if the sweep meets a zero local pivot
+    or a non-finite value), METHOD_BAND or METHOD_SWEEP (one of them only)."""
+    n = phi.shape[0]
+    N = NB * n
+    c = work[:n]
+    s = work[n:2 * n]
+    for k in range(n):
+        c[k] = np.cos(phi[k])
+        s[k] = np.sin(phi[k])
+    vec = work[2 * n:7 * n]
+    _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
+    fp, fa, fb = vec[:n], vec[n:2 * n], vec[2 * n:3 * n]
+    rest = work[7 * n:]
+    if method != METHOD_BAND:
+        T = rest[:12 * n].reshape((n, 3, 4))
+        if _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
+            return True
+        if method == METHOD_SWEEP:
+            ddphi_out[:] = np.nan
+            gamma_out[:] = np.nan
+            return False
+    o1 = N * (KL + KU + 1)
+    o2 = o1 + N + KL + KU
+    U = rest[:o1].reshape((N, KL + KU + 1))
+    A = rest[o2:o2 + RING * W].reshape((RING, W))
+    if _solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi_out, gamma_out):
+        return True
+    ddphi_out[:] = np.nan
+    gamma_out[:] = np.nan
+    return False
+
+
+@njit(cache=True)
 def reduced_accel_banded(Cst, phi, dphi, has_load, SX, SY, damped, out):
     """phi'' of the reduced model into ``out`` (the argument list of kernels.reduced_accel
     with ``Cst`` in place of (V, Mt)); O(n) time and memory."""
-    n = phi.shape[0]
-    size = work_size(n)
-    work = np.empty(size + 2 * n)
-    reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, out, work[size:], work[:size])
+    gamma = np.empty(2 * phi.shape[0])
+    reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, out, gamma)
 
 
 @njit(cache=True)
@@ -417,8 +567,8 @@ def banded_constants(cc, chain, variant: str = "printed") -> np.ndarray:
     return np.ascontiguousarray(Cst)
 
 
-def bending_at(Cst: np.ndarray, phi: np.ndarray, dphi: np.ndarray, sums, damped: bool
-               ) -> tuple[np.ndarray, np.ndarray]:
+def bending_at(Cst: np.ndarray, phi: np.ndarray, dphi: np.ndarray, sums, damped: bool,
+               method: int = METHOD_AUTO) -> tuple[np.ndarray, np.ndarray]:
     """(phi'', gamma) at one state, ``sums`` = LoadSet.suffix_sums(t) (None: no load).
     The O(n) replacement of ReducedSystem.recover_bending (which returns gamma)."""
     n = phi.shape[0]
@@ -429,5 +579,7 @@ def bending_at(Cst: np.ndarray, phi: np.ndarray, dphi: np.ndarray, sums, damped:
     else:
         SX, SY = (np.ascontiguousarray(v, dtype=np.float64) for v in sums)
     ddphi, gamma = np.empty(n), np.empty(2 * n)
-    reduced_solve(Cst, phi, dphi, sums is not None, SX, SY, bool(damped), ddphi, gamma)
+    work = np.empty(work_size(n))
+    reduced_solve_work(Cst, phi, dphi, sums is not None, SX, SY, bool(damped), ddphi, gamma,
+                       work, method)
     return ddphi, gamma
