@@ -1,7 +1,11 @@
-"""Cost of one reduced-model right-hand side: the O(n) banded solve
-(rodval.models.reduced_banded.reduced_accel_banded) against the dense kernels.reduced_accel
-(O(n^2) assembly + O(n^3) solve, timed for n <= 512). "+work": reduced_solve_work with a
-work array allocated once (what a compiled integrator would do), phi'' and gamma.
+"""Cost of one reduced-model right-hand side: the O(n) solves of rodval.models.reduced_banded
+against the dense kernels.reduced_accel (O(n^2) assembly + O(n^3) solve, timed for n <= 512).
+
+Columns: "default" = reduced_accel_banded (the sweep, work allocated per call); "sweep+work"
+and "band+work" = reduced_solve_work with a work array allocated once (what a compiled
+integrator would do), METHOD_SWEEP and METHOD_BAND (banded LU with partial pivoting);
+"band diff" = max |phi''_band - phi''_sweep| / max |phi''_sweep| (the banded LU loses digits
+on long chains, see tests/test_reduced_banded.py::test_backward_error_on_a_long_chain).
 
 Seconds per evaluation = min over repeats of (timed loop time / evaluations in the loop), at a
 random state (phi ~ 1 rad, phi' ~ 1 rad/s), damped, with a load active. Prints a table and
@@ -64,8 +68,8 @@ def main() -> None:
     args = ap.parse_args()
     min_time, repeats = (0.05, 3) if args.quick else (0.2, 5)
     rows = []
-    print(f"{'n':>7} {'banded s/eval':>14} {'us/eval':>10} {'ns/rod':>8} {'+work s/eval':>13} "
-          f"{'dense s/eval':>13} {'dense/banded':>12}")
+    print(f"{'n':>7} {'default s/eval':>14} {'us/eval':>10} {'ns/rod':>8} {'sweep+work':>11} "
+          f"{'band+work':>11} {'band diff':>9} {'dense s/eval':>13} {'dense/default':>13}")
     for n in SIZES:
         ch = chain(n)
         Cst = rb.banded_constants(None, ch, "printed")
@@ -79,8 +83,12 @@ def main() -> None:
             min_time, repeats)
         work, gamma, dd = np.empty(rb.work_size(n)), np.empty(2 * n), np.empty(n)
         t_w = seconds_per_call(
-            lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma, work),
-            min_time, repeats)
+            lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma, work,
+                                          rb.METHOD_SWEEP), min_time, repeats)
+        t_band = seconds_per_call(
+            lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma, work,
+                                          rb.METHOD_BAND), min_time, repeats)
+        band_diff = np.max(np.abs(out - dd)) / np.max(np.abs(out))   # |band - sweep| / max|sweep|
         t_d = None
         if n <= DENSE_MAX:
             V, Mt = dense_setup(ch)
@@ -90,18 +98,20 @@ def main() -> None:
                 min_time, repeats)
             err = np.max(np.abs(out - ref)) / np.max(np.abs(ref))
             assert err < 1e-9, f"banded and dense kernels disagree at n = {n}: {err:.1e}"
-        rows.append((n, t_b))
-        dense = f"{t_d:13.3e} {t_d / t_b:12.1f}" if t_d is not None else f"{'-':>13} {'-':>12}"
-        print(f"{n:7d} {t_b:14.3e} {t_b * 1e6:10.1f} {t_b / n * 1e9:8.0f} {t_w:13.3e} {dense}",
-              flush=True)
-    ns, ts = np.array(rows).T
-    fit = ns >= 64                     # the small chains only show the dense kernel's range
-    ns, ts = ns[fit], ts[fit]
-    slope = np.polyfit(np.log(ns), np.log(ts), 1)[0]
+        rows.append((n, t_b, t_w, t_band))
+        dense = f"{t_d:13.3e} {t_d / t_b:13.1f}" if t_d is not None else f"{'-':>13} {'-':>13}"
+        print(f"{n:7d} {t_b:14.3e} {t_b * 1e6:10.1f} {t_b / n * 1e9:8.0f} {t_w:11.3e} "
+              f"{t_band:11.3e} {band_diff:9.1e} {dense}", flush=True)
+    data = np.array(rows)
+    data = data[data[:, 0] >= 64]      # the small chains only show the dense kernel's range
+    ns = data[:, 0]
     big = ns >= 1024
-    slope_big = np.polyfit(np.log(ns[big]), np.log(ts[big]), 1)[0]
-    print(f"log-log exponent of the banded kernel: {slope:.3f} (n = {int(ns[0])}..{int(ns[-1])}), "
-          f"{slope_big:.3f} (n >= 1024); target <= 1.2")
+    for col, label in ((1, "default"), (2, "sweep+work"), (3, "band+work")):
+        ts = data[:, col]
+        slope = np.polyfit(np.log(ns), np.log(ts), 1)[0]
+        slope_big = np.polyfit(np.log(ns[big]), np.log(ts[big]), 1)[0]
+        print(f"log-log exponent, {label:>10}: {slope:.3f} (n = {int(ns[0])}..{int(ns[-1])}), "
+              f"{slope_big:.3f} (n >= 1024); target <= 1.2")
 
 
 if __name__ == "__main__":
