@@ -82,9 +82,10 @@ def main() -> None:
             lambda: rb.reduced_accel_banded(Cst, phi, dphi, True, SX, SY, True, out),
             min_time, repeats)
         work, gamma, dd = np.empty(rb.work_size(n)), np.empty(2 * n), np.empty(n)
+        sweep_work = np.empty(rb.sweep_work_size(n))
         t_w = seconds_per_call(
-            lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma, work,
-                                          rb.METHOD_SWEEP), min_time, repeats)
+            lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma,
+                                          sweep_work, rb.METHOD_SWEEP), min_time, repeats)
         t_band = seconds_per_call(
             lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma, work,
                                           rb.METHOD_BAND), min_time, repeats)

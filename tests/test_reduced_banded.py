@@ -197,7 +197,7 @@ def test_work_array_variant(n, method):
     Cst = rb.banded_constants(None, sc.chain, "published")
     rng = np.random.default_rng(4)
     SX, SY = rng.normal(size=n), rng.normal(size=n)
-    work = np.full(rb.work_size(n) + 3, np.nan)
+    work = np.full((rb.work_size(n) if method == rb.METHOD_BAND else rb.sweep_work_size(n)) + 3, np.nan)
     for _ in range(2):
         phi, dphi = rng.normal(size=n), rng.normal(size=n)
         a = np.empty(n), np.empty(2 * n)

@@ -419,24 +419,37 @@ def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out
     sums (N, see kernels.load_sums), used when ``has_load``; ``damped`` adds the hinge
     dampers. O(n) time and memory per evaluation. Returns False if the system is singular
     (outputs then hold NaN)."""
-    work = np.empty(work_size(phi.shape[0]))
+    work = np.empty(sweep_work_size(phi.shape[0]))    # the fallback allocates its own
     return reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out,
                               work, METHOD_AUTO)
 
 
 @njit(cache=True)
+def _band_size(n):
+    return NB * n * (KL + KU + 1) + NB * n + KL + KU + RING * W
+
+
+@njit(cache=True)
 def work_size(n):
-    """Length of the float64 work array of ``reduced_solve_work`` for n rods: 7n scratch,
-    then the larger of the sweep's T (12n) and the banded LU's U (7n x 11), right-hand side
-    (7n + 10) and ring of active rows."""
-    return 7 * n + max(12 * n, NB * n * (KL + KU + 1) + NB * n + KL + KU + RING * W)
+    """Length of a float64 work array of ``reduced_solve_work`` that serves every method for
+    n rods: 7n scratch, then the larger of the sweep's T (12n) and the banded LU's U
+    (7n x 11), right-hand side (7n + 10) and ring of active rows."""
+    return 7 * n + max(12 * n, _band_size(n))
+
+
+@njit(cache=True)
+def sweep_work_size(n):
+    """Length of a work array that serves METHOD_SWEEP (19n); with METHOD_AUTO the rare
+    fallback to the banded LU then allocates what it needs."""
+    return 19 * n
 
 
 @njit(cache=True)
 def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work,
                        method):
-    """``reduced_solve`` with a caller-provided float64 work array of length >= work_size(n)
-    (a caller that evaluates many times, such as an integrator, allocates it once) and a
+    """``reduced_solve`` with a caller-provided float64 work array of length >= work_size(n),
+    or >= sweep_work_size(n) (then the banded LU, if used, allocates its part), so that a
+    caller that evaluates many times, such as an integrator, allocates it once; and a
     ``method``: METHOD_AUTO (the sweep; the banded LU if the sweep meets a zero local pivot
     or a non-finite value), METHOD_BAND or METHOD_SWEEP (one of them only)."""
     n = phi.shape[0]
@@ -458,6 +471,8 @@ def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamm
             ddphi_out[:] = np.nan
             gamma_out[:] = np.nan
             return False
+    if rest.shape[0] < _band_size(n):
+        rest = np.empty(_band_size(n))
     o1 = N * (KL + KU + 1)
     o2 = o1 + N + KL + KU
     U = rest[:o1].reshape((N, KL + KU + 1))
