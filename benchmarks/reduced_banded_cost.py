@@ -62,6 +62,42 @@ def dense_setup(ch: Chain):
     return system.V, system.Mt
 
 
+def measure(n: int, min_time: float, repeats: int) -> tuple[int, float, float, float]:
+    """Time the kernels at n rods, print the table row; (n, default, sweep+work, band+work)."""
+    ch = chain(n)
+    Cst = rb.banded_constants(None, ch, "printed")
+    rng = np.random.default_rng(0)
+    phi, dphi = rng.normal(size=n), rng.normal(size=n)
+    SX = np.cumsum(rng.normal(size=n)[::-1])[::-1] * 100.0
+    SY = np.cumsum(rng.normal(size=n)[::-1])[::-1] * 100.0
+    out = np.empty(n)
+    t_b = seconds_per_call(
+        lambda: rb.reduced_accel_banded(Cst, phi, dphi, True, SX, SY, True, out),
+        min_time, repeats)
+    work, gamma, dd = np.empty(rb.work_size(n)), np.empty(2 * n), np.empty(n)
+    sweep_work = np.empty(rb.sweep_work_size(n))
+    t_w = seconds_per_call(
+        lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma,
+                                      sweep_work, rb.METHOD_SWEEP), min_time, repeats)
+    t_band = seconds_per_call(
+        lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma, work,
+                                      rb.METHOD_BAND), min_time, repeats)
+    band_diff = np.max(np.abs(out - dd)) / np.max(np.abs(out))   # |band - sweep| / max|sweep|
+    dense = f"{'-':>13} {'-':>13}"
+    if n <= DENSE_MAX:
+        V, Mt = dense_setup(ch)
+        ref = np.empty(n)
+        t_d = seconds_per_call(
+            lambda: kernels.reduced_accel(V, Mt, phi, dphi, True, SX, SY, True, ref),
+            min_time, repeats)
+        err = np.max(np.abs(out - ref)) / np.max(np.abs(ref))
+        assert err < 1e-9, f"banded and dense kernels disagree at n = {n}: {err:.1e}"
+        dense = f"{t_d:13.3e} {t_d / t_b:13.1f}"
+    print(f"{n:7d} {t_b:14.3e} {t_b * 1e6:10.1f} {t_b / n * 1e9:8.0f} {t_w:11.3e} "
+          f"{t_band:11.3e} {band_diff:9.1e} {dense}", flush=True)
+    return n, t_b, t_w, t_band
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="shorter timing loops")
@@ -71,38 +107,7 @@ def main() -> None:
     print(f"{'n':>7} {'default s/eval':>14} {'us/eval':>10} {'ns/rod':>8} {'sweep+work':>11} "
           f"{'band+work':>11} {'band diff':>9} {'dense s/eval':>13} {'dense/default':>13}")
     for n in SIZES:
-        ch = chain(n)
-        Cst = rb.banded_constants(None, ch, "printed")
-        rng = np.random.default_rng(0)
-        phi, dphi = rng.normal(size=n), rng.normal(size=n)
-        SX = np.cumsum(rng.normal(size=n)[::-1])[::-1] * 100.0
-        SY = np.cumsum(rng.normal(size=n)[::-1])[::-1] * 100.0
-        out = np.empty(n)
-        t_b = seconds_per_call(
-            lambda: rb.reduced_accel_banded(Cst, phi, dphi, True, SX, SY, True, out),
-            min_time, repeats)
-        work, gamma, dd = np.empty(rb.work_size(n)), np.empty(2 * n), np.empty(n)
-        sweep_work = np.empty(rb.sweep_work_size(n))
-        t_w = seconds_per_call(
-            lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma,
-                                          sweep_work, rb.METHOD_SWEEP), min_time, repeats)
-        t_band = seconds_per_call(
-            lambda: rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, dd, gamma, work,
-                                          rb.METHOD_BAND), min_time, repeats)
-        band_diff = np.max(np.abs(out - dd)) / np.max(np.abs(out))   # |band - sweep| / max|sweep|
-        t_d = None
-        if n <= DENSE_MAX:
-            V, Mt = dense_setup(ch)
-            ref = np.empty(n)
-            t_d = seconds_per_call(
-                lambda: kernels.reduced_accel(V, Mt, phi, dphi, True, SX, SY, True, ref),
-                min_time, repeats)
-            err = np.max(np.abs(out - ref)) / np.max(np.abs(ref))
-            assert err < 1e-9, f"banded and dense kernels disagree at n = {n}: {err:.1e}"
-        rows.append((n, t_b, t_w, t_band))
-        dense = f"{t_d:13.3e} {t_d / t_b:13.1f}" if t_d is not None else f"{'-':>13} {'-':>13}"
-        print(f"{n:7d} {t_b:14.3e} {t_b * 1e6:10.1f} {t_b / n * 1e9:8.0f} {t_w:11.3e} "
-              f"{t_band:11.3e} {band_diff:9.1e} {dense}", flush=True)
+        rows.append(measure(n, min_time, repeats))
     data = np.array(rows)
     data = data[data[:, 0] >= 64]      # the small chains only show the dense kernel's range
     ns = data[:, 0]

@@ -6,8 +6,12 @@ import pytest
 
 from rodval.loads import constant, pulse
 from rodval.models import reduced_banded as rb
-from rodval.models.paper_matrices import (assemble_mass, angle_differences, chain_constants,
-                                          convective_terms)
+from rodval.models.paper_matrices import (
+    angle_differences,
+    assemble_mass,
+    chain_constants,
+    convective_terms,
+)
 from rodval.models.reduced import ReducedSystem
 from rodval.scene import Chain, InitialState, Scene
 

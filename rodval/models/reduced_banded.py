@@ -76,8 +76,18 @@ from types import SimpleNamespace
 import numpy as np
 from numba import njit
 
-from .kernels import (V_KAPPA, V_KB, V_L, V_NU, V_OUTER, V_PPDIAG, V_W, _gpp_times,
-                      _hinge_forces, _upper_t_times)
+from .kernels import (
+    V_KAPPA,
+    V_KB,
+    V_L,
+    V_NU,
+    V_OUTER,
+    V_PPDIAG,
+    V_W,
+    _gpp_times,
+    _hinge_forces,
+    _upper_t_times,
+)
 from .paper_matrices import VARIANTS
 
 # Rows of Cst: the first rows are laid out like kernels.V (so that the kernels' O(n) helpers
@@ -517,8 +527,7 @@ def _ruiz(T, rs, cs, sweeps):
             rmax[i] = 0.0
             for o in range(T.shape[1]):
                 v = T[i, o]
-                if v > rmax[i]:
-                    rmax[i] = v
+                rmax[i] = max(rmax[i], v)
                 j = i - KL + o
                 if v > 0.0 and v > cmax[j]:
                     cmax[j] = v
