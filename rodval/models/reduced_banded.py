@@ -1,0 +1,609 @@
+"""The reduced model's right-hand side and bending recovery in O(n) time and memory.
+
+API: ``banded_constants`` (once per chain), ``reduced_solve`` (phi'' and gamma at a state),
+``reduced_solve_work`` (the same with a reusable work array and a method choice),
+``reduced_accel_banded`` (phi'' only, the argument list of kernels.reduced_accel with Cst in
+place of (V, Mt)), ``bending_at`` (Python convenience).
+
+The dense route (``kernels.reduced_accel``, ``ReducedSystem.recover_bending``) eliminates the
+bending angles first, M_r = M_pp - K_pg B^-1 M_gp, which is a dense n x n matrix (O(n^2) to
+assemble, O(n^3) to solve). Here the elimination is not done: the *unreduced* algebraic system
+in x = phi'' (rad/s^2) and gamma = [alpha; beta] (rad),
+
+    phi rows      M_pp x + K_pg gamma = r_p,   r_p = Q - G_pp phi'^2 - C_pp phi' - K_pp phi  (N m)
+    bending rows  M_gp x + B gamma    = r_g,   r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi)   (N m)
+
+(B = K_gg, constant and positive definite since EI > 0; eliminating gamma gives back the
+reduced equations of ``reduced.py``, whose matrix M_r is the Schur complement of B), is made
+banded by adding the running sums of the dense products as unknowns. With
+e_k = (cos phi_k, sin phi_k) and rods k = 0..n-1 (0-based):
+
+    P_k = sum_{j<k} l_j e_j x_j          (m/s^2, prefix *excluding* k, P_0 = 0)
+    S_k = sum_{j>=k} M_j l_j e_j x_j     (N, suffix *including* k, S_n = 0; M_k = outer_mass)
+
+    (M_pp x)_k = pp_k x_k + l_k M_k e_k . P_k + l_k e_k . S_{k+1}
+    (M_ap x)_k =  w_k e_k . P_k + ap_k x_k,   (M_bp x)_k = -w_k e_k . P_k + bp_k x_k
+    (w_k = m_k l_k^2 / 12; ap, bp are the variant's bending-row diagonals)
+
+K_pg and B come from the hinge angles D_k = phi_k + alpha_k - phi_{k-1} - beta_{k-1} and the
+per-rod blocks (4 EI_k / l_k) [[1, 1/2], [1/2, 1]]:
+
+    (K_pg gamma)_k = kappa_k (alpha_k - beta_{k-1}) - kappa_{k+1} (alpha_{k+1} - beta_k)
+    (B gamma)_alpha_k = kappa_k (alpha_k - beta_{k-1}) + kb_k (alpha_k + beta_k / 2)
+    (B gamma)_beta_k  = kappa_{k+1} (beta_k - alpha_{k+1}) + kb_k (alpha_k / 2 + beta_k)
+
+Two O(n) eliminations of this system are implemented; ``reduced_solve`` uses the sweep and
+falls back to the banded LU if the sweep meets an exactly zero local pivot (METHOD_AUTO).
+
+Sweep (tip to root, then root to tip; the default, about 6x faster). The rods k..n-1 interact
+with the rods before them only through z_k = (P_k, beta_{k-1}) (3 numbers; beta_{-1} = 0).
+Going from the tip (S_n = 0, kappa_n = 0) to the root, each rod's three rows (phi, alpha,
+beta) are written in its own unknowns u_k = (x_k, alpha_k, beta_k), with the tail relation of
+rod k+1, S_{k+1} = F z_{k+1} + f and alpha_{k+1} = G . z_{k+1} + g, and z_{k+1} =
+(P_k + l_k e_k x_k, beta_k) substituted; that 3 x 3 system (all rows in N m) is solved by
+Gaussian elimination with partial pivoting for u_k = T_k z_k + t_k, and S_k = S_{k+1} +
+M_k l_k e_k x_k gives rod k's tail relation. Then z_0 = 0 and u_k, z_{k+1} follow rod by rod.
+This is block elimination of the banded system below in the order tip to root (like the
+articulated-body algorithm of multibody dynamics); each local 3 x 3 matrix is the Schur
+complement of the sub-chain k..n-1, itself a chain of the same model.
+
+Banded LU (METHOD_BAND; Gaussian elimination with partial pivoting over the whole band).
+Unknowns, 7 per rod, ordered rod by rod as (S_k,x  S_k,y  alpha_k  P_k,x  P_k,y  x_k  beta_k);
+equations per rod in the row order
+
+    P_k - P_{k-1} - l_{k-1} e_{k-1} x_{k-1} = 0   (2 rows; P_0 = 0)
+    alpha row k,  phi row k,
+    S_k - S_{k+1} - M_k l_k e_k x_k = 0           (2 rows; S_{n-1} = M l e x at the tip)
+    beta row k.
+
+With this order every row touches only its own rod and the two neighbours, and the 7n x 7n
+matrix is banded with kl = 4 sub- and ku = 6 super-diagonals. It is solved by Gaussian
+elimination with partial pivoting on the band (LAPACK gbtf2/gbtrs style, the right-hand side
+eliminated on the fly; U then has kl + ku super-diagonals). Rows and columns are equilibrated
+by constant powers of two (Ruiz scaling of the angle-independent coefficient magnitudes,
+computed once in ``banded_constants``), which changes no value in exact arithmetic and makes
+the pivot choice independent of units. Its determinant is +-det(B) det(M_r), so the
+banded system is regular exactly when the dense reduced one is.
+
+Cost: O(n) time and memory per evaluation, no n x n array anywhere: the sweep ~250 flops and
+19 doubles per rod, the banded LU ~800 flops and ~90 doubles per rod (U factor 7n x 11). phi''
+and gamma come out of the same solve, so the bending recovery is the same routine.
+"""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+from numba import njit
+
+from .kernels import (
+    V_KAPPA,
+    V_KB,
+    V_L,
+    V_NU,
+    V_OUTER,
+    V_PPDIAG,
+    V_W,
+    _gpp_times,
+    _hinge_forces,
+    _upper_t_times,
+)
+from .paper_matrices import VARIANTS
+
+# Rows of Cst: the first rows are laid out like kernels.V (so that the kernels' O(n) helpers
+# read them), then the bending-row diagonals and the equilibration scales.
+_BASE = max(V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB) + 1
+C_AP, C_BP = _BASE, _BASE + 1
+#: first of 7 rows of row scales (one per local equation) and of 7 rows of column scales
+C_RSCALE = _BASE + 2
+C_CSCALE = C_RSCALE + 7
+N_CST = C_CSCALE + 7
+
+#: unknowns per rod and their local order
+NB = 7
+U_SX, U_SY, U_A, U_PX, U_PY, U_X, U_B = range(NB)
+#: equations per rod and their local order
+E_PX, E_PY, E_AL, E_PHI, E_SX, E_SY, E_BE = range(NB)
+#: sub- and super-diagonals of the banded matrix (before pivoting)
+KL, KU = 4, 6
+#: band storage width: row i keeps columns i - KL .. i + KL + KU (room for pivoting fill)
+W = 2 * KL + KU + 1
+#: rows of the ring of active rows (a power of two > rows alive at once, 2 NB + KL)
+RING = 16
+RMASK = RING - 1
+
+
+@njit(cache=True, inline="always")
+def _put(A, mask, i, j, v):
+    """A[i, j] = v in row-relative band storage: row i lives in A[i & mask] (mask = -1: all
+    rows; mask = RING - 1: a ring of rows) and keeps column j at offset j - i + KL."""
+    A[i & mask, j - i + KL] = v
+
+
+@njit(cache=True)
+def _fill_rod(Cst, k, c, s, A, mask):
+    """Write the 7 equation rows of rod k (rows 7k .. 7k+6) into the band storage ``A``,
+    equilibrated (entry (i, j) times row scale R_i and column scale C_j); c, s = cos, sin of
+    phi. The rows are zeroed first; row i is stored in A[i & mask] (see _put)."""
+    n = Cst.shape[1]
+    r0 = NB * k
+    for i in range(r0, r0 + NB):
+        for o in range(W):
+            A[i & mask, o] = 0.0
+    R = Cst[C_RSCALE:C_RSCALE + NB, k]           # this rod's row scales
+    Ch = Cst[C_CSCALE:C_CSCALE + NB, k]          # column scales: this rod, previous, next
+    Cp = Cst[C_CSCALE:C_CSCALE + NB, k - 1] if k > 0 else Ch
+    Cn = Cst[C_CSCALE:C_CSCALE + NB, k + 1] if k + 1 < n else Ch
+    l, outer, w = Cst[V_L, k], Cst[V_OUTER, k], Cst[V_W, k]
+    kap, kb = Cst[V_KAPPA, k], Cst[V_KB, k]
+    kap_next = Cst[V_KAPPA, k + 1] if k + 1 < n else 0.0
+    ck, sk = c[k], s[k]
+    here = NB * k
+    prev = here - NB
+    nxt = here + NB
+    # prefix sums: P_k - P_{k-1} - l_{k-1} e_{k-1} x_{k-1} = 0
+    rx, ry = R[E_PX], R[E_PY]
+    _put(A, mask, r0 + E_PX, here + U_PX, rx * Ch[U_PX])
+    _put(A, mask, r0 + E_PY, here + U_PY, ry * Ch[U_PY])
+    if k > 0:
+        lp = Cst[V_L, k - 1]
+        _put(A, mask, r0 + E_PX, prev + U_PX, -rx * Cp[U_PX])
+        _put(A, mask, r0 + E_PY, prev + U_PY, -ry * Cp[U_PY])
+        _put(A, mask, r0 + E_PX, prev + U_X, -rx * lp * c[k - 1] * Cp[U_X])
+        _put(A, mask, r0 + E_PY, prev + U_X, -ry * lp * s[k - 1] * Cp[U_X])
+    # alpha row: w e.P + ap x + kappa_k (alpha_k - beta_{k-1}) + kb (alpha + beta/2)
+    row = r0 + E_AL
+    r = R[E_AL]
+    _put(A, mask, row, here + U_PX, r * w * ck * Ch[U_PX])
+    _put(A, mask, row, here + U_PY, r * w * sk * Ch[U_PY])
+    _put(A, mask, row, here + U_X, r * Cst[C_AP, k] * Ch[U_X])
+    _put(A, mask, row, here + U_A, r * (kap + kb) * Ch[U_A])
+    _put(A, mask, row, here + U_B, r * 0.5 * kb * Ch[U_B])
+    if k > 0:
+        _put(A, mask, row, prev + U_B, -r * kap * Cp[U_B])
+    # phi row: pp x + l M e.P + l e.S_{k+1} + (K_pg gamma)_k
+    row = r0 + E_PHI
+    r = R[E_PHI]
+    _put(A, mask, row, here + U_X, r * Cst[V_PPDIAG, k] * Ch[U_X])
+    _put(A, mask, row, here + U_PX, r * l * outer * ck * Ch[U_PX])
+    _put(A, mask, row, here + U_PY, r * l * outer * sk * Ch[U_PY])
+    _put(A, mask, row, here + U_A, r * kap * Ch[U_A])
+    _put(A, mask, row, here + U_B, r * kap_next * Ch[U_B])
+    if k > 0:
+        _put(A, mask, row, prev + U_B, -r * kap * Cp[U_B])
+    if k + 1 < n:
+        _put(A, mask, row, nxt + U_SX, r * l * ck * Cn[U_SX])
+        _put(A, mask, row, nxt + U_SY, r * l * sk * Cn[U_SY])
+        _put(A, mask, row, nxt + U_A, -r * kap_next * Cn[U_A])
+    # suffix sums: S_k - S_{k+1} - M_k l_k e_k x_k = 0
+    rx, ry = R[E_SX], R[E_SY]
+    _put(A, mask, r0 + E_SX, here + U_SX, rx * Ch[U_SX])
+    _put(A, mask, r0 + E_SY, here + U_SY, ry * Ch[U_SY])
+    _put(A, mask, r0 + E_SX, here + U_X, -rx * outer * l * ck * Ch[U_X])
+    _put(A, mask, r0 + E_SY, here + U_X, -ry * outer * l * sk * Ch[U_X])
+    if k + 1 < n:
+        _put(A, mask, r0 + E_SX, nxt + U_SX, -rx * Cn[U_SX])
+        _put(A, mask, r0 + E_SY, nxt + U_SY, -ry * Cn[U_SY])
+    # beta row: -w e.P + bp x + kappa_{k+1} (beta_k - alpha_{k+1}) + kb (alpha/2 + beta)
+    row = r0 + E_BE
+    r = R[E_BE]
+    _put(A, mask, row, here + U_PX, -r * w * ck * Ch[U_PX])
+    _put(A, mask, row, here + U_PY, -r * w * sk * Ch[U_PY])
+    _put(A, mask, row, here + U_X, r * Cst[C_BP, k] * Ch[U_X])
+    _put(A, mask, row, here + U_A, r * 0.5 * kb * Ch[U_A])
+    _put(A, mask, row, here + U_B, r * (kb + kap_next) * Ch[U_B])
+    if k + 1 < n:
+        _put(A, mask, row, nxt + U_A, -r * kap_next * Cn[U_A])
+
+
+@njit(cache=True)
+def _eliminate(A, b, j, U):
+    """Column j of banded Gaussian elimination with partial pivoting: pivot among rows
+    j .. j+KL, swap, eliminate below (the right-hand side b follows), and move the finished
+    row j (diagonal and KL + KU super-diagonals) to U[j]. Active rows live in the ring A
+    (row i in A[i & RMASK], column c at offset c - i + KL); past the last equation the ring
+    holds KL zero rows, so that all loops have fixed trip counts."""
+    p = 0
+    big = abs(A[j & RMASK, KL])
+    for r in range(1, KL + 1):
+        v = abs(A[(j + r) & RMASK, KL - r])
+        if v > big:
+            big = v
+            p = r
+    if big == 0.0:
+        return False
+    rj = j & RMASK
+    if p != 0:
+        rq = (j + p) & RMASK
+        for o in range(KL, W):
+            t = A[rj, o]
+            A[rj, o] = A[rq, o - p]
+            A[rq, o - p] = t
+        t = b[j]
+        b[j] = b[j + p]
+        b[j + p] = t
+    piv = A[rj, KL]
+    bj = b[j]
+    for r in range(1, KL + 1):
+        ri = (j + r) & RMASK
+        f = A[ri, KL - r]
+        if f != 0.0:
+            f /= piv
+            A[ri, KL - r] = 0.0
+            for o in range(KL + 1, W):
+                A[ri, o - r] -= f * A[rj, o]
+            b[j + r] -= f * bj
+    for o in range(KL, W):
+        U[j, o - KL] = A[rj, o]
+    return True
+
+
+@njit(cache=True)
+def _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec):
+    """Right-hand sides (N m) into vec (scratch of 5n): vec[:n] = r_p = Q - G_pp phi'^2
+    - C_pp phi' - K_pp phi, vec[n:2n] = r_alpha, vec[2n:3n] = r_beta, with
+    r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi) (C only when ``damped``)."""
+    n = phi.shape[0]
+    vec[:4 * n] = 0.0
+    fp = vec[:n]
+    fa = vec[n:2 * n]
+    fb = vec[2 * n:3 * n]
+    zero = vec[3 * n:4 * n]
+    w2 = vec[4 * n:5 * n]
+    for k in range(n):
+        w2[k] = dphi[k] * dphi[k]
+    _hinge_forces(Cst, phi, zero, zero, V_KAPPA, fp, fa, fb)       # K_qp phi
+    if damped:
+        _hinge_forces(Cst, dphi, zero, zero, V_NU, fp, fa, fb)     # C_qp phi'
+    for k in range(n):
+        fp[k] = -fp[k]
+        fa[k] = -fa[k]
+        fb[k] = -fb[k]
+    _gpp_times(Cst, c, s, w2, fp)                  # - G_pp phi'^2
+    _upper_t_times(Cst, c, s, w2, False, fa, 1.0)  # - G_ap phi'^2 = + G_pa^T phi'^2
+    _upper_t_times(Cst, c, s, w2, False, fb, -1.0)  # - G_bp phi'^2 = - G_pa^T phi'^2
+    if has_load:
+        l = Cst[V_L]
+        for k in range(n):
+            fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
+
+
+@njit(cache=True)
+def _solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
+    """The banded LU with partial pivoting (module docstring) of the 7n x 7n system. U (7n x
+    11), b (7n + 10), A (RING x W): work storage. False if a pivot column is exactly zero."""
+    n = c.shape[0]
+    N = NB * n
+    for k in range(n):
+        r0 = NB * k
+        for e in range(NB):
+            b[r0 + e] = 0.0
+        b[r0 + E_AL] = fa[k] * Cst[C_RSCALE + E_AL, k]
+        b[r0 + E_PHI] = fp[k] * Cst[C_RSCALE + E_PHI, k]
+        b[r0 + E_BE] = fb[k] * Cst[C_RSCALE + E_BE, k]
+    b[N:] = 0.0                         # padding: see _eliminate and the back substitution
+    _fill_rod(Cst, 0, c, s, A, RMASK)
+    for k in range(n):
+        if k + 1 < n:                   # rows 7k+7.. are reached from column 7k+3 on
+            _fill_rod(Cst, k + 1, c, s, A, RMASK)
+        else:                           # KL zero rows past the last equation
+            for i in range(N, N + KL):
+                for o in range(W):
+                    A[i & RMASK, o] = 0.0
+        for j in range(NB * k, NB * k + NB):
+            if not _eliminate(A, b, j, U):
+                return False
+    # back substitution with U (KL + KU super-diagonals), then undo the column scaling
+    for i in range(N - 1, -1, -1):
+        acc = b[i]
+        for o in range(1, KL + KU + 1):          # columns i+1 .. i+KL+KU (b is padded)
+            acc -= U[i, o] * b[i + o]
+        b[i] = acc / U[i, 0]
+    for k in range(n):
+        r0 = NB * k
+        ddphi_out[k] = b[r0 + U_X] * Cst[C_CSCALE + U_X, k]
+        gamma_out[k] = b[r0 + U_A] * Cst[C_CSCALE + U_A, k]
+        gamma_out[n + k] = b[r0 + U_B] * Cst[C_CSCALE + U_B, k]
+    return True
+
+
+@njit(cache=True)
+def _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
+    """The tip-to-root elimination (module docstring, "sweep"). T (n x 3 x 4): work storage
+    for u_k = T_k[:, :3] z_k + T_k[:, 3]. False if a local pivot is zero or a result is not
+    finite."""
+    n = c.shape[0]
+    F = np.zeros((2, 4))        # tail relation of rod k+1: S_{k+1} = F[:, :3] z_{k+1} + F[:, 3]
+    G = np.zeros(4)             #                           alpha_{k+1} = G[:3] . z_{k+1} + G[3]
+    L = np.empty((3, 3))
+    R = np.empty((3, 4))
+    for k in range(n - 1, -1, -1):
+        l, M, w = Cst[V_L, k], Cst[V_OUTER, k], Cst[V_W, k]
+        kap, kb = Cst[V_KAPPA, k], Cst[V_KB, k]
+        kapn = Cst[V_KAPPA, k + 1] if k + 1 < n else 0.0
+        ex, ey = c[k], s[k]
+        Fe0 = F[0, 0] * ex + F[0, 1] * ey           # F_P e
+        Fe1 = F[1, 0] * ex + F[1, 1] * ey
+        FTe0 = F[0, 0] * ex + F[1, 0] * ey          # F_P^T e
+        FTe1 = F[0, 1] * ex + F[1, 1] * ey
+        eFe = ex * Fe0 + ey * Fe1
+        eFb = ex * F[0, 2] + ey * F[1, 2]
+        ef = ex * F[0, 3] + ey * F[1, 3]
+        Ge = G[0] * ex + G[1] * ey
+        # L u = R [P; beta_{k-1}; 1], u = (x_k, alpha_k, beta_k): the phi, alpha, beta rows
+        # of rod k with S_{k+1}, alpha_{k+1} from the tail relation, z_{k+1} = (P_k + l e x_k,
+        # beta_k)
+        L[0, 0] = Cst[V_PPDIAG, k] + l * l * eFe - kapn * l * Ge
+        L[0, 1] = kap
+        L[0, 2] = l * eFb + kapn * (1.0 - G[2])
+        R[0, 0] = kapn * G[0] - l * (M * ex + FTe0)
+        R[0, 1] = kapn * G[1] - l * (M * ey + FTe1)
+        R[0, 2] = kap
+        R[0, 3] = fp[k] - l * ef + kapn * G[3]
+        L[1, 0] = Cst[C_AP, k]
+        L[1, 1] = kap + kb
+        L[1, 2] = 0.5 * kb
+        R[1, 0] = -w * ex
+        R[1, 1] = -w * ey
+        R[1, 2] = kap
+        R[1, 3] = fa[k]
+        L[2, 0] = Cst[C_BP, k] - kapn * l * Ge
+        L[2, 1] = 0.5 * kb
+        L[2, 2] = kb + kapn * (1.0 - G[2])
+        R[2, 0] = w * ex + kapn * G[0]
+        R[2, 1] = w * ey + kapn * G[1]
+        R[2, 2] = 0.0
+        R[2, 3] = fb[k] + kapn * G[3]
+        # T_k = L^-1 R: 3 x 3 Gaussian elimination with partial pivoting (rows all in N m)
+        for j in range(3):
+            p = j
+            big = abs(L[j, j])
+            for i in range(j + 1, 3):
+                if abs(L[i, j]) > big:
+                    big = abs(L[i, j])
+                    p = i
+            if big == 0.0:
+                return False
+            if p != j:
+                for q in range(3):
+                    t = L[j, q]
+                    L[j, q] = L[p, q]
+                    L[p, q] = t
+                for q in range(4):
+                    t = R[j, q]
+                    R[j, q] = R[p, q]
+                    R[p, q] = t
+            for i in range(j + 1, 3):
+                f = L[i, j] / L[j, j]
+                for q in range(j + 1, 3):
+                    L[i, q] -= f * L[j, q]
+                for q in range(4):
+                    R[i, q] -= f * R[j, q]
+        for j in range(2, -1, -1):
+            for q in range(4):
+                acc = R[j, q]
+                for i in range(j + 1, 3):
+                    acc -= L[j, i] * T[k, i, q]
+                T[k, j, q] = acc / L[j, j]
+        # tail relation of rod k: S_k = S_{k+1} + M l e x_k
+        #   = [F_P | 0 | f] + F_b (x) T_k[2] + (l F_P e + M l e) (x) T_k[0]
+        v0 = l * (Fe0 + M * ex)
+        v1 = l * (Fe1 + M * ey)
+        Fb0 = F[0, 2]
+        Fb1 = F[1, 2]
+        F[0, 2] = 0.0
+        F[1, 2] = 0.0
+        for q in range(4):
+            F[0, q] += Fb0 * T[k, 2, q] + v0 * T[k, 0, q]
+            F[1, q] += Fb1 * T[k, 2, q] + v1 * T[k, 0, q]
+            G[q] = T[k, 1, q]
+    # root to tip: z_0 = 0, u_k = T_k [z_k; 1], z_{k+1} = (P_k + l_k e_k x_k, beta_k)
+    P0 = 0.0
+    P1 = 0.0
+    bprev = 0.0
+    for k in range(n):
+        x = T[k, 0, 0] * P0 + T[k, 0, 1] * P1 + T[k, 0, 2] * bprev + T[k, 0, 3]
+        a = T[k, 1, 0] * P0 + T[k, 1, 1] * P1 + T[k, 1, 2] * bprev + T[k, 1, 3]
+        bb = T[k, 2, 0] * P0 + T[k, 2, 1] * P1 + T[k, 2, 2] * bprev + T[k, 2, 3]
+        if not (np.isfinite(x) and np.isfinite(a) and np.isfinite(bb)):
+            return False
+        ddphi_out[k] = x
+        gamma_out[k] = a
+        gamma_out[n + k] = bb
+        l = Cst[V_L, k]
+        P0 += l * c[k] * x
+        P1 += l * s[k] * x
+        bprev = bb
+    return True
+
+
+#: ``method`` of reduced_solve_work
+METHOD_AUTO, METHOD_BAND, METHOD_SWEEP = 0, 1, 2
+
+
+@njit(cache=True)
+def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out):
+    """phi'' (rad/s^2, n) into ``ddphi_out`` and gamma = [alpha; beta] (rad, 2n) into
+    ``gamma_out`` of the reduced model at state (phi, phi') (module docstring: the sweep, with
+    the banded LU as fallback). ``Cst`` from ``banded_constants``; SX, SY are the load suffix
+    sums (N, see kernels.load_sums), used when ``has_load``; ``damped`` adds the hinge
+    dampers. O(n) time and memory per evaluation. Returns False if the system is singular
+    (outputs then hold NaN)."""
+    work = np.empty(sweep_work_size(phi.shape[0]))    # the fallback allocates its own
+    return reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out,
+                              work, METHOD_AUTO)
+
+
+@njit(cache=True)
+def _band_size(n):
+    return NB * n * (KL + KU + 1) + NB * n + KL + KU + RING * W
+
+
+@njit(cache=True)
+def work_size(n):
+    """Length of a float64 work array of ``reduced_solve_work`` that serves every method for
+    n rods: 7n scratch, then the larger of the sweep's T (12n) and the banded LU's U
+    (7n x 11), right-hand side (7n + 10) and ring of active rows."""
+    return 7 * n + max(12 * n, _band_size(n))
+
+
+@njit(cache=True)
+def sweep_work_size(n):
+    """Length of a work array that serves METHOD_SWEEP (19n); with METHOD_AUTO the rare
+    fallback to the banded LU then allocates what it needs."""
+    return 19 * n
+
+
+@njit(cache=True)
+def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work,
+                       method):
+    """``reduced_solve`` with a caller-provided float64 work array of length >= work_size(n),
+    or >= sweep_work_size(n) (then the banded LU, if used, allocates its part), so that a
+    caller that evaluates many times, such as an integrator, allocates it once; and a
+    ``method``: METHOD_AUTO (the sweep; the banded LU if the sweep meets a zero local pivot
+    or a non-finite value), METHOD_BAND or METHOD_SWEEP (one of them only)."""
+    n = phi.shape[0]
+    N = NB * n
+    c = work[:n]
+    s = work[n:2 * n]
+    for k in range(n):
+        c[k] = np.cos(phi[k])
+        s[k] = np.sin(phi[k])
+    vec = work[2 * n:7 * n]
+    _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
+    fp, fa, fb = vec[:n], vec[n:2 * n], vec[2 * n:3 * n]
+    rest = work[7 * n:]
+    if method != METHOD_BAND:
+        T = rest[:12 * n].reshape((n, 3, 4))
+        if _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
+            return True
+        if method == METHOD_SWEEP:
+            ddphi_out[:] = np.nan
+            gamma_out[:] = np.nan
+            return False
+    if rest.shape[0] < _band_size(n):
+        rest = np.empty(_band_size(n))
+    o1 = N * (KL + KU + 1)
+    o2 = o1 + N + KL + KU
+    U = rest[:o1].reshape((N, KL + KU + 1))
+    A = rest[o2:o2 + RING * W].reshape((RING, W))
+    if _solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi_out, gamma_out):
+        return True
+    ddphi_out[:] = np.nan
+    gamma_out[:] = np.nan
+    return False
+
+
+@njit(cache=True)
+def reduced_accel_banded(Cst, phi, dphi, has_load, SX, SY, damped, out):
+    """phi'' of the reduced model into ``out`` (the argument list of kernels.reduced_accel
+    with ``Cst`` in place of (V, Mt)); O(n) time and memory."""
+    gamma = np.empty(2 * phi.shape[0])
+    reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, out, gamma)
+
+
+@njit(cache=True)
+def _magnitudes(Cst):
+    """Angle-independent coefficient magnitudes |A| of the banded matrix (c = s = 1,
+    unit scales), in band storage."""
+    n = Cst.shape[1]
+    one = np.ones(n)
+    A = np.empty((NB * n, W))
+    for k in range(n):
+        _fill_rod(Cst, k, one, one, A, -1)
+    return np.abs(A)
+
+
+@njit(cache=True)
+def _ruiz(T, rs, cs, sweeps):
+    """Ruiz equilibration of the band magnitudes T (modified in place): after the sweeps
+    every row and column of diag(rs) |A| diag(cs) has its largest entry close to 1."""
+    N = T.shape[0]
+    rmax = np.empty(N)
+    cmax = np.empty(N)
+    for _ in range(sweeps):
+        cmax[:] = 0.0
+        for i in range(N):
+            rmax[i] = 0.0
+            for o in range(T.shape[1]):
+                v = T[i, o]
+                rmax[i] = max(rmax[i], v)
+                j = i - KL + o
+                if v > 0.0 and v > cmax[j]:
+                    cmax[j] = v
+        for i in range(N):
+            fr = 1.0 / np.sqrt(rmax[i]) if rmax[i] > 0.0 else 1.0
+            fc = 1.0 / np.sqrt(cmax[i]) if cmax[i] > 0.0 else 1.0
+            rs[i] *= fr
+            cs[i] *= fc
+        for i in range(N):
+            fr = 1.0 / np.sqrt(rmax[i]) if rmax[i] > 0.0 else 1.0
+            for o in range(T.shape[1]):
+                j = i - KL + o
+                if T[i, o] > 0.0:
+                    T[i, o] *= fr / np.sqrt(cmax[j])
+
+
+def _rod_constants(chain, variant: str) -> SimpleNamespace:
+    """The per-rod fields of paper_matrices.chain_constants (same formulas) in O(n) memory:
+    chain_constants also builds two n x n arrays, which a long chain cannot afford."""
+    if variant not in VARIANTS:
+        raise ValueError(f"coefficients must be one of {VARIANTS}, got {variant!r}")
+    l, m, mu = chain.l, chain.m, chain.mu
+    rod_mass = m * l
+    outer = np.cumsum((mu + rod_mass)[::-1])[::-1] - rod_mass / 2.0
+    ml3 = m * l**3
+    half = 0.5 if variant == "published" else 1.0
+    return SimpleNamespace(l=l, outer_mass=outer,
+                           pp_diag=l**2 * (outer - rod_mass / 2.0) + ml3 / 3.0,
+                           ap_diag=half * ml3 / 30.0, bp_diag=-half * ml3 / 20.0)
+
+
+def banded_constants(cc, chain, variant: str = "printed") -> np.ndarray:
+    """Every angle-independent per-rod constant of ``reduced_solve`` as a float64 array
+    (N_CST, n); ``cc = paper_matrices.chain_constants(chain, variant)``, or None to compute
+    the per-rod constants here for ``variant`` (O(n) memory; chain_constants is O(n^2)). O(n).
+
+    Rows: the kernels.V layout (l (m), outer mass M_k (kg), M_pp diagonal (kg m^2),
+    w = m l^2/12 (kg m), kappa (N m/rad), nu (N m s/rad), 4 EI/l (N m)), then the bending-row
+    diagonals ap, bp (kg m^2; the only difference between the "printed" and "published"
+    variants), then 7 row and 7 column equilibration scales (powers of two, per rod)."""
+    n = chain.n
+    if cc is None:
+        cc = _rod_constants(chain, variant)
+    Cst = np.zeros((N_CST, n))
+    Cst[V_L] = cc.l
+    Cst[V_OUTER] = cc.outer_mass
+    Cst[V_PPDIAG] = cc.pp_diag
+    Cst[V_W] = chain.m * chain.l**2 / 12.0
+    Cst[V_KAPPA] = chain.kappa
+    Cst[V_NU] = chain.nu
+    Cst[V_KB] = 4.0 * chain.EI / chain.l
+    Cst[C_AP] = cc.ap_diag
+    Cst[C_BP] = cc.bp_diag
+    Cst[C_RSCALE:] = 1.0
+    rs = np.ones(NB * n)
+    cs = np.ones(NB * n)
+    _ruiz(_magnitudes(Cst), rs, cs, 20)
+    pow2 = lambda v: np.exp2(np.round(np.log2(v)))        # exact scaling: no rounding
+    Cst[C_RSCALE:C_RSCALE + NB] = pow2(rs).reshape(n, NB).T
+    Cst[C_CSCALE:C_CSCALE + NB] = pow2(cs).reshape(n, NB).T
+    return np.ascontiguousarray(Cst)
+
+
+def bending_at(Cst: np.ndarray, phi: np.ndarray, dphi: np.ndarray, sums, damped: bool,
+               method: int = METHOD_AUTO) -> tuple[np.ndarray, np.ndarray]:
+    """(phi'', gamma) at one state, ``sums`` = LoadSet.suffix_sums(t) (None: no load).
+    The O(n) replacement of ReducedSystem.recover_bending (which returns gamma)."""
+    n = phi.shape[0]
+    phi = np.ascontiguousarray(phi, dtype=np.float64)
+    dphi = np.ascontiguousarray(dphi, dtype=np.float64)
+    if sums is None:
+        SX = SY = np.zeros(n)
+    else:
+        SX, SY = (np.ascontiguousarray(v, dtype=np.float64) for v in sums)
+    ddphi, gamma = np.empty(n), np.empty(2 * n)
+    work = np.empty(work_size(n))
+    reduced_solve_work(Cst, phi, dphi, sums is not None, SX, SY, bool(damped), ddphi, gamma,
+                       work, method)
+    return ddphi, gamma
