@@ -106,3 +106,34 @@ def test_node_positions_follow_chords():
     phi = np.array([0.0, np.pi / 2, np.pi])
     x, y = pm.node_positions(l, phi)
     assert np.allclose(x, [0, 1, 1, 0.5]) and np.allclose(y, [0, 0, 2, 2])
+
+
+def test_rest_angles_and_quasi_static_bending_against_the_dense_forms():
+    """The O(n) potential with hinge rest angles has gradient K q - A^T kappa rest, and the
+    O(n) quasi-static bending solves the dense bending rows B gamma = rest_g - K_gp phi."""
+    rng = np.random.default_rng(1)
+    n = 6
+    chain = Chain(
+        l=rng.uniform(1, 2, n),
+        m=1.0,
+        EI=rng.uniform(1e3, 1e4, n),
+        mu=0.0,
+        kappa=[0, 5, 10, 0, 3, 7],
+        nu=0.0,
+        rest_angle=rng.normal(size=n),
+    )
+    K, rest = pm.stiffness_matrix(chain), pm.rest_forces(chain)
+    q = rng.normal(size=3 * n)
+    h = 1e-2  # Pi is quadratic: central differences are exact up to round-off
+    grad = [
+        (
+            pm.potential_energy(chain, *np.split(q + h * e, 3))
+            - pm.potential_energy(chain, *np.split(q - h * e, 3))
+        )
+        / (2 * h)
+        for e in np.eye(3 * n)
+    ]
+    np.testing.assert_allclose(grad, K @ q - rest, rtol=1e-9, atol=1e-9)
+    phi, g, p = q[:n], slice(n, 3 * n), slice(0, n)
+    dense = np.linalg.solve(K[g, g], rest[g] - K[g, p] @ phi)
+    np.testing.assert_allclose(pm.quasi_static_bending(chain, phi), dense, rtol=1e-12, atol=1e-14)

@@ -1,10 +1,12 @@
 """The O(n) reduced-model solves (rodval.models.reduced_banded: the tip-to-root sweep and the
 banded LU) against the dense numpy reference (ReducedSystem with kernel="numpy": numpy_rhs for
 phi'', recover_bending for gamma)."""
+
 import numpy as np
 import pytest
 
-from rodval.loads import constant, pulse
+from rodval.core.loads import constant, pulse
+from rodval.core.scene import Chain, InitialState, Scene
 from rodval.models import reduced_banded as rb
 from rodval.models.paper_matrices import (
     angle_differences,
@@ -13,22 +15,24 @@ from rodval.models.paper_matrices import (
     convective_terms,
 )
 from rodval.models.reduced import ReducedSystem
-from rodval.scene import Chain, InitialState, Scene
 
 RTOL = 1e-9
-TIMES = (0.3, 0.5, 1.7)       # both loads on; at the X kink; past the pulse (constant only)
+TIMES = (0.3, 0.5, 1.7)  # both loads on; at the X kink; past the pulse (constant only)
 
 
 def make_scene(n: int, damped: bool, loaded: bool, seed: int = 0, kappa=None, mu=None) -> Scene:
     """A non-uniform chain (so that no symmetry hides an index error)."""
     rng = np.random.default_rng(1000 * n + seed)
-    chain = Chain(l=rng.uniform(0.5, 2.5, n), m=rng.uniform(1, 4, n), EI=rng.uniform(1e3, 1e5, n),
-                  mu=rng.uniform(0, 3, n) if mu is None else mu,
-                  kappa=rng.uniform(0, 200, n) if kappa is None else kappa,
-                  nu=rng.uniform(0.01, 0.5, n) if damped else 0.0)
+    chain = Chain(
+        l=rng.uniform(0.5, 2.5, n),
+        m=rng.uniform(1, 4, n),
+        EI=rng.uniform(1e3, 1e5, n),
+        mu=rng.uniform(0, 3, n) if mu is None else mu,
+        kappa=rng.uniform(0, 200, n) if kappa is None else kappa,
+        nu=rng.uniform(0.01, 0.5, n) if damped else 0.0,
+    )
     loads = (pulse(n), constant(max(1, n // 2), X=30.0, Y=-20.0, t_on=0.2)) if loaded else ()
-    return Scene(chain=chain, loads=loads, t_end=2.0,
-                 initial=InitialState(phi=rng.normal(size=n)))
+    return Scene(chain=chain, loads=loads, t_end=2.0, initial=InitialState(phi=rng.normal(size=n)))
 
 
 METHODS = (rb.METHOD_SWEEP, rb.METHOD_BAND)
@@ -49,7 +53,7 @@ def check_scene(sc: Scene, coefficients: str, seed: int, times=TIMES, states: in
     rng = np.random.default_rng(seed)
     for t in times:
         for _ in range(states):
-            phi, dphi = rng.normal(size=n), rng.normal(size=n)    # ~1 rad, ~1 rad/s
+            phi, dphi = rng.normal(size=n), rng.normal(size=n)  # ~1 rad, ~1 rad/s
             y = np.concatenate([phi, dphi])
             want_ddphi, want_gamma = ref.numpy_rhs(t, y)[n:], ref.recover_bending(t, y)
             for method in METHODS:
@@ -110,8 +114,12 @@ def refined_solution(ref: ReducedSystem, t, phi, dphi):
     K, C = ref.K, ref.C if ref.damped else 0.0 * ref.C
     p, g = slice(0, n), slice(n, 3 * n)
     Q = ref.generalized_force(t, phi)
-    r = np.concatenate([(0.0 if Q is None else Q) - h_p - C[p, p] @ dphi - K[p, p] @ phi,
-                        -(h_g + C[g, p] @ dphi + K[g, p] @ phi)])
+    r = np.concatenate(
+        [
+            (0.0 if Q is None else Q) - h_p - C[p, p] @ dphi - K[p, p] @ phi,
+            -(h_g + C[g, p] @ dphi + K[g, p] @ phi),
+        ]
+    )
     A = np.block([[M[p, p], K[p, g]], [M[g, p], K[g, g]]])
     x = np.linalg.solve(A, r)
     AL, rL = A.astype(np.longdouble), r.astype(np.longdouble)
@@ -140,11 +148,14 @@ def test_stiff_hinges_and_wide_parameters(coefficients):
     round-off of the (refined) unreduced solution, where the dense M_r route loses digits."""
     n = 40
     rng = np.random.default_rng(11)
-    chain = Chain(l=10 ** rng.uniform(-1, 0.7, n), m=10 ** rng.uniform(-0.5, 1.5, n),
-                  EI=10 ** rng.uniform(2, 7, n),
-                  mu=np.where(rng.random(n) < 0.5, 0.0, 10 ** rng.uniform(-1, 1, n)),
-                  kappa=np.where(rng.random(n) < 0.3, 1e9, rng.uniform(0, 200, n)),
-                  nu=rng.uniform(0, 0.5, n))
+    chain = Chain(
+        l=10 ** rng.uniform(-1, 0.7, n),
+        m=10 ** rng.uniform(-0.5, 1.5, n),
+        EI=10 ** rng.uniform(2, 7, n),
+        mu=np.where(rng.random(n) < 0.5, 0.0, 10 ** rng.uniform(-1, 1, n)),
+        kappa=np.where(rng.random(n) < 0.3, 1e9, rng.uniform(0, 200, n)),
+        nu=rng.uniform(0, 0.5, n),
+    )
     sc = Scene(chain=chain, loads=(pulse(n),), t_end=2.0)
     ref = ReducedSystem(sc, coefficients, "numpy")
     for _ in range(3):
@@ -183,10 +194,10 @@ def test_accel_wrapper_and_band_structure():
     ddphi, _ = rb.bending_at(Cst, phi, dphi, (SX, SY), True, rb.METHOD_SWEEP)
     np.testing.assert_array_equal(out, ddphi)
     assert_close(out, ref.numpy_rhs(0.3, np.concatenate([phi, dphi]))[n:])
-    scales = Cst[rb.C_RSCALE:]
+    scales = Cst[rb.C_RSCALE :]
     np.testing.assert_array_equal(np.exp2(np.round(np.log2(scales))), scales)
-    T = rb._magnitudes(Cst)                    # (7n, W), row i holds columns i-KL .. i+KL+KU
-    assert not np.any(T[:, rb.KL + rb.KU + 1:]), "the pivoting fill columns must start empty"
+    T = rb._magnitudes(Cst)  # (7n, W), row i holds columns i-KL .. i+KL+KU
+    assert not np.any(T[:, rb.KL + rb.KU + 1 :]), "the pivoting fill columns must start empty"
     for i in range(rb.NB * n):
         cols = i - rb.KL + np.flatnonzero(T[i])
         assert cols.min() >= 0 and cols.max() < rb.NB * n
@@ -201,13 +212,16 @@ def test_work_array_variant(n, method):
     Cst = rb.banded_constants(None, sc.chain, "published")
     rng = np.random.default_rng(4)
     SX, SY = rng.normal(size=n), rng.normal(size=n)
-    work = np.full((rb.work_size(n) if method == rb.METHOD_BAND else rb.sweep_work_size(n)) + 3, np.nan)
+    work = np.full(
+        (rb.work_size(n) if method == rb.METHOD_BAND else rb.sweep_work_size(n)) + 3, np.nan
+    )
     for _ in range(2):
         phi, dphi = rng.normal(size=n), rng.normal(size=n)
         a = np.empty(n), np.empty(2 * n)
         b = np.empty(n), np.empty(2 * n)
-        assert rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, *a,
-                                     np.empty(rb.work_size(n)), method)
+        assert rb.reduced_solve_work(
+            Cst, phi, dphi, True, SX, SY, True, *a, np.empty(rb.work_size(n)), method
+        )
         assert rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, *b, work, method)
         np.testing.assert_array_equal(a[0], b[0])
         np.testing.assert_array_equal(a[1], b[1])
@@ -223,9 +237,14 @@ def test_sweep_and_band_agree_on_a_long_chain(coefficients):
     dense reference would be slow."""
     n = 3000
     rng = np.random.default_rng(8)
-    chain = Chain(l=rng.uniform(0.5, 2.5, n), m=rng.uniform(1, 4, n), EI=rng.uniform(1e3, 1e5, n),
-                  mu=rng.uniform(0, 3, n), kappa=np.where(rng.random(n) < 0.2, 0.0, 100.0),
-                  nu=0.05)
+    chain = Chain(
+        l=rng.uniform(0.5, 2.5, n),
+        m=rng.uniform(1, 4, n),
+        EI=rng.uniform(1e3, 1e5, n),
+        mu=rng.uniform(0, 3, n),
+        kappa=np.where(rng.random(n) < 0.2, 0.0, 100.0),
+        nu=0.05,
+    )
     Cst = rb.banded_constants(None, chain, coefficients)
     phi, dphi = rng.normal(size=n), rng.normal(size=n)
     SX, SY = np.cumsum(rng.normal(size=n)[::-1])[::-1], np.cumsum(rng.normal(size=n)[::-1])[::-1]
@@ -245,13 +264,13 @@ def band_residual(Cst, phi, dphi, SX, SY, ddphi, gamma):
     vec = np.empty(5 * n)
     rb._forces(Cst, phi, dphi, c, s, True, SX, SY, True, vec)
     unscaled = Cst.copy()
-    unscaled[rb.C_RSCALE:] = 1.0
+    unscaled[rb.C_RSCALE :] = 1.0
     A = np.empty((N, rb.W))
     for k in range(n):
         rb._fill_rod(unscaled, k, c, s, A, -1)
     i = rb.NB * np.arange(n)
     b = np.zeros(N)
-    b[i + rb.E_PHI], b[i + rb.E_AL], b[i + rb.E_BE] = vec[:n], vec[n:2 * n], vec[2 * n:3 * n]
+    b[i + rb.E_PHI], b[i + rb.E_AL], b[i + rb.E_BE] = vec[:n], vec[n : 2 * n], vec[2 * n : 3 * n]
     l, M = Cst[rb.V_L], Cst[rb.V_OUTER]
     u = np.zeros(N)
     u[i + rb.U_X], u[i + rb.U_A], u[i + rb.U_B] = ddphi, gamma[:n], gamma[n:]
@@ -275,8 +294,14 @@ def test_backward_error_on_a_long_chain():
     the running sums), which is why the sweep is the default."""
     n = 20000
     rng = np.random.default_rng(12)
-    chain = Chain(l=rng.uniform(0.5, 2.5, n), m=rng.uniform(1, 4, n), EI=rng.uniform(1e3, 1e5, n),
-                  mu=rng.uniform(0, 3, n), kappa=rng.uniform(0, 200, n), nu=rng.uniform(0.01, 0.5, n))
+    chain = Chain(
+        l=rng.uniform(0.5, 2.5, n),
+        m=rng.uniform(1, 4, n),
+        EI=rng.uniform(1e3, 1e5, n),
+        mu=rng.uniform(0, 3, n),
+        kappa=rng.uniform(0, 200, n),
+        nu=rng.uniform(0.01, 0.5, n),
+    )
     Cst = rb.banded_constants(None, chain, "printed")
     phi, dphi = rng.normal(size=n), rng.normal(size=n)
     SX = np.cumsum(rng.normal(size=n)[::-1])[::-1] * 100.0

@@ -190,9 +190,10 @@ def _index(name: str, value, n: int) -> int:
         raise ValueError(
             f"{name} must be an integer hinge index in 0..n-1 = 0..{n - 1}, got {value!r}"
         )
-    if not 0 <= value < n:
+    index = int(value)
+    if not 0 <= index < n:
         raise ValueError(f"{name} must be in 0..n-1 = 0..{n - 1}, got {value}")
-    return int(value)
+    return index
 
 
 def _finite(name: str, value, unit: str, *, positive: bool | None = None) -> float:

@@ -16,11 +16,13 @@ from rodval.models.paper_matrices import (
     angle_jacobian,
     assemble_mass,
     convective_terms,
+    potential_energy,
 )
 from rodval.models.paper_system import PaperModel, PaperSystem
 
 
 class FullSystem(PaperSystem):
+    full = True
     accel_kernel = staticmethod(kernels.full_accel)
     compiled_rhs = staticmethod(kernels.full_rhs)
     compiled_mechanics = staticmethod(kernels.full_mechanics)
@@ -34,13 +36,13 @@ class FullSystem(PaperSystem):
         self.use_kernel()
 
     def kernel_constants(self):
-        return kernels.full_constants(self.cc, self.scene.chain), np.zeros((0, self.n, self.n))
+        return kernels.full_constants(self.cc, self.scene.chain)
 
     def forces(self, t: float, q: np.ndarray, v: np.ndarray, skj: np.ndarray) -> np.ndarray:
         """Right-hand side f = [Q; 0; 0] - h - C q' - K q of M q'' = f (3n)."""
         n = self.n
         h_phi, h_gamma = convective_terms(self.cc, skj, v[:n], v[n : 2 * n], v[2 * n :])
-        f = -(self.K @ q)
+        f = self.rest - self.K @ q
         if self.damped:
             f -= self.C @ v
         f[:n] -= h_phi
@@ -108,8 +110,10 @@ class FullSystem(PaperSystem):
         return y[3 * self.n :]
 
     def energy_budget(self, t, y):
-        q = y[: 3 * self.n]
-        return self.kinetic_energy(t, y) + 0.5 * float(q @ self.K @ q)
+        n = self.n
+        return self.kinetic_energy(t, y) + float(
+            potential_energy(self.chain, y[:n], y[n : 2 * n], y[2 * n : 3 * n])
+        )
 
     def rigid(self, Y):
         n = self.n

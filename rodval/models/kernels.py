@@ -1,13 +1,15 @@
-"""Compiled (numba) right-hand sides of the paper's full and reduced models.
+"""Compiled (numba) kernels of the paper's models: the full model's right-hand side and the
+O(n) helpers both models share (the reduced model's solve is in ``reduced_banded``).
 
-The numpy right-hand sides in ``full.py``/``reduced.py`` are the straightforward reference
-(``kernel="numpy"``); the kernels here compute the same accelerations with the chain
-structure exploited (``kernel="numba"``, the default):
+The numpy right-hand sides in ``full.py``/``reduced.py`` are the straightforward dense
+reference (``kernel="numpy"``); the kernels compute the same with the chain structure
+exploited (``kernel="numba"``, the default):
 
 * every product with an angle-dependent block (M_pp, G_pp, U = M_pa off-diagonal, G_pa and
   their transposes) is O(n): with c_kj = c_k c_j + s_k s_j and s_kj = s_k c_j - c_k s_j the
   sums over j < k or j > k are running (prefix/suffix) sums;
-* K q and C q' go through the hinge angles D = A q (A bidiagonal), O(n);
+* K q and C q' go through the hinge angles D = A q (A bidiagonal), springs about their rest
+  angles, O(n);
 * the full model's 3n x 3n solve eliminates the bending coordinates (M_gg is constant and
   2 x 2 block diagonal per rod); the n x n Schur complement S = M_pp - M_pg M_gg^-1 M_gp is
   "diagonal + rank-2 semiseparable": S[k,j] = a_k . b_j (k > j), b_k . e_j (k < j), so its
@@ -15,16 +17,11 @@ structure exploited (``kernel="numba"``, the default):
   by Foreman-Mackey et al. 2017, "celerite", generalised to a non-symmetric matrix for the
   ``published`` coefficients).
 
-The reduced model's M_r = M_pp - P M_gp has the dense constant factor P = K_pg B^-1, so it
-is assembled in O(n^2) and solved densely (O(n^3), n is small for that model).
-
-Each model has an acceleration kernel with one argument list,
-``*_accel(V, Mt, y, has_load, SX, SY, damped, out)`` (used by the Python-side right-hand side,
-whose loads may be any callable), and a right-hand side of the compiled integrators' type
-``rodval.solvers.compiled.RHS_TYPE`` (``full_rhs``, ``reduced_rhs``; loads from the compiled
-load table, ``rodval.core.loads.load_sums``). Parameters are packed into plain arrays:
-``V`` (rows of length-n vectors, layout ``V_*`` below), ``Mt`` (stack of n x n matrices of the
-reduced model, layout ``M_*``; empty for the full model), ``S = [damped]``.
+Argument conventions: ``full_accel(V, y, has_load, SX, SY, damped, out)`` for the Python-side
+right-hand side (whose loads may be any callable); ``full_rhs`` and ``*_mechanics`` have the
+compiled integrators' type ``rodval.solvers.signature.RHS_TYPE`` (loads from the compiled load
+table, ``rodval.core.loads.load_sums``). ``V`` holds rows of length-n vectors (layout ``V_*``
+below), ``S = [damped]``.
 """
 
 from __future__ import annotations
@@ -33,25 +30,25 @@ import numpy as np
 from numba import njit
 
 from rodval.core.loads import load_sums
-from rodval.solvers.compiled import RHS_SIGNATURE
+from rodval.solvers.signature import RHS_SIGNATURE
 
 # Rows of V (per-rod vectors). Shared by both models.
-V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB = range(7)
+V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST = range(8)
 # Full model only: Schur-complement constants per rod (see full_constants).
-V_PA, V_PB, V_AP, V_BP, V_AA, V_AB, V_EPS, V_PI, V_RHO, V_TAU = range(7, 17)
-# Stack Mt of the reduced model: P_a - P_b, P_a ap + P_b bp, K_r, C_r.
-M_PDIFF, M_PDIAG, M_KR, M_CR = range(4)
+V_PA, V_PB, V_AP, V_BP, V_AA, V_AB, V_EPS, V_PI, V_RHO, V_TAU = range(8, 18)
 
 
 def _rows(cc, chain) -> list[np.ndarray]:
+    """The rows V_L .. V_REST shared by every kernel (and by reduced_banded's constants)."""
     return [
         cc.l,
         cc.outer_mass,
         cc.pp_diag,
-        chain.m * chain.l**2 / 12.0,
+        cc.w,
         chain.kappa,
         chain.nu,
         4.0 * chain.EI / chain.l,
+        chain.rest_angle,
     ]
 
 
@@ -83,21 +80,17 @@ def full_constants(cc, chain) -> np.ndarray:
     return np.ascontiguousarray(np.vstack(rows), dtype=np.float64)
 
 
-def reduced_constants(cc, chain, P_diff, P_diag, K_r, C_r) -> tuple[np.ndarray, np.ndarray]:
-    """(V, Mt) for the reduced model."""
-    V = np.ascontiguousarray(np.vstack(_rows(cc, chain)), dtype=np.float64)
-    Mt = np.ascontiguousarray(np.stack([P_diff, P_diag, K_r, C_r]), dtype=np.float64)
-    return V, Mt
-
-
 @njit(cache=True)
 def _hinge_forces(V, phi, alpha, beta, row, out_p, out_a, out_b):
-    """out += A^T diag(V[row]) A [phi; alpha; beta] (hinge springs or dampers), O(n)."""
+    """out += A^T diag(V[row]) (A [phi; alpha; beta] - rest), O(n): hinge springs about
+    their rest angles (row V_KAPPA) or dampers (row V_NU: no rest rate)."""
     n = phi.shape[0]
     for i in range(n):
         D = phi[i] + alpha[i]
         if i > 0:
             D -= phi[i - 1] + beta[i - 1]
+        if row == V_KAPPA:
+            D -= V[V_REST, i]
         T = V[row, i] * D
         out_p[i] += T
         out_a[i] += T
@@ -222,10 +215,10 @@ def _schur_solve(V, c, s, r, x):
 
 
 @njit(cache=True)
-def full_accel(V, Mt, y, has_load, SX, SY, damped, out):
+def full_accel(V, y, has_load, SX, SY, damped, out):
     """Accelerations q'' (3n) of the full model at y = [q; q'] into ``out``: M(phi) q'' =
     [Q; 0; 0] - h - C q' - K q. SX, SY are the load suffix sums (N), used when ``has_load``.
-    O(n) time and memory (``Mt`` is unused)."""
+    O(n) time and memory."""
     n = V.shape[1]
     q, v = y[: 3 * n], y[3 * n :]
     phi, alpha, beta = q[:n], q[n : 2 * n], q[2 * n :]
@@ -276,55 +269,6 @@ def full_accel(V, Mt, y, has_load, SX, SY, damped, out):
         out[2 * n + k] = (aa[k] * rb - ab[k] * ra) / det
 
 
-@njit(cache=True)
-def reduced_matrix(V, Mt, c, s):
-    """M_r(phi) = M_pp - (P_a - P_b) U^T - (P_a ap + P_b bp), O(n^2) (U^T by running sums)."""
-    n = c.shape[0]
-    l, outer = V[V_L], V[V_OUTER]
-    w = V[V_W]
-    Pd = Mt[M_PDIFF]
-    M = -Mt[M_PDIAG].copy()
-    for k in range(n):
-        M[k, k] += V[V_PPDIAG, k]
-        for j in range(k):
-            v = l[k] * l[j] * outer[k] * (c[k] * c[j] + s[k] * s[j])
-            M[k, j] += v
-            M[j, k] += v
-    # (Pd U^T)[i, k] = l_k sum_{j>k} Pd[i, j] w_j c_kj: suffix sums over j per row i.
-    for i in range(n):
-        acc_c = 0.0
-        acc_s = 0.0
-        for k in range(n - 1, -1, -1):
-            M[i, k] -= l[k] * (c[k] * acc_c + s[k] * acc_s)
-            acc_c += Pd[i, k] * w[k] * c[k]
-            acc_s += Pd[i, k] * w[k] * s[k]
-    return M
-
-
-@njit(cache=True)
-def reduced_accel(V, Mt, y, has_load, SX, SY, damped, out):
-    """phi'' of the reduced model at y = [phi; phi'] into ``out``: M_r phi'' = Q - G_r phi'^2
-    - C_r phi' - K_r phi, G_r phi'^2 = G_pp phi'^2 + (P_a - P_b) G_pa^T phi'^2.
-    O(n^2) assembly and O(n^3) dense solve."""
-    n = V.shape[1]
-    phi, dphi = y[:n], y[n:]
-    c = np.cos(phi)
-    s = np.sin(phi)
-    w2 = dphi * dphi
-    f = -(Mt[M_KR] @ phi)
-    if damped:
-        f -= Mt[M_CR] @ dphi
-    _gpp_times(V, c, s, w2, f)
-    gt = np.zeros(n)
-    _upper_t_times(V, c, s, w2, False, gt, 1.0)
-    f -= Mt[M_PDIFF] @ gt
-    if has_load:
-        l = V[V_L]
-        for k in range(n):
-            f[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
-    out[:] = np.linalg.solve(reduced_matrix(V, Mt, c, s), f)
-
-
 @njit(RHS_SIGNATURE, cache=True)
 def full_rhs(t, y, P, S, M, L, out):
     """y' of the full model (compiled integrators' right-hand side, loads from table L)."""
@@ -334,19 +278,7 @@ def full_rhs(t, y, P, S, M, L, out):
     SX = np.empty(n)
     SY = np.empty(n)
     has_load = load_sums(L, t, SX, SY)
-    full_accel(P, M, y, has_load, SX, SY, S[0] != 0.0, out[half:])
-
-
-@njit(RHS_SIGNATURE, cache=True)
-def reduced_rhs(t, y, P, S, M, L, out):
-    """y' of the reduced model (compiled integrators' right-hand side, loads from table L)."""
-    half = y.shape[0] // 2
-    out[:half] = y[half:]
-    n = P.shape[1]
-    SX = np.empty(n)
-    SY = np.empty(n)
-    has_load = load_sums(L, t, SX, SY)
-    reduced_accel(P, M, y, has_load, SX, SY, S[0] != 0.0, out[half:])
+    full_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[half:])
 
 
 @njit(cache=True)

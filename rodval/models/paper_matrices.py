@@ -34,24 +34,27 @@ kept only to document that erratum (see model.md).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
+from scipy.linalg import solveh_banded
 
-from rodval.core.scene import Chain
+from rodval.core.scene import Chain, hinge_angles
 
 VARIANTS = ("printed", "published")
 
 
 @dataclass(frozen=True, eq=False)
 class ChainConstants:
-    """Angle-independent arrays of a chain, computed once per scene."""
+    """Angle-independent arrays of a chain, computed once per scene: per-rod vectors (O(n));
+    the two n x n scales of the dense reference (``pp_scale``, ``w_upper``) only when asked
+    for (the O(n) kernels never ask)."""
 
     n: int
     l: np.ndarray
+    w: np.ndarray  # m l^2 / 12 (kg m)
     outer_mass: np.ndarray  # M_k (kg)
-    pp_scale: np.ndarray  # l_k l_j M_max(k,j), (n, n)
     pp_diag: np.ndarray  # diagonal of M_pp (kg m^2)
-    w_upper: np.ndarray  # w_j l_k for k < j, else 0 (kg m^2), (n, n)
     pa_diag: np.ndarray  # m l^3/30 in phi rows
     pb_diag: np.ndarray  # -m l^3/20 in phi rows
     ap_diag: np.ndarray  # bending-row diagonal coupling (variant dependent)
@@ -59,30 +62,33 @@ class ChainConstants:
     aa_diag: np.ndarray  # m l^3/105
     ab_diag: np.ndarray  # -m l^3/140
 
+    @cached_property
+    def pp_scale(self) -> np.ndarray:
+        """l_k l_j M_max(k,j), (n, n): O(n^2) memory, for the dense reference only."""
+        idx = np.arange(self.n)
+        return np.outer(self.l, self.l) * self.outer_mass[np.maximum.outer(idx, idx)]
+
+    @cached_property
+    def w_upper(self) -> np.ndarray:
+        """w_j l_k for k < j, else 0 (kg m^2), (n, n): for the dense reference only."""
+        return np.triu(np.outer(self.l, self.w), k=1)
+
 
 def chain_constants(chain: Chain, variant: str = "printed") -> ChainConstants:
-    """Precompute everything in M and G that does not depend on the angles."""
+    """Precompute everything in M and G that does not depend on the angles (O(n))."""
     if variant not in VARIANTS:
         raise ValueError(f"coefficients must be one of {VARIANTS}, got {variant!r}")
     l, m, mu = chain.l, chain.m, chain.mu
-    n = chain.n
     rod_mass = m * l
     outer = np.cumsum((mu + rod_mass)[::-1])[::-1] - rod_mass / 2.0
-    idx = np.arange(n)
-    kmax = np.maximum.outer(idx, idx)
-    pp_scale = np.outer(l, l) * outer[kmax]
-    pp_diag = l**2 * (outer - rod_mass / 2.0) + m * l**3 / 3.0
-    w = m * l**2 / 12.0
-    w_upper = np.triu(np.outer(l, w), k=1)  # [k, j] = l_k w_j for k < j
     ml3 = m * l**3
     half = 0.5 if variant == "published" else 1.0
     return ChainConstants(
-        n=n,
+        n=chain.n,
         l=l,
+        w=m * l**2 / 12.0,
         outer_mass=outer,
-        pp_scale=pp_scale,
-        pp_diag=pp_diag,
-        w_upper=w_upper,
+        pp_diag=l**2 * (outer - rod_mass / 2.0) + ml3 / 3.0,
         pa_diag=ml3 / 30.0,
         pb_diag=-ml3 / 20.0,
         ap_diag=half * ml3 / 30.0,
@@ -185,6 +191,58 @@ def stiffness_matrix(chain: Chain) -> np.ndarray:
     K[n + d, 2 * n + d] += kb / 2.0
     K[2 * n + d, n + d] += kb / 2.0
     return K
+
+
+def rest_forces(chain: Chain) -> np.ndarray:
+    """A^T (kappa * rest_angle) (N m, 3n): with it the spring forces are K q - A^T kappa rest,
+    the gradient of 1/2 sum kappa_k (D_k - rest_k)^2."""
+    t = chain.kappa * chain.rest_angle
+    f = np.zeros(3 * chain.n)
+    f[: chain.n] += t
+    f[chain.n : 2 * chain.n] += t
+    f[: chain.n - 1] -= t[1:]
+    f[2 * chain.n : 3 * chain.n - 1] -= t[1:]
+    return f
+
+
+def potential_energy(
+    chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray
+) -> np.ndarray:
+    """Pi = 1/2 sum_k kappa_k (D_k - rest_k)^2 + 1/2 sum_k (4 EI_k/l_k)(a^2 + a b + b^2) (J),
+    per row of (..., n) arrays, O(n)."""
+    D = hinge_angles(phi, alpha, beta) - chain.rest_angle
+    kb = 4.0 * chain.EI / chain.l
+    return 0.5 * np.sum(
+        chain.kappa * D * D + kb * (alpha * alpha + alpha * beta + beta * beta), axis=-1
+    )
+
+
+def quasi_static_bending(chain: Chain, phi: np.ndarray) -> np.ndarray:
+    """gamma = [alpha; beta] (rad) minimising Pi at fixed phi: B gamma = A_g^T kappa rest -
+    K_gp phi with B = K_gg, which is tridiagonal in the order (alpha_1, beta_1, alpha_2, ...)
+    and positive definite (EI > 0); O(n) by a banded Cholesky solve."""
+    n = chain.n
+    kappa, kb = chain.kappa, 4.0 * chain.EI / chain.l
+    dphi = phi - np.concatenate([[0.0], phi[:-1]]) - chain.rest_angle  # D_i at gamma = 0
+    kap_next = np.concatenate([kappa[1:], [0.0]])
+    diag = np.empty(2 * n)
+    diag[0::2] = kb + kappa
+    diag[1::2] = kb + kap_next
+    off = np.empty(2 * n)  # upper diagonal: (alpha_i, beta_i) = kb/2, (beta_i, alpha_i+1) = -kappa
+    off[0] = 0.0
+    off[1::2] = kb / 2.0
+    off[2::2] = -kappa[1:]
+    rhs = np.empty(2 * n)
+    rhs[0::2] = -kappa * dphi
+    rhs[1::2] = np.concatenate([kappa[1:] * dphi[1:], [0.0]])
+    x = solveh_banded(np.vstack([off, diag]), rhs)
+    return np.concatenate([x[0::2], x[1::2]])
+
+
+def damper_power(chain: Chain, dphi: np.ndarray, dalpha: np.ndarray, dbeta: np.ndarray) -> float:
+    """P_diss = sum_k nu_k (dD_k/dt)^2 >= 0 (W), O(n)."""
+    rates = hinge_angles(dphi, dalpha, dbeta)
+    return float(np.sum(chain.nu * rates * rates))
 
 
 def damping_matrix(chain: Chain) -> np.ndarray:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -10,13 +11,16 @@ from rodval.core.loads import LoadSet, load_table
 from rodval.core.scene import Scene
 from rodval.models.paper_matrices import (
     VARIANTS,
+    ChainConstants,
     angle_differences,
     assemble_mass,
     chain_constants,
+    damper_power,
     damping_matrix,
     generalized_forces,
-    hinge_matrix,
     node_positions,
+    potential_energy,
+    rest_forces,
     stiffness_matrix,
 )
 from rodval.solvers.ode_model import OdeModel
@@ -34,7 +38,9 @@ class PaperSystem(OdeSystem):
 
     has_jacobian = True
     has_energy = True
-    #: kernels.*_accel(V, Mt, y, has_load, SX, SY, damped, out) and the RHS_TYPE function.
+    #: True for the full model (state [q; q'], 6n), False for the reduced one ([phi; phi']).
+    full: bool
+    #: accel(V, y, has_load, SX, SY, damped, out) and the RHS_TYPE functions (rhs, mechanics).
     accel_kernel: Any
     compiled_rhs: Any
     compiled_mechanics: Any
@@ -43,32 +49,49 @@ class PaperSystem(OdeSystem):
         if kernel not in KERNELS:
             raise ValueError(f"kernel must be one of {KERNELS}, got {kernel!r}")
         self.kernel = kernel
+        self.coefficients = coefficients
         chain = scene.chain
+        self.chain = chain
         self.scene = scene
         self.n = chain.n
         self.l = chain.l
         self.cc = chain_constants(chain, coefficients)
-        # the kinetic energy always uses the kinematic (printed, symmetric) mass matrix
-        self.cc_kinetic = self.cc if coefficients == "printed" else chain_constants(chain)
-        self.A = hinge_matrix(chain.n)
-        self.nu = chain.nu
-        self.K = stiffness_matrix(chain)
-        self.C = damping_matrix(chain)
         self.damped = bool(np.any(chain.nu > 0))
         self.loads = LoadSet(scene.loads, chain.n)
         self.initial = scene.initial.resolve(chain.n)
+
+    # Dense matrices of the numpy reference and the analytic Jacobians (O(n^2) memory): built
+    # only when one of those asks; the default O(n) path never does.
+    @cached_property
+    def K(self) -> np.ndarray:
+        return stiffness_matrix(self.chain)
+
+    @cached_property
+    def C(self) -> np.ndarray:
+        return damping_matrix(self.chain)
+
+    @cached_property
+    def rest(self) -> np.ndarray:
+        """A^T kappa rest (N m, 3n): spring forces are K q - rest."""
+        return rest_forces(self.chain)
+
+    @cached_property
+    def cc_kinetic(self) -> ChainConstants:
+        """The kinetic energy always uses the kinematic (printed, symmetric) mass matrix."""
+        return self.cc if self.coefficients == "printed" else chain_constants(self.chain)
 
     def use_kernel(self) -> None:
         """Set up the compiled kernel (subclasses call this last in __init__) and evaluate it
         once, so that loading or compiling it is not part of the integration's wall time."""
         if self.kernel == "numba":
-            self.V, self.Mt = self.kernel_constants()
+            self.V = self.kernel_constants()
             self._no_load = np.zeros(self.n)
             self._flags = np.array([1.0 if self.damped else 0.0])
+            self._mech = np.zeros(2)
         self.rhs(0.0, self.y0)
 
-    def kernel_constants(self) -> tuple[np.ndarray, np.ndarray]:
-        """(V, Mt) of ``rodval.models.kernels`` for this system."""
+    def kernel_constants(self) -> np.ndarray:
+        """The compiled kernels' constant rows V for this system (O(n))."""
         raise NotImplementedError
 
     def numpy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -82,7 +105,7 @@ class PaperSystem(OdeSystem):
         half = y.size // 2
         out = np.empty_like(y)
         out[:half] = y[half:]
-        self.accel_kernel(self.V, self.Mt, y, sums is not None, SX, SY, self.damped, out[half:])
+        self.accel_kernel(self.V, y, sums is not None, SX, SY, self.damped, out[half:])
         return out
 
     def compiled(self) -> CompiledForm | None:
@@ -97,7 +120,7 @@ class PaperSystem(OdeSystem):
             self.compiled_rhs,
             self.V,
             self._flags,
-            self.Mt,
+            _NO_MATRICES,
             table,
             mechanics=self.compiled_mechanics,
             name=type(self).__name__,
@@ -135,8 +158,9 @@ class PaperSystem(OdeSystem):
         p_ext = 0.0 if Q is None else float(Q @ dphi)
         if not self.damped:
             return p_ext, 0.0
-        hinge_rates = self.A @ self.generalized_rates(y)
-        return p_ext, float(self.nu @ (hinge_rates * hinge_rates))
+        n = self.n
+        v = self.generalized_rates(y)
+        return p_ext, damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n :])
 
     def observe(self, times, Y):
         scene, n = self.scene, self.n
@@ -169,20 +193,37 @@ class PaperSystem(OdeSystem):
         return out
 
     def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
+        """1/2 v^T M(phi) v with the kinematic mass matrix: the compiled O(n) form, or the
+        dense one with the numpy kernel (the reference)."""
+        if self.kernel == "numba":
+            n = self.n
+            y = (
+                np.concatenate([phi, np.zeros(2 * n), v])
+                if self.full
+                else np.concatenate([phi, v[:n]])
+            )
+            self.compiled_mechanics(
+                0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech
+            )
+            return float(self._mech[0])
         return 0.5 * float(v @ assemble_mass(self.cc_kinetic, angle_differences(phi)[0]) @ v)
 
     def kinetic_energy(self, t: float, y: np.ndarray) -> float:
-        """T = 1/2 q'^T M(phi) q' (J) at one state, without recovering bending angles."""
+        """T = 1/2 q'^T M(phi) q' (J) at one state, without recovering bending angles; O(n)
+        with the compiled kernels."""
         return self._kinetic(self.rigid(y[None, :])[0][0], self.generalized_rates(y))
 
     def energies(self, phi, dphi, alpha, beta, dalpha, dbeta) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic T = 1/2 q'^T M(phi) q' with the kinematic (printed) mass matrix, and
-        Pi = 1/2 q^T K q (J), per output time."""
-        q = np.concatenate([phi, alpha, beta], axis=1)
+        Pi = 1/2 sum kappa (D - rest)^2 + bending (J), per output time; O(n) each."""
         v = np.concatenate([dphi, dalpha, dbeta], axis=1)
         kin = np.array([self._kinetic(p, vi) for p, vi in zip(phi, v)])
-        pot = 0.5 * np.einsum("ti,ij,tj->t", q, self.K, q)
-        return kin, pot
+        return kin, potential_energy(self.chain, phi, alpha, beta)
+
+
+#: Placeholders for the compiled forms' unused arrays (no dense matrices, no loads).
+_NO_MATRICES = np.zeros((0, 0, 0))
+_NO_LOADS = np.zeros((0, 9))
 
 
 class PaperModel(OdeModel):

@@ -14,59 +14,82 @@ energy) are asked for. State y = [phi; phi'] (2n).
 
 from __future__ import annotations
 
+from functools import cached_property
+from types import SimpleNamespace
+
 import numpy as np
 
 from rodval.core.scene import Scene
-from rodval.models import kernels
-from rodval.models.paper_matrices import angle_differences, angle_jacobian
+from rodval.models import kernels, reduced_banded
+from rodval.models.paper_matrices import (
+    angle_differences,
+    angle_jacobian,
+    potential_energy,
+    quasi_static_bending,
+)
 from rodval.models.paper_system import PaperModel, PaperSystem
 
 
 class ReducedSystem(PaperSystem):
-    accel_kernel = staticmethod(kernels.reduced_accel)
-    compiled_rhs = staticmethod(kernels.reduced_rhs)
+    full = False
+    accel_kernel = staticmethod(reduced_banded.reduced_accel)
+    compiled_rhs = staticmethod(reduced_banded.reduced_rhs)
     compiled_mechanics = staticmethod(kernels.reduced_mechanics)
 
     def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
         super().__init__(scene, coefficients, kernel)
-        n = self.n
-        p, g = slice(0, n), slice(n, 3 * n)
-        K, C = self.K, self.C
-        self.B = K[g, g]
-        self.B_inv = np.linalg.inv(self.B)
-        P = K[p, g] @ self.B_inv  # K_pg B^-1, (n, 2n)
-        self.P_diff = P[:, :n] - P[:, n:]  # P_a - P_b
-        self.P_a, self.P_b = P[:, :n], P[:, n:]
-        self.K_r = K[p, p] - P @ K[g, p]
-        self.C_r = C[p, p] - P @ C[g, p]
-        self.K_gp, self.C_gp = K[g, p], C[g, p]
         i = self.initial
         self.y0 = np.concatenate([i["phi"], i["dphi"]])
         self.use_kernel()
 
     def kernel_constants(self):
-        P_diag = self.P_a * self.cc.ap_diag + self.P_b * self.cc.bp_diag
-        return kernels.reduced_constants(
-            self.cc, self.scene.chain, self.P_diff, P_diag, self.K_r, self.C_r
+        return reduced_banded.banded_constants(self.cc, self.chain)
+
+    # The dense reference (kernel="numpy") and the analytic Jacobian: O(n^2) memory, O(n^3)
+    # set-up, built only when one of them asks.
+    @cached_property
+    def _dense(self) -> SimpleNamespace:
+        n = self.n
+        p, g = slice(0, n), slice(n, 3 * n)
+        K, C = self.K, self.C
+        B_inv = np.linalg.inv(K[g, g])
+        P = K[p, g] @ B_inv  # K_pg B^-1, (n, 2n)
+        return SimpleNamespace(
+            B_inv=B_inv,
+            P_a=P[:, :n],
+            P_b=P[:, n:],
+            P_diff=P[:, :n] - P[:, n:],
+            K_r=K[p, p] - P @ K[g, p],
+            C_r=C[p, p] - P @ C[g, p],
+            K_gp=K[g, p],
+            C_gp=C[g, p],
+            rest_r=self.rest[p] - P @ self.rest[g],
+            rest_g=self.rest[g],
         )
+
+    @property
+    def K_r(self) -> np.ndarray:
+        """Reduced stiffness K_pp - K_pg B^-1 K_gp (N m/rad, n x n, dense)."""
+        return self._dense.K_r
 
     def reduced_matrices(self, phi: np.ndarray):
         """M_r(phi), G_r(phi) and the bending-row blocks M_gp, G_gp (for recovery)."""
-        cc = self.cc
+        cc, d = self.cc, self._dense
         ckj, skj = angle_differences(phi)
         U, G_pa = cc.w_upper * ckj, cc.w_upper * skj
         M_pp = cc.pp_scale * ckj
         np.fill_diagonal(M_pp, cc.pp_diag)
         # M_ap = U^T + diag(ap), M_bp = -U^T + diag(bp); G_ap = -G_pa^T, G_bp = G_pa^T
-        M_r = M_pp - self.P_diff @ U.T - self.P_a * cc.ap_diag - self.P_b * cc.bp_diag
-        G_r = cc.pp_scale * skj + self.P_diff @ G_pa.T
+        M_r = M_pp - d.P_diff @ U.T - d.P_a * cc.ap_diag - d.P_b * cc.bp_diag
+        G_r = cc.pp_scale * skj + d.P_diff @ G_pa.T
         return M_r, G_r, U, G_pa
 
     def forces(self, t: float, phi: np.ndarray, dphi: np.ndarray, G_r: np.ndarray) -> np.ndarray:
-        """f_r = Q - G_r phi'^2 - C_r phi' - K_r phi of M_r phi'' = f_r (n)."""
-        f = -(self.K_r @ phi) - G_r @ (dphi * dphi)
+        """f_r = Q - G_r phi'^2 - C_r phi' - K_r phi + rest_r of M_r phi'' = f_r (n)."""
+        d = self._dense
+        f = d.rest_r - d.K_r @ phi - G_r @ (dphi * dphi)
         if self.damped:
-            f -= self.C_r @ dphi
+            f -= d.C_r @ dphi
         Q = self.generalized_force(t, phi)
         if Q is not None:
             f += Q
@@ -81,30 +104,36 @@ class ReducedSystem(PaperSystem):
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         """Analytic Jacobian df/dy (2n, 2n): [[0, I], [M_r^-1 (df_r/dphi - dM_r/dphi phi''),
         M_r^-1 df_r/dphi']]."""
-        n, cc = self.n, self.cc
+        n, cc, d = self.n, self.cc, self._dense
         phi, dphi = y[:n], y[n:]
         ckj, skj = angle_differences(phi)
         M_r, G_r, _, G_pa = self.reduced_matrices(phi)
         a = np.linalg.solve(M_r, self.forces(t, phi, dphi, G_r))
         Wt, w2 = cc.w_upper.T, dphi * dphi
         # M_r a = M_pp a - P_diff (W^T o c_jk) a - const;  G_pa^T w2 = -(W^T o s_jk) w2
-        dM_a = angle_jacobian(cc.pp_scale, -skj, a) - self.P_diff @ angle_jacobian(Wt, -skj, a)
-        dG_w2 = angle_jacobian(cc.pp_scale, ckj, w2) - self.P_diff @ angle_jacobian(Wt, ckj, w2)
-        dfdphi = -self.K_r - dG_w2 - dM_a
+        dM_a = angle_jacobian(cc.pp_scale, -skj, a) - d.P_diff @ angle_jacobian(Wt, -skj, a)
+        dG_w2 = angle_jacobian(cc.pp_scale, ckj, w2) - d.P_diff @ angle_jacobian(Wt, ckj, w2)
+        dfdphi = -d.K_r - dG_w2 - dM_a
         sums = self.loads.suffix_sums(t)
         if sums is not None:
             SX, SY = sums
             dfdphi[np.arange(n), np.arange(n)] -= self.l * (np.sin(phi) * SY + np.cos(phi) * SX)
-        dfdv = -2.0 * G_r * dphi - (self.C_r if self.damped else 0.0)
+        dfdv = -2.0 * G_r * dphi - (d.C_r if self.damped else 0.0)
         J = np.zeros((2 * n, 2 * n))
         J[:n, n:] = np.eye(n)
         J[n:] = np.linalg.solve(M_r, np.hstack([dfdphi, dfdv]))
         return J
 
     def recover_bending(self, t: float, y: np.ndarray) -> np.ndarray:
-        """gamma = [alpha; beta] (rad) at one time from the algebraic bending rows."""
-        n, cc = self.n, self.cc
+        """gamma = [alpha; beta] (rad) at one time from the algebraic bending rows: the O(n)
+        solve with the compiled kernel, the dense elimination with the numpy one."""
+        n = self.n
         phi, dphi = y[:n], y[n:]
+        if self.kernel == "numba":
+            return reduced_banded.bending_at(
+                self.V, phi, dphi, self.loads.suffix_sums(t), self.damped
+            )[1]
+        cc, d = self.cc, self._dense
         M_r, G_r, U, G_pa = self.reduced_matrices(phi)  # once: phi'' and gamma share them
         ddphi = np.linalg.solve(M_r, self.forces(t, phi, dphi, G_r))
         w2 = dphi * dphi
@@ -113,10 +142,10 @@ class ReducedSystem(PaperSystem):
         r = np.concatenate(
             [Ut_dd + cc.ap_diag * ddphi - GT_w2, -Ut_dd + cc.bp_diag * ddphi + GT_w2]
         )
-        r += self.K_gp @ phi
+        r += d.K_gp @ phi - d.rest_g
         if self.damped:
-            r += self.C_gp @ dphi
-        return -self.B_inv @ r
+            r += d.C_gp @ dphi
+        return -d.B_inv @ r
 
     def generalized_rates(self, y):
         """[phi'; 0; 0]: the reduced model drops the bending rates from its kinetic energy and
@@ -125,10 +154,13 @@ class ReducedSystem(PaperSystem):
         return np.concatenate([y[n:], np.zeros(2 * n)])
 
     def energy_budget(self, t, y):
-        """T + 1/2 phi^T K_r phi: K_r is the Schur complement of B in K, so this is Pi at the
-        quasi-static bending gamma = -B^-1 K_gp phi (exact when phi'' = phi' = 0)."""
-        phi = y[: self.n]
-        return self.kinetic_energy(t, y) + 0.5 * float(phi @ self.K_r @ phi)
+        """T + Pi at the quasi-static bending gamma = B^-1 (A_g^T kappa rest - K_gp phi)
+        (exact when phi'' = phi' = 0); O(n)."""
+        n = self.n
+        gamma = quasi_static_bending(self.chain, y[:n])
+        return self.kinetic_energy(t, y) + float(
+            potential_energy(self.chain, y[:n], gamma[:n], gamma[n:])
+        )
 
     def rigid(self, Y):
         n = self.n

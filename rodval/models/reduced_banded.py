@@ -69,30 +69,33 @@ Cost: O(n) time and memory per evaluation, no n x n array anywhere: the sweep ~2
 19 doubles per rod, the banded LU ~800 flops and ~90 doubles per rod (U factor 7n x 11). phi''
 and gamma come out of the same solve, so the bending recovery is the same routine.
 """
-from __future__ import annotations
 
-from types import SimpleNamespace
+from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-from .kernels import (
+from rodval.core.loads import load_sums
+from rodval.models.kernels import (
     V_KAPPA,
     V_KB,
     V_L,
     V_NU,
     V_OUTER,
     V_PPDIAG,
+    V_REST,
     V_W,
     _gpp_times,
     _hinge_forces,
+    _rows,
     _upper_t_times,
 )
-from .paper_matrices import VARIANTS
+from rodval.models.paper_matrices import chain_constants
+from rodval.solvers.signature import RHS_SIGNATURE
 
 # Rows of Cst: the first rows are laid out like kernels.V (so that the kernels' O(n) helpers
 # read them), then the bending-row diagonals and the equilibration scales.
-_BASE = max(V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB) + 1
+_BASE = max(V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST) + 1
 C_AP, C_BP = _BASE, _BASE + 1
 #: first of 7 rows of row scales (one per local equation) and of 7 rows of column scales
 C_RSCALE = _BASE + 2
@@ -130,10 +133,10 @@ def _fill_rod(Cst, k, c, s, A, mask):
     for i in range(r0, r0 + NB):
         for o in range(W):
             A[i & mask, o] = 0.0
-    R = Cst[C_RSCALE:C_RSCALE + NB, k]           # this rod's row scales
-    Ch = Cst[C_CSCALE:C_CSCALE + NB, k]          # column scales: this rod, previous, next
-    Cp = Cst[C_CSCALE:C_CSCALE + NB, k - 1] if k > 0 else Ch
-    Cn = Cst[C_CSCALE:C_CSCALE + NB, k + 1] if k + 1 < n else Ch
+    R = Cst[C_RSCALE : C_RSCALE + NB, k]  # this rod's row scales
+    Ch = Cst[C_CSCALE : C_CSCALE + NB, k]  # column scales: this rod, previous, next
+    Cp = Cst[C_CSCALE : C_CSCALE + NB, k - 1] if k > 0 else Ch
+    Cn = Cst[C_CSCALE : C_CSCALE + NB, k + 1] if k + 1 < n else Ch
     l, outer, w = Cst[V_L, k], Cst[V_OUTER, k], Cst[V_W, k]
     kap, kb = Cst[V_KAPPA, k], Cst[V_KB, k]
     kap_next = Cst[V_KAPPA, k + 1] if k + 1 < n else 0.0
@@ -244,22 +247,22 @@ def _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec):
     - C_pp phi' - K_pp phi, vec[n:2n] = r_alpha, vec[2n:3n] = r_beta, with
     r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi) (C only when ``damped``)."""
     n = phi.shape[0]
-    vec[:4 * n] = 0.0
+    vec[: 4 * n] = 0.0
     fp = vec[:n]
-    fa = vec[n:2 * n]
-    fb = vec[2 * n:3 * n]
-    zero = vec[3 * n:4 * n]
-    w2 = vec[4 * n:5 * n]
+    fa = vec[n : 2 * n]
+    fb = vec[2 * n : 3 * n]
+    zero = vec[3 * n : 4 * n]
+    w2 = vec[4 * n : 5 * n]
     for k in range(n):
         w2[k] = dphi[k] * dphi[k]
-    _hinge_forces(Cst, phi, zero, zero, V_KAPPA, fp, fa, fb)       # K_qp phi
+    _hinge_forces(Cst, phi, zero, zero, V_KAPPA, fp, fa, fb)  # K_qp phi
     if damped:
-        _hinge_forces(Cst, dphi, zero, zero, V_NU, fp, fa, fb)     # C_qp phi'
+        _hinge_forces(Cst, dphi, zero, zero, V_NU, fp, fa, fb)  # C_qp phi'
     for k in range(n):
         fp[k] = -fp[k]
         fa[k] = -fa[k]
         fb[k] = -fb[k]
-    _gpp_times(Cst, c, s, w2, fp)                  # - G_pp phi'^2
+    _gpp_times(Cst, c, s, w2, fp)  # - G_pp phi'^2
     _upper_t_times(Cst, c, s, w2, False, fa, 1.0)  # - G_ap phi'^2 = + G_pa^T phi'^2
     _upper_t_times(Cst, c, s, w2, False, fb, -1.0)  # - G_bp phi'^2 = - G_pa^T phi'^2
     if has_load:
@@ -281,12 +284,12 @@ def _solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
         b[r0 + E_AL] = fa[k] * Cst[C_RSCALE + E_AL, k]
         b[r0 + E_PHI] = fp[k] * Cst[C_RSCALE + E_PHI, k]
         b[r0 + E_BE] = fb[k] * Cst[C_RSCALE + E_BE, k]
-    b[N:] = 0.0                         # padding: see _eliminate and the back substitution
+    b[N:] = 0.0  # padding: see _eliminate and the back substitution
     _fill_rod(Cst, 0, c, s, A, RMASK)
     for k in range(n):
-        if k + 1 < n:                   # rows 7k+7.. are reached from column 7k+3 on
+        if k + 1 < n:  # rows 7k+7.. are reached from column 7k+3 on
             _fill_rod(Cst, k + 1, c, s, A, RMASK)
-        else:                           # KL zero rows past the last equation
+        else:  # KL zero rows past the last equation
             for i in range(N, N + KL):
                 for o in range(W):
                     A[i & RMASK, o] = 0.0
@@ -296,7 +299,7 @@ def _solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
     # back substitution with U (KL + KU super-diagonals), then undo the column scaling
     for i in range(N - 1, -1, -1):
         acc = b[i]
-        for o in range(1, KL + KU + 1):          # columns i+1 .. i+KL+KU (b is padded)
+        for o in range(1, KL + KU + 1):  # columns i+1 .. i+KL+KU (b is padded)
             acc -= U[i, o] * b[i + o]
         b[i] = acc / U[i, 0]
     for k in range(n):
@@ -313,8 +316,8 @@ def _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
     for u_k = T_k[:, :3] z_k + T_k[:, 3]. False if a local pivot is zero or a result is not
     finite."""
     n = c.shape[0]
-    F = np.zeros((2, 4))        # tail relation of rod k+1: S_{k+1} = F[:, :3] z_{k+1} + F[:, 3]
-    G = np.zeros(4)             #                           alpha_{k+1} = G[:3] . z_{k+1} + G[3]
+    F = np.zeros((2, 4))  # tail relation of rod k+1: S_{k+1} = F[:, :3] z_{k+1} + F[:, 3]
+    G = np.zeros(4)  #                           alpha_{k+1} = G[:3] . z_{k+1} + G[3]
     L = np.empty((3, 3))
     R = np.empty((3, 4))
     for k in range(n - 1, -1, -1):
@@ -322,9 +325,9 @@ def _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
         kap, kb = Cst[V_KAPPA, k], Cst[V_KB, k]
         kapn = Cst[V_KAPPA, k + 1] if k + 1 < n else 0.0
         ex, ey = c[k], s[k]
-        Fe0 = F[0, 0] * ex + F[0, 1] * ey           # F_P e
+        Fe0 = F[0, 0] * ex + F[0, 1] * ey  # F_P e
         Fe1 = F[1, 0] * ex + F[1, 1] * ey
-        FTe0 = F[0, 0] * ex + F[1, 0] * ey          # F_P^T e
+        FTe0 = F[0, 0] * ex + F[1, 0] * ey  # F_P^T e
         FTe1 = F[0, 1] * ex + F[1, 1] * ey
         eFe = ex * Fe0 + ey * Fe1
         eFb = ex * F[0, 2] + ey * F[1, 2]
@@ -429,9 +432,10 @@ def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out
     sums (N, see kernels.load_sums), used when ``has_load``; ``damped`` adds the hinge
     dampers. O(n) time and memory per evaluation. Returns False if the system is singular
     (outputs then hold NaN)."""
-    work = np.empty(sweep_work_size(phi.shape[0]))    # the fallback allocates its own
-    return reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out,
-                              work, METHOD_AUTO)
+    work = np.empty(sweep_work_size(phi.shape[0]))  # the fallback allocates its own
+    return reduced_solve_work(
+        Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work, METHOD_AUTO
+    )
 
 
 @njit(cache=True)
@@ -455,8 +459,9 @@ def sweep_work_size(n):
 
 
 @njit(cache=True)
-def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work,
-                       method):
+def reduced_solve_work(
+    Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work, method
+):
     """``reduced_solve`` with a caller-provided float64 work array of length >= work_size(n),
     or >= sweep_work_size(n) (then the banded LU, if used, allocates its part), so that a
     caller that evaluates many times, such as an integrator, allocates it once; and a
@@ -465,16 +470,16 @@ def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamm
     n = phi.shape[0]
     N = NB * n
     c = work[:n]
-    s = work[n:2 * n]
+    s = work[n : 2 * n]
     for k in range(n):
         c[k] = np.cos(phi[k])
         s[k] = np.sin(phi[k])
-    vec = work[2 * n:7 * n]
+    vec = work[2 * n : 7 * n]
     _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
-    fp, fa, fb = vec[:n], vec[n:2 * n], vec[2 * n:3 * n]
-    rest = work[7 * n:]
+    fp, fa, fb = vec[:n], vec[n : 2 * n], vec[2 * n : 3 * n]
+    rest = work[7 * n :]
     if method != METHOD_BAND:
-        T = rest[:12 * n].reshape((n, 3, 4))
+        T = rest[: 12 * n].reshape((n, 3, 4))
         if _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
             return True
         if method == METHOD_SWEEP:
@@ -486,7 +491,7 @@ def reduced_solve_work(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamm
     o1 = N * (KL + KU + 1)
     o2 = o1 + N + KL + KU
     U = rest[:o1].reshape((N, KL + KU + 1))
-    A = rest[o2:o2 + RING * W].reshape((RING, W))
+    A = rest[o2 : o2 + RING * W].reshape((RING, W))
     if _solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi_out, gamma_out):
         return True
     ddphi_out[:] = np.nan
@@ -544,21 +549,6 @@ def _ruiz(T, rs, cs, sweeps):
                     T[i, o] *= fr / np.sqrt(cmax[j])
 
 
-def _rod_constants(chain, variant: str) -> SimpleNamespace:
-    """The per-rod fields of paper_matrices.chain_constants (same formulas) in O(n) memory:
-    chain_constants also builds two n x n arrays, which a long chain cannot afford."""
-    if variant not in VARIANTS:
-        raise ValueError(f"coefficients must be one of {VARIANTS}, got {variant!r}")
-    l, m, mu = chain.l, chain.m, chain.mu
-    rod_mass = m * l
-    outer = np.cumsum((mu + rod_mass)[::-1])[::-1] - rod_mass / 2.0
-    ml3 = m * l**3
-    half = 0.5 if variant == "published" else 1.0
-    return SimpleNamespace(l=l, outer_mass=outer,
-                           pp_diag=l**2 * (outer - rod_mass / 2.0) + ml3 / 3.0,
-                           ap_diag=half * ml3 / 30.0, bp_diag=-half * ml3 / 20.0)
-
-
 def banded_constants(cc, chain, variant: str = "printed") -> np.ndarray:
     """Every angle-independent per-rod constant of ``reduced_solve`` as a float64 array
     (N_CST, n); ``cc = paper_matrices.chain_constants(chain, variant)``, or None to compute
@@ -570,29 +560,32 @@ def banded_constants(cc, chain, variant: str = "printed") -> np.ndarray:
     variants), then 7 row and 7 column equilibration scales (powers of two, per rod)."""
     n = chain.n
     if cc is None:
-        cc = _rod_constants(chain, variant)
+        cc = chain_constants(chain, variant)
     Cst = np.zeros((N_CST, n))
-    Cst[V_L] = cc.l
-    Cst[V_OUTER] = cc.outer_mass
-    Cst[V_PPDIAG] = cc.pp_diag
-    Cst[V_W] = chain.m * chain.l**2 / 12.0
-    Cst[V_KAPPA] = chain.kappa
-    Cst[V_NU] = chain.nu
-    Cst[V_KB] = 4.0 * chain.EI / chain.l
+    Cst[:_BASE] = np.vstack(_rows(cc, chain))
     Cst[C_AP] = cc.ap_diag
     Cst[C_BP] = cc.bp_diag
     Cst[C_RSCALE:] = 1.0
     rs = np.ones(NB * n)
     cs = np.ones(NB * n)
     _ruiz(_magnitudes(Cst), rs, cs, 20)
-    pow2 = lambda v: np.exp2(np.round(np.log2(v)))        # exact scaling: no rounding
-    Cst[C_RSCALE:C_RSCALE + NB] = pow2(rs).reshape(n, NB).T
-    Cst[C_CSCALE:C_CSCALE + NB] = pow2(cs).reshape(n, NB).T
+
+    def pow2(v):
+        return np.exp2(np.round(np.log2(v)))  # exact scaling: no rounding
+
+    Cst[C_RSCALE : C_RSCALE + NB] = pow2(rs).reshape(n, NB).T
+    Cst[C_CSCALE : C_CSCALE + NB] = pow2(cs).reshape(n, NB).T
     return np.ascontiguousarray(Cst)
 
 
-def bending_at(Cst: np.ndarray, phi: np.ndarray, dphi: np.ndarray, sums, damped: bool,
-               method: int = METHOD_AUTO) -> tuple[np.ndarray, np.ndarray]:
+def bending_at(
+    Cst: np.ndarray,
+    phi: np.ndarray,
+    dphi: np.ndarray,
+    sums,
+    damped: bool,
+    method: int = METHOD_AUTO,
+) -> tuple[np.ndarray, np.ndarray]:
     """(phi'', gamma) at one state, ``sums`` = LoadSet.suffix_sums(t) (None: no load).
     The O(n) replacement of ReducedSystem.recover_bending (which returns gamma)."""
     n = phi.shape[0]
@@ -604,6 +597,27 @@ def bending_at(Cst: np.ndarray, phi: np.ndarray, dphi: np.ndarray, sums, damped:
         SX, SY = (np.ascontiguousarray(v, dtype=np.float64) for v in sums)
     ddphi, gamma = np.empty(n), np.empty(2 * n)
     work = np.empty(work_size(n))
-    reduced_solve_work(Cst, phi, dphi, sums is not None, SX, SY, bool(damped), ddphi, gamma,
-                       work, method)
+    reduced_solve_work(
+        Cst, phi, dphi, sums is not None, SX, SY, bool(damped), ddphi, gamma, work, method
+    )
     return ddphi, gamma
+
+
+@njit(cache=True)
+def reduced_accel(Cst, y, has_load, SX, SY, damped, out):
+    """phi'' at y = [phi; phi'] into ``out`` (the argument convention of
+    ``kernels.full_accel``); O(n)."""
+    n = Cst.shape[1]
+    reduced_accel_banded(Cst, y[:n], y[n:], has_load, SX, SY, damped, out)
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def reduced_rhs(t, y, P, S, M, L, out):
+    """y' of the reduced model (compiled integrators' right-hand side, loads from table L);
+    O(n) time and memory per evaluation."""
+    half = y.shape[0] // 2
+    out[:half] = y[half:]
+    SX = np.empty(half)
+    SY = np.empty(half)
+    has_load = load_sums(L, t, SX, SY)
+    reduced_accel_banded(P, y[:half], y[half:], has_load, SX, SY, S[0] != 0.0, out[half:])

@@ -23,9 +23,6 @@ from rodval.solvers import dop853
 from rodval.solvers.guard import ENERGY_FLOOR_J
 from rodval.solvers.system import CompiledForm
 
-RHS_TYPE = dop853.RHS_TYPE
-RHS_SIGNATURE = dop853.RHS_SIGNATURE
-
 _CODES = {
     dop853.STEP_TOO_SMALL: (
         STATUS_FAILED,

@@ -18,12 +18,10 @@ import numpy as np
 from numba import njit, types
 from scipy.integrate._ivp import dop853_coefficients as dc
 
-_F1 = types.float64[::1]
-_F2 = types.float64[:, ::1]
-_F3 = types.float64[:, :, ::1]
-#: rhs(t, y, P, S, M, L, out): writes y' into out (see CompiledForm).
-RHS_SIGNATURE = types.void(types.float64, _F1, _F2, _F1, _F3, _F2, _F1)
-RHS_TYPE = types.FunctionType(RHS_SIGNATURE)
+from rodval.solvers.signature import F1 as _F1
+from rodval.solvers.signature import F2 as _F2
+from rodval.solvers.signature import F3 as _F3
+from rodval.solvers.signature import RHS_TYPE
 
 N_STAGES = dc.N_STAGES
 _A = np.ascontiguousarray(dc.A)

@@ -277,8 +277,7 @@ def integrate(
             for _ in at_zero:
                 ledger.record()
         if form is not None:
-            energy0 = system.energy_budget(0.0, y) if system.has_energy else 0.0
-            out.n = run_compiled(form, y, edges, scene, settings, energy0, out.Y, stats)
+            out.n = run_compiled(form, y, edges, scene, settings, guard.E0, out.Y, stats)
             t_now = stats.t_reached
         else:
             scipy_run = _ScipyRun(system, scene, settings, method, stats, out, ledger, guard)

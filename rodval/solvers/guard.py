@@ -43,6 +43,8 @@ class DivergenceGuard:
         self.n_short = 0
         self.factor = settings.blowup_factor
         self.system = system if (system.has_energy and math.isfinite(self.factor)) else None
+        #: E(0) of the budget (J); 0 when there is no energy check
+        self.E0 = 0.0
         if self.system is not None:
             self.E0 = system.energy_budget(0.0, y0)
             self.w_plus = 0.0

@@ -33,7 +33,7 @@ Observed = dict[str, tuple[np.ndarray, np.ndarray]]
 class CompiledForm:
     """A system's compiled right-hand side and the arrays it reads.
 
-    ``rhs`` is a numba function of the first-class type ``rodval.solvers.compiled.RHS_TYPE``:
+    ``rhs`` is a numba function of the first-class type ``rodval.solvers.signature.RHS_TYPE``:
     ``rhs(t, y, P, S, M, L, out)`` writes y' (same length as y) into ``out``. What the arrays
     hold is the model's business: ``P`` (rows of per-rod constants, float64 2-D), ``S``
     (scalars, float64 1-D), ``M`` (dense matrices, float64 3-D, may be empty), ``L`` (the load
