@@ -1,0 +1,122 @@
+"""rodval modes SCENE --model M --out DIR: linearized natural frequencies and mode shapes."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..scene_file import load_scene
+from .options import key_value, positive_int
+
+MODEL_CHOICES = ("full", "reduced", "exudyn")
+#: Mode shapes drawn in modes.png.
+DRAWN = 4
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "modes", help="natural frequencies and mode shapes about a configuration",
+        description="Linearize SCENE ('paper' or a TOML scene file) about its initial state or "
+                    "its static equilibrium under its constant loads and write "
+                    "DIR/frequencies.csv (mode, omega_rad_s, f_hz, damping_ratio), DIR/modes.csv "
+                    "(mode, kind node_dx/node_dy/hinge, k, value; shapes normalized to a largest "
+                    "node displacement of 1), DIR/modes.png and DIR/modes.json. With --compare, "
+                    "also DIR/compare.csv: the modes of the other models paired with this "
+                    "model's by MAC (see docs/modes.md).")
+    p.add_argument("scene", metavar="SCENE", help="'paper' or a TOML scene file")
+    p.add_argument("--model", default="full", choices=MODEL_CHOICES)
+    p.add_argument("--out", required=True, type=Path, help="output folder")
+    p.add_argument("--count", type=positive_int("--count"), default=10,
+                   help="number of lowest modes to write (default 10)")
+    p.add_argument("--about", default="initial", choices=("initial", "equilibrium"),
+                   help="linearize about the initial state (loads ignored) or the static "
+                        "equilibrium under the scene's constant loads (default initial)")
+    p.add_argument("--coefficients", choices=("printed", "published"), default="printed",
+                   help="coefficient variant of the native models (default printed)")
+    p.add_argument("--set", dest="options", type=key_value, action="append", default=[],
+                   metavar="KEY=VALUE", help="exudyn model option, e.g. elements=8 (repeatable)")
+    p.add_argument("--compare", nargs="?", const="full,reduced,exudyn", metavar="MODELS",
+                   help="also pair the modes of these models (comma-separated, default "
+                        "full,reduced,exudyn) with --model's and write DIR/compare.csv")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..modes import compare_modes, model_modes
+
+    scene = load_scene(args.scene)
+    options = dict(args.options)
+    if options and args.model != "exudyn" and not args.compare:
+        raise ValueError(f"--set applies to the exudyn model only, got {sorted(options)}")
+    m = model_modes(scene, args.model, about=args.about, count=args.count,
+                    coefficients=args.coefficients,
+                    **(options if args.model == "exudyn" else {}))
+    args.out.mkdir(parents=True, exist_ok=True)
+    m.frequencies_frame().to_csv(args.out / "frequencies.csv", index=False)
+    m.modes_frame().to_csv(args.out / "modes.csv", index=False)
+    plot_modes(m, args.out / "modes.png", title=f"{scene.name}: {m.model} about {m.about}")
+    record = {"scene": scene.name, "model": m.model, "about": m.about,
+              "coefficients": args.coefficients if m.model != "exudyn" else None,
+              "options": m.info.get("options", {}), "count": m.count}
+    eq = m.equilibrium
+    if eq is not None:
+        record["equilibrium"] = {"iterations": eq.iterations, "load_steps": eq.load_steps,
+                                 "residual_Nm": eq.residual, "phi": eq.phi.tolist(),
+                                 "ignored_loads": list(eq.loads.ignored) if eq.loads else []}
+    lines = [f"{m.model} modes of {scene.name} about the {m.about} state -> {args.out}"]
+    if eq is not None:
+        ign = f"; ignored loads: {', '.join(eq.loads.ignored)}" if eq.loads and eq.loads.ignored else ""
+        res = f", residual {eq.residual:.2g} N m" if np.isfinite(eq.residual) else ""
+        lines.append(f"static equilibrium: {eq.iterations} Newton iterations{res}{ign}")
+    lines.append(" mode   omega (rad/s)        f (Hz)   damping ratio")
+    for i in range(m.count):
+        z = "" if not np.isfinite(m.damping[i]) else f"{m.damping[i]:.3e}"
+        lines.append(f"{i + 1:5d} {m.omega[i]:15.6g} {m.f_hz[i]:13.6g}   {z}")
+    if args.compare:
+        models = tuple(x.strip() for x in args.compare.split(",") if x.strip())
+        bad = [x for x in models if x not in MODEL_CHOICES]
+        if bad or not models:
+            raise ValueError(f"--compare models must be from {MODEL_CHOICES}, got {args.compare!r}")
+        computed = {args.model: m}
+        for other in models:
+            if other not in computed:
+                computed[other] = model_modes(scene, other, about=args.about,
+                                              coefficients=args.coefficients,
+                                              **(options if other == "exudyn" else {}))
+        order = tuple(x for x in models if x != args.model) + (args.model,)
+        table = compare_modes(scene, order, about=args.about, count=args.count,
+                              reference=args.model, computed=computed)
+        table.to_csv(args.out / "compare.csv", index=False)
+        lines.append("paired by MAC (gap relative to " + args.model + "):")
+        lines.append(table.to_string(index=False, float_format=lambda v: f"{v:.6g}"))
+    (args.out / "modes.json").write_text(json.dumps(record, indent=2, default=str))
+    print("\n".join(lines))
+    return 0
+
+
+def plot_modes(m, path: Path, title: str = "", count: int = DRAWN) -> Path:
+    """The first ``count`` mode shapes drawn on the chain (nodes displaced by a scale of 0.15
+    of the chain length times the normalized shape; hinge angles are in modes.csv)."""
+    from ..figures import plt
+
+    k = min(count, m.count)
+    x0, y0 = m.node_positions()
+    span = max(np.ptp(x0), np.ptp(y0), float(np.sum(m.l)) * 0.2)
+    amp = 0.15 * span
+    fig, axes = plt.subplots(k, 1, figsize=(7, 1.9 * k + 0.6), squeeze=False, sharex=True)
+    for i, ax in enumerate(axes[:, 0]):
+        ax.plot(x0, y0, "-o", color="0.7", ms=3, lw=1, label="configuration")
+        ax.plot(x0 + amp * m.dx[i], y0 + amp * m.dy[i], "-o", color="C0", ms=3, lw=1.5,
+                label="mode")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_ylabel("y (m)")
+        ax.set_title(f"mode {i + 1}: {m.omega[i]:.4g} rad/s ({m.f_hz[i]:.4g} Hz)", fontsize=9)
+    axes[-1, 0].set_xlabel("x (m)")
+    axes[0, 0].legend(fontsize=7, loc="upper left")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
