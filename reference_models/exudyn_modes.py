@@ -12,7 +12,10 @@ revolute joints, hinge springs, point masses and load user functions). Then:
 ``exudyn.solver.ComputeODE2Eigenvalues`` linearizes there (mass matrix and ODE2 Jacobian of
 the static solver, so the axial force's geometric stiffness is included) and handles the
 joints' algebraic constraints as exudyn documents: projection of M and K onto the null space
-of the constraint Jacobian (SVD), eigenvectors mapped back to ODE2 coordinates.
+of the constraint Jacobian (SVD), eigenvectors mapped back to ODE2 coordinates. With hinge
+dampers (nu > 0) it is called again with ``computeComplexEigenvalues=True`` (the damping
+matrix from the ODE2 velocity Jacobian, same projection); each undamped mode is paired with the
+complex eigenvalue s (Im s > 0) of nearest |s|, damping ratio -Re(s) / |s|.
 
 The measures are taken by definition from the eigenvectors, independently of the paper's
 equations: node k (k = 1..n) is the end node of rod k's beam (node 0 the pinned root), its
@@ -34,17 +37,27 @@ from rodval.scene import Scene
 
 #: Elongation/displacement ratio above which an exudyn mode counts as axial.
 AXIAL_TOL = 1e-3
+#: ExudynModel options changed for modal analysis (others: ExudynModel's DEFAULTS).
+#: EA = 1e8 N instead of 1e10: ComputeODE2Eigenvalues solves one dense problem whose spectrum
+#: runs up to the axial modes (omega^2 ~ EA / (m le^2)), and its round-off in the lowest
+#: (hinge) modes grows with EA: n = 8, 8 elements per rod, mode 1 = 0.0781417 (EA 1e8),
+#: 0.0781445 (1e9), 0.0781616 (1e10), 0.0777761 (1e11) rad/s against 0.0781421 natively.
+#: About the straight state bending and stretching decouple, so the hinge and bending
+#: frequencies do not depend on EA otherwise (mode 9: 452.44309 rad/s for EA 1e8 to 1e11);
+#: under a load the static stretch is F / EA (3e-7 for 30 N).
+MODES_DEFAULTS = {"EA": 1e8, "elements": 8}
 
 
 def exudyn_modes(scene: Scene, *, about: str = "initial", count: int | None = None,
                  load_steps: int = 20, axial_tol: float = AXIAL_TOL, **options) -> Modes:
     """Modes of the exudyn beam model about the scene's initial state or its static
-    equilibrium (see module docstring); ``options``: ExudynModel options (elements, EA)."""
+    equilibrium (see module docstring); ``options``: ExudynModel options (elements, EA; the
+    defaults for modes are ``MODES_DEFAULTS``)."""
     import exudyn as exu
 
     if about not in ABOUT:
         raise ValueError(f"about must be one of {ABOUT}, got {about!r}")
-    model = ExudynModel(**options)
+    model = ExudynModel(**{**MODES_DEFAULTS, **options})
     n = scene.n
     if about == "initial":
         built_scene = scene.with_(loads=())
@@ -76,6 +89,10 @@ def exudyn_modes(scene: Scene, *, about: str = "initial", count: int | None = No
             if not ok:
                 raise ValueError("exudyn static solve failed")
         lam, V = exu.solver.ComputeODE2Eigenvalues(mbs, useAbsoluteValues=False)
+        s_damped = None
+        if np.any(scene.chain.nu > 0):
+            s_damped, _ = exu.solver.ComputeODE2Eigenvalues(
+                mbs, computeComplexEigenvalues=True, useAbsoluteValues=False)
     finally:
         exu.config.printToConsole = console
     lam = np.asarray(lam, float)
@@ -122,6 +139,18 @@ def exudyn_modes(scene: Scene, *, about: str = "initial", count: int | None = No
     tiny = 1e-13 * np.max(np.abs(lam)) if lam.size else 0.0
     lam = np.where(np.abs(lam) <= tiny, 0.0, lam)
     omega = np.sign(lam) * np.sqrt(np.abs(lam))
+    zeta = np.full(omega.size, np.nan)
+    if s_damped is None:
+        zeta[omega > 0] = 0.0
+    else:
+        # pair each undamped mode with the damped eigenvalue (Im > 0) of nearest |s|
+        from scipy.optimize import linear_sum_assignment
+        s_up = np.asarray(s_damped)[np.asarray(s_damped).imag > 0]
+        pos = np.flatnonzero(omega > 0)
+        if pos.size and s_up.size:
+            cost = np.abs(np.abs(s_up)[None, :] - omega[pos, None]) / omega[pos, None]
+            r, c = linear_sum_assignment(cost)
+            zeta[pos[r]] = -s_up[c].real / np.abs(s_up[c])
     ends = np.concatenate([state[:1, 0, :2], state[:, -1, :2]])
     d = np.diff(ends, axis=0)
     phi0 = np.arctan2(d[:, 1], d[:, 0])
@@ -131,7 +160,7 @@ def exudyn_modes(scene: Scene, *, about: str = "initial", count: int | None = No
         eq = Equilibrium(q=np.concatenate([phi0, np.zeros(2 * n)]), iterations=iters if built_scene.loads else 0,
                          load_steps=int(load_steps), residual=float("nan"), converged=True,
                          loads=constant_loads(scene))
-    return Modes(model="exudyn", about=about, omega=omega, damping=np.full(omega.size, np.nan),
+    return Modes(model="exudyn", about=about, omega=omega, damping=zeta,
                  dx=dx, dy=dy, hinge=hinge, phi0=phi0, l=np.linalg.norm(d, axis=1),
                  equilibrium=eq, info={"node_positions": ends, "axial_modes_dropped": int(axial.sum()),
                                        "options": model.options()})

@@ -517,7 +517,10 @@ def model_modes(scene: Scene, model: str, *, about: str = "initial", count: int 
             from reference_models.exudyn_modes import exudyn_modes
         except ImportError as exc:
             raise ValueError(f"model 'exudyn' is not available: {exc}") from exc
-        return exudyn_modes(scene, about=about, count=count, **options)
+        try:
+            return exudyn_modes(scene, about=about, count=count, **options)
+        except TypeError as exc:                       # an unknown option name
+            raise ValueError(f"model 'exudyn' does not accept options {sorted(options)}: {exc}") from None
     if options:
         raise ValueError(f"model {model!r} takes no options, got {sorted(options)}")
     return modes(scene, model, about=about, count=count, coefficients=coefficients)
