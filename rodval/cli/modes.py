@@ -109,7 +109,9 @@ def plot_modes(m, path: Path, title: str = "", count: int = DRAWN) -> Path:
         ax.plot(x0, y0, "-o", color="0.7", ms=3, lw=1, label="configuration")
         ax.plot(x0 + amp * m.dx[i], y0 + amp * m.dy[i], "-o", color="C0", ms=3, lw=1.5,
                 label="mode")
-        ax.set_aspect("equal", adjustable="datalim")
+        ys = np.concatenate([y0, y0 + amp * m.dy[i]])
+        pad = 0.1 * max(np.ptp(ys), amp)
+        ax.set_ylim(ys.min() - pad, ys.max() + pad)
         ax.set_ylabel("y (m)")
         ax.set_title(f"mode {i + 1}: {m.omega[i]:.4g} rad/s ({m.f_hz[i]:.4g} Hz)", fontsize=9)
     axes[-1, 0].set_xlabel("x (m)")
