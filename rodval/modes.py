@@ -252,12 +252,13 @@ def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors
     diag(rho^k) per rod, for each rho of ``RHO`` (see the module docstring).
 
     Each run gives first-order error estimates err = eps (|K| + |lam| |M|) kappa_lam from its
-    left and right eigenvectors (kappa_lam = |y| |x| / |y^H M x|). The spectrum is taken from
-    the run with a real spectrum whose largest relative estimate is smallest; then each of its
-    eigenvalues is replaced by the nearest eigenvalue of any other run when that one is real,
-    has a smaller estimate and lies within the two estimates (the geometric scaling that
-    conditions the tip-localized bending cluster de-conditions the extended low modes, which
-    the unscaled run gets right). Returns (lam, X, info); lam is complex when no rho gave a
+    left and right eigenvectors (kappa_lam = |y| |x| / |y^H M x|). The spectrum starts from the
+    run with the fewest complex eigenvalues (then the smallest median relative estimate), its
+    complex ones unresolved; then, run by run, its eigenvalues are matched one-to-one
+    (Hungarian, on the distance) with the run's, and each is replaced by its match when that
+    one is real, has a smaller estimate and lies within the two estimates (an unresolved one:
+    by any real match). The geometric scaling that conditions the tip-localized bending
+    cluster de-conditions the extended low modes, which the unscaled run gets right. Returns (lam, X, info); lam is complex when no rho gave a
     real spectrum (the caller decides)."""
     T, rod = _node_transform(chain, model)
     Kz, Mz = T.T @ K @ T, T.T @ M @ T
@@ -273,30 +274,29 @@ def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors
         kappa = (np.linalg.norm(VL, axis=0) * np.linalg.norm(VR, axis=0)
                  / np.maximum(np.abs(np.sum(VL.conj() * (Ms @ VR), axis=0)), 1e-300))
         err = eps * (np.linalg.norm(Ks, 2) + np.abs(lam) * np.linalg.norm(Ms, 2)) * kappa
-        real = np.abs(lam.imag) <= np.maximum(err, IMAG_TOL * np.max(np.abs(lam)))
+        real = np.abs(lam.imag) <= IMAG_TOL * np.max(np.abs(lam))
         runs.append({"rho": rho, "lam": lam, "VR": VR, "err": err, "real": real})
-    full = [r for r in runs if r["real"].all()]
-    if not full:
-        r = min(runs, key=lambda r: np.max(np.abs(r["lam"].imag)))
-        X = T @ ((np.float64(r["rho"]) ** rod)[:, None] * r["VR"]) if vectors else None
-        return r["lam"], X, {"rho": [r["rho"]] * r["lam"].size}
-    base = min(full, key=lambda r: np.max(r["err"] / np.maximum(np.abs(r["lam"]), 1e-300)))
-    lam = base["lam"].real.copy()
-    err = base["err"].copy()
+    rel = lambda r: np.median(r["err"] / np.maximum(np.abs(r["lam"]), 1e-300))  # noqa: E731
+    base = min(runs, key=lambda r: (int(np.sum(~r["real"])), rel(r)))
+    lam = base["lam"].copy()
+    err = np.where(base["real"], base["err"], np.inf)       # complex entries: unresolved
     src = [(base, i) for i in range(lam.size)]
-    for r in runs:
-        if r is base:
-            continue
-        for i in range(lam.size):
-            j = int(np.argmin(np.abs(r["lam"] - lam[i])))
-            if (r["real"][j] and r["err"][j] < err[i]
-                    and abs(r["lam"][j].real - lam[i]) <= err[i] + r["err"][j]):
-                lam[i], err[i], src[i] = r["lam"][j].real, r["err"][j], (r, j)
+    for r in sorted((r for r in runs if r is not base), key=rel):
+        # one-to-one matching of the current spectrum with this run's eigenvalues
+        rows, cols = linear_sum_assignment(np.abs(lam[:, None] - r["lam"][None, :]))
+        for i, j in zip(rows, cols):
+            mu, e = r["lam"][j], r["err"][j]
+            if r["real"][j] and e < err[i] and (np.isinf(err[i]) or abs(mu - lam[i]) <= err[i] + e):
+                lam[i], err[i], src[i] = mu.real, e, (r, j)
+    if np.all(np.isfinite(err)):
+        lam = lam.real
     X = None
     if vectors:
-        X = np.column_stack([T @ ((np.float64(r["rho"]) ** rod) * r["VR"][:, j].real)
+        X = np.column_stack([T @ ((np.float64(r["rho"]) ** rod) * r["VR"][:, j])
                              for r, j in src])
-    order = np.argsort(lam)
+        if np.isrealobj(lam):
+            X = X.real
+    order = np.argsort(lam.real)
     return (lam[order], None if X is None else X[:, order],
             {"rho": [src[i][0]["rho"] for i in order], "error_estimate": err[order]})
 
