@@ -63,7 +63,7 @@ def exudyn_modes(scene: Scene, *, about: str = "initial", count: int | None = No
         built_scene = scene.with_(loads=())
     else:
         built_scene = scene.with_(loads=tuple(f for f in scene.loads if f.name == "constant"))
-    SC, mbs, nodes = model.assembled(built_scene)
+    _, mbs, nodes = model.assembled(built_scene)
     for row in nodes:
         for nd in row:
             if mbs.GetNode(nd)["nodeType"] != "Point2DSlope1":

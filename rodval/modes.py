@@ -77,8 +77,13 @@ import pandas as pd
 import scipy.linalg
 from scipy.optimize import linear_sum_assignment
 
-from .models.paper_matrices import (chain_constants, damping_matrix, hinge_matrix, mass_matrix,
-                                    stiffness_matrix)
+from .models.paper_matrices import (
+    chain_constants,
+    damping_matrix,
+    hinge_matrix,
+    mass_matrix,
+    stiffness_matrix,
+)
 from .models.reduced import ReducedSystem
 from .scene import Chain, InitialState, Scene
 
@@ -279,7 +284,7 @@ def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors
         err = eps * (np.linalg.norm(Ks, 2) + np.abs(lam) * np.linalg.norm(Ms, 2)) * kappa
         real = np.abs(lam.imag) <= IMAG_TOL * np.max(np.abs(lam))
         runs.append({"rho": rho, "lam": lam, "VR": VR, "err": err, "real": real})
-    rel = lambda r: np.median(r["err"] / np.maximum(np.abs(r["lam"]), 1e-300))  # noqa: E731
+    rel = lambda r: np.median(r["err"] / np.maximum(np.abs(r["lam"]), 1e-300))
     base = min(runs, key=lambda r: (int(np.sum(~r["real"])), rel(r)))
     lam = base["lam"].copy()
     err = np.where(base["real"], base["err"], np.inf)       # complex entries: unresolved
