@@ -367,11 +367,26 @@ def test_cli_modes_writes_files(tmp_path, capsys):
     assert "0.0781" in capsys.readouterr().out
 
 
+def test_cli_modes_compare_writes_paired_table(tmp_path, capsys):
+    """--compare pairs the other models' modes with --model's by MAC into compare.csv."""
+    from rodval.cli import main
+    out = tmp_path / "c"
+    assert main(["modes", "paper", "--model", "reduced", "--count", "8", "--compare", "full",
+                 "--out", str(out)]) == 0
+    import pandas as pd
+    t = pd.read_csv(out / "compare.csv")
+    assert list(t.columns) == ["mode", "omega_reduced", "omega_full", "gap_full", "mac_full"]
+    assert (t["mac_full"] > 0.999).all() and (t["gap_full"].abs() < 1e-4).all()
+    assert "paired by MAC" in capsys.readouterr().out
+
+
 @pytest.mark.parametrize("argv", [
     ["modes", "paper", "--model", "nope", "--out", "x"],
     ["modes", "paper", "--count", "0", "--out", "x"],
     ["modes", "paper", "--about", "sideways", "--out", "x"],
     ["modes", "missing.toml", "--out", "x"],
+    ["modes", "paper", "--compare", "full,bogus", "--out", "x"],
+    ["modes", "paper", "--model", "exudyn", "--set", "elements=0", "--out", "x"],
 ])
 def test_cli_modes_bad_input_one_line_exit_2(argv, tmp_path, capsys, monkeypatch):
     from rodval.cli import main

@@ -45,6 +45,12 @@ def register(sub) -> None:
 def run(args) -> int:
     from ..modes import compare_modes, model_modes
 
+    compare = ()
+    if args.compare:
+        compare = tuple(x.strip() for x in args.compare.split(",") if x.strip())
+        bad = [x for x in compare if x not in MODEL_CHOICES]
+        if bad or not compare:
+            raise ValueError(f"--compare models must be from {MODEL_CHOICES}, got {args.compare!r}")
     scene = load_scene(args.scene)
     options = dict(args.options)
     if options and args.model != "exudyn" and not args.compare:
@@ -73,11 +79,8 @@ def run(args) -> int:
     for i in range(m.count):
         z = "" if not np.isfinite(m.damping[i]) else f"{m.damping[i]:.3e}"
         lines.append(f"{i + 1:5d} {m.omega[i]:15.6g} {m.f_hz[i]:13.6g}   {z}")
-    if args.compare:
-        models = tuple(x.strip() for x in args.compare.split(",") if x.strip())
-        bad = [x for x in models if x not in MODEL_CHOICES]
-        if bad or not models:
-            raise ValueError(f"--compare models must be from {MODEL_CHOICES}, got {args.compare!r}")
+    if compare:
+        models = compare
         computed = {args.model: m}
         for other in models:
             if other not in computed:
