@@ -71,6 +71,7 @@ def exudyn_modes(scene: Scene, *, about: str = "initial", count: int | None = No
     console = exu.config.printToConsole
     exu.config.printToConsole = False
     eq = None
+    residual = float("nan")
     try:
         if about == "equilibrium" and built_scene.loads:
             sim = exu.SimulationSettings()
@@ -86,6 +87,8 @@ def exudyn_modes(scene: Scene, *, about: str = "initial", count: int | None = No
             ok = exu.solver.SolveStatic(mbs, sim, updateInitialValues=True)
             solver = mbs.sys.get("staticSolver")
             iters = int(solver.it.newtonStepsCount) if solver is not None else -1
+            # exudyn's last Newton residual (its own norm, N, relative to its tolerances)
+            residual = float(solver.conv.residual) if solver is not None else float("nan")
             if not ok:
                 raise ValueError("exudyn static solve failed")
         lam, V = exu.solver.ComputeODE2Eigenvalues(mbs, useAbsoluteValues=False)
@@ -158,7 +161,8 @@ def exudyn_modes(scene: Scene, *, about: str = "initial", count: int | None = No
         ini = scene.initial.resolve(n)
         phi0 = ini["phi"] + (phi0 - ini["phi"] + np.pi) % (2 * np.pi) - np.pi
         eq = Equilibrium(q=np.concatenate([phi0, np.zeros(2 * n)]), iterations=iters if built_scene.loads else 0,
-                         load_steps=int(load_steps), residual=float("nan"), converged=True,
+                         load_steps=int(load_steps),
+                         residual=residual if built_scene.loads else 0.0, converged=True,
                          loads=constant_loads(scene))
     return Modes(model="exudyn", about=about, omega=omega, damping=zeta,
                  dx=dx, dy=dy, hinge=hinge, phi0=phi0, l=np.linalg.norm(d, axis=1),

@@ -73,7 +73,8 @@ def run(args) -> int:
     lines = [f"{m.model} modes of {scene.name} about the {m.about} state -> {args.out}"]
     if eq is not None:
         ign = f"; ignored loads: {', '.join(eq.loads.ignored)}" if eq.loads and eq.loads.ignored else ""
-        res = f", residual {eq.residual:.2g} N m" if np.isfinite(eq.residual) else ""
+        unit = "(exudyn's Newton residual norm)" if m.model == "exudyn" else "N m"
+        res = f", residual {eq.residual:.2g} {unit}" if np.isfinite(eq.residual) else ""
         lines.append(f"static equilibrium: {eq.iterations} Newton iterations{res}{ign}")
     lines.append(" mode   omega (rad/s)        f (Hz)   damping ratio")
     for i in range(m.count):
