@@ -363,6 +363,15 @@ class ExudynModel(Model):
     def options(self) -> dict[str, Any]:
         return {k: getattr(self, k) for k in DEFAULTS}
 
+    def assembled(self, scene: Scene) -> tuple[Any, Any, list[list[int]]]:
+        """(SC, mbs, nodes) of ``scene``, assembled as for a run (for analyses other than time
+        integration, e.g. reference_models.exudyn_modes): nodes[k][j] is the exudyn node
+        number of beam node j = 0..elements of rod k (0-based); the scene's loads are attached."""
+        built = self._build(scene)
+        E = self.elements
+        nodes = [[k * (E + 1) + j for j in range(E + 1)] for k in range(scene.n)]
+        return built.SC, built.mbs, nodes
+
     # -- system ------------------------------------------------------------------------------
     def _build(self, scene: Scene) -> _Built:
         import exudyn as exu

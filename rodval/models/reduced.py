@@ -72,6 +72,11 @@ class ReducedSystem(PaperSystem):
         """Reduced stiffness K_pp - K_pg B^-1 K_gp (N m/rad, n x n, dense)."""
         return self._dense.K_r
 
+    @property
+    def C_r(self) -> np.ndarray:
+        """Reduced damping C_pp - K_pg B^-1 C_gp (N m s/rad, n x n, dense)."""
+        return self._dense.C_r
+
     def reduced_matrices(self, phi: np.ndarray):
         """M_r(phi), G_r(phi) and the bending-row blocks M_gp, G_gp (for recovery)."""
         cc, d = self.cc, self._dense

@@ -17,6 +17,7 @@ from matplotlib import colormaps, ticker
 from matplotlib.figure import Figure
 
 from rodval.analysis.metrics import pareto_front
+from rodval.core.modal import Modes
 from rodval.core.scene import UNITS
 from rodval.core.trajectory import Trajectory
 
@@ -303,3 +304,30 @@ def plot_work_precision(
             fig.savefig(path, dpi=110)
             paths.append(path)
     return paths
+
+
+def plot_modes(m: Modes, path: Path, title: str = "", count: int = 4) -> Path:
+    """The first ``count`` mode shapes drawn on the chain (nodes displaced by a scale of 0.15
+    of the chain length times the normalized shape; hinge angles are in modes.csv)."""
+    k = min(count, m.count)
+    x0, y0 = m.node_positions()
+    span = max(np.ptp(x0), np.ptp(y0), float(np.sum(m.l)) * 0.2)
+    amp = 0.15 * span
+    fig, axes = _figure(k, 1, figsize=(7, 1.9 * k + 0.6), squeeze=False, sharex=True)
+    for i, ax in enumerate(axes[:, 0]):
+        ax.plot(x0, y0, "-o", color="0.7", ms=3, lw=1, label="configuration")
+        ax.plot(
+            x0 + amp * m.dx[i], y0 + amp * m.dy[i], "-o", color="C0", ms=3, lw=1.5, label="mode"
+        )
+        ys = np.concatenate([y0, y0 + amp * m.dy[i]])
+        pad = 0.1 * max(np.ptp(ys), amp)
+        ax.set_ylim(ys.min() - pad, ys.max() + pad)
+        ax.set_ylabel("y (m)")
+        ax.set_title(f"mode {i + 1}: {m.omega[i]:.4g} rad/s ({m.f_hz[i]:.4g} Hz)", fontsize=9)
+    axes[-1, 0].set_xlabel("x (m)")
+    axes[0, 0].legend(fontsize=7, loc="upper left")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return path

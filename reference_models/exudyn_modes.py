@@ -1,0 +1,197 @@
+"""Modes of the exudyn reference model (ANCF cable beams), by exudyn's own solvers.
+
+The system is the one ``ExudynModel`` integrates (its ``assembled`` method: same mesh,
+revolute joints, hinge springs, point masses and load user functions). Then:
+
+* ``about="initial"``: the scene's initial state, without loads;
+* ``about="equilibrium"``: exudyn's static solver (``exudyn.solver.SolveStatic``, load
+  factor ramped over ``load_steps`` steps, Newton absolute tolerance scaled with EA) under the
+  scene's constant loads (``rodval.loads.constant``; other load laws are left out), its result
+  written to the initial state (``updateInitialValues=True``).
+
+``exudyn.solver.ComputeODE2Eigenvalues`` linearizes there (mass matrix and ODE2 Jacobian of
+the static solver, so the axial force's geometric stiffness is included) and handles the
+joints' algebraic constraints as exudyn documents: projection of M and K onto the null space
+of the constraint Jacobian (SVD), eigenvectors mapped back to ODE2 coordinates. With hinge
+dampers (nu > 0) it is called again with ``computeComplexEigenvalues=True`` (the damping
+matrix from the ODE2 velocity Jacobian, same projection); each undamped mode is paired with the
+complex eigenvalue s (Im s > 0) of nearest |s|, damping ratio -Re(s) / |s|.
+
+The measures are taken by definition from the eigenvectors, independently of the paper's
+equations: node k (k = 1..n) is the end node of rod k's beam (node 0 the pinned root), its
+displacement the (x, y) part of the eigenvector there; hinge angle D_k is the change of the
+angle of rod k+1's root tangent minus that of rod k's end tangent (hinge 0: rod 1's root
+tangent), linearized: d atan2(s_y, s_x) = (s_x ds_y - s_y ds_x) / |s|^2 with s the slope
+vector at the linearization state. Modes that stretch the beams (axial modes, absent from the
+inextensible native models) are left out: a mode is axial when the largest element elongation
+(the relative axial displacement of neighbouring beam nodes) exceeds ``axial_tol`` times its
+largest beam-node displacement.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reference_models.exudyn_chain import ExudynModel
+from rodval.core.modal import ABOUT, Equilibrium, Modes, constant_loads, normalize_shapes
+from rodval.core.scene import Scene
+
+#: Elongation/displacement ratio above which an exudyn mode counts as axial.
+AXIAL_TOL = 1e-3
+#: ExudynModel options changed for modal analysis (others: ExudynModel's DEFAULTS).
+#: EA = 1e8 N instead of 1e10: ComputeODE2Eigenvalues solves one dense problem whose spectrum
+#: runs up to the axial modes (omega^2 ~ EA / (m le^2)), and its round-off in the lowest
+#: (hinge) modes grows with EA: n = 8, 8 elements per rod, mode 1 = 0.0781417 (EA 1e8),
+#: 0.0781445 (1e9), 0.0781616 (1e10), 0.0777761 (1e11) rad/s against 0.0781421 natively.
+#: About the straight state bending and stretching decouple, so the hinge and bending
+#: frequencies do not depend on EA otherwise (mode 9: 452.44309 rad/s for EA 1e8 to 1e11);
+#: under a load the static stretch is F / EA (3e-7 for 30 N).
+MODES_DEFAULTS = {"EA": 1e8, "elements": 8}
+
+
+def exudyn_modes(
+    scene: Scene,
+    *,
+    about: str = "initial",
+    count: int | None = None,
+    load_steps: int = 20,
+    axial_tol: float = AXIAL_TOL,
+    **options,
+) -> Modes:
+    """Modes of the exudyn beam model about the scene's initial state or its static
+    equilibrium (see module docstring); ``options``: ExudynModel options (elements, EA; the
+    defaults for modes are ``MODES_DEFAULTS``)."""
+    import exudyn as exu
+
+    if about not in ABOUT:
+        raise ValueError(f"about must be one of {ABOUT}, got {about!r}")
+    model = ExudynModel(**{**MODES_DEFAULTS, **options})
+    n = scene.n
+    if about == "initial":
+        built_scene = scene.with_(loads=())
+    else:
+        built_scene = scene.with_(loads=tuple(f for f in scene.loads if f.name == "constant"))
+    _, mbs, nodes = model.assembled(built_scene)
+    for row in nodes:
+        for nd in row:
+            if mbs.GetNode(nd)["nodeType"] != "Point2DSlope1":
+                raise RuntimeError("unexpected exudyn node numbering")
+    console = exu.config.printToConsole
+    exu.config.printToConsole = False
+    eq = None
+    residual = float("nan")
+    try:
+        if about == "equilibrium" and built_scene.loads:
+            sim = exu.SimulationSettings()
+            st = sim.staticSolver
+            st.numberOfLoadSteps = int(load_steps)
+            st.useLoadFactor = True
+            st.verboseMode = 0
+            st.newton.relativeTolerance = 1e-10
+            st.newton.absoluteTolerance = model.newton_atol_per_EA * model.EA
+            st.newton.maxIterations = 50
+            sim.solution.file.write = False
+            sim.show.computationTime = False
+            ok = exu.solver.SolveStatic(mbs, sim, updateInitialValues=True)
+            solver = mbs.sys.get("staticSolver")
+            iters = int(solver.it.newtonStepsCount) if solver is not None else -1
+            # exudyn's last Newton residual (its own norm, N, relative to its tolerances)
+            residual = float(solver.conv.residual) if solver is not None else float("nan")
+            if not ok:
+                raise ValueError("exudyn static solve failed")
+        lam, V = exu.solver.ComputeODE2Eigenvalues(mbs, useAbsoluteValues=False)
+        s_damped = None
+        if np.any(scene.chain.nu > 0):
+            s_damped, _ = exu.solver.ComputeODE2Eigenvalues(
+                mbs, computeComplexEigenvalues=True, useAbsoluteValues=False
+            )
+    finally:
+        exu.config.printToConsole = console
+    lam = np.asarray(lam, float)
+    V = np.asarray(V, float)
+    cfg = exu.ConfigurationType.Initial
+    q_all = np.asarray(mbs.systemData.GetODE2Coordinates(configuration=cfg))
+
+    def node_state(nd):
+        i = mbs.GetNodeODE2Index(nd)
+        ref = np.asarray(mbs.GetNodeParameter(nd, "referenceCoordinates"), float)
+        return i, ref + q_all[i : i + 4]
+
+    idx, state = zip(*(node_state(nd) for row in nodes for nd in row))
+    idx = np.array(idx).reshape(n, -1)  # (n, E+1) first ODE2 index
+    state = np.array(state).reshape(n, idx.shape[1], 4)  # position and slope at q0
+    # per mode: beam-node displacements (n, E+1, 2) and slope changes
+    U = np.stack([V[idx + c] for c in range(4)], axis=-1)  # (n, E+1, modes, 4)
+    U = np.moveaxis(U, 2, 0)  # (modes, n, E+1, 4)
+    disp = U[..., :2]
+    # axial test: element elongation along the current tangent
+    chord = state[:, 1:, :2] - state[:, :-1, :2]
+    t_hat = chord / np.linalg.norm(chord, axis=-1, keepdims=True)
+    elong = np.abs(np.sum((disp[:, :, 1:] - disp[:, :, :-1]) * t_hat, -1))
+    dmax = np.max(np.linalg.norm(disp, axis=-1), axis=(1, 2))
+    axial = np.max(elong, axis=(1, 2)) > axial_tol * np.maximum(dmax, 1e-300)
+    keep = ~axial
+    lam, U = lam[keep], U[keep]
+    order = np.argsort(lam)
+    lam, U = lam[order], U[order]
+    if count is not None:
+        lam, U = lam[: int(count)], U[: int(count)]
+    # node displacements: node 0 = rod 1's root (pinned), node k = rod k's end
+    dx = np.concatenate([U[:, :1, 0, 0], U[:, :, -1, 0]], axis=1)
+    dy = np.concatenate([U[:, :1, 0, 1], U[:, :, -1, 1]], axis=1)
+
+    def dtheta(s, ds):
+        return (s[..., 0] * ds[..., 1] - s[..., 1] * ds[..., 0]) / np.sum(s * s, -1)
+
+    root = dtheta(state[None, :, 0, 2:], U[:, :, 0, 2:])  # (modes, n) rod k root tangent
+    end = dtheta(state[None, :, -1, 2:], U[:, :, -1, 2:])  # rod k end tangent
+    hinge = root.copy()
+    hinge[:, 1:] -= end[:, :-1]
+    dx, dy, hinge = normalize_shapes(dx, dy, hinge)
+    tiny = 1e-13 * np.max(np.abs(lam)) if lam.size else 0.0
+    lam = np.where(np.abs(lam) <= tiny, 0.0, lam)
+    omega = np.sign(lam) * np.sqrt(np.abs(lam))
+    zeta = np.full(omega.size, np.nan)
+    if s_damped is None:
+        zeta[omega > 0] = 0.0
+    else:
+        # pair each undamped mode with the damped eigenvalue (Im > 0) of nearest |s|
+        from scipy.optimize import linear_sum_assignment
+
+        s_up = np.asarray(s_damped)[np.asarray(s_damped).imag > 0]
+        pos = np.flatnonzero(omega > 0)
+        if pos.size and s_up.size:
+            cost = np.abs(np.abs(s_up)[None, :] - omega[pos, None]) / omega[pos, None]
+            r, c = linear_sum_assignment(cost)
+            zeta[pos[r]] = -s_up[c].real / np.abs(s_up[c])
+    ends = np.concatenate([state[:1, 0, :2], state[:, -1, :2]])
+    d = np.diff(ends, axis=0)
+    phi0 = np.arctan2(d[:, 1], d[:, 0])
+    if about == "equilibrium":
+        ini = scene.initial.resolve(n)
+        phi0 = ini["phi"] + (phi0 - ini["phi"] + np.pi) % (2 * np.pi) - np.pi
+        eq = Equilibrium(
+            q=np.concatenate([phi0, np.zeros(2 * n)]),
+            iterations=iters if built_scene.loads else 0,
+            load_steps=int(load_steps),
+            residual=residual if built_scene.loads else 0.0,
+            converged=True,
+            loads=constant_loads(scene),
+        )
+    return Modes(
+        model="exudyn",
+        about=about,
+        omega=omega,
+        damping=zeta,
+        dx=dx,
+        dy=dy,
+        hinge=hinge,
+        phi0=phi0,
+        l=np.linalg.norm(d, axis=1),
+        equilibrium=eq,
+        info={
+            "node_positions": ends,
+            "axial_modes_dropped": int(axial.sum()),
+            "options": model.options(),
+        },
+    )

@@ -1,0 +1,150 @@
+"""Results of a modal analysis, shared by the native models' analysis
+(``rodval.analysis.modes``) and the reference model's (``reference_models.exudyn_modes``):
+the configuration a model is linearised about, its constant loads, and the modes.
+
+Units: frequencies in rad/s (``omega``) and Hz (``f_hz``); mode shapes as node displacements
+(m per unit of the largest node displacement) and hinge angles (rad per the same unit).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from rodval.core.scene import Scene
+
+#: What a model is linearised about: its initial state (loads ignored) or the static
+#: equilibrium under the scene's constant loads and hinge rest angles.
+ABOUT = ("initial", "equilibrium")
+
+
+@dataclass(frozen=True)
+class ConstantLoads:
+    """Suffix sums SX, SY (N) of the scene's constant nodal loads and what was left out."""
+
+    SX: np.ndarray
+    SY: np.ndarray
+    ignored: tuple[str, ...] = ()
+
+    @property
+    def any(self) -> bool:
+        return bool(np.any(self.SX) or np.any(self.SY))
+
+
+def constant_loads(scene: Scene) -> ConstantLoads:
+    """The scene's constant loads (``rodval.loads.constant``) as suffix sums; loads with other
+    laws (pulse, callables) are ignored and named in ``ignored``."""
+    n = scene.n
+    X, Y = np.zeros(n), np.zeros(n)
+    ignored = []
+    for f in scene.loads:
+        if f.name == "constant":
+            X[f.node - 1] += float(f.params.get("X", 0.0))
+            Y[f.node - 1] += float(f.params.get("Y", 0.0))
+        else:
+            ignored.append(f"{f.name} at node {f.node}")
+    return ConstantLoads(np.cumsum(X[::-1])[::-1], np.cumsum(Y[::-1])[::-1], tuple(ignored))
+
+
+@dataclass
+class Equilibrium:
+    """A static equilibrium of the full model: q = [phi; alpha; beta] (rad), Newton
+    iterations (all load steps), load steps, final residual max |R| (N m), converged."""
+
+    q: np.ndarray
+    iterations: int
+    load_steps: int
+    residual: float
+    converged: bool
+    loads: ConstantLoads | None = None
+
+    @property
+    def phi(self) -> np.ndarray:
+        return self.q[: self.q.size // 3]
+
+
+@dataclass
+class Modes:
+    """Linearized modes of one model about one configuration.
+
+    omega (rad/s, ascending; negative = unstable), damping (damping ratio, NaN where not
+    defined), dx, dy (count, n+1) node displacements of nodes 0..n, hinge (count, n) hinge
+    angles D_0..D_{n-1} (rad per unit of the largest node displacement), phi0 (configuration
+    chord angles), l (rod lengths), equilibrium (the static solve, when about="equilibrium").
+    """
+
+    model: str
+    about: str
+    omega: np.ndarray
+    damping: np.ndarray
+    dx: np.ndarray
+    dy: np.ndarray
+    hinge: np.ndarray
+    phi0: np.ndarray
+    l: np.ndarray
+    equilibrium: Equilibrium | None = None
+    info: dict = field(default_factory=dict)
+
+    @property
+    def f_hz(self) -> np.ndarray:
+        return self.omega / (2 * np.pi)
+
+    @property
+    def count(self) -> int:
+        return self.omega.size
+
+    def shape_vectors(self) -> np.ndarray:
+        """(count, 3n+2): [dx; dy; l_mean * D] per mode, the vectors MAC compares."""
+        return np.hstack([self.dx, self.dy, float(np.mean(self.l)) * self.hinge])
+
+    def node_positions(self) -> tuple[np.ndarray, np.ndarray]:
+        """Node coordinates (m) of the configuration, nodes 0..n."""
+        x = np.concatenate([[0.0], np.cumsum(self.l * np.cos(self.phi0))])
+        y = np.concatenate([[0.0], np.cumsum(self.l * np.sin(self.phi0))])
+        return x, y
+
+    def frequencies_frame(self) -> pd.DataFrame:
+        return pd.DataFrame(
+            {
+                "mode": np.arange(1, self.count + 1),
+                "omega_rad_s": self.omega,
+                "f_hz": self.f_hz,
+                "damping_ratio": self.damping,
+            }
+        )
+
+    def modes_frame(self) -> pd.DataFrame:
+        """Tidy: mode, kind (node_dx, node_dy, hinge), k (node 0..n or hinge 0..n-1), value."""
+        rows = []
+        for kind, arr in (("node_dx", self.dx), ("node_dy", self.dy), ("hinge", self.hinge)):
+            m, k = np.meshgrid(np.arange(1, self.count + 1), np.arange(arr.shape[1]), indexing="ij")
+            rows.append(
+                pd.DataFrame(
+                    {"mode": m.ravel(), "kind": kind, "k": k.ravel(), "value": arr.ravel()}
+                )
+            )
+        return pd.concat(rows, ignore_index=True).sort_values(
+            ["mode", "kind", "k"], kind="stable", ignore_index=True
+        )
+
+
+def normalize_shapes(dx: np.ndarray, dy: np.ndarray, hinge: np.ndarray):
+    """Scale each mode (row) so that the largest node displacement magnitude is 1 (or, if the
+    nodes do not move, the largest |hinge angle| is 1) and the largest node-displacement
+    component (else hinge angle) is positive."""
+    dx, dy, hinge = (np.array(a, float) for a in (dx, dy, hinge))
+    for i in range(dx.shape[0]):
+        mag = np.hypot(dx[i], dy[i])
+        ref = np.concatenate([dx[i], dy[i]])
+        if mag.max() <= 1e-12 * max(np.max(np.abs(hinge[i])), 1e-300):
+            scale, ref = np.max(np.abs(hinge[i])), hinge[i]
+        else:
+            scale = mag.max()
+        sign = np.sign(ref[np.argmax(np.abs(ref))]) or 1.0
+        s = sign / scale if scale > 0 else 1.0
+        dx[i] *= s
+        dy[i] *= s
+        hinge[i] *= s
+    return dx, dy, hinge
