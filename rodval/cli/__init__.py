@@ -9,7 +9,7 @@ import re
 import sys
 
 #: Subcommand modules, in the order ``rodval --help`` lists them.
-COMMANDS = ("reproduce", "simulate", "study", "report", "bench", "modes")
+COMMANDS = ("reproduce", "simulate", "compare", "study", "report", "bench", "modes")
 
 
 class CliError(Exception):

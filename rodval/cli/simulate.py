@@ -6,10 +6,8 @@ same resolved scene, model, options and integrator settings; options given here 
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
-from typing import Any
 
 from rodval.cli.options import (
     add_integrator_options,
@@ -18,10 +16,10 @@ from rodval.cli.options import (
     positive_float,
     time_list,
 )
-from rodval.core.provenance import provenance
-from rodval.core.scene_file import read_scene_document, scene_from_dict, scene_to_dict, with_horizon
+from rodval.core.scene_file import read_scene_document, scene_from_dict, with_horizon
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
-from rodval.models import REGISTRY, simulate
+from rodval.models import REGISTRY, model_class, simulate
+from rodval.report.run_files import read_run_record, write_run
 from rodval.solvers.progress import progress_bar
 
 
@@ -64,35 +62,17 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _previous_run(path: Path) -> dict[str, Any] | None:
-    """The run record if ``path`` is a run.json written by `rodval simulate`."""
-    if path.suffix != ".json":
-        return None
-    if not path.is_file():
-        raise ValueError(f"SCENE {str(path)!r} does not exist")
-    try:
-        rec = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ValueError(f"{path}: not a readable run.json ({exc})") from None
-    missing = [
-        k
-        for k in ("scene", "model", "settings", "options")
-        if not isinstance(rec, dict) or k not in rec
-    ]
-    if missing:
-        raise ValueError(f"{path}: not a run.json of rodval simulate (no {missing[0]!r})")
-    return rec
-
-
 def run(args) -> int:
-    previous = _previous_run(Path(args.scene))
+    path = Path(args.scene)
+    previous = read_run_record(path) if path.suffix == ".json" else None
     if previous is not None:
         doc, model = dict(previous["scene"]), args.model or previous["model"]
-        settings_kw = {k: v for k, v in previous["settings"].items() if k in SETTING_NAMES}
-        settings_kw["method"] = previous["settings"].get(
-            "requested_method", settings_kw.get("method")
-        )
         options = dict(previous["options"]) if model == previous["model"] else {}
+        settings_kw = {}
+        if getattr(model_class(model), "USES_INTEGRATOR_SETTINGS", True):
+            ran = previous["settings"]
+            settings_kw = {k: v for k, v in ran.items() if k in SETTING_NAMES}
+            settings_kw["method"] = ran.get("requested_method", settings_kw.get("method"))
     else:
         doc, model, settings_kw, options = (
             read_scene_document(args.scene),
@@ -101,10 +81,11 @@ def run(args) -> int:
             {},
         )
     where = str(args.scene)
-    if args.t_end is not None:
-        scene = with_horizon(doc, args.t_end, where)
-    else:
-        scene = scene_from_dict(doc, where=where)
+    scene = (
+        with_horizon(doc, args.t_end, where)
+        if args.t_end is not None
+        else scene_from_dict(doc, where=where)
+    )
     if args.times is not None:
         scene = scene.with_(times=args.times)
     options.update(dict(args.options))
@@ -113,18 +94,7 @@ def run(args) -> int:
     settings_kw.update(integrator_settings(args))
     with progress_bar(scene.t_end, enabled=sys.stderr.isatty()):
         traj = simulate(scene, model, settings=IntegratorSettings(**settings_kw), **options)
-    args.out.mkdir(parents=True, exist_ok=True)
-    traj.to_frame().to_csv(args.out / "trajectory.csv", index=False)
-    record = {
-        "scene": scene_to_dict(scene),
-        "model": traj.model,
-        "options": traj.options,
-        "settings": traj.settings,
-        "stats": traj.stats.as_dict(),
-        "events": traj.events,
-        "provenance": provenance(),
-    }
-    (args.out / "run.json").write_text(json.dumps(record, indent=2, default=str))
+    write_run(traj, scene, args.out)
     print(
         f"{traj.model}: {traj.stats.message}, method {traj.settings.get('method')}, "
         f"t_reached = {traj.stats.t_reached:g} s, nfev = {traj.stats.nfev}, "
