@@ -5,12 +5,16 @@ the imports: core <- solvers <- models, reference_models <- analysis <- report <
 <- cli (see docs/architecture.md).
 """
 
+from rodval.analysis.metrics import discrepancies as compare
+from rodval.analysis.modes import model_modes as modes
 from rodval.core.contract import Model
 from rodval.core.loads import NodalForce, constant, harmonic, pulse, ramp, tabulated
-from rodval.core.scene import TABLE1_TIMES, Chain, InitialState, Scene, paper_scene
+from rodval.core.scene import TABLE1_TIMES, Chain, InitialState, Latch, Scene, Stop, paper_scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.models import FullModel, ReducedModel, get_model, simulate
+from rodval.report.tables import read_tables as read_study_tables
+from rodval.study import load_study, run_study
 
 __version__ = "0.2.0"
 
@@ -18,6 +22,8 @@ __all__ = [
     "Chain",
     "InitialState",
     "Scene",
+    "Latch",
+    "Stop",
     "NodalForce",
     "pulse",
     "constant",
@@ -34,5 +40,10 @@ __all__ = [
     "simulate",
     "Trajectory",
     "SolverStats",
+    "compare",
+    "modes",
+    "load_study",
+    "run_study",
+    "read_study_tables",
     "__version__",
 ]

@@ -1,28 +1,8 @@
-"""Scenes from TOML files or plain dicts (the format studies reuse for their base scene).
+"""Scenes from TOML files or plain dicts (the format studies reuse for their base scene), and
+the complete resolved scene as a dict (``scene_to_dict``: run records, reruns).
 
-Format (every key optional except where noted)::
-
-    base = "paper"            # start from the paper example; omitted: "paper" as well
-    name = "my-chain"
-    n = 8                     # number of rods (the paper's per-rod data are repeated)
-    t_end = 2.0               # horizon, s
-    times = [0.5, 1.0, 1.5, 2.0]          # or {start = 0.0, stop = 2.0, num = 201}
-    outputs = ["phi", "dphi", "alpha", "beta"]   # from rodval.core.scene.QUANTITIES
-
-    [chain]                   # scalars or lists of length n
-    l = 2.0
-    m = 3.0
-    EI = 1e5
-    mu = 3.0
-    kappa = 100.0
-    nu = 0.01
-
-    [[loads]]                 # replaces the base scene's loads; `loads = []` for none
-    type = "pulse"            # pulse: node, Xbar, Ybar, T;  constant: node, X, Y, t_on, t_off
-    node = 8                  # or "last": node n (follows n in studies)
-
-    [initial]                 # scalars or lists of length n (rad, rad/s)
-    phi = 0.0
+Every key, with its unit, meaning, default and allowed range: ``docs/scene_file.md``.
+Every error is a ValueError that names the file and the offending key.
 """
 
 from __future__ import annotations
