@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rodval.cli.options import key_value, positive_int
+from rodval.cli.options import add_model_options, positive_int
 from rodval.core.scene_file import load_scene
 from rodval.report.figures import plot_modes
 
@@ -43,21 +43,7 @@ def register(sub) -> None:
         help="linearize about the initial state (loads ignored) or the static "
         "equilibrium under the scene's constant loads (default initial)",
     )
-    p.add_argument(
-        "--coefficients",
-        choices=("printed", "published"),
-        default="printed",
-        help="coefficient variant of the native models (default printed)",
-    )
-    p.add_argument(
-        "--set",
-        dest="options",
-        type=key_value,
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="exudyn model option, e.g. elements=8 (repeatable)",
-    )
+    add_model_options(p, coefficients_default="printed")
     p.add_argument(
         "--compare",
         nargs="?",

@@ -130,3 +130,23 @@ def integrator_settings(args: argparse.Namespace) -> dict:
         "max_wall_s": args.max_wall,
     }
     return {k: v for k, v in given.items() if v != DEFAULTS[k]}
+
+
+def add_model_options(p: argparse.ArgumentParser, *, coefficients_default: str | None) -> None:
+    """--coefficients (the native models' variant) and --set KEY=VALUE (any model option)."""
+    p.add_argument(
+        "--coefficients",
+        choices=("printed", "published"),
+        default=coefficients_default,
+        help="coefficient variant of the native models (default printed)",
+    )
+    p.add_argument(
+        "--set",
+        dest="options",
+        type=key_value,
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="model option, e.g. elements=8 for exudyn (repeatable); the allowed "
+        "keys of each model: docs/scene_file.md",
+    )

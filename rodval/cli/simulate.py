@@ -11,8 +11,8 @@ from pathlib import Path
 
 from rodval.cli.options import (
     add_integrator_options,
+    add_model_options,
     integrator_settings,
-    key_value,
     positive_float,
     time_list,
 )
@@ -44,20 +44,7 @@ def register(sub) -> None:
         help="horizon, s (> 0); the scene's output times up to it are kept",
     )
     p.add_argument("--times", type=time_list, help="output times t1,t2,... (s), increasing")
-    p.add_argument(
-        "--coefficients",
-        choices=("printed", "published"),
-        help="coefficient variant of the native models (default printed)",
-    )
-    p.add_argument(
-        "--set",
-        dest="options",
-        type=key_value,
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="model option, e.g. elements=2 (repeatable)",
-    )
+    add_model_options(p, coefficients_default=None)
     p.add_argument("--out", required=True, type=Path, help="output folder")
     p.set_defaults(func=run)
 
