@@ -1266,6 +1266,16 @@ class _Latches:
         d, dd = q[b] - q[a], v[b] - v[a]
         return float((d[0] * dd[1] - d[1] * dd[0]) / (d @ d))
 
+    def _root_moment(self, j: int, q) -> float:
+        """EI kappa_b (N m) at the root of rod j (0-based): the moment the hinge there
+        transmits, in the sense of its spring's kappa (D - rest)."""
+        E, le = self.E, self.scene.chain.l[j] / self.E
+        _, dS, ddS = _hermite(np.zeros(1), le)
+        a, b = self.ltg[j][0], self.ltg[j][1 if E >= 1 else 0]
+        Q = np.stack([q[a[:2]], q[a[2:]], q[b[:2]], q[b[2:]]])  # (4, 2)
+        r1, r2 = dS[0] @ Q, ddS[0] @ Q
+        return float(self.scene.chain.EI[j] * (r1[0] * r2[1] - r1[1] * r2[0]) / (r1 @ r1))
+
     def _measures(self, t: float, item, q, v, a) -> dict:
         k, chain = item["k"], self.scene.chain
         p, h = self._momenta(q, v)
@@ -1296,6 +1306,7 @@ class _Latches:
         return {
             "t": t,
             "rel": rel,
+            "M_beam": self._root_moment(k, q),
             "H_out": H_out,
             "finite": finite,
             "H_root": float(h.sum()),
@@ -1328,6 +1339,7 @@ class _Latches:
             ev["root_integral"] += (
                 0.5 * (now_m["t"] - last["t"]) * (last["root_moment"] + now_m["root_moment"])
             )
+            ev["peak"] = max(ev["peak"], abs(now_m["M_beam"]))
             s0 = np.sign(ev["before"]["rel"])
             if ev["steps"] > LOCK_SETTLE_STEPS and np.sign(now_m["rel"]) != s0:
                 self._finish(ev, last, now_m)
@@ -1364,6 +1376,7 @@ class _Latches:
                     "last": before,
                     "integral": 0.0,
                     "root_integral": 0.0,
+                    "peak": abs(before["M_beam"]),
                     "step": h,
                 }
             )
@@ -1410,6 +1423,7 @@ class _Latches:
                 "angular_momentum_root_before": float(before["H_root"]),
                 "angular_momentum_root_after": float(after["H_root"]),
                 "angular_momentum_root_jump": float(root_jump),
+                "peak_moment": float(ev["peak"]),
                 "t_activated": float(before["t"]),
                 "lock_duration": float(after["t"] - before["t"]),
                 "window_closed": closed,
