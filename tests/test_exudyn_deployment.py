@@ -163,3 +163,88 @@ def test_latch_scene_refused_before_any_work(options, match):
 def test_bad_latches_refused_by_the_scene(latch, match):
     with pytest.raises(ValueError, match=match):
         two_rod_latch(outputs=("phi",)).with_(latches=(latch,))
+
+
+def synthetic_record(case: str, events: dict[str, list[dict]]):
+    """A CaseRecord whose runs carry the given events (label -> events), no values."""
+    from rodval.core.trajectory import SolverStats, Trajectory
+    from rodval.study.records import CaseRecord, RunRecord
+
+    runs = [
+        RunRecord(
+            label, 0.0, Trajectory(label, case, np.zeros(0), {}, {}, SolverStats(), events=ev)
+        )
+        for label, ev in events.items()
+    ]
+    scene = {"chain": {"l": [1.0, 1.0]}, "t_end": 1.0}
+    return CaseRecord(case, "f", {}, scene, "exudyn", runs, [])
+
+
+NATIVE_EVENT = {
+    "t": 0.4041,
+    "label": "latch hinge 1",
+    "hinge": 1,
+    "angular_impulse": 22.9,
+    "kinetic_before": 242.8,
+    "kinetic_after": 1.0,
+}
+
+
+def test_events_table_and_discrepancies_with_native_records():
+    """The events table takes the native models' records (keys t, label, hinge,
+    angular_impulse, kinetic_before, kinetic_after) and exudyn's (more keys) side by side;
+    the discrepancies pair them by case and label."""
+    from rodval.report.study_report import event_discrepancies
+    from rodval.study.tables import EVENT_COLUMNS, events_table
+
+    exudyn_event = {**NATIVE_EVENT, "t": 0.4040, "angular_impulse": 23.0, "lock_duration": 6e-3}
+    rec = synthetic_record(
+        "base", {"exudyn": [exudyn_event], "full": [NATIVE_EVENT], "reduced": []}
+    )
+    table = events_table([rec], {})
+    assert list(table.columns[: 4 + len(EVENT_COLUMNS)]) == [
+        "case",
+        "n",
+        "horizon",
+        "model",
+        *EVENT_COLUMNS,
+    ]
+    assert "lock_duration" in table
+    assert table["energy_lost"].tolist() == pytest.approx([241.8, 241.8])
+    disc = event_discrepancies(table, "exudyn")
+    row = disc.iloc[0]
+    assert row["model"] == "full" and row["label"] == "latch hinge 1"
+    assert row["dt"] == pytest.approx(1e-4)
+    assert row["impulse_rel"] == pytest.approx(0.1 / 23.0)
+
+
+def test_report_renders_the_deployment_section(tmp_path):
+    """A tiny study run by the native reduced models, with an events.csv of native-style
+    records added: the report gains the deployment section (events, discrepancies, residual
+    vibration) and the deployment figure."""
+    from study_helpers import write_study
+
+    from rodval.report.study_report import build_report
+    from rodval.study import load_study, run_study
+    from rodval.study.tables import events_table
+
+    path = write_study(tmp_path, grid="scene.t_end = [0.1]")
+    out = tmp_path / "out"
+    run_study(load_study(path), out, workers=1, progress=False)
+    cases = sorted(p.stem for p in (out / "cases").glob("*.json"))
+    recs = [
+        synthetic_record(
+            c,
+            {
+                "reduced": [{**NATIVE_EVENT, "t": 0.05}],
+                "published": [{**NATIVE_EVENT, "t": 0.052, "angular_impulse": 23.4}],
+            },
+        )
+        for c in cases
+    ]
+    events_table(recs, {}).to_csv(out / "events.csv", index=False)
+    text = build_report(out).read_text()
+    assert "## Deployment: locks, impulses and residual vibration" in text
+    assert "Lock discrepancies against `reduced`" in text
+    assert "Residual vibration after the last lock" in text
+    assert list((out / "figures").glob("deployment_*.png"))
