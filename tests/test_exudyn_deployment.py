@@ -115,9 +115,12 @@ def test_latch_lock_measured_on_the_beam_solution(hinge_quantities):
     dphi = tr["dphi"]
     late = tr.times > ev["t"] + 0.05
     assert abs(np.mean(dphi[late, 1] - dphi[late, 0])) < 0.05 * abs(ev["chord_rate_before"])
-    # hinge moment before the lock: the spring law kappa (D - rest)
+    # hinge moment before the lock: the spring law kappa (D - rest); after it, the beam's
+    # root bending moment, whose largest value in the lock window is recorded
     M = tr["hinge_moment"][:, 1]
     assert M[0] == pytest.approx(50.0 * (math.pi - 0.05), rel=1e-9)
+    window = (tr.times > ev["t_activated"]) & (tr.times < ev["t_activated"] + ev["lock_duration"])
+    assert ev["peak_moment"] >= 0.9 * np.abs(M[window]).max() > 0
 
 
 def test_latch_measures_converge_with_step(hinge_quantities):
