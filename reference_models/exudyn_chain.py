@@ -269,6 +269,7 @@ class _Built:
     load_errors: list
     nodes: list | None = None  # beam node numbers per rod
     initial: tuple | None = None  # _initial_node_states: ref, offsets, velocities
+    latch_joints: dict | None = None  # hinge -> exudyn object number of its locking joint
 
 
 class ExudynModel(Model):
@@ -385,6 +386,7 @@ class ExudynModel(Model):
             ObjectANCFCable2D,
             ObjectConnectorTorsionalSpringDamper,
             ObjectGround,
+            ObjectJointGeneric,
             ObjectJointRevolute2D,
             ObjectMassPoint2D,
             SensorNode,
@@ -424,10 +426,18 @@ class ExudynModel(Model):
                     for j in range(E)
                 ]
             )
-        # hinges: position joint + torsional spring-damper on the end tangents
+        # hinges: position joint + torsional spring-damper on the end tangents (relaxed at the
+        # rest angle: exudyn's ``offset``); limit stops: a second torsional spring-damper with a
+        # one-sided user law; latches: a rotation-locking ObjectJointGeneric, inactive until
+        # the pre-step function (``_Latches``) switches it on
         ini = scene.initial.resolve(chain.n)
         tangent_left = ini["phi"] + ini["alpha"]
         tangent_right = ini["phi"] + ini["beta"]
+        latch_of = {latch.hinge: latch for latch in scene.latches}
+        stops_of: dict[int, list] = {}
+        for stop in scene.stops:
+            stops_of.setdefault(stop.hinge, []).append(stop)
+        latch_joints: dict[int, int] = {}
         for k in range(chain.n):
             if k == 0:
                 pos0 = mbs.AddMarker(MarkerBodyPosition(bodyNumber=ground))
@@ -443,10 +453,15 @@ class ExudynModel(Model):
                 angle0 = tangent_left[k] - tangent_right[k - 1]
             pos1 = mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[k][0]))
             mbs.AddObject(ObjectJointRevolute2D(markerNumbers=[pos0, pos1]))
-            if chain.kappa[k] > 0 or chain.nu[k] > 0:
-                rot1 = mbs.AddMarker(
-                    MarkerBodyRigid(bodyNumber=elems[k][0], localPosition=[0, 0, 0])
-                )
+            rot1 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=elems[k][0], localPosition=[0, 0, 0]))
+            springs = [(float(chain.kappa[k]), float(chain.nu[k]), float(chain.rest_angle[k]), 0)]
+            springs += [
+                (stop.stiffness, stop.damping, stop.angle, _stop_law(stop.side))
+                for stop in stops_of.get(k, [])
+            ]
+            for stiffness, damping, offset, law in springs:
+                if stiffness == 0 and damping == 0:
+                    continue
                 turns = mbs.AddNode(
                     NodeGenericData(
                         numberOfDataCoordinates=1, initialCoordinates=[_revolutions(angle0)]
@@ -456,8 +471,23 @@ class ExudynModel(Model):
                     ObjectConnectorTorsionalSpringDamper(
                         markerNumbers=[rot0, rot1],
                         nodeNumber=turns,
-                        stiffness=float(chain.kappa[k]),
-                        damping=float(chain.nu[k]),
+                        stiffness=stiffness,
+                        damping=damping,
+                        offset=offset,
+                        springTorqueUserFunction=law,
+                    )
+                )
+            if k in latch_of:
+                # joint frame 1 = marker 1 turned back by the latch angle: the joint's locked
+                # relative rotation is D_k = angle (locally unique)
+                a = float(latch_of[k].angle)
+                c, sn = math.cos(-a), math.sin(-a)
+                latch_joints[k] = mbs.AddObject(
+                    ObjectJointGeneric(
+                        markerNumbers=[rot0, rot1],
+                        constrainedAxes=[0, 0, 0, 0, 0, 1],
+                        rotationMarker1=[[c, -sn, 0.0], [sn, c, 0.0], [0.0, 0.0, 1.0]],
+                        activeConnector=False,
                     )
                 )
         for k in range(chain.n):
@@ -475,9 +505,9 @@ class ExudynModel(Model):
             )
         # sensors on the beam nodes the outputs need
         wanted = set()
-        if scene.wants("phi", "dphi", "alpha", "beta", "x", "y"):
+        if scene.wants("phi", "dphi", "alpha", "beta", "x", "y", "hinge_angle", "hinge_moment"):
             wanted |= {(k, 0) for k in range(chain.n)} | {(k, E) for k in range(chain.n)}
-        if scene.wants("energy"):
+        if scene.wants("energy") or scene.latches:
             wanted |= {(k, j) for k in range(chain.n) for j in range(E + 1)}
         ovt = exu.OutputVariableType
         node_sensors = {
@@ -495,7 +525,7 @@ class ExudynModel(Model):
             for key in sorted(wanted)
         }
         mbs.Assemble()
-        return _Built(SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0))
+        return _Built(SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints)
 
     def _settings(self, t_end: float):
         import exudyn as exu
@@ -541,6 +571,31 @@ class ExudynModel(Model):
                     "at their defaults"
                 )
 
+    #: Largest generalized-alpha spectral radius accepted with latches: above it the index-3
+    #: lock leaves a slowly decaying step-to-step oscillation of the relative rate
+    #: (docs/deployment.md); 0 damps it within two steps.
+    LATCH_MAX_SPECTRAL_RADIUS = 0.5
+
+    def check_scene(self, scene: Scene) -> None:
+        """Refuse, before any work, what this model cannot honour in ``scene``: latches with the
+        trapezoidal (index-2) solver, which would hold a latched hinge at the angle where its
+        joint was switched on instead of the latch angle, or with a spectral radius above
+        ``LATCH_MAX_SPECTRAL_RADIUS``."""
+        if not scene.latches:
+            return
+        if self.solver == "trapezoidal":
+            raise ValueError(
+                "the exudyn model locks latches with an index-3 rotation constraint: use "
+                "solver='generalized-alpha' (the trapezoidal solver's index-2 constraints would "
+                "hold the hinge at the angle of activation, not at the latch angle)"
+            )
+        if self.spectral_radius > self.LATCH_MAX_SPECTRAL_RADIUS:
+            raise ValueError(
+                f"scenes with latches need spectral_radius <= {self.LATCH_MAX_SPECTRAL_RADIUS} "
+                f"(0 recommended), got {self.spectral_radius}: with less numerical damping the "
+                "locked hinge's relative rate oscillates from step to step after the lock"
+            )
+
     def simulate(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
         """Run the scene. Of the native integrator ``settings`` only ``blowup_factor`` applies;
         any other non-default field raises ValueError before any work (``check_settings``): the
@@ -549,6 +604,7 @@ class ExudynModel(Model):
         import exudyn as exu
 
         self.check_settings(settings)
+        self.check_scene(scene)
         factor = (settings or IntegratorSettings()).blowup_factor
         stats = SolverStats()
         run_info: dict[str, Any] = {"blowup_factor": factor}
@@ -563,7 +619,24 @@ class ExudynModel(Model):
         run_info.update(steps_planned=int(ti.numberOfSteps), step_used=float(ti.initialStepSize))
         solver = exu.MainSolverImplicitSecondOrder()
         guard.solver = solver
-        built.mbs.SetPreStepUserFunction(guard.pre_step)
+        latches = _Latches(built, guard, scene, self.elements) if scene.latches else None
+
+        def pre_step(mbs, t):
+            go = guard.pre_step(mbs, t)
+            if latches is not None and go:
+                try:
+                    latches.pre_step(t, float(solver.it.currentStepSize))
+                except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
+                    guard.verdict = (
+                        STATUS_ERROR,
+                        f"latch handling failed at t = {t:.6g} s: {type(exc).__name__}: {exc}",
+                        t,
+                        True,
+                    )
+                    return False
+            return go
+
+        built.mbs.SetPreStepUserFunction(pre_step)
         if self.solver == "trapezoidal":
             sim.timeIntegration.generalizedAlpha.useNewmark = True
             sim.timeIntegration.generalizedAlpha.useIndex2Constraints = True
@@ -620,9 +693,20 @@ class ExudynModel(Model):
             times = times[times <= stats.t_reached + tol]
         else:  # the state at the detection time is the bad one: keep the times before it
             times = times[times < stats.t_reached - tol]
+        if latches is not None:
+            try:
+                latches.close()
+            except Exception:  # noqa: BLE001 - the pending locks stay unrecorded
+                pass
+        events = sorted(latches.events, key=lambda ev: ev["t"]) if latches is not None else []
+        lock_steps = {}
+        if latches is not None:
+            lock_steps = {k: t for k, t in latches.lock_times.items()}
         try:
             observed = (
-                _observe(scene, self.elements, self.EA, times, t_rec, records) if times.size else {}
+                _observe(scene, self.elements, self.EA, times, t_rec, records, lock_steps)
+                if times.size
+                else {}
             )
         except Exception as exc:  # noqa: BLE001
             stats.status, stats.message = (
@@ -630,7 +714,7 @@ class ExudynModel(Model):
                 f"observation failed: {type(exc).__name__}: {exc}",
             )
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
-        return self._trajectory(scene, times, observed, stats, run_info)
+        return self._trajectory(scene, times, observed, stats, run_info, events)
 
     def _records(self, built: _Built):
         """Recorded times (s); per (rod, local node), arrays q, v, a (nt, 4) up to the first
@@ -657,7 +741,7 @@ class ExudynModel(Model):
         t = t[keep][:end]
         return t, {key: tuple(x[:end] for x in arrs) for key, arrs in out.items()}, bool(bad.size)
 
-    def _trajectory(self, scene, times, observed, stats, run_info=None) -> Trajectory:
+    def _trajectory(self, scene, times, observed, stats, run_info=None, events=()) -> Trajectory:
         """``settings``: the integrator, every option, and what the run used (``run_info``:
         steps_planned, step_used (s, the fixed step), steps (taken), min_step_used (s, smaller
         than step_used only if Newton failures halved it), max_rotation_per_step_seen (rad),
@@ -671,6 +755,7 @@ class ExudynModel(Model):
             stats=stats,
             settings={"method": f"exudyn {self.solver}", "step": self.step, **(run_info or {})},
             options=self.options(),
+            events=[dict(ev) for ev in events],
         )
 
 
@@ -840,6 +925,29 @@ def _revolutions(angle: float) -> float:
     return float(round(angle / (2.0 * math.pi)))
 
 
+def _stop_law(side: str):
+    """springTorqueUserFunction of a one-sided limit stop (exudyn's sign: the returned torque
+    is the spring's restoring torque, k (rotation - offset) for a plain spring): stiffness x
+    penetration + damping x rate beyond the stop angle (``offset``), zero on the free side."""
+    upper = side == "upper"
+
+    def law(mbs, t, item, rotation, omega, stiffness, damping, offset):
+        pen = rotation - offset
+        if (pen > 0.0) if upper else (pen < 0.0):
+            return stiffness * pen + damping * omega
+        return 0.0
+
+    return law
+
+
+def stop_moment(stop, D, dD):
+    """The moment (N m, same sign as a hinge spring's kappa (D - rest)) of a limit stop at
+    hinge angle(s) D (rad) and rate(s) dD (rad/s): zero on the free side."""
+    pen = np.asarray(D, float) - stop.angle
+    inside = pen > 0 if stop.side == "upper" else pen < 0
+    return np.where(inside, stop.stiffness * pen + stop.damping * np.asarray(dD, float), 0.0)
+
+
 def _solver_message(solver, default: str) -> str:
     try:
         msg = solver.GetErrorString()
@@ -878,8 +986,23 @@ def _interpolate(times: np.ndarray, t_rec: np.ndarray, y: np.ndarray, dy: np.nda
     return h00 * y[i] + h10 * h * dy[i] + h01 * y[i + 1] + h11 * h * dy[i + 1]
 
 
-def _observe(scene: Scene, E: int, EA: float, times: np.ndarray, t_rec: np.ndarray, records: dict):
-    """The scene's quantities at ``times`` from recorded node states (see module docstring)."""
+def _observe(
+    scene: Scene,
+    E: int,
+    EA: float,
+    times: np.ndarray,
+    t_rec: np.ndarray,
+    records: dict,
+    lock_steps: dict | None = None,
+):
+    """The scene's quantities at ``times`` from recorded node states (see module docstring).
+
+    "hinge_angle": D_k (k = 0..n-1) from the continuous tangent angles; "hinge_moment" (N m):
+    the moment of hinge k, in the sense of its spring's kappa (D - rest): the spring, damper
+    and stop laws at the measured D and dD while the hinge is free, and from the state
+    where its latch was switched on (``lock_steps``: hinge -> time, s) the beam's own bending
+    moment EI kappa_b at the root of rod k+1 (the hinge has no inertia: it transmits that
+    moment), kappa_b the curvature of the cable's field there."""
     n = scene.n
     rods = np.arange(1, n + 1)
     at = {
@@ -887,7 +1010,9 @@ def _observe(scene: Scene, E: int, EA: float, times: np.ndarray, t_rec: np.ndarr
         for key, (q, v, a) in records.items()
     }
     out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-    if not scene.wants("phi", "dphi", "alpha", "beta", "x", "y", "energy"):
+    if not scene.wants(
+        "phi", "dphi", "alpha", "beta", "x", "y", "energy", "hinge_angle", "hinge_moment"
+    ):
         return out
     left = [records[(k, 0)] for k in range(n)]
     right = [records[(k, E)] for k in range(n)]
@@ -918,6 +1043,40 @@ def _observe(scene: Scene, E: int, EA: float, times: np.ndarray, t_rec: np.ndarr
             out["x"] = (x, nodes)
         if scene.wants("y"):
             out["y"] = (y, nodes)
+    if scene.wants("hinge_angle", "hinge_moment"):
+        hinges = np.arange(n)
+        left = np.concatenate([np.zeros((phi.shape[0], 1)), (phi + beta)[:, :-1]], 1)
+        D = (phi + alpha) - left
+
+        def rate(q, v):
+            return (q[..., 2] * v[..., 3] - q[..., 3] * v[..., 2]) / (
+                q[..., 2] ** 2 + q[..., 3] ** 2
+            )
+
+        rate_left = rate(qL, vL)
+        rate_right = np.concatenate([np.zeros((phi.shape[0], 1)), rate(qR, vR)[:, :-1]], 1)
+        dD = rate_left - rate_right
+        if scene.wants("hinge_angle"):
+            out["hinge_angle"] = (D, hinges)
+        if scene.wants("hinge_moment"):
+            chain = scene.chain
+            M = chain.kappa * (D - chain.rest_angle) + chain.nu * dD
+            for stop in scene.stops:
+                M[:, stop.hinge] += stop_moment(stop, D[:, stop.hinge], dD[:, stop.hinge])
+            for k, t_on in (lock_steps or {}).items():
+                after = times >= t_on - 1e-12
+                if not after.any():
+                    continue
+                le = chain.l[k] / E
+                ddS = _hermite(np.zeros(1), le)[2][0]  # (4,) at s = 0
+                dS = _hermite(np.zeros(1), le)[1][0]
+                qa, qb = at[(k, 0)][0], at[(k, 1)][0]
+                Q = np.stack([qa[:, :2], qa[:, 2:], qb[:, :2], qb[:, 2:]], 1)  # (nt, 4, 2)
+                r1 = np.einsum("i,tic->tc", dS, Q)
+                r2 = np.einsum("i,tic->tc", ddS, Q)
+                curv = (r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]) / np.sum(r1**2, -1)
+                M[after, k] = chain.EI[k] * curv[after]
+            out["hinge_moment"] = (M, hinges)
     if scene.wants("energy"):
         kin, pot = _energies(scene, E, EA, at, phi, alpha, beta)
         zero = np.zeros(1, dtype=int)
@@ -958,5 +1117,352 @@ def _energies(
         kin += 0.5 * chain.mu[k] * np.sum(vt**2, -1)
     left = np.concatenate([np.zeros((phi.shape[0], 1)), (phi + beta)[:, :-1]], 1)
     D = (phi + alpha) - left
-    pot += 0.5 * np.sum(chain.kappa * D**2, -1)
+    pot += 0.5 * np.sum(chain.kappa * (D - chain.rest_angle) ** 2, -1)
+    for stop in scene.stops:
+        pen = D[:, stop.hinge] - stop.angle
+        inside = pen > 0 if stop.side == "upper" else pen < 0
+        pot += np.where(inside, 0.5 * stop.stiffness * pen**2, 0.0)
     return kin, pot
+
+
+#: Steps after the activation step at which a lock's "after" state is taken (the index-3
+#: constraint brings the relative rate to zero within the activation step; the extra steps let
+#: the generalized-alpha velocity transient settle; see docs/deployment.md).
+LOCK_SETTLE_STEPS = 2
+
+
+class _Latches:
+    """The latches of one run, driven from exudyn's PreStepUserFunction (state of the last
+    accepted step, at t - h, before the step to t).
+
+    Each latch's hinge angle D = (tangent angle of rod k+1's root) - (tangent angle of rod k's
+    end) is measured on the beam nodes' slopes, continuous in time from the scene's initial D,
+    with its rate and acceleration. The latch's ObjectJointGeneric (relative rotation locked
+    at the latch angle) is switched on before the step in which D reaches the angle: when D
+    is already past it, or its second-order Taylor extrapolation D + dD h + ddD h^2 / 2 passes
+    it within the coming step. The lock time is where D crosses the angle: the root of that
+    extrapolation within the coming step, or of the cubic Hermite interpolant between the last
+    two states when D is already past (bracketed between steps either way).
+
+    Measures of each lock, on the beam solution: the kinetic energy v^T M v / 2 of the whole
+    chain (consistent mass), the angular momentum about the root (node 0) and the angular
+    momentum H_k of the outboard part (rods k+1..n and their node masses) about the hinge node
+    k, just before the activation step and ``LOCK_SETTLE_STEPS`` steps after it. The angular
+    impulse of the latch on the outboard part is
+    S = H_k(after) - H_k(before) - int M_k dt, with M_k the finite moments on the outboard part
+    about the moving hinge node (hinge k's spring, damper and stops, the outboard loads, and
+    -v_P x p of the moving reference point), integrated by the trapezoid rule: the jump of the
+    relative angular momentum (N m s, counter-clockwise positive on rod k+1)."""
+
+    def __init__(self, built: _Built, guard: _Guard, scene: Scene, E: int):
+        self.mbs, self.guard, self.scene, self.E = built.mbs, guard, scene, E
+        chain, n = scene.chain, scene.n
+        sd = built.mbs.systemData
+        ltg = [[np.asarray(sd.GetNodeLTGODE2(nd), int) for nd in rod] for rod in built.nodes]
+        self.ltg = ltg
+        size = guard.ref.size
+        D0 = scene.initial_hinge_angles()
+        self.items = []
+        for latch in scene.latches:
+            k = latch.hinge
+            direction = latch.direction or int(np.sign(latch.angle - D0[k]))
+            self.items.append(
+                {
+                    "latch": latch,
+                    "k": k,
+                    "dir": direction,
+                    "joint": built.latch_joints[latch.hinge],
+                    "left": None if k == 0 else ltg[k - 1][E][2:],
+                    "right": ltg[k][0][2:],
+                    "D": float(D0[k]),
+                    "state": "armed",
+                }
+            )
+        # quadrature points of every rod (5 Gauss points per element) and the node masses:
+        # position rows Gx, Gy (points x size), weights (kg), rod of each point
+        rows_x, rows_y, wts, rod_of = [], [], [], []
+        for k in range(n):
+            le = chain.l[k] / E
+            sg = 0.5 * le * (_GAUSS_X + 1.0)
+            S = _hermite(sg, le)[0]
+            for j in range(E):
+                a, b = ltg[k][j], ltg[k][j + 1]
+                dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
+                for g in range(sg.size):
+                    for rows, c in ((rows_x, 0), (rows_y, 1)):
+                        r = np.zeros(size)
+                        r[dofs[:, c]] = S[g]
+                        rows.append(r)
+                    wts.append(chain.m[k] * 0.5 * le * _GAUSS_W[g])
+                    rod_of.append(k)
+            if chain.mu[k] > 0:
+                for rows, c in ((rows_x, 0), (rows_y, 1)):
+                    r = np.zeros(size)
+                    r[ltg[k][E][c]] = 1.0
+                    rows.append(r)
+                wts.append(chain.mu[k])
+                rod_of.append(k)
+        self.Gx, self.Gy = np.array(rows_x), np.array(rows_y)
+        self.w, self.rod_of = np.array(wts), np.array(rod_of)
+        self.loads = [(f, ltg[f.node - 1][E][:2], f.node) for f in scene.loads]
+        self.stops = {}
+        for stop in scene.stops:
+            self.stops.setdefault(stop.hinge, []).append(stop)
+        self.root = {"left": None, "right": ltg[0][0][2:], "D": float(D0[0])}
+        self.prev: dict | None = None
+        self.pending: list[dict] = []
+        self.events: list[dict] = []
+        self.lock_times: dict[int, float] = {}
+        self.step_count = 0
+        self._cfg = None  # exudyn's configuration of the last accepted state (StartOfStep)
+
+    # -- measures --------------------------------------------------------------------------
+    def _state(self):
+        import exudyn as exu
+
+        sd, cfg = self.mbs.systemData, self._cfg
+        if cfg is None:
+            cfg = exu.ConfigurationType.StartOfStep
+        q = np.asarray(sd.GetODE2Coordinates(cfg)) + self.guard.ref
+        return (
+            q,
+            np.asarray(sd.GetODE2Coordinates_t(cfg)),
+            np.asarray(sd.GetODE2Coordinates_tt(cfg)),
+        )
+
+    @staticmethod
+    def _angle(q, v, a, idx):
+        """Tangent angle (wrapped), its rate and acceleration of slope dofs ``idx`` (None: the
+        x axis)."""
+        if idx is None:
+            return 0.0, 0.0, 0.0
+        sx, sy = q[idx]
+        vx, vy = v[idx]
+        ax, ay = a[idx]
+        r2 = sx * sx + sy * sy
+        cross = sx * vy - sy * vx
+        rate = cross / r2
+        acc = (sx * ay - sy * ax) / r2 - 2.0 * (sx * vx + sy * vy) * cross / r2**2
+        return math.atan2(sy, sx), rate, acc
+
+    def _hinge(self, item, q, v, a):
+        tl, rl, al = self._angle(q, v, a, item["left"])
+        tr, rr, ar = self._angle(q, v, a, item["right"])
+        D = item["D"] + float(_wrap(np.array((tr - tl) - item["D"])))
+        return D, rr - rl, ar - al
+
+    def _momenta(self, q, v):
+        """Per rod: linear momentum (n, 2) and angular momentum about the origin (n,)."""
+        x, y, vx, vy = self.Gx @ q, self.Gy @ q, self.Gx @ v, self.Gy @ v
+        n = self.scene.n
+        px = np.bincount(self.rod_of, self.w * vx, n)
+        py = np.bincount(self.rod_of, self.w * vy, n)
+        h = np.bincount(self.rod_of, self.w * (x * vy - y * vx), n)
+        return np.stack([px, py], -1), h
+
+    def _chord_rate(self, j: int, q, v) -> float:
+        """d(phi)/dt of rod j (0-based): (d x d') / |d|^2, d the chord vector."""
+        a, b = self.ltg[j][0][:2], self.ltg[j][self.E][:2]
+        d, dd = q[b] - q[a], v[b] - v[a]
+        return float((d[0] * dd[1] - d[1] * dd[0]) / (d @ d))
+
+    def _root_moment(self, j: int, q) -> float:
+        """EI kappa_b (N m) at the root of rod j (0-based): the moment the hinge there
+        transmits, in the sense of its spring's kappa (D - rest)."""
+        E, le = self.E, self.scene.chain.l[j] / self.E
+        _, dS, ddS = _hermite(np.zeros(1), le)
+        a, b = self.ltg[j][0], self.ltg[j][1 if E >= 1 else 0]
+        Q = np.stack([q[a[:2]], q[a[2:]], q[b[:2]], q[b[2:]]])  # (4, 2)
+        r1, r2 = dS[0] @ Q, ddS[0] @ Q
+        return float(self.scene.chain.EI[j] * (r1[0] * r2[1] - r1[1] * r2[0]) / (r1 @ r1))
+
+    def _measures(self, t: float, item, q, v, a) -> dict:
+        k, chain = item["k"], self.scene.chain
+        p, h = self._momenta(q, v)
+        P = q[self.ltg[k][0][:2]]
+        vP = v[self.ltg[k][0][:2]]
+        p_out = p[k:].sum(0)
+        H_out = float(h[k:].sum() - (P[0] * p_out[1] - P[1] * p_out[0]))
+        D, dD, _ = self._hinge(item, q, v, a)
+        moment = chain.kappa[k] * (D - chain.rest_angle[k]) + chain.nu[k] * dD
+        moment += sum(float(stop_moment(st, D, dD)) for st in self.stops.get(k, []))
+        finite = -moment - (vP[0] * p_out[1] - vP[1] * p_out[0])
+        for f, idx, node in self.loads:
+            if node > k and f.active(t):
+                fx = f.fx(t) if f.fx is not None else 0.0
+                fy = f.fy(t) if f.fy is not None else 0.0
+                r = q[idx] - P
+                finite += r[0] * fy - r[1] * fx
+        # about the origin: hinge 0's spring, damper and stops on rod 1, and all loads
+        D0, dD0, _ = self._hinge(self.root, q, v, a)
+        root_moment = -(chain.kappa[0] * (D0 - chain.rest_angle[0]) + chain.nu[0] * dD0)
+        root_moment -= sum(float(stop_moment(st, D0, dD0)) for st in self.stops.get(0, []))
+        for f, idx, _ in self.loads:
+            if f.active(t):
+                fx = f.fx(t) if f.fx is not None else 0.0
+                fy = f.fy(t) if f.fy is not None else 0.0
+                root_moment += q[idx][0] * fy - q[idx][1] * fx
+        rel = self._chord_rate(k, q, v) - (self._chord_rate(k - 1, q, v) if k > 0 else 0.0)
+        return {
+            "t": t,
+            "rel": rel,
+            "M_beam": self._root_moment(k, q),
+            "H_out": H_out,
+            "finite": finite,
+            "H_root": float(h.sum()),
+            "root_moment": root_moment,
+            "T": 0.5 * float(v @ self.guard.M @ v),
+            "D": D,
+            "dD": dD,
+        }
+
+    # -- per step --------------------------------------------------------------------------
+    def pre_step(self, t: float, h: float) -> None:
+        """Called before the step to t, on the state at t - h (the last accepted step)."""
+        if h <= 0:
+            return
+        t0 = t - h
+        q, v, a = self._state()
+        self.root["D"] = self._hinge(self.root, q, v, a)[0]
+        now = {}
+        for item in self.items:
+            if item["state"] != "armed":
+                continue
+            D, dD, ddD = self._hinge(item, q, v, a)
+            item["D"] = D
+            now[item["k"]] = (D, dD, ddD)
+        for ev in list(self.pending):
+            ev["steps"] += 1
+            now_m = self._measures(t0, ev["item"], q, v, a)
+            last = ev["last"]
+            ev["integral"] += 0.5 * (now_m["t"] - last["t"]) * (last["finite"] + now_m["finite"])
+            ev["root_integral"] += (
+                0.5 * (now_m["t"] - last["t"]) * (last["root_moment"] + now_m["root_moment"])
+            )
+            ev["peak"] = max(ev["peak"], abs(now_m["M_beam"]))
+            s0 = np.sign(ev["before"]["rel"])
+            if ev["steps"] > LOCK_SETTLE_STEPS and np.sign(now_m["rel"]) != s0:
+                self._finish(ev, last, now_m)
+            else:
+                ev["last"] = now_m
+        for item in self.items:
+            if item["state"] != "armed":
+                continue
+            D, dD, ddD = now[item["k"]]
+            angle, s = item["latch"].angle, item["dir"]
+            t_lock = None
+            if s * (D - angle) >= 0:  # already at or past: Hermite root in the last step
+                if self.prev is not None and item["k"] in self.prev["D"]:
+                    Dp, dDp, _ = self.prev["D"][item["k"]]
+                    t_lock = _hermite_root(self.prev["t"], t0, Dp - angle, dDp, D - angle, dD)
+                else:
+                    t_lock = t0
+            else:
+                tau = _taylor_root(D - angle, dD, ddD, h)
+                if tau is not None:
+                    t_lock = t0 + tau
+            if t_lock is None:
+                continue
+            self.mbs.SetObjectParameter(item["joint"], "activeConnector", True)
+            item["state"] = "locking"
+            self.lock_times[item["k"]] = t0
+            before = self._measures(t0, item, q, v, a)
+            self.pending.append(
+                {
+                    "item": item,
+                    "t_lock": t_lock,
+                    "steps": 0,
+                    "before": before,
+                    "last": before,
+                    "integral": 0.0,
+                    "root_integral": 0.0,
+                    "peak": abs(before["M_beam"]),
+                    "step": h,
+                }
+            )
+        self.prev = {"t": t0, "D": now}
+
+    def close(self) -> None:
+        """At the end of the run: locks whose window has not closed are recorded with the
+        last state (``window_closed`` False)."""
+        for ev in list(self.pending):
+            self._finish(ev, ev["last"], None)
+
+    def _finish(self, ev: dict, last: dict, now: dict | None) -> None:
+        """Record a lock. The lock window ends where the relative chord rate of the two rods
+        (d phi_{k+1}/dt - d phi_k/dt) first reaches zero after the activation (linear
+        interpolation between ``last`` and ``now``; the last state if it never does)."""
+        item, before = ev["item"], ev["before"]
+        if now is None:
+            after, frac, closed = last, 0.0, False
+        else:
+            frac = last["rel"] / (last["rel"] - now["rel"]) if last["rel"] != now["rel"] else 1.0
+            frac = min(max(frac, 0.0), 1.0)
+            after = {key: last[key] + frac * (now[key] - last[key]) for key in last}
+            closed = True
+            # the integral holds the whole last step: take back the part beyond the crossing
+            h = now["t"] - last["t"]
+            ev["integral"] -= 0.5 * (1 - frac) * h * (after["finite"] + now["finite"])
+            ev["root_integral"] -= (
+                0.5 * (1 - frac) * h * (after["root_moment"] + now["root_moment"])
+            )
+        impulse = after["H_out"] - before["H_out"] - ev["integral"]
+        root_jump = after["H_root"] - before["H_root"] - ev["root_integral"]
+        latch = item["latch"]
+        self.events.append(
+            {
+                "t": float(ev["t_lock"]),
+                "label": f"latch hinge {latch.hinge}",
+                "hinge": int(latch.hinge),
+                "angle": float(latch.angle),
+                "angular_impulse": float(impulse),
+                "kinetic_before": float(before["T"]),
+                "kinetic_after": float(after["T"]),
+                "rate_before": float(before["dD"]),
+                "chord_rate_before": float(before["rel"]),
+                "angular_momentum_root_before": float(before["H_root"]),
+                "angular_momentum_root_after": float(after["H_root"]),
+                "angular_momentum_root_jump": float(root_jump),
+                "peak_moment": float(ev["peak"]),
+                "t_activated": float(before["t"]),
+                "lock_duration": float(after["t"] - before["t"]),
+                "window_closed": closed,
+                "step": float(ev["step"]),
+            }
+        )
+        item["state"] = "locked"
+        self.pending.remove(ev)
+
+
+def _taylor_root(g: float, dg: float, ddg: float, h: float) -> float | None:
+    """Smallest tau in (0, h] where g + dg tau + ddg tau^2 / 2 changes sign from that of g
+    (None if it does not within the step)."""
+    tau = np.array([h])
+    coeffs = [0.5 * ddg, dg, g]
+    roots = np.roots(coeffs) if abs(ddg) > 0 or abs(dg) > 0 else np.array([])
+    real = sorted(
+        float(r.real) for r in np.atleast_1d(roots) if abs(r.imag) < 1e-12 and 0 < r.real <= tau[0]
+    )
+    return real[0] if real else None
+
+
+def _hermite_root(t0: float, t1: float, g0: float, dg0: float, g1: float, dg1: float) -> float:
+    """Where the cubic Hermite interpolant of g between (t0, g0, dg0) and (t1, g1, dg1) crosses
+    zero (g0 and g1 of opposite sign or g1 = 0), by bisection; t1 when not bracketed."""
+    h = t1 - t0
+    if h <= 0 or g0 * g1 > 0:
+        return t1
+
+    def g(th):
+        h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
+        h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
+        return h00 * g0 + h10 * h * dg0 + h01 * g1 + h11 * h * dg1
+
+    lo, hi = 0.0, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if (g(mid) > 0) == (g0 > 0) and g(mid) != 0:
+            lo = mid
+        else:
+            hi = mid
+    return t0 + hi * h

@@ -331,3 +331,59 @@ def plot_modes(m: Modes, path: Path, title: str = "", count: int = 4) -> Path:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     return path
+
+
+def plot_deployment(
+    trajectories: Mapping[str, Trajectory],
+    events: pd.DataFrame,
+    times: Sequence[float],
+    l: np.ndarray,
+    path: Path | str,
+    title: str = "",
+) -> Path:
+    """A deployment: one panel per model with the chain at ``times`` (the deployment
+    sequence, light to dark), and below them the tip's y (m) against time, every model
+    overlaid, with each model's lock times (``events``: columns model, t, label) as dotted
+    vertical lines in its colour."""
+    styles = model_styles(list(trajectories))
+    ncol = max(len(trajectories), 1)
+    fig = Figure(figsize=(4.0 * ncol, 7.5))
+    grid = fig.add_gridspec(2, ncol, height_ratios=[1.4, 1.0])
+    colours = colormaps["viridis"](np.linspace(0.0, 0.9, max(len(times), 1)))
+    for c, (label, traj) in enumerate(trajectories.items()):
+        ax = fig.add_subplot(grid[0, c])
+        for t, col in zip(times, colours):
+            if not np.any(np.abs(traj.times - t) < 1e-9):
+                continue
+            x, y = chain_nodes(traj, t, l)
+            ax.plot(x, y, "-", color=col, marker="o", ms=2.5, lw=1.2, label=f"t = {t:.3g} s")
+        ax.plot([0], [0], "k^", ms=8)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title(label)
+        ax.set_xlabel("x, m")
+        ax.grid(alpha=0.3)
+        if c == 0:
+            ax.set_ylabel("y, m")
+            ax.legend(fontsize=6, loc="best")
+    ax = fig.add_subplot(grid[1, :])
+    for label, traj in trajectories.items():
+        x_tip = None
+        if "y" in traj.values:
+            x_tip = traj.values["y"][:, -1]
+        elif "phi" in traj.values:
+            x_tip = np.sum(l * np.sin(traj.values["phi"]), axis=1)
+        if x_tip is not None:
+            ax.plot(traj.times, x_tip, lw=1.1, label=label, **styles[label])
+        if not events.empty and "model" in events:
+            for t in events.loc[events["model"] == label, "t"]:
+                ax.axvline(float(t), color=styles[label]["color"], ls=":", lw=0.9)
+    ax.set_xlabel("t, s")
+    ax.set_ylabel("tip y, m")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    return path

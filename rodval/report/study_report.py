@@ -1,5 +1,6 @@
 """The study report: ``OUT/report.md`` and ``OUT/figures/*.png`` rebuilt from the saved tables
-(``cases.csv``, ``trajectories.csv``, ``discrepancies.csv``, ``runtime.csv``) and the study's
+(``cases.csv``, ``trajectories.csv``, ``discrepancies.csv``, ``runtime.csv``, and
+``events.csv`` when some run recorded events: the deployment section) and the study's
 ``study.json`` / ``provenance.json``; nothing is recomputed."""
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import pandas as pd
 from rodval.core.trajectory import Trajectory
 from rodval.report.figures import (
     plot_configurations,
+    plot_deployment,
     plot_discrepancy_vs,
     plot_runtime_vs,
     plot_speedup_vs,
@@ -203,6 +205,191 @@ def _param_figures(
     return lines
 
 
+#: Columns of the events table shown in the report, when present.
+EVENT_REPORT_COLUMNS = (
+    "case",
+    "model",
+    "label",
+    "t",
+    "angular_impulse",
+    "kinetic_before",
+    "kinetic_after",
+    "energy_lost",
+    "peak_moment",
+    "lock_duration",
+    "angular_momentum_root_jump",
+)
+
+
+def read_events(out: Path) -> pd.DataFrame:
+    """``out/events.csv`` (empty frame if the study recorded no events)."""
+    path = out / "events.csv"
+    if not path.is_file():
+        return pd.DataFrame(columns=["case", "model", "t", "label"])
+    try:
+        events = pd.read_csv(path)
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise ValueError(f"{path}: unreadable ({type(exc).__name__}: {exc})") from None
+    missing = [c for c in ("case", "model", "t", "label") if c not in events]
+    if missing:
+        raise ValueError(f"{path}: column {missing[0]!r} is missing")
+    return events
+
+
+def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
+    """Each model's events against the reference's event of the same case and label: lock
+    time difference dt (s, model - reference), angular impulse difference and its ratio to
+    the reference's |impulse| (impulse_rel), energy_lost difference (J). Events the reference
+    lacks (or the model lacks) are listed with blanks."""
+    cols = ["case", "label", "model", "reference", "dt", "impulse_abs", "impulse_rel", "dE_lost"]
+    if events.empty:
+        return pd.DataFrame(columns=cols)
+    ref = events[events["model"] == reference].set_index(["case", "label"])
+    rows = []
+    for _, ev in events[events["model"] != reference].iterrows():
+        key = (ev["case"], ev["label"])
+        row = {
+            "case": ev["case"],
+            "label": ev["label"],
+            "model": ev["model"],
+            "reference": reference,
+        }
+        if key in ref.index:
+            r = ref.loc[key]
+            r = r.iloc[0] if isinstance(r, pd.DataFrame) else r
+            row["dt"] = float(ev["t"]) - float(r["t"])
+            if "angular_impulse" in events:
+                d = float(ev["angular_impulse"]) - float(r["angular_impulse"])
+                row["impulse_abs"] = d
+                row["impulse_rel"] = abs(d) / abs(float(r["angular_impulse"]))
+            if "energy_lost" in events:
+                row["dE_lost"] = float(ev["energy_lost"]) - float(r["energy_lost"])
+        rows.append(row)
+    return pd.DataFrame(rows).reindex(columns=cols)
+
+
+def residual_vibration(
+    traj: pd.DataFrame, events: pd.DataFrame, cases: pd.DataFrame
+) -> pd.DataFrame:
+    """Per case and model, after its last lock (t_last + lock_duration where recorded): the
+    tip's y amplitude (max - min) / 2 and mean (m), the largest |alpha| and |beta| (rad), and
+    the chord angles' spread max - min of phi over the rods at the last output time (rad, 0
+    for a straight chain). Models without events are measured after the last lock of any
+    model of the case."""
+    rows = []
+    for (case, model), part in traj.groupby(["case", "model"], sort=False):
+        evs = events[events["case"] == case]
+        own = evs[evs["model"] == model]
+        use = own if not own.empty else evs
+        if use.empty:
+            continue
+        ends = use["t"].astype(float)
+        if "lock_duration" in use:
+            ends = ends + use["lock_duration"].astype(float).fillna(0.0)
+        t_last = float(ends.max())
+        after = part[part["t"] > t_last]
+        row = {"case": case, "model": model, "last_lock_end": t_last, "locks": len(own)}
+        n = int(cases.loc[cases["case"] == case, "n"].iloc[0]) if not cases.empty else None
+        tip = after[(after["quantity"] == "y") & (after["k"] == n)]["value"]
+        if not tip.empty:
+            row["tip_y_amplitude"] = 0.5 * float(tip.max() - tip.min())
+            row["tip_y_mean"] = float(tip.mean())
+        for q in ("alpha", "beta"):
+            vals = after[after["quantity"] == q]["value"]
+            if not vals.empty:
+                row[f"max_abs_{q}"] = float(vals.abs().max())
+        phi = part[part["quantity"] == "phi"]
+        if not phi.empty:
+            last = phi[phi["t"] == phi["t"].max()]["value"]
+            row["final_phi_spread"] = float(last.max() - last.min())
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def peak_hinge_moments(traj: pd.DataFrame, events: pd.DataFrame) -> pd.DataFrame:
+    """Largest |hinge moment| (N m) per case, model and hinge: from the "hinge_moment"
+    trajectories when recorded, else the events' peak_moment (the lock window's peak)."""
+    hm = traj[traj["quantity"] == "hinge_moment"]
+    if not hm.empty:
+        g = hm.assign(abs_value=hm["value"].abs()).groupby(["case", "model", "k"], sort=False)
+        out = g["abs_value"].max().reset_index().rename(columns={"k": "hinge"})
+        return out.rename(columns={"abs_value": "peak_moment"}).assign(source="hinge_moment")
+    if "peak_moment" in events and events["peak_moment"].notna().any():
+        cols = ["case", "model", "hinge", "peak_moment"]
+        part = events.dropna(subset=["peak_moment"])[[c for c in cols if c in events]]
+        return part.assign(source="lock window")
+    return pd.DataFrame()
+
+
+def _deployment_section(
+    out: Path, fig_dir: Path, meta: dict, tables: dict[str, pd.DataFrame]
+) -> list[str]:
+    events = read_events(out)
+    if events.empty:
+        return []
+    ref, labels = meta["reference"], [m["label"] for m in meta["models"]]
+    lines = [
+        "## Deployment: locks, impulses and residual vibration\n",
+        "Every recorded event (`events.csv`): lock time t (s), angular impulse of the latch "
+        "(N m s, on the outboard rod, counter-clockwise positive), kinetic energy before and "
+        "after the lock and their difference (J); exudyn adds the lock window's peak hinge "
+        "moment (N m), its duration (s) and the jump of the angular momentum about the root "
+        "through it (N m s; an internal impulse leaves it unchanged). See docs/deployment.md "
+        "for how each model measures them.\n",
+        to_markdown(events[[c for c in EVENT_REPORT_COLUMNS if c in events]], ".5g"),
+    ]
+    silent = [lab for lab in labels if not (events["model"] == lab).any()]
+    if silent:
+        lines.append(
+            "No events from " + ", ".join(f"`{s}`" for s in silent) + ": those runs did not "
+            "latch (a model without latch support ignores the scene's latches).\n"
+        )
+    disc = event_discrepancies(events, ref)
+    if not disc.empty:
+        lines += [
+            f"Lock discrepancies against `{ref}` (dt in s, impulse_rel = |dS| / |S_ref|, "
+            "dE_lost in J):\n",
+            to_markdown(disc, ".3g"),
+        ]
+    peaks = peak_hinge_moments(tables["trajectories"], events)
+    if not peaks.empty:
+        lines += ["Peak hinge moments (N m):\n", to_markdown(peaks, ".4g")]
+    resid = residual_vibration(tables["trajectories"], events, tables["cases"])
+    if not resid.empty:
+        lines += [
+            "Residual vibration after the last lock (tip y amplitude and mean in m, largest "
+            "|alpha|, |beta| in rad, spread of the chord angles at the end in rad):\n",
+            to_markdown(resid, ".4g"),
+        ]
+    traj, cases = tables["trajectories"], tables["cases"]
+    for cid in meta["report"]["cases"]:
+        sub = traj[traj["case"] == cid]
+        if sub.empty or not (sub["quantity"] == "phi").any():
+            continue
+        row = cases[cases["case"] == cid].iloc[0]
+        l = np.asarray(json.loads(row["l"]))
+        trajs = {
+            lab: Trajectory.from_frame(sub[sub["model"] == lab], lab, cid)
+            for lab in labels
+            if (sub["model"] == lab).any()
+        }
+        out_t = np.unique(sub["t"].to_numpy())
+        horizon = float(row["horizon"])
+        want = meta["report"]["times"] or [horizon * f for f in (0.0, 0.25, 0.5, 0.75, 1.0)]
+        snapped = sorted({float(out_t[np.abs(out_t - t).argmin()]) for t in want if t <= horizon})
+        slug = cid.replace(",", "_").replace("=", "")
+        fig = plot_deployment(
+            trajs,
+            events[events["case"] == cid],
+            snapped,
+            l,
+            fig_dir / f"deployment_{slug}.png",
+            title=f"case {cid}: deployment sequence and tip y (dotted: lock times)",
+        )
+        lines.append(f"![deployment, case {cid}](figures/{fig.name})\n")
+    return lines
+
+
 def _header(meta: dict, prov: dict) -> list[str]:
     models = pd.DataFrame(
         [
@@ -262,6 +449,7 @@ def build_report(out: str | Path) -> Path:
     figs = _param_figures(fig_dir, meta, tables, params)
     if figs:
         lines += ["## Discrepancy, run time and speed-up against the grid parameters\n", *figs]
+    lines += _deployment_section(out, fig_dir, meta, tables)
     lines += ["## Time histories and configurations\n", *_case_figures(out, fig_dir, meta, tables)]
     path = out / "report.md"
     path.write_text("\n".join(x for x in lines if x))

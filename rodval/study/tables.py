@@ -8,6 +8,12 @@
   (integration, s), setup_s (model set-up, s), nfev, njev, nlu, nsteps, t_reached (s),
   status, message.
 
+* ``events``: case, n, horizon, axes, model, then one row per state event of a run
+  (``Trajectory.events``: t (s), label, hinge, angular_impulse (N m s), kinetic_before,
+  kinetic_after (J), energy_lost = kinetic_before - kinetic_after (J), and every further key
+  a model records, e.g. exudyn's lock_duration, angular_momentum_root_jump). Written only when
+  some run has events.
+
 ``provenance.json`` (machine and package versions) and ``study.json`` lie beside them.
 """
 
@@ -97,6 +103,36 @@ def runtime_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFra
     return pd.DataFrame(rows)
 
 
+#: The leading columns of the events table (after the case columns and model); the keys the
+#: native and exudyn latch records share.
+EVENT_COLUMNS = (
+    "t",
+    "label",
+    "hinge",
+    "angular_impulse",
+    "kinetic_before",
+    "kinetic_after",
+    "energy_lost",
+)
+
+
+def events_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFrame:
+    """One row per event of every run (see module docstring); columns beyond EVENT_COLUMNS are
+    the union of the models' own keys, in first-seen order (blank where a model lacks one)."""
+    rows = []
+    for rec in records:
+        for run in rec.runs:
+            for ev in run.trajectory.events:
+                row = {**_case_columns(rec, axes), "model": run.label, **ev}
+                before, after = ev.get("kinetic_before"), ev.get("kinetic_after")
+                if isinstance(before, (int, float)) and isinstance(after, (int, float)):
+                    row["energy_lost"] = before - after
+                rows.append(row)
+    lead = [*(_case_columns(records[0], axes) if records else {}), "model", *EVENT_COLUMNS]
+    extra = [c for c in dict.fromkeys(k for row in rows for k in row) if c not in lead]
+    return pd.DataFrame(rows).reindex(columns=[*lead, *extra])
+
+
 def load_records(out: Path, case_ids: list[str], labels: list[str]) -> list[CaseRecord]:
     """The verified records of ``case_ids`` (ValueError naming the first missing or damaged)."""
     store, records = StudyStore(out), []
@@ -124,12 +160,16 @@ def build_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd
     labels = [m["label"] for m in meta["models"]]
     records = load_records(out, ids, labels)
     axes = axis_columns(meta)
-    return {
+    tables = {
         "cases": cases_table(records, axes),
         "trajectories": trajectories_table(records),
         "discrepancies": discrepancies_table(records, axes),
         "runtime": runtime_table(records, axes),
     }
+    events = events_table(records, axes)
+    if not events.empty:
+        tables["events"] = events
+    return tables
 
 
 def write_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd.DataFrame]:
@@ -142,6 +182,8 @@ def write_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd
     assert meta is not None
     (out / "discrepancies.md").write_text(to_markdown(tables["discrepancies"]))
     (out / "runtime.md").write_text(to_markdown(tables["runtime"]))
+    if "events" in tables:
+        (out / "events.md").write_text(to_markdown(tables["events"], ".6g"))
     (out / "trajectories.md").write_text(
         to_markdown(trajectory_samples(tables["trajectories"], meta, tables["cases"]), ".6g")
     )
