@@ -99,6 +99,8 @@ def test_shipped_studies_and_the_readme_example_are_valid():
     root = Path(__file__).parent.parent / "studies"
     sizes = {p.stem: len(load_study(p).cases) for p in sorted(root.glob("*.toml"))}
     assert sizes == {
+        "companion_three_panel": 1,
+        "deployment": 1,
         "exudyn_convergence": 80,
         "n_sweep": 20,
         "paper": 1,

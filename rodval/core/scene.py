@@ -29,7 +29,7 @@ from rodval.core.loads import NodalForce
 
 #: Quantities a scene may ask for. "x"/"y" are node positions (k = 0..n); "energy" yields
 #: kinetic, potential and total energy (k = 0).
-QUANTITIES = ("phi", "dphi", "alpha", "beta", "x", "y", "energy")
+QUANTITIES = ("phi", "dphi", "alpha", "beta", "x", "y", "energy", "hinge_angle", "hinge_moment")
 #: Units of every trajectory quantity (the energy audit adds work, dissipated, residual).
 UNITS = {
     "phi": "rad",
