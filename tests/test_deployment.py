@@ -296,20 +296,44 @@ RELEASE_RESIDUAL = {"full": 1e-3, "reduced": 1e-5}
 
 @pytest.mark.parametrize("name", ["reduced", "full"])
 def test_stop_bounces_the_hinge_back(name):
-    chain = Chain.uniform(1, l=1.0, m=1.0, EI=1e5, mu=0.5, kappa=0.0, nu=0.0)
+    """A free rod swings into an undamped upper stop and comes back at the same speed; the
+    contact is two mode switches (on, off) and the audit counts the stop's spring energy."""
+    EI, settings = {"reduced": (1e5, TIGHT), "full": (1e3, FULL)}[name]
+    chain = Chain.uniform(1, l=1.0, m=1.0, EI=EI, mu=0.5, kappa=0.0, nu=0.0)
     sc = Scene(
         chain=chain,
-        t_end=1.0,
-        times=np.linspace(0.0, 1.0, 101),
+        t_end=0.6,
+        times=np.linspace(0.0, 0.6, 61),
         initial=InitialState(dphi=[2.0]),
         stops=(Stop(0, 0.5, "upper", stiffness=2e3, damping=0.0),),
         outputs=("phi", "dphi", "hinge_angle", "energy"),
     )
-    traj = MODELS[name]().simulate(sc, IntegratorSettings(rtol=1e-10, atol=1e-12))
+    traj = MODELS[name]().simulate(sc, settings)
     assert traj.stats.status == 0, traj.stats.message
     labels = [e["label"] for e in traj.events]
     assert labels == ["stop hinge 0 on", "stop hinge 0 off"]
+    assert traj.events[0]["t"] == pytest.approx(0.25, abs=1e-9)  # 0.5 rad at 2 rad/s
     D = traj.values["hinge_angle"][:, 0]
     assert 0.5 < D.max() < 0.6
-    assert traj.values["dphi"][-1, 0] == pytest.approx(-2.0, rel=1e-3)  # elastic: no damping
-    assert traj.stats.energy_residual < 1e-6
+    # no damping: the rod comes back at its speed (the full model keeps part of the energy
+    # in the bending vibration the contact excites, at EI = 1e3 a few per cent)
+    rel = {"reduced": 2e-3, "full": 5e-2}[name]
+    assert traj.values["dphi"][-1, 0] == pytest.approx(-2.0, rel=rel)
+    assert traj.stats.energy_residual < STOP_RESIDUAL[name]
+
+
+#: measured: reduced 4.1e-4 at EI = 1e5 (4.1e-6 at 1e7: the model's 1/EI residual during
+#: the contact, which loads the quasi-static bending), full 1.7e-13 at EI = 1e5
+STOP_RESIDUAL = {"reduced": 1e-3, "full": 1e-9}
+
+
+def test_implicit_method_runs_through_a_lock():
+    """Radau (Jacobian by differences while a hinge is held) finds the same lock as DOP853
+    and holds the hinge."""
+    sc = two_rods(EI=1e4, t_end=0.7, dphi=(0.0, 0.0))
+    ref = ReducedModel().simulate(sc, TIGHT)
+    rad = ReducedModel().simulate(sc, IntegratorSettings(method="Radau", rtol=1e-10, atol=1e-12))
+    assert rad.stats.status == 0, rad.stats.message
+    assert rad.events[0]["t"] == pytest.approx(ref.events[0]["t"], abs=1e-7)
+    after = rad.times > rad.events[0]["t"]
+    assert np.max(np.abs(rad.values["hinge_angle"][after, 1])) < 1e-9

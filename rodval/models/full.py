@@ -61,6 +61,8 @@ class FullSystem(PaperSystem):
 
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         """Analytic Jacobian df/dy (6n, 6n): [[0, I], [M^-1 (df/dq - dM/dphi q''), M^-1 df/dq']]."""
+        if self.locked:
+            return self.difference_jacobian(t, y)
         n, cc = self.n, self.cc
         q, v = y[: 3 * n], y[3 * n :]
         phi, dphi, dgam = q[:n], v[:n], v[n : 2 * n] - v[2 * n :]

@@ -392,7 +392,9 @@ class PaperSystem(OdeSystem):
 
     def event_functions(self) -> tuple[EventSpec, ...]:
         """Latches not yet locked (g = D_k - angle in the latch's direction) and limit stops
-        on hinges not locked (g = D_k - angle, both directions: contact begins or ends)."""
+        on hinges not locked (g = D_k - angle in the direction that switches the stop: into
+        its side while it is off, out of it while it acts; a root found again just after the
+        switch, where g may sit a rounding error on the old side, then cannot fire twice)."""
         specs = []
         self._spec_map: list[tuple[str, int]] = []
         held = {self.latches[j].hinge for j in self.locked}
@@ -410,10 +412,11 @@ class PaperSystem(OdeSystem):
         for i, st in enumerate(self.stops):
             if st.hinge in held:
                 continue
+            entering = 1 if st.side == "upper" else -1
             specs.append(
                 EventSpec(
                     g=lambda t, y, h=st.hinge, a=st.angle: self.hinge_angles_at(t, y)[h] - a,
-                    direction=0,
+                    direction=-entering if self.stop_active[i] else entering,
                     label=f"stop hinge {st.hinge}",
                 )
             )
@@ -426,8 +429,7 @@ class PaperSystem(OdeSystem):
         kind, j = self._spec_map[index]
         if kind == "stop":
             st = self.stops[j]
-            rate = self.hinge_rates(y)[st.hinge]
-            on = bool(rate > 0) if st.side == "upper" else bool(rate < 0)
+            on = not self.stop_active[j]  # the event looks for the crossing that switches
             active = list(self.stop_active)
             active[j] = on
             self._set_mode((tuple(active), self.locked), t)
@@ -487,6 +489,18 @@ class PaperSystem(OdeSystem):
     def plastic_jump(self, y, hinges, angles) -> tuple[np.ndarray, np.ndarray]:
         """(state after the impact, multiplier impulses mu (N m s))."""
         raise NotImplementedError
+
+    def difference_jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
+        """df/dy by central differences (the analytic Jacobians do not include the locked
+        hinges' multipliers): for implicit methods on a run with latches."""
+        J = np.empty((y.size, y.size))
+        for i in range(y.size):
+            h = 1e-7 * max(1.0, abs(y[i]))
+            yp, ym = y.copy(), y.copy()
+            yp[i] += h
+            ym[i] -= h
+            J[:, i] = (self.rhs(t, yp) - self.rhs(t, ym)) / (2 * h)
+        return J
 
     def accel_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(accelerations, multipliers lambda (N m)) with the locked hinges held."""

@@ -111,6 +111,8 @@ class ReducedSystem(PaperSystem):
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         """Analytic Jacobian df/dy (2n, 2n): [[0, I], [M_r^-1 (df_r/dphi - dM_r/dphi phi''),
         M_r^-1 df_r/dphi']]."""
+        if self.locked:
+            return self.difference_jacobian(t, y)
         n, cc, d = self.n, self.cc, self._dense
         phi, dphi = y[:n], y[n:]
         ckj, skj = angle_differences(phi)
