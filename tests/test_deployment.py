@@ -133,8 +133,15 @@ def test_rigid_limit_energy_loss_matches_closed_form():
     assert abs(ev["kinetic_before"] - T_before) <= 1e-9 * T_before
 
 
-@pytest.mark.parametrize("name", ["reduced", "full"])
-@pytest.mark.parametrize("kernel", ["numba", "numpy"])
+@pytest.mark.parametrize(
+    "name,kernel",
+    [
+        ("reduced", "numba"),
+        ("reduced", "numpy"),
+        ("full", "numba"),
+        pytest.param("full", "numpy", marks=pytest.mark.slow),  # ~30 s: dense Python rhs
+    ],
+)
 def test_locked_hinge_stays_at_its_angle(name, kernel):
     sc = two_rods(EI=SETUP[name][0], t_end=0.7, dphi=(0.0, 0.0))
     traj = MODELS[name](kernel=kernel).simulate(sc, FULL)
@@ -172,7 +179,8 @@ def test_two_latches_lock_at_different_times_and_stay(name):
         H0 = angular_momentum(sc.chain, before, system.full)
         H1 = angular_momentum(sc.chain, after, system.full)
         assert abs(H1 - H0) <= 1e-9 * max(abs(H0), 1.0)
-        assert set(ev["hinges"]) <= set(ev["angular_impulses"])
+        assert set(ev["hinges"]) <= set(ev["held_hinges"])
+        assert len(ev["angular_impulses"]) == len(ev["held_hinges"])
     t_last = traj.events[-1]["t"]
     D = traj.values["hinge_angle"][traj.times > t_last]
     assert np.max(np.abs(D[:, 1:])) < 1e-9

@@ -466,12 +466,12 @@ class PaperSystem(OdeSystem):
         y_new, mu = self.plastic_jump(y, hinges, angles)
         T1 = self.kinetic_energy(t, y_new)
         S = self.momenta(y_new) - P0
-        first = self.latches[new[0]].hinge
-        impulses = {int(h): float(-m) for h, m in zip(hinges, mu)}
+        impulses = [float(-m) for m in mu]
         return y_new, {
-            "hinge": first,
+            "hinge": self.latches[new[0]].hinge,
             "hinges": [self.latches[j].hinge for j in new],
-            "angular_impulse": impulses[first],
+            "angular_impulse": impulses[len(locked) - len(new)],
+            "held_hinges": [int(h) for h in hinges],
             "angular_impulses": impulses,
             "joint_impulses": S.tolist(),
             "root_impulse": S[0].tolist(),
