@@ -345,3 +345,26 @@ def test_implicit_method_runs_through_a_lock():
     assert rad.events[0]["t"] == pytest.approx(ref.events[0]["t"], abs=1e-7)
     after = rad.times > rad.events[0]["t"]
     assert np.max(np.abs(rad.values["hinge_angle"][after, 1])) < 1e-9
+
+
+@pytest.mark.parametrize("system_cls,width", [(FullSystem, 6), (ReducedSystem, 2)])
+def test_locked_kernels_at_larger_n(system_cls, width):
+    """The O(n m) superposition (m + 1 O(n) solves and an m x m capacitance system) against
+    the dense constrained reference on a 40-rod chain with 3 held hinges."""
+    n = 40
+    sc = Scene(
+        chain=Chain.uniform(n, rest_angle=0.2),
+        t_end=1.0,
+        initial=InitialState(phi=np.linspace(0.0, -3.0, n)),
+        latches=(Latch(3, 0.5), Latch(17, 0.5), Latch(39, 0.5)),
+    )
+    fast, ref = system_cls(sc, kernel="numba"), system_cls(sc, kernel="numpy")
+    mode = ((), (2, 0, 1))
+    fast._activate(mode)
+    ref._activate(mode)
+    y = np.random.default_rng(5).normal(scale=0.5, size=width * n)
+    a, b = fast.rhs(0.3, y), ref.rhs(0.3, y)
+    np.testing.assert_allclose(a, b, rtol=0, atol=1e-9 * np.max(np.abs(b)))
+    np.testing.assert_allclose(
+        fast.accel_locked(0.3, y)[1], ref.accel_locked(0.3, y)[1], rtol=1e-7, atol=1e-6
+    )
