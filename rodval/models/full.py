@@ -10,13 +10,13 @@ from __future__ import annotations
 import numpy as np
 
 from rodval.core.scene import Scene
-from rodval.models import kernels
+from rodval.models import deployment, kernels
 from rodval.models.paper_matrices import (
     angle_differences,
     angle_jacobian,
     assemble_mass,
     convective_terms,
-    potential_energy,
+    hinge_matrix,
 )
 from rodval.models.paper_system import PaperModel, PaperSystem
 
@@ -36,7 +36,7 @@ class FullSystem(PaperSystem):
         self.use_kernel()
 
     def kernel_constants(self):
-        return kernels.full_constants(self.cc, self.scene.chain)
+        return kernels.full_constants(self.cc, self.chain)
 
     def forces(self, t: float, q: np.ndarray, v: np.ndarray, skj: np.ndarray) -> np.ndarray:
         """Right-hand side f = [Q; 0; 0] - h - C q' - K q of M q'' = f (3n)."""
@@ -61,6 +61,8 @@ class FullSystem(PaperSystem):
 
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         """Analytic Jacobian df/dy (6n, 6n): [[0, I], [M^-1 (df/dq - dM/dphi q''), M^-1 df/dq']]."""
+        if self.locked:
+            return self.difference_jacobian(t, y)
         n, cc = self.n, self.cc
         q, v = y[: 3 * n], y[3 * n :]
         phi, dphi, dgam = q[:n], v[:n], v[n : 2 * n] - v[2 * n :]
@@ -109,10 +111,61 @@ class FullSystem(PaperSystem):
     def generalized_rates(self, y):
         return y[3 * self.n :]
 
+    def accel_locked(self, t, y):
+        """q'' and the multipliers of M q'' = f + A_L^T lambda, A_L q'' = 0 (A_L: the rows of
+        the locked hinges): the dense KKT system with the numpy kernel, superposition of
+        O(n) solves with the compiled one (deployment.full_accel_locked)."""
+        n, h = self.n, self._lock_h
+        if self.kernel == "numba":
+            sums = self.loads.suffix_sums(t)
+            SX, SY = (self._no_load, self._no_load) if sums is None else sums
+            out = np.empty(3 * n)
+            lam = np.empty(h.size)
+            deployment.full_accel_locked(
+                self.V, y, sums is not None, SX, SY, self.damped, h, out, lam
+            )
+            return out, lam
+        q, v = y[: 3 * n], y[3 * n :]
+        ckj, skj = angle_differences(q[:n])
+        A = hinge_matrix(n)[h]
+        m = h.size
+        K = np.zeros((3 * n + m, 3 * n + m))
+        K[: 3 * n, : 3 * n] = assemble_mass(self.cc, ckj)
+        K[: 3 * n, 3 * n :] = -A.T
+        K[3 * n :, : 3 * n] = A
+        rhs = np.concatenate([self.forces(t, q, v, skj), np.zeros(m)])
+        z = np.linalg.solve(K, rhs)
+        return z[: 3 * n], z[3 * n :]
+
+    def unit_responses(self, phi, hinges) -> np.ndarray:
+        """M(phi)^-1 a_k for each hinge k, (m, 3n)."""
+        n = self.n
+        if self.kernel == "numba":
+            U = np.empty((len(hinges), 3 * n))
+            deployment.full_unit_responses(self.V, phi, np.asarray(hinges, np.int64), U)
+            return U
+        M = assemble_mass(self.cc, angle_differences(phi)[0])
+        return np.linalg.solve(M, hinge_matrix(n)[hinges].T).T
+
+    def plastic_jump(self, y, hinges, angles):
+        """Delta q' = M^-1 A^T mu, (A M^-1 A^T) mu = -A q' (the hinges' rates become zero;
+        the velocity closest to the old one in the kinetic metric M); D is first projected
+        onto the latch angles in the same metric (a round-off-sized correction)."""
+        n = self.n
+        y = y.copy()
+        q, v = y[: 3 * n], y[3 * n :]
+        U = self.unit_responses(q[:n], hinges)
+        A = hinge_matrix(n)[hinges]
+        G = A @ U.T
+        q += U.T @ np.linalg.solve(G, angles - A @ q)
+        mu = np.linalg.solve(G, -(A @ v))
+        v += U.T @ mu
+        return y, mu
+
     def energy_budget(self, t, y):
         n = self.n
         return self.kinetic_energy(t, y) + float(
-            potential_energy(self.chain, y[:n], y[n : 2 * n], y[2 * n : 3 * n])
+            self.potential(y[:n], y[n : 2 * n], y[2 * n : 3 * n])
         )
 
     def rigid(self, Y):

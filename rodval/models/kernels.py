@@ -151,35 +151,10 @@ def _upper_t_times(V, c, s, x, cos_part, out, sign):
 
 
 @njit(cache=True)
-def _schur_solve(V, c, s, r, x):
-    """Solve S x = r for the full model's Schur complement S = M_pp - M_pg M_gg^-1 M_gp in
-    O(n): S = diag(d) + tril(a b^T) + triu(b e^T) with 2-vectors a_k, b_k, e_k per rod."""
-    n = c.shape[0]
-    l, outer, w = V[V_L], V[V_OUTER], V[V_W]
-    eps, pi, rho, tau = V[V_EPS], V[V_PI], V[V_RHO], V[V_TAU]
-    a = np.empty((n, 2))
-    b = np.empty((n, 2))
-    e = np.empty((n, 2))
-    d = np.empty(n)
-    scc = 0.0
-    scs = 0.0
-    sss = 0.0  # sum_{j>k} w_j^2 eps_j (c c, c s, s s)_j
-    for k in range(n - 1, -1, -1):
-        g0 = c[k] * scc + s[k] * scs
-        g1 = c[k] * scs + s[k] * sss
-        base0 = l[k] * (outer[k] * c[k] - g0)
-        base1 = l[k] * (outer[k] * s[k] - g1)
-        a[k, 0] = base0 - w[k] * pi[k] * c[k]
-        a[k, 1] = base1 - w[k] * pi[k] * s[k]
-        e[k, 0] = base0 - w[k] * rho[k] * c[k]
-        e[k, 1] = base1 - w[k] * rho[k] * s[k]
-        b[k, 0] = l[k] * c[k]
-        b[k, 1] = l[k] * s[k]
-        d[k] = V[V_PPDIAG, k] - l[k] * l[k] * (c[k] * g0 + s[k] * g1) - tau[k]
-        we = w[k] * w[k] * eps[k]
-        scc += we * c[k] * c[k]
-        scs += we * c[k] * s[k]
-        sss += we * s[k] * s[k]
+def _generator_solve(d, a, b, e, r, x):
+    """Solve S x = r for S = diag(d) + tril(a b^T, -1) + triu(b e^T, 1) (2-vectors a_k, b_k,
+    e_k per row, (n, 2) arrays): S[k,j] = a_k . b_j (k > j), b_k . e_j (k < j); O(n)."""
+    n = d.shape[0]
     # LU with L[k,j] = a_k . W_j, R[j,k] = Z_j . e_k (unit triangular), pivots D_k.
     S00 = 0.0
     S01 = 0.0
@@ -215,19 +190,49 @@ def _schur_solve(V, c, s, r, x):
 
 
 @njit(cache=True)
-def full_accel(V, y, has_load, SX, SY, damped, out):
-    """Accelerations q'' (3n) of the full model at y = [q; q'] into ``out``: M(phi) q'' =
-    [Q; 0; 0] - h - C q' - K q. SX, SY are the load suffix sums (N), used when ``has_load``.
-    O(n) time and memory."""
+def _schur_solve(V, c, s, r, x):
+    """Solve S x = r for the full model's Schur complement S = M_pp - M_pg M_gg^-1 M_gp in
+    O(n): S = diag(d) + tril(a b^T) + triu(b e^T) with 2-vectors a_k, b_k, e_k per rod."""
+    n = c.shape[0]
+    l, outer, w = V[V_L], V[V_OUTER], V[V_W]
+    eps, pi, rho, tau = V[V_EPS], V[V_PI], V[V_RHO], V[V_TAU]
+    a = np.empty((n, 2))
+    b = np.empty((n, 2))
+    e = np.empty((n, 2))
+    d = np.empty(n)
+    scc = 0.0
+    scs = 0.0
+    sss = 0.0  # sum_{j>k} w_j^2 eps_j (c c, c s, s s)_j
+    for k in range(n - 1, -1, -1):
+        g0 = c[k] * scc + s[k] * scs
+        g1 = c[k] * scs + s[k] * sss
+        base0 = l[k] * (outer[k] * c[k] - g0)
+        base1 = l[k] * (outer[k] * s[k] - g1)
+        a[k, 0] = base0 - w[k] * pi[k] * c[k]
+        a[k, 1] = base1 - w[k] * pi[k] * s[k]
+        e[k, 0] = base0 - w[k] * rho[k] * c[k]
+        e[k, 1] = base1 - w[k] * rho[k] * s[k]
+        b[k, 0] = l[k] * c[k]
+        b[k, 1] = l[k] * s[k]
+        d[k] = V[V_PPDIAG, k] - l[k] * l[k] * (c[k] * g0 + s[k] * g1) - tau[k]
+        we = w[k] * w[k] * eps[k]
+        scc += we * c[k] * c[k]
+        scs += we * c[k] * s[k]
+        sss += we * s[k] * s[k]
+    _generator_solve(d, a, b, e, r, x)
+
+
+@njit(cache=True)
+def _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
+    """f = [Q; 0; 0] - h - C q' - K q + A^T kappa rest of the full model (N m) into fp, fa, fb
+    (zeroed here), O(n)."""
     n = V.shape[1]
     q, v = y[: 3 * n], y[3 * n :]
     phi, alpha, beta = q[:n], q[n : 2 * n], q[2 * n :]
     dphi, dalpha, dbeta = v[:n], v[n : 2 * n], v[2 * n :]
-    c = np.cos(phi)
-    s = np.sin(phi)
-    fp = np.zeros(n)
-    fa = np.zeros(n)
-    fb = np.zeros(n)
+    fp[:] = 0.0
+    fa[:] = 0.0
+    fb[:] = 0.0
     _hinge_forces(V, phi, alpha, beta, V_KAPPA, fp, fa, fb)
     if damped:
         _hinge_forces(V, dphi, dalpha, dbeta, V_NU, fp, fa, fb)
@@ -247,6 +252,13 @@ def full_accel(V, y, has_load, SX, SY, damped, out):
         l = V[V_L]
         for k in range(n):
             fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
+
+
+@njit(cache=True)
+def _full_solve(V, c, s, fp, fa, fb, out):
+    """q'' = M(phi)^-1 [fp; fa; fb] (3n) into ``out``, O(n): the bending coordinates are
+    eliminated per rod, the Schur complement is solved by ``_schur_solve``."""
+    n = V.shape[1]
     # g = M_gg^-1 f_g per rod; r = f_p - M_pg g; S x_p = r; x_g = M_gg^-1 (f_g - M_gp x_p)
     aa, ab = V[V_AA], V[V_AB]
     ga = np.empty(n)
@@ -267,6 +279,21 @@ def full_accel(V, y, has_load, SX, SY, damped, out):
         det = aa[k] * aa[k] - ab[k] * ab[k]
         out[n + k] = (aa[k] * ra - ab[k] * rb) / det
         out[2 * n + k] = (aa[k] * rb - ab[k] * ra) / det
+
+
+@njit(cache=True)
+def full_accel(V, y, has_load, SX, SY, damped, out):
+    """Accelerations q'' (3n) of the full model at y = [q; q'] into ``out``: M(phi) q'' =
+    [Q; 0; 0] - h - C q' - K q. SX, SY are the load suffix sums (N), used when ``has_load``.
+    O(n) time and memory."""
+    n = V.shape[1]
+    c = np.cos(y[:n])
+    s = np.sin(y[:n])
+    fp = np.empty(n)
+    fa = np.empty(n)
+    fb = np.empty(n)
+    _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb)
+    _full_solve(V, c, s, fp, fa, fb, out)
 
 
 @njit(RHS_SIGNATURE, cache=True)

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from functools import cached_property
 from typing import Any
 
 import numpy as np
 
 from rodval.core.loads import LoadSet, load_table
-from rodval.core.scene import Scene
+from rodval.core.scene import Scene, hinge_angles
+from rodval.models import deployment
 from rodval.models.paper_matrices import (
     VARIANTS,
     ChainConstants,
@@ -24,7 +26,7 @@ from rodval.models.paper_matrices import (
     stiffness_matrix,
 )
 from rodval.solvers.ode_model import OdeModel
-from rodval.solvers.system import CompiledForm, OdeSystem
+from rodval.solvers.system import CompiledForm, EventRecord, EventSpec, OdeSystem
 
 #: Right-hand-side implementations: "numba" (compiled, structured; default) or "numpy"
 #: (the straightforward dense reference).
@@ -51,6 +53,9 @@ class PaperSystem(OdeSystem):
         self.kernel = kernel
         self.coefficients = coefficients
         chain = scene.chain
+        #: the scene's chain; ``chain`` is the effective one of the current mode (active
+        #: limit stops add their spring and damper to their hinge's)
+        self.base_chain = chain
         self.chain = chain
         self.scene = scene
         self.n = chain.n
@@ -59,6 +64,24 @@ class PaperSystem(OdeSystem):
         self.damped = bool(np.any(chain.nu > 0))
         self.loads = LoadSet(scene.loads, chain.n)
         self.initial = scene.initial.resolve(chain.n)
+        self.latches = tuple(scene.latches)
+        self.stops = tuple(scene.stops)
+        D0 = scene.initial_hinge_angles()
+        #: latch directions resolved (None: towards the angle from the initial state)
+        self.latch_dir = tuple(
+            int(np.sign(la.angle - D0[la.hinge])) if la.direction is None else la.direction
+            for la in self.latches
+        )
+        self._initial_stops = tuple(self._beyond(st, D0[st.hinge]) for st in self.stops)
+        #: mode: which stops act, which latches are locked (in lock order)
+        self.stop_active: tuple[bool, ...] = self._initial_stops
+        self.locked: tuple[int, ...] = ()
+        self._history: list[tuple[float, tuple]] = []
+        self._lock_h = np.zeros(0, dtype=np.int64)
+        self._lock_a = np.zeros(0)
+        self._lam = np.zeros(0)
+        if any(self.stop_active):
+            self._apply_stops()
 
     # Dense matrices of the numpy reference and the analytic Jacobians (O(n^2) memory): built
     # only when one of those asks; the default O(n) path never does.
@@ -98,6 +121,12 @@ class PaperSystem(OdeSystem):
         raise NotImplementedError
 
     def rhs(self, t, y):
+        if self.locked:
+            out = np.empty_like(y)
+            half = y.size // 2
+            out[:half] = y[half:]
+            out[half:], self._lam = self.accel_locked(t, y)
+            return out
         if self.kernel == "numpy":
             return self.numpy_rhs(t, y)
         sums = self.loads.suffix_sums(t)
@@ -146,7 +175,8 @@ class PaperSystem(OdeSystem):
     def energy(self, t: float, y: np.ndarray) -> float:
         """E = T + Pi (J) at one state (the same energy ``observe`` reports)."""
         Y = y[None, :]
-        kin, pot = self.energies(*self.rigid(Y), *self.bending(np.array([t]), Y))
+        with self._mode_at(t):
+            kin, pot = self.energies(*self.rigid(Y), *self.bending(np.array([t]), Y))
         return float(kin[0] + pot[0])
 
     def power(self, t: float, y: np.ndarray) -> tuple[float, float]:
@@ -156,13 +186,31 @@ class PaperSystem(OdeSystem):
         phi, dphi = (a[0] for a in self.rigid(y[None, :]))
         Q = self.generalized_force(t, phi)
         p_ext = 0.0 if Q is None else float(Q @ dphi)
-        if not self.damped:
-            return p_ext, 0.0
-        n = self.n
-        v = self.generalized_rates(y)
-        return p_ext, damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n :])
+        with self._mode_at(t):
+            if not self.damped:
+                return p_ext, 0.0
+            n = self.n
+            v = self.generalized_rates(y)
+            return p_ext, damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n :])
 
     def observe(self, times, Y):
+        """The scene's quantities; each output time is observed in the mode (active stops,
+        locked hinges) in effect there (an output time at an event: the mode before it)."""
+        times = np.asarray(times, float)
+        modes = [self._mode_for(t) for t in times]
+        out: dict = {}
+        start = 0
+        for i in range(1, len(times) + 1):
+            if i < len(times) and modes[i] == modes[start]:
+                continue
+            with self._mode(modes[start]):
+                part = self._observe_rows(times[start:i], Y[start:i])
+            for key, (v, k) in part.items():
+                out[key] = (np.concatenate([out[key][0], v]), k) if key in out else (v, k)
+            start = i
+        return out
+
+    def _observe_rows(self, times, Y):
         scene, n = self.scene, self.n
         rods = np.arange(1, n + 1)
         phi, dphi = self.rigid(Y)
@@ -184,6 +232,15 @@ class PaperSystem(OdeSystem):
                 out["x"] = (x, nodes)
             if scene.wants("y"):
                 out["y"] = (y, nodes)
+        if scene.wants("hinge_angle", "hinge_moment"):
+            if not scene.wants("alpha", "beta", "energy"):
+                alpha, beta, dalpha, dbeta = self.bending(times, Y)
+            D = hinge_angles(phi, alpha, beta)
+            hinges = np.arange(n)
+            if scene.wants("hinge_angle"):
+                out["hinge_angle"] = (D, hinges)
+            if scene.wants("hinge_moment"):
+                out["hinge_moment"] = (self.hinge_moments(times, Y, D), hinges)
         if scene.wants("energy"):
             kin, pot = self.energies(phi, dphi, alpha, beta, dalpha, dbeta)
             zero = np.zeros(1, dtype=int)
@@ -218,7 +275,236 @@ class PaperSystem(OdeSystem):
         Pi = 1/2 sum kappa (D - rest)^2 + bending (J), per output time; O(n) each."""
         v = np.concatenate([dphi, dalpha, dbeta], axis=1)
         kin = np.array([self._kinetic(p, vi) for p, vi in zip(phi, v)])
-        return kin, potential_energy(self.chain, phi, alpha, beta)
+        return kin, self.potential(phi, alpha, beta)
+
+    def potential(self, phi, alpha, beta) -> np.ndarray:
+        """Pi (J) per row: the scene chain's springs and bending, plus 1/2 k (D - angle)^2 of
+        every limit stop acting in the current mode."""
+        pot = potential_energy(self.base_chain, phi, alpha, beta)
+        if any(self.stop_active):
+            D = hinge_angles(phi, alpha, beta)
+            for st, on in zip(self.stops, self.stop_active):
+                if on:
+                    pot = pot + 0.5 * st.stiffness * (D[..., st.hinge] - st.angle) ** 2
+        return pot
+
+    # ----------------------------------------------------------------- deployment: modes
+    @staticmethod
+    def _beyond(stop, D: float) -> bool:
+        return bool(D > stop.angle) if stop.side == "upper" else bool(D < stop.angle)
+
+    def _apply_stops(self) -> None:
+        """Rebuild the effective chain (and every constant derived from it) for the current
+        stop activity: an acting stop adds its stiffness and damping to its hinge, the rest
+        angle becomes the stiffness-weighted mean (kappa (D - rest) + k (D - angle) =
+        (kappa + k)(D - rest'))."""
+        base = self.base_chain
+        kappa = base.kappa.copy()
+        ka = base.kappa * base.rest_angle
+        nu = base.nu.copy()
+        for st, on in zip(self.stops, self.stop_active):
+            if on:
+                kappa[st.hinge] += st.stiffness
+                ka[st.hinge] += st.stiffness * st.angle
+                nu[st.hinge] += st.damping
+        safe = np.where(kappa > 0, kappa, 1.0)
+        rest = np.where(kappa > 0, ka / safe, base.rest_angle)
+        self.chain = base.with_(kappa=kappa, nu=nu, rest_angle=rest)
+        for name in ("K", "C", "rest", "_dense"):
+            self.__dict__.pop(name, None)
+        self.damped = bool(np.any(nu > 0))
+        if self.kernel == "numba" and hasattr(self, "V"):
+            self.V[:] = self.kernel_constants()
+            self._flags[0] = 1.0 if self.damped else 0.0
+
+    def _activate(self, mode: tuple) -> None:
+        stops, locked = mode
+        if stops != self.stop_active:
+            self.stop_active = stops
+            self._apply_stops()
+        if locked != self.locked:
+            self.locked = locked
+            self._lock_h = np.array([self.latches[j].hinge for j in locked], dtype=np.int64)
+            self._lock_a = np.array([self.latches[j].angle for j in locked], dtype=float)
+            self._lam = np.zeros(len(locked))
+
+    @property
+    def mode(self) -> tuple:
+        return (self.stop_active, self.locked)
+
+    def _mode_for(self, t: float) -> tuple:
+        """The mode in effect at time t: set by the last event strictly before t."""
+        mode = (self._initial_stops, ())
+        for ts, m in self._history:
+            if ts < t:
+                mode = m
+        return mode
+
+    @contextmanager
+    def _mode(self, mode: tuple):
+        old = self.mode
+        self._activate(mode)
+        try:
+            yield
+        finally:
+            self._activate(old)
+
+    def _mode_at(self, t: float):
+        return self._mode(self._mode_for(t))
+
+    def reset(self) -> None:
+        """Back to the initial mode (no hinge locked, the stops the initial state is beyond),
+        forgetting the event history: called by the driver before a run."""
+        self._history = []
+        self._activate((self._initial_stops, ()))
+
+    def _set_mode(self, mode: tuple, t: float) -> None:
+        self._history.append((t, mode))
+        self._activate(mode)
+
+    # ------------------------------------------------------------- deployment: events
+    def hinge_angles_at(self, t: float, y: np.ndarray) -> np.ndarray:
+        """D_k (rad, n) at one state in the current mode."""
+        Y = y[None, :]
+        phi = self.rigid(Y)[0]
+        alpha, beta = self.bending(np.array([t]), Y)[:2]
+        return hinge_angles(phi, alpha, beta)[0]
+
+    def hinge_rates(self, y: np.ndarray) -> np.ndarray:
+        """dD_k/dt as the model's dampers see it: A q' (reduced: chord rates, the bending
+        rates being dropped)."""
+        n = self.n
+        v = self.generalized_rates(y)
+        return hinge_angles(v[:n], v[n : 2 * n], v[2 * n :])
+
+    def hinge_moments(self, times, Y, D) -> np.ndarray:
+        """Hinge moments (N m, (nt, n)), positive when resisting an increase of D: spring
+        kappa (D - rest) + damper nu dD/dt + acting stops + the constraint moment -lambda of
+        locked hinges (from the constrained acceleration solve)."""
+        ch = self.chain
+        rates = np.array([self.hinge_rates(y) for y in Y]).reshape(D.shape)
+        M = ch.kappa * (D - ch.rest_angle) + ch.nu * rates
+        if self.locked:
+            for i, (t, y) in enumerate(zip(times, Y)):
+                lam = self.accel_locked(t, y)[1]
+                M[i, self._lock_h] -= lam
+        return M
+
+    def event_functions(self) -> tuple[EventSpec, ...]:
+        """Latches not yet locked (g = D_k - angle in the latch's direction) and limit stops
+        on hinges not locked (g = D_k - angle in the direction that switches the stop: into
+        its side while it is off, out of it while it acts; a root found again just after the
+        switch, where g may sit a rounding error on the old side, then cannot fire twice)."""
+        specs = []
+        self._spec_map: list[tuple[str, int]] = []
+        held = {self.latches[j].hinge for j in self.locked}
+        for j, la in enumerate(self.latches):
+            if j in self.locked:
+                continue
+            specs.append(
+                EventSpec(
+                    g=lambda t, y, h=la.hinge, a=la.angle: self.hinge_angles_at(t, y)[h] - a,
+                    direction=self.latch_dir[j],
+                    label=f"latch hinge {la.hinge}",
+                )
+            )
+            self._spec_map.append(("latch", j))
+        for i, st in enumerate(self.stops):
+            if st.hinge in held:
+                continue
+            entering = 1 if st.side == "upper" else -1
+            specs.append(
+                EventSpec(
+                    g=lambda t, y, h=st.hinge, a=st.angle: self.hinge_angles_at(t, y)[h] - a,
+                    direction=-entering if self.stop_active[i] else entering,
+                    label=f"stop hinge {st.hinge}",
+                )
+            )
+            self._spec_map.append(("stop", i))
+        return tuple(specs)
+
+    def apply_event(self, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:
+        """A stop switching (no jump: the integrator restarts at the kink) or a latch locking
+        (a plastic impact, then the hinge is held); see docs/deployment_native.md."""
+        kind, j = self._spec_map[index]
+        if kind == "stop":
+            st = self.stops[j]
+            on = not self.stop_active[j]  # the event looks for the crossing that switches
+            active = list(self.stop_active)
+            active[j] = on
+            self._set_mode((tuple(active), self.locked), t)
+            return y.copy(), EventRecord(
+                t,
+                f"stop hinge {st.hinge} {'on' if on else 'off'}",
+                {"hinge": st.hinge, "active": on},
+            )
+        D = self.hinge_angles_at(t, y)
+        group = [j] + [
+            i
+            for i, la in enumerate(self.latches)
+            if i != j
+            and i not in self.locked
+            and abs(D[la.hinge] - la.angle) <= deployment.SIMULTANEOUS_RAD
+        ]
+        locked = self.locked + tuple(group)
+        y_new, data = self.lock_impulse(t, y, locked, tuple(group))
+        self._set_mode((self.stop_active, locked), t)
+        hinges = [self.latches[i].hinge for i in group]
+        label = "latch hinge " + ", ".join(str(h) for h in hinges)
+        return y_new, EventRecord(t, label, data)
+
+    def lock_impulse(
+        self, t: float, y: np.ndarray, locked: tuple[int, ...], new: tuple[int, ...]
+    ) -> tuple[np.ndarray, dict]:
+        """The state after the plastic lock of the latches ``new`` with ``locked`` (all held
+        after it) and the event's data: angular impulses (N m s, hinge-moment sign), joint
+        linear impulses (N s), kinetic energy before and after (J)."""
+        hinges = np.array([self.latches[j].hinge for j in locked], dtype=np.int64)
+        angles = np.array([self.latches[j].angle for j in locked])
+        T0 = self.kinetic_energy(t, y)
+        P0 = self.momenta(y)
+        y_new, mu = self.plastic_jump(y, hinges, angles)
+        T1 = self.kinetic_energy(t, y_new)
+        S = self.momenta(y_new) - P0
+        impulses = [float(-m) for m in mu]
+        return y_new, {
+            "hinge": self.latches[new[0]].hinge,
+            "hinges": [self.latches[j].hinge for j in new],
+            "angular_impulse": impulses[len(locked) - len(new)],
+            "held_hinges": [int(h) for h in hinges],
+            "angular_impulses": impulses,
+            "joint_impulses": S.tolist(),
+            "root_impulse": S[0].tolist(),
+            "kinetic_before": T0,
+            "kinetic_after": T1,
+        }
+
+    def momenta(self, y: np.ndarray) -> np.ndarray:
+        """Linear momentum beyond each node (N s, (n, 2)), see deployment.outer_momenta."""
+        n = self.n
+        v = self.generalized_rates(y)
+        phi = self.rigid(y[None, :])[0][0]
+        return deployment.outer_momenta(self.base_chain, phi, v[:n], v[n : 2 * n], v[2 * n :])
+
+    def plastic_jump(self, y, hinges, angles) -> tuple[np.ndarray, np.ndarray]:
+        """(state after the impact, multiplier impulses mu (N m s))."""
+        raise NotImplementedError
+
+    def difference_jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
+        """df/dy by central differences (the analytic Jacobians do not include the locked
+        hinges' multipliers): for implicit methods on a run with latches."""
+        J = np.empty((y.size, y.size))
+        for i in range(y.size):
+            h = 1e-7 * max(1.0, abs(y[i]))
+            yp, ym = y.copy(), y.copy()
+            yp[i] += h
+            ym[i] -= h
+            J[:, i] = (self.rhs(t, yp) - self.rhs(t, ym)) / (2 * h)
+        return J
+
+    def accel_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(accelerations, multipliers lambda (N m)) with the locked hinges held."""
+        raise NotImplementedError
 
 
 #: Placeholders for the compiled forms' unused arrays (no dense matrices, no loads).

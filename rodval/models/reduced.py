@@ -20,11 +20,13 @@ from types import SimpleNamespace
 import numpy as np
 
 from rodval.core.scene import Scene
-from rodval.models import kernels, reduced_banded
+from rodval.models import deployment, kernels, reduced_banded
 from rodval.models.paper_matrices import (
     angle_differences,
     angle_jacobian,
-    potential_energy,
+    assemble_mass,
+    convective_terms,
+    hinge_matrix,
     quasi_static_bending,
 )
 from rodval.models.paper_system import PaperModel, PaperSystem
@@ -109,6 +111,8 @@ class ReducedSystem(PaperSystem):
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         """Analytic Jacobian df/dy (2n, 2n): [[0, I], [M_r^-1 (df_r/dphi - dM_r/dphi phi''),
         M_r^-1 df_r/dphi']]."""
+        if self.locked:
+            return self.difference_jacobian(t, y)
         n, cc, d = self.n, self.cc, self._dense
         phi, dphi = y[:n], y[n:]
         ckj, skj = angle_differences(phi)
@@ -134,6 +138,8 @@ class ReducedSystem(PaperSystem):
         solve with the compiled kernel, the dense elimination with the numpy one."""
         n = self.n
         phi, dphi = y[:n], y[n:]
+        if self.locked:
+            return self.solve_locked(t, y)[1]
         if self.kernel == "numba":
             return reduced_banded.bending_at(
                 self.V, phi, dphi, self.loads.suffix_sums(t), self.damped
@@ -152,6 +158,79 @@ class ReducedSystem(PaperSystem):
             r += d.C_gp @ dphi
         return -d.B_inv @ r
 
+    def solve_locked(self, t, y):
+        """phi'' (n), gamma (2n) and the multipliers (m) with the locked hinges held at their
+        angles, D_k = a_p^T phi + a_g^T gamma = angle_k an equation of the solve (the
+        kappa_k -> infinity limit of the reduced model). numpy: the dense unreduced system
+        [M_pp K_pg -A_p^T; M_gp B -A_g^T; 0 A_g 0] [phi''; gamma; lambda] = [r_p; r_g;
+        angle - A_p phi]; numba: superposition of m + 1 O(n) sweeps."""
+        n, h = self.n, self._lock_h
+        phi, dphi = y[:n], y[n:]
+        sums = self.loads.suffix_sums(t)
+        m = h.size
+        if self.kernel == "numba":
+            SX, SY = (self._no_load, self._no_load) if sums is None else sums
+            x, gamma, lam = np.empty(n), np.empty(2 * n), np.empty(m)
+            ok = deployment.reduced_solve_locked(
+                self.V,
+                phi,
+                dphi,
+                sums is not None,
+                SX,
+                SY,
+                self.damped,
+                h,
+                self._lock_a,
+                x,
+                gamma,
+                lam,
+            )
+            if not ok:
+                raise FloatingPointError("singular constrained reduced solve")
+            return x, gamma, lam
+        ckj, skj = angle_differences(phi)
+        h_phi, h_gamma = convective_terms(self.cc, skj, dphi)
+        r = self.rest - self.K[:, :n] @ phi - np.concatenate([h_phi, h_gamma])
+        if self.damped:
+            r -= self.C[:, :n] @ dphi
+        Q = self.generalized_force(t, phi)
+        if Q is not None:
+            r[:n] += Q
+        A = hinge_matrix(n)[h]
+        Kz = np.zeros((3 * n + m, 3 * n + m))
+        Kz[: 3 * n, :n] = assemble_mass(self.cc, ckj)[:, :n]
+        Kz[: 3 * n, n : 3 * n] = self.K[:, n:]
+        Kz[: 3 * n, 3 * n :] = -A.T
+        Kz[3 * n :, n : 3 * n] = A[:, n:]
+        rhs = np.concatenate([r, self._lock_a - A[:, :n] @ phi])
+        z = np.linalg.solve(Kz, rhs)
+        return z[:n], z[n : 3 * n], z[3 * n :]
+
+    def accel_locked(self, t, y):
+        x, _, lam = self.solve_locked(t, y)
+        return x, lam
+
+    def plastic_jump(self, y, hinges, angles):
+        """Delta phi' = M_pp^-1 C^T mu, (C M_pp^-1 C^T) mu = -C phi', with C the rows
+        c_k = dD_k/dphi of the static hinge angles (deployment.reduced_hinge_gradient) and
+        M_pp the reduced model's kinetic metric (T = 1/2 phi'^T M_pp phi'): the velocity
+        closest to the old one in that metric with the locking hinges' static rates zero.
+        No position change: the constrained solve holds D_k exactly."""
+        n = self.n
+        y = y.copy()
+        phi, dphi = y[:n], y[n:]
+        C = np.array([deployment.reduced_hinge_gradient(self.chain, int(k)) for k in hinges])
+        if self.kernel == "numba":
+            W = np.empty((len(hinges), n))
+            for j in range(len(hinges)):
+                deployment.mpp_solve(self.V, phi, np.ascontiguousarray(C[j]), W[j])
+        else:
+            M_pp = assemble_mass(self.cc_kinetic, angle_differences(phi)[0])[:n, :n]
+            W = np.linalg.solve(M_pp, C.T).T
+        mu = np.linalg.solve(C @ W.T, -(C @ dphi))
+        dphi += W.T @ mu
+        return y, mu
+
     def generalized_rates(self, y):
         """[phi'; 0; 0]: the reduced model drops the bending rates from its kinetic energy and
         from its phi rows, so its dampers dissipate phi'^T C_pp phi' (see docs/stability.md)."""
@@ -163,9 +242,7 @@ class ReducedSystem(PaperSystem):
         (exact when phi'' = phi' = 0); O(n)."""
         n = self.n
         gamma = quasi_static_bending(self.chain, y[:n])
-        return self.kinetic_energy(t, y) + float(
-            potential_energy(self.chain, y[:n], gamma[:n], gamma[n:])
-        )
+        return self.kinetic_energy(t, y) + float(self.potential(y[:n], gamma[:n], gamma[n:]))
 
     def rigid(self, Y):
         n = self.n

@@ -224,6 +224,10 @@ class _ScipyRun:
                     y_event = solver.dense_output()(t_event)
                     y_new, record = self.system.apply_event(index, t_event, y_event)
                     self.events.append(record.as_dict())
+                    if self.ledger and "kinetic_before" in record.data:
+                        # an impact's kinetic energy loss is dissipated energy of the audit
+                        lost = record.data["kinetic_before"] - record.data["kinetic_after"]
+                        self.ledger.total = self.ledger.total + np.array([0.0, lost])
                     events.reset(t_event, y_new)
                     self._count(solver)
                     return y_new, t_event, t_event
@@ -252,6 +256,7 @@ def integrate(
     Never raises for a failed run: status, message and time reached are in ``stats``; a bad
     request (a compiled method for a system without compiled form) is a ValueError.
     """
+    system.reset()
     method = choose_method(system, scene, settings)
     ran = {**settings.as_dict(), "method": method}
     if settings.method == AUTO:

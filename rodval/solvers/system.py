@@ -142,6 +142,11 @@ class OdeSystem(ABC):
         may change)."""
         raise NotImplementedError
 
+    def reset(self) -> None:
+        """Return to the initial mode before a run (a system whose events switch its
+        equations forgets them here); the driver calls it first. Nothing by default."""
+        return None
+
     def compiled(self) -> CompiledForm | None:
         """The compiled form, or None when the system has none."""
         return None

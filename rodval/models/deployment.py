@@ -1,0 +1,269 @@
+"""Deployment mechanics of the paper's models: locked hinges (latches) as exact constraints,
+their plastic lock impulses, and the helpers the systems' event handling uses (O(n) kernels).
+
+Conventions (docs/deployment_native.md has the derivations):
+
+* A hinge moment lambda_k acting at hinge k is the generalized force a_k lambda_k, a_k = dD_k/dq
+  the k-th row of the hinge matrix A (``paper_matrices.hinge_matrix``): +1 on phi_k, alpha_k,
+  -1 on phi_{k-1}, beta_{k-1}. ``hinge_moment`` reports moments with the sign of a spring
+  (positive when the hinge resists increasing D_k), so a multiplier lambda is reported as
+  -lambda.
+* Full model: a locked hinge k is the linear constraint a_k^T q = angle_k. Its multiplier
+  comes from M q'' = f + A_L^T lambda, A_L q'' = 0, solved by superposition: q'' = u_0 +
+  sum_j lambda_j u_j with u_0 = M^-1 f and u_j = M^-1 a_j (m + 1 O(n) solves), then the m x m
+  capacitance system (A_L U) lambda = -A_L u_0. An explicit Runge-Kutta method keeps the
+  linear invariants a^T q' = 0 and a^T q = angle to round-off (every stage combination of
+  states with a^T q'' = 0).
+* Reduced model: D_k = a_p^T phi + a_g^T gamma with gamma the quasi-static bending, an
+  unknown of the same linear solve as phi''. A locked hinge adds the unknown lambda_k and the
+  equation a_g^T gamma = angle_k - a_p^T phi to that solve (the kappa_k -> infinity limit of
+  the reduced model); solved again by superposition, m + 1 O(n) sweeps.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from scipy.linalg import solveh_banded
+
+from rodval.models.kernels import (
+    V_L,
+    V_OUTER,
+    V_PPDIAG,
+    _full_forces,
+    _full_solve,
+    _generator_solve,
+)
+from rodval.models.reduced_banded import _band_size, _forces, _solve_band, _solve_sweep
+
+#: Another armed latch locks together with the one whose crossing was located when its
+#: angle is within this distance (rad) of its latch angle at that time.
+SIMULTANEOUS_RAD = 1e-8
+
+
+@njit(cache=True)
+def _unit_moment(k, fp, fa, fb):
+    """fp, fa, fb += a_k (generalized force of a unit moment at hinge k)."""
+    fp[k] += 1.0
+    fa[k] += 1.0
+    if k > 0:
+        fp[k - 1] -= 1.0
+        fb[k - 1] -= 1.0
+
+
+@njit(cache=True)
+def _hinge_of(v, k, n):
+    """a_k . v for v = [phi; alpha; beta]-shaped (3n)."""
+    r = v[k] + v[n + k]
+    if k > 0:
+        r -= v[k - 1] + v[2 * n + k - 1]
+    return r
+
+
+@njit(cache=True)
+def small_solve(G, r):
+    """Solve the small dense system G x = r (Gaussian elimination with partial pivoting);
+    G and r are overwritten, the solution is returned."""
+    m = r.shape[0]
+    for j in range(m):
+        p = j
+        for i in range(j + 1, m):
+            if abs(G[i, j]) > abs(G[p, j]):
+                p = i
+        if p != j:
+            for q in range(m):
+                t = G[j, q]
+                G[j, q] = G[p, q]
+                G[p, q] = t
+            t = r[j]
+            r[j] = r[p]
+            r[p] = t
+        for i in range(j + 1, m):
+            f = G[i, j] / G[j, j]
+            for q in range(j, m):
+                G[i, q] -= f * G[j, q]
+            r[i] -= f * r[j]
+    x = np.empty(m)
+    for j in range(m - 1, -1, -1):
+        acc = r[j]
+        for q in range(j + 1, m):
+            acc -= G[j, q] * x[q]
+        x[j] = acc / G[j, j]
+    return x
+
+
+@njit(cache=True)
+def full_unit_responses(V, phi, locks, U):
+    """U[j] = M(phi)^-1 a_{locks[j]} (3n each), O(n) per hinge."""
+    n = V.shape[1]
+    c = np.cos(phi)
+    s = np.sin(phi)
+    fp = np.empty(n)
+    fa = np.empty(n)
+    fb = np.empty(n)
+    for j in range(locks.shape[0]):
+        fp[:] = 0.0
+        fa[:] = 0.0
+        fb[:] = 0.0
+        _unit_moment(locks[j], fp, fa, fb)
+        _full_solve(V, c, s, fp, fa, fb, U[j])
+
+
+@njit(cache=True)
+def full_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
+    """q'' (3n) of the full model with the hinges ``locks`` held (a_k^T q'' = 0) into
+    ``out``, their multipliers (N m, generalized force a_k lambda_k) into ``lam``; O(n m)."""
+    n = V.shape[1]
+    m = locks.shape[0]
+    c = np.cos(y[:n])
+    s = np.sin(y[:n])
+    fp = np.empty(n)
+    fa = np.empty(n)
+    fb = np.empty(n)
+    _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb)
+    _full_solve(V, c, s, fp, fa, fb, out)
+    if m == 0:
+        return
+    U = np.empty((m, 3 * n))
+    full_unit_responses(V, y[:n], locks, U)
+    G = np.empty((m, m))
+    r = np.empty(m)
+    for i in range(m):
+        r[i] = -_hinge_of(out, locks[i], n)
+        for j in range(m):
+            G[i, j] = _hinge_of(U[j], locks[i], n)
+    x = small_solve(G, r)
+    for j in range(m):
+        lam[j] = x[j]
+        out += x[j] * U[j]
+
+
+@njit(cache=True)
+def _reduced_linear(Cst, c, s, fp, fa, fb, T, ddphi, gamma):
+    """The reduced model's unreduced linear solve for given right-hand sides (the sweep, the
+    banded LU as fallback)."""
+    if _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi, gamma):
+        return True
+    n = c.shape[0]
+    N = 7 * n
+    rest = np.empty(_band_size(n))
+    o1 = N * 11
+    o2 = o1 + N + 10
+    U = rest[:o1].reshape((N, 11))
+    A = rest[o2 : o2 + 16 * 15].reshape((16, 15))
+    return _solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi, gamma)
+
+
+@njit(cache=True)
+def reduced_solve_locked(
+    Cst, phi, dphi, has_load, SX, SY, damped, locks, angles, ddphi, gamma, lam
+):
+    """phi'' (n), gamma (2n) and the multipliers lambda (m) of the reduced model with the
+    hinges ``locks`` held at ``angles``: D_k = a_p^T phi + a_g^T gamma = angle_k exactly
+    (an algebraic equation of the solve); O(n m). False if a solve is singular."""
+    n = phi.shape[0]
+    m = locks.shape[0]
+    c = np.cos(phi)
+    s = np.sin(phi)
+    vec = np.empty(5 * n)
+    _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
+    T = np.empty((n, 3, 4))
+    fp = vec[:n].copy()
+    fa = vec[n : 2 * n].copy()
+    fb = vec[2 * n : 3 * n].copy()
+    if not _reduced_linear(Cst, c, s, fp, fa, fb, T, ddphi, gamma):
+        return False
+    if m == 0:
+        return True
+    X = np.empty((m, n))
+    Gm = np.empty((m, 2 * n))
+    for j in range(m):
+        fp[:] = 0.0
+        fa[:] = 0.0
+        fb[:] = 0.0
+        _unit_moment(locks[j], fp, fa, fb)
+        if not _reduced_linear(Cst, c, s, fp, fa, fb, T, X[j], Gm[j]):
+            return False
+    G = np.empty((m, m))
+    r = np.empty(m)
+    for i in range(m):
+        k = locks[i]
+        D = phi[k] + gamma[k]
+        if k > 0:
+            D -= phi[k - 1] + gamma[n + k - 1]
+        r[i] = angles[i] - D
+        for j in range(m):
+            g = Gm[j, k]
+            if k > 0:
+                g -= Gm[j, n + k - 1]
+            G[i, j] = g
+    x = small_solve(G, r)
+    for j in range(m):
+        lam[j] = x[j]
+        ddphi += x[j] * X[j]
+        gamma += x[j] * Gm[j]
+    return True
+
+
+@njit(cache=True)
+def mpp_solve(V, phi, r, x):
+    """Solve M_pp(phi) x = r (the rigid chords' mass matrix, the reduced model's kinetic
+    metric) in O(n): M_pp = diag(pp) + tril(a b^T) + triu(b e^T) with a_k = e_k' = l_k M_k e_k,
+    b_k = l_k e_k (e_k = (cos phi_k, sin phi_k))."""
+    n = phi.shape[0]
+    a = np.empty((n, 2))
+    b = np.empty((n, 2))
+    for k in range(n):
+        ck = np.cos(phi[k])
+        sk = np.sin(phi[k])
+        b[k, 0] = V[V_L, k] * ck
+        b[k, 1] = V[V_L, k] * sk
+        a[k, 0] = V[V_OUTER, k] * b[k, 0]
+        a[k, 1] = V[V_OUTER, k] * b[k, 1]
+    _generator_solve(V[V_PPDIAG], a, b, a, r, x)
+
+
+def reduced_hinge_gradient(chain, k: int) -> np.ndarray:
+    """c_k = dD_k/dphi of the reduced model's static hinge angle (gamma at its quasi-static
+    value B^-1 (rest terms - K_gp phi)): c_k = a_p,k - K_pg B^-1 a_g,k (n), O(n) by the banded
+    solve of B. It is also the generalized force on phi of a unit moment at hinge k once the
+    bending rows are eliminated statically."""
+    n = chain.n
+    kappa, kb = chain.kappa, 4.0 * chain.EI / chain.l
+    kap_next = np.concatenate([kappa[1:], [0.0]])
+    diag = np.empty(2 * n)
+    diag[0::2] = kb + kappa
+    diag[1::2] = kb + kap_next
+    off = np.empty(2 * n)
+    off[0] = 0.0
+    off[1::2] = kb / 2.0
+    off[2::2] = -kappa[1:]
+    rhs = np.zeros(2 * n)  # interleaved (alpha_0, beta_0, alpha_1, ...)
+    rhs[2 * k] = 1.0
+    if k > 0:
+        rhs[2 * k - 1] = -1.0
+    x = solveh_banded(np.vstack([off, diag]), rhs)
+    alpha, beta = x[0::2], x[1::2]
+    # (K_pg gamma)_i = kappa_i (alpha_i - beta_{i-1}) - kappa_{i+1} (alpha_{i+1} - beta_i)
+    t = kappa * (alpha - np.concatenate([[0.0], beta[:-1]]))
+    kpg = t - np.concatenate([t[1:], [0.0]])
+    c = -kpg
+    c[k] += 1.0
+    if k > 0:
+        c[k - 1] -= 1.0
+    return c
+
+
+def outer_momenta(chain, phi, dphi, dalpha, dbeta) -> np.ndarray:
+    """Linear momentum (N s, (n, 2)) of everything beyond node k (rods k+1..n and their far
+    nodes), k = 0..n-1, with the model's velocity field: chord velocity plus the bending rate
+    eta' n (to first order, as in the models' kinetic energy; zero bending rates for the
+    reduced model). Row 0 is the whole chain's momentum."""
+    l, m, mu = chain.l, chain.m, chain.mu
+    e_n = np.stack([-np.sin(phi), np.cos(phi)], axis=-1)  # n_k
+    v_tip = np.cumsum((l * dphi)[:, None] * e_n, axis=0)  # node k+1
+    v_root = np.vstack([[0.0, 0.0], v_tip[:-1]])
+    w = m * l**2 / 12.0
+    rod = (m * l)[:, None] * v_root + (0.5 * m * l**2 * dphi + w * (dalpha - dbeta))[:, None] * e_n
+    p = rod + mu[:, None] * v_tip
+    return np.cumsum(p[::-1], axis=0)[::-1]
