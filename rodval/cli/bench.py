@@ -125,6 +125,11 @@ def register(sub) -> None:
     )
     sc.add_argument("--n-values", type=_int_list, default=list(bench.SCALE_N))
     sc.add_argument(
+        "--models",
+        type=_choice_list("--models", ("reduced", "full")),
+        default=["reduced", "full"],
+    )
+    sc.add_argument(
         "--budget",
         type=positive_float("--budget"),
         default=60.0,
@@ -342,7 +347,9 @@ def _load() -> str:
 
 def run_scale(args) -> int:
     load_before = _load()
-    frame, notes = bench.scale_rows(args.n_values, repeats=args.repeats, budget_s=args.budget)
+    frame, notes = bench.scale_rows(
+        args.n_values, args.models, repeats=args.repeats, budget_s=args.budget
+    )
     args.out.mkdir(parents=True, exist_ok=True)
     frame.to_csv(args.out / "scale.csv", index=False)
     fits = bench.scale_fits(frame, 64)
