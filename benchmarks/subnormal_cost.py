@@ -13,7 +13,7 @@ mode and with flush-to-zero + denormals-are-zero (MXCSR FTZ|DAZ, set through LLV
 ldmxcsr intrinsic, for this thread only), side by side, and reports how far the results
 differ (they may differ only through values below 2.2e-308). x86-64 only.
 
-Run: OMP_NUM_THREADS=1 PYTHONPATH=. python benchmarks/subnormal_cost.py [n ...]
+Run: OMP_NUM_THREADS=1 PYTHONPATH=. python benchmarks/subnormal_cost.py [--reduced-only] [n ...]
 """
 
 from __future__ import annotations
@@ -104,14 +104,16 @@ def timed_pair(f, repeats: int) -> tuple[float, float, object, object]:
 
 
 def main() -> None:
-    sizes = [int(a) for a in sys.argv[1:]] or [64, 1024, 8192, 65536]
+    args = sys.argv[1:]
+    models = ("reduced",) if "--reduced-only" in args else ("reduced", "full")
+    sizes = [int(a) for a in args if a != "--reduced-only"] or [64, 1024, 8192, 65536]
     settings = IntegratorSettings("DOP853-numba", rtol=1e-6, atol=1e-8)
     print(
         f"{'model':8s} {'n':>6s} {'run s':>9s} {'run FTZ s':>10s} {'ratio':>6s} {'nfev':>12s} "
         f"{'phi diff':>9s} {'RHS@0.5 us':>11s} {'FTZ us':>9s} {'ratio':>6s} {'subn. y':>7s}"
     )
     for n in sizes:
-        for model in ("reduced", "full"):
+        for model in models:
             if model == "full" and n > 8192:
                 continue
             scene = bench.scale_scene(n)
