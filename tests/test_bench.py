@@ -53,3 +53,49 @@ def test_bench_cli_rejects_bad_options(argv, capsys):
         main(argv)
     assert exc.value.code == 2
     assert "must" in capsys.readouterr().err
+
+
+def test_scale_scene_is_the_paper_chain_with_the_pulse_at_the_last_node():
+    sc = bench.scale_scene(5)
+    assert sc.chain.n == 5 and sc.outputs == ("phi", "dphi")
+    assert sc.times[0] == 0.0 and sc.times[-1] == 2.0 and len(sc.times) == 21
+    assert sc.loads[0].node == 5
+
+
+def test_subnormal_count():
+    tiny = np.finfo(float).tiny
+    assert bench.subnormal_count(np.array([0.0, tiny, tiny / 4, -5e-324, 1.0])) == 2
+
+
+def test_scale_fits_recover_each_models_exponent():
+    import pandas as pd
+
+    n = np.array([16, 64, 256, 1024, 4096])
+    rows = []
+    for model, p in (("reduced", 1.0), ("full", 1.5)):
+        for k, c in zip(n, 1e-6 * n.astype(float) ** p):
+            rows.append(
+                {
+                    "model": model,
+                    "n": k,
+                    **dict.fromkeys(
+                        ("wall_s", "rhs_random_s", "rhs_run_s", "wall_per_eval_s", "setup_s"), c
+                    ),
+                }
+            )
+    fits = bench.scale_fits(pd.DataFrame(rows), 64).set_index("model")
+    assert fits.loc["reduced", "wall_s"] == pytest.approx(1.0)
+    assert fits.loc["full", "rhs_run_s"] == pytest.approx(1.5)
+    assert fits.loc["full", "n range"] == "64..4096"
+
+
+def test_bench_scale_cli_rejects_bad_options(capsys):
+    for argv in (
+        ["bench", "scale", "--out", "x", "--n-values", "0,4"],
+        ["bench", "scale", "--out", "x", "--budget", "-1"],
+        ["bench", "scale", "--out", "x", "--speedup-n", "a"],
+    ):
+        with pytest.raises(SystemExit) as exc:
+            main(argv)
+        assert exc.value.code == 2
+    assert "must" in capsys.readouterr().err

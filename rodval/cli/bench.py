@@ -1,4 +1,4 @@
-"""rodval bench {work-precision, cost-n, skips, speedup} --out DIR: performance measurements
+"""rodval bench {work-precision, cost-n, skips, speedup, scale} --out DIR: performance measurements
 (see ``rodval.bench``). Each writes a CSV (with machine and package versions), a markdown
 summary and, where it applies, plots into DIR."""
 
@@ -118,7 +118,34 @@ def register(sub) -> None:
     )
     sp.add_argument("--n-values", type=_int_list, default=[2, 4, 8, 16, 32])
     sp.set_defaults(func=run_speedup)
-    for q in (wp, cn, sk, sp):
+    sc = bsub.add_parser(
+        "scale",
+        help="wall time and cost per evaluation against n up to 1e5 (reduced vs full), "
+        "exponents, speed-up at equal phi accuracy",
+    )
+    sc.add_argument("--n-values", type=_int_list, default=list(bench.SCALE_N))
+    sc.add_argument(
+        "--models",
+        type=_choice_list("--models", ("reduced", "full")),
+        default=["reduced", "full"],
+    )
+    sc.add_argument(
+        "--budget",
+        type=positive_float("--budget"),
+        default=60.0,
+        help="a model stops after its first run slower than this, s (default 60)",
+    )
+    sc.add_argument(
+        "--speedup-n",
+        type=_int_list,
+        default=[2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 10000],
+        help="n of the reduced-vs-full speed-up at equal phi accuracy",
+    )
+    sc.add_argument(
+        "--no-speedup", dest="speedup", action="store_false", help="skip the speed-up part"
+    )
+    sc.set_defaults(func=run_scale)
+    for q in (wp, cn, sk, sp, sc):
         q.add_argument(
             "--repeats", type=_repeats, default=3, help="timed runs after a warm-up (min is kept)"
         )
@@ -268,4 +295,112 @@ def run_speedup(args) -> int:
         *[f"- {n}" for n in notes],
     ]
     _write(args.out, "speedup", frame, "Speed-up at equal phi accuracy against n", body)
+    return 0
+
+
+def _no_provenance(frame):
+    return frame[
+        [
+            c
+            for c in frame
+            if not c.startswith(("version_", "python", "platform", "processor", "cpu_count"))
+        ]
+    ]
+
+
+def plot_scale(frame, speedup, path: Path) -> Path:
+    """Wall time over 0..2 s, RHS cost and (if given) the equal-accuracy speed-up against n,
+    log-log. Drawn on a matplotlib Figure (no pyplot), like rodval.report.figures; to be moved
+    there."""
+    from matplotlib.figure import Figure
+
+    panels = 3 if speedup is not None and len(speedup) else 2
+    fig = Figure(figsize=(4.4 * panels, 3.8))
+    axes = fig.subplots(1, panels)
+    for model, part in frame.groupby("model", sort=False):
+        axes[0].loglog(part.n, part.wall_s, "o-", ms=3, label=model)
+        axes[1].loglog(part.n, part.rhs_random_s, "o-", ms=3, label=f"{model}, random state")
+        axes[1].loglog(part.n, part.rhs_run_s, "x--", ms=4, label=f"{model}, state at t = 0.5 s")
+    axes[0].set_ylabel("wall time over 0..2 s (s)")
+    axes[1].set_ylabel("compiled RHS, s per evaluation")
+    if panels == 3:
+        axes[2].semilogx(speedup.n, speedup["full/reduced"], "o-", ms=3)
+        axes[2].axhline(1.0, color="k", lw=0.8)
+        axes[2].set_ylabel("full / reduced wall time, phi error <= 1e-6")
+    for ax in axes:
+        ax.set_xlabel("rods n")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=7)
+    axes[1].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def _load() -> str:
+    """The machine's load averages (1, 5, 15 min) and core count, for the record."""
+    import os
+
+    one, five, fifteen = os.getloadavg()
+    return f"load average {one:.2f} / {five:.2f} / {fifteen:.2f} on {os.cpu_count()} cores"
+
+
+def run_scale(args) -> int:
+    load_before = _load()
+    frame, notes = bench.scale_rows(
+        args.n_values, args.models, repeats=args.repeats, budget_s=args.budget
+    )
+    args.out.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(args.out / "scale.csv", index=False)
+    fits = bench.scale_fits(frame, 64)
+    speedup = None
+    if args.speedup:
+        speedup = bench.speedup_scale(args.speedup_n, repeats=args.repeats)
+        speedup.to_csv(args.out / "speedup_scale.csv", index=False)
+    plot = plot_scale(frame, speedup, args.out / "scale.png")
+    wall = frame.pivot(index="n", columns="model", values="wall_s")
+    wall.columns = [f"{m} wall (s)" for m in wall.columns]
+    cols = [
+        "model",
+        "n",
+        "setup_s",
+        "wall_s",
+        "nfev",
+        "nsteps",
+        "wall_per_eval_s",
+        "rhs_random_s",
+        "rhs_run_s",
+        "observe_s_per_time",
+        "subnormals_run_state",
+    ]
+    body = [
+        "Paper chain of n rods, the paper's pulse at the last node, 0..2 s, 21 output times "
+        "(phi, phi'), compiled DOP853 at rtol 1e-6 (atol 1e-8); wall = integration and "
+        "observation (stats.wall_s), min over runs. rhs_random_s / rhs_run_s: the compiled "
+        "right-hand side called from a compiled loop at a random state / at the run's state at "
+        "t = 0.5 s; wall_per_eval_s = wall / nfev; observe_s_per_time: alpha, beta recovery per "
+        "output time.",
+        "",
+        to_markdown(wall.reset_index(), ".3g"),
+        "",
+        "## All columns",
+        "",
+        _table(frame, cols),
+        "",
+        "## Fitted exponents (cost ~ n^p, n >= 64)",
+        "",
+        to_markdown(fits, ".2f"),
+        "",
+    ]
+    if speedup is not None:
+        body += [
+            "## Reduced vs full at equal phi accuracy (<= 1e-6 against the same model at "
+            f"rtol {bench.SCALE_REFERENCE_RTOL:g})",
+            "",
+            to_markdown(_no_provenance(speedup), ".3g"),
+            "",
+        ]
+    notes = [f"machine before: {load_before}; after: {_load()}", *notes]
+    body += ["## Notes", "", *[f"- {n}" for n in notes], "", f"Plot: {plot.name}"]
+    _write(args.out, "scale", frame, "Scale: cost against n", body)
     return 0
