@@ -18,7 +18,7 @@ from rodval.cli.options import positive_float
 from rodval.core.provenance import provenance
 from rodval.core.scene import paper_scene
 from rodval.core.settings import METHODS
-from rodval.report.figures import plot_work_precision
+from rodval.report.figures import plot_scale, plot_work_precision
 from rodval.report.markdown import to_markdown
 
 DEFAULT_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "DOP853-numba")
@@ -306,35 +306,6 @@ def _no_provenance(frame):
             if not c.startswith(("version_", "python", "platform", "processor", "cpu_count"))
         ]
     ]
-
-
-def plot_scale(frame, speedup, path: Path) -> Path:
-    """Wall time over 0..2 s, RHS cost and (if given) the equal-accuracy speed-up against n,
-    log-log. Drawn on a matplotlib Figure (no pyplot), like rodval.report.figures; to be moved
-    there."""
-    from matplotlib.figure import Figure
-
-    panels = 3 if speedup is not None and len(speedup) else 2
-    fig = Figure(figsize=(4.4 * panels, 3.8))
-    axes = fig.subplots(1, panels)
-    for model, part in frame.groupby("model", sort=False):
-        axes[0].loglog(part.n, part.wall_s, "o-", ms=3, label=model)
-        axes[1].loglog(part.n, part.rhs_random_s, "o-", ms=3, label=f"{model}, random state")
-        axes[1].loglog(part.n, part.rhs_run_s, "x--", ms=4, label=f"{model}, state at t = 0.5 s")
-    axes[0].set_ylabel("wall time over 0..2 s (s)")
-    axes[1].set_ylabel("compiled RHS, s per evaluation")
-    if panels == 3:
-        axes[2].semilogx(speedup.n, speedup["full/reduced"], "o-", ms=3)
-        axes[2].axhline(1.0, color="k", lw=0.8)
-        axes[2].set_ylabel("full / reduced wall time, phi error <= 1e-6")
-    for ax in axes:
-        ax.set_xlabel("rods n")
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=7)
-    axes[1].legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    return path
 
 
 def _load() -> str:
