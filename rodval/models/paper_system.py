@@ -149,11 +149,15 @@ class PaperSystem(OdeSystem):
             self.compiled_rhs,
             self.V,
             self._flags,
-            _NO_MATRICES,
+            self.compiled_scratch(),
             table,
             mechanics=self.compiled_mechanics,
             name=type(self).__name__,
         )
+
+    def compiled_scratch(self) -> np.ndarray:
+        """The compiled form's M: work space its right-hand side reuses (none by default)."""
+        return _NO_MATRICES
 
     def generalized_force(self, t: float, phi: np.ndarray) -> np.ndarray | None:
         """Q(phi, t) (N m) on the phi coordinates, or None when no load acts at t."""

@@ -47,6 +47,10 @@ class ReducedSystem(PaperSystem):
     def kernel_constants(self):
         return reduced_banded.banded_constants(self.cc, self.chain)
 
+    def compiled_scratch(self) -> np.ndarray:
+        """Work space of ``reduced_banded.reduced_rhs`` (allocated once per run, O(n))."""
+        return np.zeros((1, 1, reduced_banded.rhs_work_size(self.n)))
+
     # The dense reference (kernel="numpy") and the analytic Jacobian: O(n^2) memory, O(n^3)
     # set-up, built only when one of them asks.
     @cached_property

@@ -310,6 +310,20 @@ def _solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
     return True
 
 
+#: Magnitudes below this are set to zero in the sweep (physical units: N, rad, rad/s^2). Far
+#: below any round-off of the values they are added to, and far above the subnormal range
+#: (< 2.2e-308): on a long chain the coefficients of the tail relation and the solution decay
+#: geometrically towards the root and would otherwise sit at subnormals, where every x86
+#: operation takes a ~100-cycle microcode assist (5x slower runs at n = 8192,
+#: benchmarks/subnormal_cost.py).
+TINY = 1e-250
+
+
+@njit(cache=True, inline="always")
+def _flush(v):
+    return 0.0 if abs(v) < TINY else v
+
+
 @njit(cache=True)
 def _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
     """The tip-to-root elimination (module docstring, "sweep"). T (n x 3 x 4): work storage
@@ -387,7 +401,7 @@ def _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
                 acc = R[j, q]
                 for i in range(j + 1, 3):
                     acc -= L[j, i] * T[k, i, q]
-                T[k, j, q] = acc / L[j, j]
+                T[k, j, q] = _flush(acc / L[j, j])
         # tail relation of rod k: S_k = S_{k+1} + M l e x_k
         #   = [F_P | 0 | f] + F_b (x) T_k[2] + (l F_P e + M l e) (x) T_k[0]
         v0 = l * (Fe0 + M * ex)
@@ -397,17 +411,17 @@ def _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
         F[0, 2] = 0.0
         F[1, 2] = 0.0
         for q in range(4):
-            F[0, q] += Fb0 * T[k, 2, q] + v0 * T[k, 0, q]
-            F[1, q] += Fb1 * T[k, 2, q] + v1 * T[k, 0, q]
+            F[0, q] = _flush(F[0, q] + Fb0 * T[k, 2, q] + v0 * T[k, 0, q])
+            F[1, q] = _flush(F[1, q] + Fb1 * T[k, 2, q] + v1 * T[k, 0, q])
             G[q] = T[k, 1, q]
     # root to tip: z_0 = 0, u_k = T_k [z_k; 1], z_{k+1} = (P_k + l_k e_k x_k, beta_k)
     P0 = 0.0
     P1 = 0.0
     bprev = 0.0
     for k in range(n):
-        x = T[k, 0, 0] * P0 + T[k, 0, 1] * P1 + T[k, 0, 2] * bprev + T[k, 0, 3]
-        a = T[k, 1, 0] * P0 + T[k, 1, 1] * P1 + T[k, 1, 2] * bprev + T[k, 1, 3]
-        bb = T[k, 2, 0] * P0 + T[k, 2, 1] * P1 + T[k, 2, 2] * bprev + T[k, 2, 3]
+        x = _flush(T[k, 0, 0] * P0 + T[k, 0, 1] * P1 + T[k, 0, 2] * bprev + T[k, 0, 3])
+        a = _flush(T[k, 1, 0] * P0 + T[k, 1, 1] * P1 + T[k, 1, 2] * bprev + T[k, 1, 3])
+        bb = _flush(T[k, 2, 0] * P0 + T[k, 2, 1] * P1 + T[k, 2, 2] * bprev + T[k, 2, 3])
         if not (np.isfinite(x) and np.isfinite(a) and np.isfinite(bb)):
             return False
         ddphi_out[k] = x
@@ -596,7 +610,7 @@ def bending_at(
     else:
         SX, SY = (np.ascontiguousarray(v, dtype=np.float64) for v in sums)
     ddphi, gamma = np.empty(n), np.empty(2 * n)
-    work = np.empty(work_size(n))
+    work = np.empty(sweep_work_size(n))  # the banded LU, if needed, allocates its own
     reduced_solve_work(
         Cst, phi, dphi, sums is not None, SX, SY, bool(damped), ddphi, gamma, work, method
     )
@@ -611,13 +625,34 @@ def reduced_accel(Cst, y, has_load, SX, SY, damped, out):
     reduced_accel_banded(Cst, y[:n], y[n:], has_load, SX, SY, damped, out)
 
 
+@njit(cache=True)
+def rhs_work_size(n):
+    """Length of ``reduced_rhs``'s work space: load sums (2n), gamma (2n), the sweep (19n)."""
+    return 4 * n + sweep_work_size(n)
+
+
 @njit(RHS_SIGNATURE, cache=True)
 def reduced_rhs(t, y, P, S, M, L, out):
     """y' of the reduced model (compiled integrators' right-hand side, loads from table L);
-    O(n) time and memory per evaluation."""
+    O(n) time and memory per evaluation, no allocation: ``M[0, 0]`` is its work space
+    (``rhs_work_size``; ``ReducedSystem.compiled_scratch``)."""
     half = y.shape[0] // 2
     out[:half] = y[half:]
-    SX = np.empty(half)
-    SY = np.empty(half)
+    work = M[0, 0]
+    SX = work[:half]
+    SY = work[half : 2 * half]
+    gamma = work[2 * half : 4 * half]
     has_load = load_sums(L, t, SX, SY)
-    reduced_accel_banded(P, y[:half], y[half:], has_load, SX, SY, S[0] != 0.0, out[half:])
+    reduced_solve_work(
+        P,
+        y[:half],
+        y[half:],
+        has_load,
+        SX,
+        SY,
+        S[0] != 0.0,
+        out[half:],
+        gamma,
+        work[4 * half :],
+        METHOD_AUTO,
+    )

@@ -37,6 +37,18 @@ OK, STEP_TOO_SMALL, NON_FINITE, BUDGET, BLOWUP, STALLED = 0, 1, 2, 3, 4, 5
 SAFETY, MIN_FACTOR, MAX_FACTOR, ERROR_EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
 
 
+@njit(cache=True, inline="always")
+def _combine(out, base, K, coef, count, h):
+    """out = base + h * sum_{j < count} coef[j] K[j], as loops (no temporary arrays)."""
+    N = out.shape[0]
+    for i in range(N):
+        acc = 0.0
+        for j in range(count):
+            if coef[j] != 0.0:
+                acc += coef[j] * K[j, i]
+        out[i] = base[i] + h * acc
+
+
 @njit(cache=True)
 def _rms(x):
     return np.sqrt(np.mean(x * x))
@@ -134,6 +146,7 @@ def run(
     tmp = np.empty(N)
     f1 = np.empty(N)
     F = np.empty((7, N))
+    zero = np.zeros(N)
     nt = times.shape[0]
     n_out = 0
     nfev = 0
@@ -176,14 +189,9 @@ def run(
                 h = t_new - t
                 h_abs = h
                 for s in range(1, N_STAGES):
-                    tmp[:] = y
-                    for j in range(s):
-                        if A[s, j] != 0.0:
-                            tmp += (h * A[s, j]) * K[j]
+                    _combine(tmp, y, K, A[s], s, h)
                     rhs(t + C[s] * h, tmp, P, S, M, L, K[s])
-                y_new[:] = y
-                for j in range(N_STAGES):
-                    y_new += (h * B[j]) * K[j]
+                _combine(y_new, y, K, B, N_STAGES, h)
                 rhs(t_new, y_new, P, S, M, L, K[N_STAGES])
                 nfev += N_STAGES
                 err5 = 0.0
@@ -229,31 +237,29 @@ def run(
             if n_out < nt and times[n_out] <= t_new:
                 # dense output: three extra stages, then the 7th-order interpolant
                 for s in range(N_STAGES + 1, 16):
-                    tmp[:] = y
-                    for j in range(s):
-                        if A[s, j] != 0.0:
-                            tmp += (h * A[s, j]) * K[j]
+                    _combine(tmp, y, K, A[s], s, h)
                     rhs(t + C[s] * h, tmp, P, S, M, L, K[s])
                 nfev += 3
-                F[0] = y_new - y
-                F[1] = h * K[0] - F[0]
-                F[2] = 2.0 * F[0] - h * (K[N_STAGES] + K[0])
+                for i in range(N):
+                    f0 = y_new[i] - y[i]
+                    F[0, i] = f0
+                    F[1, i] = h * K[0, i] - f0
+                    F[2, i] = 2.0 * f0 - h * (K[N_STAGES, i] + K[0, i])
                 for p in range(4):
-                    F[3 + p] = 0.0
-                    for j in range(16):
-                        if D[p, j] != 0.0:
-                            F[3 + p] += (h * D[p, j]) * K[j]
+                    _combine(F[3 + p], zero, K, D[p], 16, h)
                 while n_out < nt and times[n_out] <= t_new:
                     x = (times[n_out] - t) / h
-                    acc = np.zeros(N)
-                    for i in range(7):
-                        acc += F[6 - i]
-                        acc *= x if i % 2 == 0 else 1.0 - x
-                    Y[n_out] = acc + y
+                    for q in range(N):
+                        acc = 0.0
+                        for i in range(7):
+                            acc += F[6 - i, q]
+                            acc *= x if i % 2 == 0 else 1.0 - x
+                        Y[n_out, q] = acc + y[q]
                     n_out += 1
             t = t_new
-            y[:] = y_new
-            K[0] = K[N_STAGES]
+            for i in range(N):
+                y[i] = y_new[i]
+                K[0, i] = K[N_STAGES, i]
     return n_out, nfev, nsteps, OK, t
 
 

@@ -36,7 +36,8 @@ class CompiledForm:
     ``rhs`` is a numba function of the first-class type ``rodval.solvers.signature.RHS_TYPE``:
     ``rhs(t, y, P, S, M, L, out)`` writes y' (same length as y) into ``out``. What the arrays
     hold is the model's business: ``P`` (rows of per-rod constants, float64 2-D), ``S``
-    (scalars, float64 1-D), ``M`` (dense matrices, float64 3-D, may be empty), ``L`` (the load
+    (scalars, float64 1-D), ``M`` (dense matrices or work space the rhs reuses, float64 3-D,
+    may be empty), ``L`` (the load
     table, ``rodval.core.loads.load_table``). The integrator passes them through untouched.
 
     ``mechanics`` (optional, same type): writes (T, P_ext) — kinetic energy (J) and power of
