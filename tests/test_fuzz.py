@@ -49,7 +49,7 @@ EXAMPLES = int(os.environ.get("RODVAL_FUZZ_EXAMPLES", "0") or 0)
 #: Time limit of one example (s).
 LIMIT_S = 60.0
 #: Budgets given to every run (the fuzzed options may come after them and override them).
-BUDGET = ["--max-wall", "5", "--max-evaluations", "100000"]
+BUDGET = ["--max-wall", "2", "--max-evaluations", "50000"]
 
 
 def budget(default: int, *, expensive: bool = False) -> settings:
@@ -264,6 +264,47 @@ def scene_doc(draw, *, valid_bias: bool = True) -> dict:
     return doc
 
 
+@st.composite
+def valid_scene_doc(draw) -> dict:
+    """A scene file of valid values only (small, short): these run."""
+    n = draw(st.integers(1, 6))
+    doc: dict = {
+        "n": n,
+        "t_end": draw(st.floats(0.01, 0.5)),
+        "times": {"num": draw(st.integers(1, 20))},
+    }
+    chain = {}
+    for key, lo, hi in (("l", 0.1, 5.0), ("m", 0.1, 10.0), ("EI", 1e2, 1e6), ("mu", 0.0, 10.0),
+                        ("kappa", 0.0, 1e3), ("nu", 0.0, 1.0)):  # fmt: skip
+        if draw(st.booleans()):
+            chain[key] = draw(
+                st.one_of(st.floats(lo, hi), st.lists(st.floats(lo, hi), min_size=n, max_size=n))
+            )
+    doc["chain"] = chain
+    doc["outputs"] = draw(
+        st.lists(
+            st.sampled_from(["phi", "dphi", "alpha", "beta", "x", "y", "energy"]),
+            min_size=1,
+            max_size=4,
+            unique=True,
+        )  # fmt: skip
+    )
+    doc["initial"] = {
+        k: draw(st.floats(-1, 1)) for k in draw(st.sets(st.sampled_from(["phi", "dphi", "alpha"])))
+    }
+    doc["loads"] = [
+        {
+            "type": "pulse",
+            "node": draw(st.integers(1, n)),
+            "Xbar": draw(st.floats(-1e3, 1e3)),
+            "Ybar": draw(st.floats(-1e3, 1e3)),
+            "T": draw(st.floats(0.05, 1.0)),
+        }  # fmt: skip
+        for _ in range(draw(st.integers(0, 2)))
+    ]
+    return doc
+
+
 def write_scene(tmp: Path, doc: dict, raw: bytes | None = None) -> Path:
     path = tmp / "scene.toml"
     if raw is not None:
@@ -290,9 +331,9 @@ def check_run(out: Path, code: int) -> int:
 # ----------------------------------------------------------------------------- tests
 
 
-@budget(30)
+@budget(15)
 @given(
-    doc=scene_doc(),
+    doc=st.one_of(scene_doc(), valid_scene_doc()),
     model=st.sampled_from(["full", "reduced"]),
     raw=st.one_of(st.none(), st.none(), st.none(), st.binary(max_size=40)),
     method=st.sampled_from([None, "auto", "RK45", "RK23", "DOP853", "DOP853-numba", "Radau"]),

@@ -168,6 +168,13 @@ def _check_trajectories(traj: pd.DataFrame, path: Path) -> None:
             f"{path}: case {case!r}, model {model!r}, {q}: {row['rows']} values for "
             f"{row['nt']} output times x {row['nk']} values of k (the table is incomplete)"
         )
+    runs = grouped.reset_index().groupby(["case", "model"], sort=False)["nt"].nunique()
+    if (runs > 1).any():
+        case, model = runs[runs > 1].index[0]
+        raise ValueError(
+            f"{path}: case {case!r}, model {model!r}: the output times differ between "
+            "quantities (the table is incomplete)"
+        )
 
 
 def trajectory_samples(

@@ -478,9 +478,9 @@ def load_study(path: str | Path) -> StudySpec:
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"study file {str(path)!r} does not exist")
-    text = path.read_text()
     try:
+        text = path.read_text()
         doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
     return study_from_dict(doc, where=str(path), text=text)
