@@ -313,3 +313,28 @@ def test_report_on_damaged_tables_names_the_file(finished, tmp_path, capsys, kin
     assert main(["report", str(out)]) == 2
     line = one_line(capsys)
     assert f"{table}.csv" in line and words in line, line
+
+
+def test_success_with_non_finite_values_is_recorded_as_diverged(tmp_path):
+    """A model that reports success with NaN values would make a record the reader refuses
+    (recomputed forever, tables never written): the pipeline records it as diverged."""
+    import math
+
+    from rodval import paper_scene, simulate
+    from rodval.core.status import STATUS_DIVERGED
+    from rodval.study.pipeline import case_record
+
+    spec = load_study(write_study(tmp_path, grid="scene.t_end = [0.1]"))
+    case = spec.cases[0]
+    runs = []
+    for m in case.models:
+        tr = simulate(paper_scene(2, t_end=0.1), "reduced")
+        if m.label == "published":
+            tr.values["phi"][-1, 0] = math.nan
+        runs.append({"label": m.label, "setup_s": 0.0, "trajectory": tr.to_dict()})
+    rec = case_record(case, runs)
+    path = tmp_path / "case.json"
+    path.write_text(rec.to_json())
+    back = read_case(path, labels=["reduced", "published"])
+    status = {r.label: r.trajectory.stats.status for r in back.runs}
+    assert status == {"reduced": 0, "published": STATUS_DIVERGED}
