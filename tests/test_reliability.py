@@ -26,7 +26,13 @@ from rodval import (
 from rodval.cli import main
 from rodval.core.resources import ENV_LIMIT, check_run_memory, estimate_run_bytes
 from rodval.core.scene_file import scene_from_dict
-from rodval.core.status import STATUS_BUDGET, STATUS_DIVERGED, STATUS_ERROR, STATUS_WALL
+from rodval.core.status import (
+    STATUS_BUDGET,
+    STATUS_DIVERGED,
+    STATUS_ERROR,
+    STATUS_STALLED,
+    STATUS_WALL,
+)
 
 SMALL = paper_scene(4, t_end=0.5, times=np.linspace(0, 0.5, 6))
 
@@ -303,8 +309,10 @@ def test_stiff_chain_ends_at_its_wall_budget(model, m):
         tr = simulate(scene, model, method="DOP853", max_wall_s=1.0)
     if model == "reduced":
         assert tr.success
-    else:
-        assert tr.stats.status == STATUS_WALL and "max_wall_s = 1 s" in tr.stats.message
+    elif tr.stats.status == STATUS_WALL:
+        assert "max_wall_s = 1 s" in tr.stats.message
+    else:  # at m = 1e-10 the steps may collapse (below 1e-9 t_end) before the wall budget
+        assert tr.stats.status == STATUS_STALLED and m == 1e-10, tr.stats.message
 
 
 def test_budgets_on_the_cli(tmp_path, capsys):
