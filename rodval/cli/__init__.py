@@ -5,8 +5,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import re
 import sys
+import traceback
+import warnings
 
 #: Subcommand modules, in the order ``rodval --help`` lists them.
 COMMANDS = ("reproduce", "simulate", "compare", "study", "report", "bench", "modes")
@@ -51,13 +54,46 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def one_line(exc: BaseException) -> str:
+    """An exception's message on one line (its lines joined by " | ")."""
+    text = " | ".join(line.strip() for line in str(exc).splitlines() if line.strip())
+    return text or type(exc).__name__
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run a subcommand. A user error (bad option, file, value) is one line on stderr and exit
+    status 2; anything unexpected is one line too, exit 2, naming the exception's type and
+    message as an internal error (a bug to report, never hidden); no traceback is printed
+    (``RODVAL_TRACEBACK=1`` prints it for debugging). Numerical RuntimeWarnings (overflow in
+    a diverging run) are not printed: the run's status reports how it ended."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return int(args.func(args) or 0)
     except (CliError, ValueError, OSError) as exc:
-        print(f"rodval {args.command}: error: {exc}", file=sys.stderr)
+        print(f"rodval {args.command}: error: {one_line(exc)}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"rodval {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except MemoryError:
+        print(
+            f"rodval {args.command}: error: out of memory (ask for fewer output times, "
+            "quantities or rods)",
+            file=sys.stderr,
+        )
+        return 2
+    except Exception as exc:  # noqa: BLE001 - one line, never a traceback, never hidden
+        if os.environ.get("RODVAL_TRACEBACK"):
+            traceback.print_exc()
+        print(
+            f"rodval {args.command}: internal error: {type(exc).__name__}: {one_line(exc)} "
+            "(a bug in rodval: please report it with the command; RODVAL_TRACEBACK=1 shows "
+            "where)",
+            file=sys.stderr,
+        )
         return 2
 
 

@@ -51,6 +51,13 @@ def register(sub) -> None:
     p.add_argument(
         "--fresh", action="store_true", help="empty DIR first (needed when DIR holds another study)"
     )
+    p.add_argument(
+        "--report",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="write report.md and figures/ after the tables (default); --no-report: tables "
+        "only (`rodval report DIR` writes it later)",
+    )
     p.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     p.set_defaults(func=run)
 
@@ -73,6 +80,7 @@ def run(args) -> int:
             backend=args.backend,
             scheduler=args.scheduler,
             progress=args.progress,
+            report=args.report,
             fresh=args.fresh,
         )
     except KeyboardInterrupt:
@@ -88,6 +96,7 @@ def run(args) -> int:
         print(f"rodval study: warning: {warning}", file=sys.stderr)
     print(
         f"{spec.name}: {len(res.ran)} cases run, {len(res.reused)} reused, "
-        f"{res.failed_runs} failed model runs, {res.wall_s:.1f} s -> {res.out / 'report.md'}"
+        f"{res.failed_runs} failed model runs, {res.wall_s:.1f} s -> "
+        f"{res.out / 'report.md' if args.report else res.out}"
     )
     return 0

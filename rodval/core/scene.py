@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from rodval.core.loads import NodalForce
+from rodval.core.resources import check_run_memory
 
 #: Quantities a scene may ask for. "x"/"y" are node positions (k = 0..n); "energy" yields
 #: kinetic, potential and total energy (k = 0).
@@ -58,9 +59,21 @@ def trajectory_quantities(outputs: Iterable[str]) -> tuple[str, ...]:
     return tuple(out)
 
 
+#: Allowed magnitudes of the chain's data (SI units): |value| <= MAX_MAGNITUDE, and the
+#: strictly positive ones (l, m, EI) >= MIN_POSITIVE. The models form products and quotients
+#: of several parameters (frequencies EI / (m l^4), kappa / (m l^3), inertias m l^3); beyond
+#: these bounds they leave the range where float64 arithmetic means anything and the runs
+#: failed at t = 0 with messages naming no parameter (m = 1e-200: ZeroDivisionError in the
+#: full model; kappa = 1e25 or EI = 1e-15: LinAlgError in the reduced model). No physical rod
+#: chain is near them: 1e12 N m^2 is a rigid limit already (a bridge girder is ~1e11).
+MAX_MAGNITUDE = 1e12
+MIN_POSITIVE = 1e-12
+
+
 def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndarray:
     """A length-n float array from a scalar or sequence of real numbers; ``positive``: True
-    for > 0, False for >= 0, None for any finite value."""
+    for > 0, False for >= 0 (both with bounded magnitudes: ``MAX_MAGNITUDE``,
+    ``MIN_POSITIVE``), None for any finite value (angles, initial state)."""
     raw = np.asarray(value) if not isinstance(value, (str, bytes, dict)) else np.asarray(None)
     if raw.dtype.kind not in "iuf":  # strings, booleans, complex, objects: refused
         raise ValueError(
@@ -77,6 +90,16 @@ def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndar
         raise ValueError(f"{name} must be > 0 (allowed range (0, inf)), got {arr.tolist()}")
     if positive is False and np.any(arr < 0):
         raise ValueError(f"{name} must be >= 0 (allowed range [0, inf)), got {arr.tolist()}")
+    lo = MIN_POSITIVE if positive is True else 0.0
+    if positive is not None and np.any(np.abs(arr) > MAX_MAGNITUDE) or np.any(np.abs(arr) < lo):
+        bad = float(arr[(np.abs(arr) > MAX_MAGNITUDE) | (np.abs(arr) < lo)][0])
+        allowed = (
+            f"[{MIN_POSITIVE:g}, {MAX_MAGNITUDE:g}]" if positive else f"[0, {MAX_MAGNITUDE:g}]"
+        )
+        raise ValueError(
+            f"{name} must lie in {allowed} (SI units; beyond that the models' arithmetic "
+            f"overflows or underflows), got {bad:g}"
+        )
     arr.setflags(write=False)
     return arr
 
@@ -364,6 +387,12 @@ class Scene:
                 f"outputs must be a non-empty subset of {QUANTITIES}, got {list(outputs)}"
             )
         object.__setattr__(self, "outputs", tuple(dict.fromkeys(outputs)))
+        check_run_memory(
+            n,
+            times.size,
+            trajectory_quantities(self.outputs),
+            what=f"scene {self.name!r} (n = {n}, {times.size} output times)",
+        )
         if not isinstance(self.initial, InitialState):
             raise ValueError("initial must be a rodval.InitialState")
         init = self.initial.resolve(n)  # validate now, before any work

@@ -43,12 +43,40 @@ FIXED = (
     "fingerprint",
     *METRICS,
 )
-#: Columns each table must have for the report (a grid axis adds more).
+#: Columns each table must have (every column ``rodval.study.tables`` writes but the grid
+#: axes, which depend on the study).
 REQUIRED = {
     "cases": ("case", "n", "horizon", "l"),
     "trajectories": ("case", "model", "t", "quantity", "k", "value"),
-    "discrepancies": ("case", "model", "reference", "quantity", "status"),
-    "runtime": ("case", "model", "method", "wall_s", "t_reached", "status", "message"),
+    "discrepancies": (
+        "case",
+        "n",
+        "horizon",
+        "model",
+        "reference",
+        "quantity",
+        "max_abs",
+        "rms",
+        "final_abs",
+        "max_rel",
+        "status",
+    ),
+    "runtime": (
+        "case",
+        "n",
+        "horizon",
+        "model",
+        "method",
+        "rtol",
+        "atol",
+        "wall_s",
+        "setup_s",
+        "nfev",
+        "nsteps",
+        "t_reached",
+        "status",
+        "message",
+    ),
 }
 
 
@@ -91,13 +119,62 @@ def read_tables(out: Path) -> dict[str, pd.DataFrame]:
             raise ValueError(
                 f"{path}: column {missing[0]!r} is missing (needed: {', '.join(REQUIRED[name])})"
             )
+        for col in NUMERIC.get(name, ()):
+            if not pd.api.types.is_numeric_dtype(df[col]):
+                bad = next((v for v in df[col] if pd.isna(pd.to_numeric(v, errors="coerce"))), None)
+                raise ValueError(f"{path}: column {col!r} must hold numbers, got {bad!r}")
+        if df["case"].isna().any():
+            raise ValueError(f"{path}: a row has no case id")
         tables[name] = df
-    cases = set(tables["cases"]["case"])
-    for name in ("runtime", "discrepancies"):
-        unknown = sorted(set(tables[name]["case"]) - cases)
+    cases = tables["cases"]
+    if cases["case"].duplicated().any():
+        dup = cases["case"][cases["case"].duplicated()].iloc[0]
+        raise ValueError(f"{out / 'cases.csv'}: case {dup!r} is listed twice")
+    known = set(cases["case"].astype(str))
+    for name in ("runtime", "discrepancies", "trajectories"):
+        unknown = sorted(set(tables[name]["case"].astype(str)) - known)
         if unknown:
             raise ValueError(f"{out / (name + '.csv')}: case {unknown[0]!r} is not in cases.csv")
+    _check_trajectories(tables["trajectories"], out / "trajectories.csv")
     return tables
+
+
+#: Columns that must be numeric in each table.
+NUMERIC = {
+    "cases": ("n", "horizon"),
+    "trajectories": ("t", "k", "value"),
+    "discrepancies": ("n", "horizon", "max_abs", "max_rel"),
+    "runtime": ("n", "horizon", "wall_s", "setup_s", "nfev", "nsteps", "t_reached"),
+}
+
+
+def _check_trajectories(traj: pd.DataFrame, path: Path) -> None:
+    """Every (case, model, quantity) of the trajectories table covers each of its output
+    times at each of its k once (a truncated or edited table does not)."""
+    keys = ["case", "model", "quantity"]
+    if traj.duplicated(keys + ["t", "k"]).any():
+        row = traj[traj.duplicated(keys + ["t", "k"])].iloc[0]
+        raise ValueError(
+            f"{path}: case {row['case']!r}, model {row['model']!r}, {row['quantity']}: "
+            f"t = {row['t']:g}, k = {row['k']:g} appears twice"
+        )
+    grouped = traj.groupby(keys, sort=False).agg(
+        rows=("value", "size"), nt=("t", "nunique"), nk=("k", "nunique")
+    )
+    short = grouped[grouped["rows"] != grouped["nt"] * grouped["nk"]]
+    if not short.empty:
+        (case, model, q), row = next(iter(short.iterrows()))
+        raise ValueError(
+            f"{path}: case {case!r}, model {model!r}, {q}: {row['rows']} values for "
+            f"{row['nt']} output times x {row['nk']} values of k (the table is incomplete)"
+        )
+    runs = grouped.reset_index().groupby(["case", "model"], sort=False)["nt"].nunique()
+    if (runs > 1).any():
+        case, model = runs[runs > 1].index[0]
+        raise ValueError(
+            f"{path}: case {case!r}, model {model!r}: the output times differ between "
+            "quantities (the table is incomplete)"
+        )
 
 
 def trajectory_samples(

@@ -14,12 +14,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from tqdm import tqdm
 
 from rodval.analysis.metrics import compare_runs
 from rodval.core.provenance import provenance
 from rodval.core.scene_file import scene_to_dict
-from rodval.core.status import STATUS_CRASHED, STATUS_TIMEOUT
+from rodval.core.status import STATUS_CRASHED, STATUS_DIVERGED, STATUS_TIMEOUT
 from rodval.core.trajectory import Trajectory
 from rodval.study.records import CaseRecord, DamagedRecord, RunRecord, read_case
 from rodval.study.schedule import BACKENDS, default_workers, run_dask, run_processes
@@ -51,6 +52,8 @@ def case_record(case: Case, runs: list[dict[str, Any]]) -> CaseRecord:
     discrepancies of every model against the reference."""
     order = {m.label: i for i, m in enumerate(case.models)}
     typed = sorted((RunRecord.from_dict(r) for r in runs), key=lambda r: order[r.label])
+    for run in typed:
+        _no_silent_nonfinite(run.trajectory)
     trajs: dict[str, Trajectory] = {r.label: r.trajectory for r in typed}
     return CaseRecord(
         case=case.id,
@@ -61,6 +64,20 @@ def case_record(case: Case, runs: list[dict[str, Any]]) -> CaseRecord:
         runs=typed,
         discrepancies=compare_runs(trajs, case.reference, case.scene.outputs),
     )
+
+
+def _no_silent_nonfinite(traj: Trajectory) -> None:
+    """A run that reports success with non-finite values is recorded as diverged (the record
+    reader refuses such a success, so it would be recomputed forever)."""
+    if not traj.success:
+        return
+    for q, v in traj.values.items():
+        if not np.all(np.isfinite(v)):
+            traj.stats.status = STATUS_DIVERGED
+            traj.stats.message = (
+                f"diverged: the model reported success with non-finite values of {q!r}"
+            )
+            return
 
 
 def _reusable(store: StudyStore, case: Case, warnings: list[str]) -> bool:

@@ -25,10 +25,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from rodval.core.scene import QUANTITIES, Scene
+from rodval.core.resources import (
+    STATE_PER_ROD,
+    check_run_memory,
+    check_study_memory,
+    dense_path,
+    output_values,
+)
+from rodval.core.scene import QUANTITIES, Scene, trajectory_quantities
 from rodval.core.scene_file import scene_from_dict
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.models import REGISTRY, get_model, model_class
+from rodval.study.store import MAX_NAME, case_file_name
 
 TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report"}
 STUDY_KEYS = {"name", "description", "reference"}
@@ -404,6 +412,8 @@ def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpe
             "two cases format to the same id; use values that differ "
             "in their first 12 significant digits",
         )
+    _check_file_names(ids, where)
+    _check_resources(cases, where)
     report = _report_spec(doc.get("report"), ids, where)
     return StudySpec(
         name=str(study.get("name", Path(where).stem)),
@@ -419,14 +429,58 @@ def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpe
     )
 
 
+def _check_file_names(ids: list[str], where: str) -> None:
+    """Every case's record file name is distinct and bounded (before any case runs)."""
+    names: dict[str, str] = {}
+    for cid in ids:
+        name = case_file_name(cid)
+        if len(name) > MAX_NAME:  # pragma: no cover - case_file_name bounds it
+            raise _err(where, "grid", f"case {cid!r}: file name longer than {MAX_NAME}")
+        if name in names:
+            raise _err(
+                where,
+                "grid",
+                f"cases {names[name]!r} and {cid!r} would share the record file {name!r}",
+            )
+        names[name] = cid
+
+
+def _check_resources(cases: tuple[Case, ...], where: str) -> None:
+    """The memory of every case's runs (model by model: the full model's state is 6 n, an
+    implicit method or the numpy kernel builds dense matrices) and of the study's tables,
+    refused above the limit (``rodval.core.resources``) before any case runs."""
+    values = 0
+    for case in cases:
+        scene = case.scene
+        quantities = trajectory_quantities(scene.outputs)
+        for m in case.models:
+            dense = m.model in STATE_PER_ROD and dense_path(m.model, m.options, m.settings.method)
+            try:
+                check_run_memory(
+                    scene.n,
+                    scene.times.size,
+                    quantities,
+                    model=m.model,
+                    dense=dense,
+                    what=f"case {case.id!r}, model {m.label!r} (n = {scene.n})",
+                )
+            except ValueError as exc:
+                raise ValueError(f"{case.where}: {exc}") from None
+            values += output_values(scene.n, scene.times.size, quantities)
+    try:
+        check_study_memory(values, len(cases))
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
+
+
 def load_study(path: str | Path) -> StudySpec:
     """Read and validate a study file."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"study file {str(path)!r} does not exist")
-    text = path.read_text()
     try:
+        text = path.read_text()
         doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
     return study_from_dict(doc, where=str(path), text=text)

@@ -1,0 +1,690 @@
+"""Fuzzing the command line (hypothesis): random scene files, study files, argument lists,
+damaged case records and damaged tables.
+
+Every example runs ``rodval.cli.main`` in this process and must end in one of two ways:
+
+* exit 0 (or 1: `rodval simulate` of a run that failed) with a status line, and a run that
+  reports success has finite outputs only;
+* exit 2 with exactly one line on stderr, a user error (never "internal error");
+
+never a traceback and never a hang: each example has a time limit (``LIMIT_S``, a SIGALRM
+for Python code and a check of the wall time afterwards for compiled loops, which the runs'
+own --max-wall budget ends). Scenes are small (n <= 6, t_end <= 0.5 s) with tight budgets.
+
+Default budget: a few dozen examples per test, about a minute in all. More on demand::
+
+    RODVAL_FUZZ_EXAMPLES=2000 RODVAL_FUZZ_STATS=/tmp/fuzz.json OMP_NUM_THREADS=1 \\
+        python -m pytest tests/test_fuzz.py -m fuzz -q -p no:cacheprovider
+
+``RODVAL_FUZZ_EXAMPLES`` is the number of examples of each cheap test (scene files, argument
+lists, study files); the tests that run a study or build a report (damaged case records,
+study runs, damaged tables) take a fortieth of it. ``RODVAL_FUZZ_STATS`` appends the counts
+of each test (examples, tracebacks, hangs, silent non-finite successes, wall time) as JSON
+lines.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+import os
+import shutil
+import signal
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from rodval.cli import main
+
+pytestmark = pytest.mark.fuzz
+
+EXAMPLES = int(os.environ.get("RODVAL_FUZZ_EXAMPLES", "0") or 0)
+#: Time limit of one example (s).
+LIMIT_S = 60.0
+#: Budgets given to every run (the fuzzed options may come after them and override them).
+BUDGET = ["--max-wall", "2", "--max-evaluations", "50000"]
+
+
+def budget(default: int, *, expensive: bool = False) -> settings:
+    n = default if not EXAMPLES else max(EXAMPLES // 40, 1) if expensive else EXAMPLES
+    return settings(
+        max_examples=n,
+        deadline=None,
+        database=None,
+        suppress_health_check=list(HealthCheck),
+    )
+
+
+class Counts:
+    """Counts of one fuzz test, appended to RODVAL_FUZZ_STATS at the end."""
+
+    def __init__(self, name: str):
+        self.name = name
+        self.examples = self.tracebacks = self.hangs = self.nonfinite = 0
+        self.exits: dict[int, int] = {}
+        self.start = self.last = time.perf_counter()
+
+    def save(self) -> None:
+        path = os.environ.get("RODVAL_FUZZ_STATS")
+        if not path:
+            return
+        row = {
+            "test": self.name,
+            "examples": self.examples,
+            "tracebacks": self.tracebacks,
+            "hangs": self.hangs,
+            "nonfinite_successes": self.nonfinite,
+            "exit_codes": {str(k): v for k, v in sorted(self.exits.items())},
+            "wall_s": round(self.last - self.start, 1),
+        }
+        with open(path, "a") as fh:
+            fh.write(json.dumps(row) + "\n")
+
+
+@pytest.fixture(scope="module")
+def counts(request):
+    registry: dict[str, Counts] = {}
+    yield lambda name: registry.setdefault(name, Counts(name))
+    for c in registry.values():
+        c.save()
+
+
+class Hang(Exception):
+    pass
+
+
+def _alarm(signum, frame):
+    raise Hang(f"example exceeded {LIMIT_S:g} s")
+
+
+def run_cli(argv: list[str], c: Counts) -> tuple[int, str, str]:
+    """(exit code, stdout, stderr) of ``rodval ARGV``, checking the contract."""
+    c.examples += 1
+    out, err = io.StringIO(), io.StringIO()
+    old = signal.signal(signal.SIGALRM, _alarm)
+    signal.setitimer(signal.ITIMER_REAL, LIMIT_S)
+    start = time.perf_counter()
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                code = main([str(a) for a in argv])
+            except SystemExit as exc:  # argparse: bad option, --help
+                code = exc.code if isinstance(exc.code, int) else 2
+    except Hang:
+        c.hangs += 1
+        raise AssertionError(f"hang: rodval {argv}") from None
+    except Exception as exc:  # noqa: BLE001 - counted, then reported
+        c.tracebacks += 1
+        raise AssertionError(f"exception escaped: rodval {argv}: {exc!r}") from exc
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    wall = time.perf_counter() - start
+    c.last = time.perf_counter()
+    if wall > LIMIT_S:
+        c.hangs += 1
+        raise AssertionError(f"hang ({wall:.0f} s): rodval {argv}")
+    c.exits[code] = c.exits.get(code, 0) + 1
+    stderr = err.getvalue()
+    if "Traceback" in stderr or "internal error" in stderr:
+        c.tracebacks += 1
+        raise AssertionError(f"rodval {argv}: {stderr}")
+    assert code in (0, 1, 2), (argv, code, stderr)
+    if code == 2:
+        lines = [line for line in stderr.splitlines() if line.strip()]
+        assert len(lines) == 1, (argv, stderr)
+    return code, out.getvalue(), stderr
+
+
+# ----------------------------------------------------------------------------- TOML writing
+
+
+def toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, list):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return (
+            "{" + ", ".join(f"{json.dumps(str(k))} = {toml_value(x)}" for k, x in v.items()) + "}"
+        )
+    raise TypeError(type(v))
+
+
+def to_toml(doc: dict) -> str:
+    return "\n".join(f"{json.dumps(str(k))} = {toml_value(v)}" for k, v in doc.items()) + "\n"
+
+
+# ----------------------------------------------------------------------------- strategies
+
+numbers = st.one_of(
+    st.integers(-3, 10),
+    st.floats(-2.0, 10.0),
+    st.sampled_from([0.0, -1.0, 1e-300, 1e-15, 1e13, 1e160, 1e305, math.inf, -math.inf, math.nan]),
+)
+junk = st.one_of(
+    st.text(max_size=5),
+    st.booleans(),
+    st.just([]),
+    st.just({}),
+    st.lists(st.integers(), max_size=3),
+)
+anything = st.one_of(numbers, numbers, junk)
+
+
+@st.composite
+def per_rod(draw, n, lo, hi):
+    """A chain value: a good scalar or list, or anything."""
+    kind = draw(st.integers(0, 4))
+    if kind == 0:
+        return draw(anything)
+    if kind == 1:
+        return [draw(st.floats(lo, hi)) for _ in range(max(min(n, 6), 1))]
+    return draw(st.floats(lo, hi))
+
+
+@st.composite
+def scene_doc(draw, *, valid_bias: bool = True) -> dict:
+    n = draw(st.one_of(st.integers(1, 5), st.integers(1, 5), anything))
+    nn = n if isinstance(n, int) and not isinstance(n, bool) else 3
+    doc: dict = {}
+    if draw(st.booleans()) or valid_bias:
+        doc["n"] = n
+    if draw(st.booleans()):
+        doc["t_end"] = draw(st.one_of(st.floats(0.01, 0.5), anything))
+    t_end = doc.get("t_end", 2.0)
+    if draw(st.booleans()) or t_end == 2.0:
+        doc["times"] = draw(
+            st.one_of(
+                st.fixed_dictionaries({"num": st.one_of(st.integers(1, 30), anything)}),
+                st.lists(st.floats(0.0, 0.5), min_size=1, max_size=5).map(sorted),
+                anything,
+            )
+        )
+    if draw(st.booleans()):
+        doc["outputs"] = draw(
+            st.one_of(
+                st.lists(
+                    st.sampled_from(["phi", "dphi", "alpha", "beta", "x", "y", "energy", "z"]),
+                    min_size=0,
+                    max_size=4,
+                ),
+                anything,
+            )
+        )
+    if draw(st.booleans()):
+        chain = {}
+        for key, lo, hi in (
+            ("l", 0.1, 5),
+            ("m", 0.1, 10),
+            ("EI", 1e2, 1e6),
+            ("mu", 0, 10),
+            ("kappa", 0, 1e3),
+            ("nu", 0, 1),
+        ):
+            if draw(st.integers(0, 3)) == 0:
+                chain[key] = draw(per_rod(nn, lo, hi))
+        if draw(st.integers(0, 9)) == 0:
+            chain["bogus"] = 1
+        doc["chain"] = chain
+    if draw(st.booleans()):
+        doc["initial"] = {
+            k: draw(st.one_of(st.floats(-1, 1), anything))
+            for k in draw(st.sets(st.sampled_from(["phi", "dphi", "alpha", "beta", "gamma"])))
+        }
+    if draw(st.booleans()):
+        loads = []
+        for _ in range(draw(st.integers(0, 3))):
+            kind = draw(st.sampled_from(["pulse", "constant", "ramp", "harmonic", "bad"]))
+            load = {"type": kind, "node": draw(st.one_of(st.just("last"), st.integers(0, 6)))}
+            for key in draw(
+                st.sets(st.sampled_from(["Xbar", "Ybar", "T", "X", "Y", "t_on", "t_off"]))
+            ):
+                load[key] = draw(st.one_of(st.floats(-500, 500), anything))
+            loads.append(load)
+        doc["loads"] = draw(st.one_of(st.just(loads), st.just(loads), anything))
+    if draw(st.integers(0, 9)) == 0:
+        doc[draw(st.sampled_from(["base", "name", "extra"]))] = draw(anything)
+    return doc
+
+
+@st.composite
+def valid_scene_doc(draw) -> dict:
+    """A scene file of valid values only (small, short): these run."""
+    n = draw(st.integers(1, 6))
+    doc: dict = {
+        "n": n,
+        "t_end": draw(st.floats(0.01, 0.5)),
+        "times": {"num": draw(st.integers(1, 20))},
+    }
+    chain = {}
+    for key, lo, hi in (("l", 0.1, 5.0), ("m", 0.1, 10.0), ("EI", 1e2, 1e6), ("mu", 0.0, 10.0),
+                        ("kappa", 0.0, 1e3), ("nu", 0.0, 1.0)):  # fmt: skip
+        if draw(st.booleans()):
+            chain[key] = draw(
+                st.one_of(st.floats(lo, hi), st.lists(st.floats(lo, hi), min_size=n, max_size=n))
+            )
+    doc["chain"] = chain
+    doc["outputs"] = draw(
+        st.lists(
+            st.sampled_from(["phi", "dphi", "alpha", "beta", "x", "y", "energy"]),
+            min_size=1,
+            max_size=4,
+            unique=True,
+        )  # fmt: skip
+    )
+    doc["initial"] = {
+        k: draw(st.floats(-1, 1)) for k in draw(st.sets(st.sampled_from(["phi", "dphi", "alpha"])))
+    }
+    doc["loads"] = [
+        {
+            "type": "pulse",
+            "node": draw(st.integers(1, n)),
+            "Xbar": draw(st.floats(-1e3, 1e3)),
+            "Ybar": draw(st.floats(-1e3, 1e3)),
+            "T": draw(st.floats(0.05, 1.0)),
+        }  # fmt: skip
+        for _ in range(draw(st.integers(0, 2)))
+    ]
+    return doc
+
+
+def write_scene(tmp: Path, doc: dict, raw: bytes | None = None) -> Path:
+    path = tmp / "scene.toml"
+    if raw is not None:
+        path.write_bytes(raw)
+    else:
+        path.write_text(to_toml(doc))
+    return path
+
+
+def check_run(out: Path, code: int) -> int:
+    """A run that reports success has finite outputs only; returns 1 for a silent
+    non-finite success."""
+    run = out / "run.json"
+    if code not in (0, 1) or not run.is_file():
+        return 0
+    rec = json.loads(run.read_text())
+    if rec["stats"]["status"] != 0:
+        return 0
+    df = pd.read_csv(out / "trajectory.csv")
+    values = df.select_dtypes("number").to_numpy()
+    return 0 if np.all(np.isfinite(values)) else 1
+
+
+# ----------------------------------------------------------------------------- tests
+
+
+@budget(15)
+@given(
+    doc=st.one_of(scene_doc(), valid_scene_doc()),
+    model=st.sampled_from(["full", "reduced"]),
+    raw=st.one_of(st.none(), st.none(), st.none(), st.binary(max_size=40)),
+    method=st.sampled_from([None, "auto", "RK45", "RK23", "DOP853", "DOP853-numba", "Radau"]),
+)
+def test_fuzz_scene_files(tmp_path_factory, counts, doc, model, raw, method):
+    """`rodval simulate FILE`: exit 0/1 with a status line, or 2 with one line."""
+    c = counts("scene_files")
+    tmp = tmp_path_factory.mktemp("scene")
+    path = write_scene(tmp, doc, raw)
+    argv = ["simulate", path, "--model", model, "--out", tmp / "out", *BUDGET]
+    if method:
+        argv += ["--method", method]
+    code, stdout, stderr = run_cli(argv, c)
+    if code in (0, 1):
+        assert stdout.strip(), stderr
+        bad = check_run(tmp / "out", code)
+        c.nonfinite += bad
+        assert not bad, f"success with non-finite outputs: {doc}"
+
+
+OPTION_POOL = {
+    "simulate": [
+        ["--model", st.sampled_from(["full", "reduced", "nope", ""])],
+        ["--t-end", st.one_of(st.sampled_from(["0.1", "-1", "0", "inf", "nan", "x", "1e9"]))],
+        ["--times", st.sampled_from(["0,0.1", "0.1,0.05", "", "a", "-1,2", "0.05", "1e9"])],
+        ["--method", st.sampled_from(["RK45", "DOP853-numba", "Radau", "LSODA", "euler"])],
+        ["--rtol", st.sampled_from(["1e-6", "0", "1", "-1e-3", "nan", "x"])],
+        ["--atol", st.sampled_from(["1e-8", "0", "inf", "x"])],
+        ["--max-step", st.sampled_from(["0.01", "0", "inf", "-1"])],
+        ["--max-evaluations", st.sampled_from(["100", "0", "1.5", "1e9"])],
+        ["--max-wall", st.sampled_from(["0.5", "0", "inf", "-2"])],
+        ["--coefficients", st.sampled_from(["published", "derived", "x"])],
+        ["--set", st.sampled_from(["kernel=numpy", "kernel=x", "rtol=1e-3", "foo=1", "noequals"])],
+        [st.sampled_from(["--bogus", "-x", "--", "--help"])],
+    ],
+    "report": [[st.sampled_from(["--bogus", "extra-arg"])]],
+    "nope": [[st.sampled_from(["--help", "x"])]],
+    "study": [
+        ["--workers", st.sampled_from(["1", "0", "x"])],
+        ["--case-timeout", st.sampled_from(["30", "0", "-1", "x"])],
+        [st.sampled_from(["--no-resume", "--fresh", "--resume", "--bogus"])],
+        ["--backend", st.sampled_from(["processes", "dask", "mpi"])],
+    ],
+}
+
+
+@st.composite
+def argument_list(draw, tmp: Path):
+    command = draw(st.sampled_from(["simulate", "simulate", "report", "study", "nope"]))
+    argv: list = [command]
+    if command == "simulate":
+        argv.append(draw(st.sampled_from(["paper", str(tmp / "missing.toml"), "", "x.json"])))
+        if draw(st.integers(0, 5)):
+            argv += ["--out", str(tmp / "out")]
+        argv += ["--t-end", "0.1", "--model", "reduced", *BUDGET]
+    elif command == "report":
+        argv.append(draw(st.sampled_from([str(tmp), str(tmp / "missing"), "", "/"])))
+    elif command == "study":
+        argv.append(draw(st.sampled_from([str(tmp / "missing.toml"), str(tmp), ""])))
+        if draw(st.booleans()):
+            argv += ["--out", str(tmp / "study-out")]
+    for option in draw(st.lists(st.sampled_from(OPTION_POOL[command]), max_size=4)):
+        argv += [draw(x) if not isinstance(x, str) else x for x in option]
+    return argv
+
+
+@budget(40)
+@given(data=st.data())
+def test_fuzz_argument_lists(tmp_path_factory, counts, data):
+    """Random argument lists to simulate, report and study: never a traceback or a hang."""
+    c = counts("argument_lists")
+    tmp = tmp_path_factory.mktemp("args")
+    argv = data.draw(argument_list(tmp))
+    code, _, _ = run_cli(argv, c)
+    c.nonfinite += check_run(tmp / "out", code)
+    assert not c.nonfinite
+
+
+@st.composite
+def study_doc(draw) -> dict:
+    doc: dict = {}
+    models = draw(
+        st.one_of(
+            st.just({"reduced": {}}),
+            st.just({"reduced": {}, "pub": {"model": "reduced", "coefficients": "published"}}),
+            st.just({"full": {"method": "DOP853-numba"}, "reduced": {}}),
+            st.just({"x": {"model": "nope"}}),
+            st.just({"reduced": {"rtol": "a"}}),
+            anything,
+        )
+    )
+    if draw(st.integers(0, 7)):
+        doc["models"] = models
+    doc["study"] = draw(
+        st.one_of(
+            st.just({"name": "fz"}),
+            st.just({"name": "fz", "reference": "reduced"}),
+            st.just({"reference": "missing"}),
+            anything,
+        )
+    )
+    scene = draw(scene_doc())
+    scene.setdefault("n", 2)
+    scene.setdefault("t_end", 0.05)
+    scene.setdefault("times", {"num": 3})
+    doc["scene"] = scene
+    doc["integrator"] = {"max_evaluations": 20000, "max_wall_s": 5.0}
+    if draw(st.booleans()):
+        doc["integrator"] = draw(
+            st.one_of(
+                st.just({"max_evaluations": 20000, "max_wall_s": 5.0}),
+                st.just({"rtol": 1e-6}),
+                st.just({"bogus": 1}),
+                st.just({"max_evaluations": 1.5}),
+                anything,
+            )
+        )
+    if draw(st.booleans()):
+        doc["grid"] = draw(
+            st.one_of(
+                st.just({"scene.n": [2, 3]}),
+                st.just({"scene.t_end": [0.05, 0.1]}),
+                st.just({"scene.chain.EI": [1e3, 1e4]}),
+                st.just({"scene.n": [2, 2]}),
+                st.just({"scene.bogus": [1]}),
+                st.just({"integrator.rtol": [1e-6, -1.0]}),
+                st.just({"scene.n": []}),
+                anything,
+            )
+        )
+    if draw(st.integers(0, 4)) == 0:
+        doc["report"] = draw(
+            st.one_of(st.just({"rods": [1, "last"]}), st.just({"cases": ["nope"]}), anything)
+        )
+    return doc
+
+
+@budget(30)
+@given(doc=study_doc(), raw=st.one_of(st.none(), st.none(), st.binary(max_size=30)))
+def test_fuzz_study_files(tmp_path_factory, counts, doc, raw):
+    """Random study files, checked before any work (``rodval study`` with a folder that is a
+    file, so that a valid study stops at the folder and never runs): exit 2, one line."""
+    c = counts("study_files")
+    tmp = tmp_path_factory.mktemp("studyfile")
+    path = tmp / "study.toml"
+    path.write_bytes(raw) if raw is not None else path.write_text(to_toml(doc))
+    (tmp / "busy").write_text("a file, not a folder")
+    code, _, stderr = run_cli(["study", path, "--out", tmp / "busy", "--no-progress"], c)
+    assert code == 2, stderr
+
+
+SMALL_STUDY = {
+    "study": {"name": "fz", "reference": "reduced"},
+    "scene": {"n": 2, "t_end": 0.05, "times": {"num": 3}},
+    "integrator": {"max_evaluations": 50000, "max_wall_s": 10.0},
+    "models": {"reduced": {}, "pub": {"model": "reduced", "coefficients": "published"}},
+    "grid": {"scene.n": [2, 3]},
+}
+
+
+@st.composite
+def valid_study_doc(draw) -> dict:
+    """A small study file of valid values (these run)."""
+    scene = draw(valid_scene_doc())
+    scene.update(n=draw(st.integers(1, 3)), t_end=draw(st.floats(0.01, 0.1)))
+    scene["times"] = {"num": draw(st.integers(1, 5))}
+    scene["loads"] = [dict(ld, node="last") for ld in scene["loads"]]
+    models = draw(
+        st.sampled_from(
+            [
+                {"reduced": {}},
+                {"reduced": {}, "pub": {"model": "reduced", "coefficients": "published"}},
+                {"full": {"method": "DOP853-numba"}, "reduced": {}},
+                {"full": {"method": "RK45"}, "reduced": {"method": "Radau"}},
+            ]
+        )
+    )
+    grid = draw(
+        st.sampled_from(
+            [
+                {},
+                {"scene.n": [1, 2]},
+                {"scene.chain.EI": [1e3, 1e5]},
+                {"integrator.rtol": [1e-6, 1e-8]},
+            ]
+        )
+    )
+    doc = {
+        "study": {"name": "fz", "reference": next(iter(models))},
+        "scene": scene,
+        "integrator": {"max_evaluations": 20000, "max_wall_s": 5.0},
+        "models": models,
+    }
+    if grid:
+        doc["grid"] = grid
+    return doc
+
+
+@budget(4, expensive=True)
+@given(doc=st.one_of(study_doc(), valid_study_doc(), valid_study_doc()))
+def test_fuzz_study_runs(tmp_path_factory, counts, doc):
+    """Random small studies run to the end: exit 0 with finished tables, or 2 with one line;
+    every successful run in the tables has finite values."""
+    c = counts("study_runs")
+    tmp = tmp_path_factory.mktemp("studyrun")
+    path = tmp / "study.toml"
+    path.write_text(to_toml(doc))
+    argv = ["study", path, "--out", tmp / "out", "--workers", "1", "--no-progress"]
+    code, _, stderr = run_cli([*argv, "--case-timeout", "20", "--no-report"], c)
+    if code == 0:
+        traj = pd.read_csv(tmp / "out" / "trajectories.csv")
+        runtime = pd.read_csv(tmp / "out" / "runtime.csv")
+        ok = runtime[runtime["status"] == 0][["case", "model"]]
+        good = traj.merge(ok, on=["case", "model"])
+        bad = int(not np.all(np.isfinite(good["value"].to_numpy(float))))
+        c.nonfinite += bad
+        assert not bad
+
+
+@pytest.fixture(scope="module")
+def finished_study(tmp_path_factory):
+    """A finished two-case study folder (run once per module)."""
+    tmp = tmp_path_factory.mktemp("finished")
+    path = tmp / "study.toml"
+    path.write_text(to_toml(SMALL_STUDY))
+    out = tmp / "out"
+    code = main(["study", str(path), "--out", str(out), "--workers", "1", "--no-progress"])
+    assert code == 0
+    return path, out
+
+
+def damage_record(path: Path, kind: str, data) -> None:
+    text = path.read_text()
+    doc = json.loads(text)
+    if kind == "empty list":
+        path.write_text("[]")
+    elif kind == "null":
+        path.write_text("null")
+    elif kind == "no runs":
+        doc.pop("runs")
+        path.write_text(json.dumps(doc))
+    elif kind == "random bytes":
+        path.write_bytes(data.draw(st.binary(min_size=0, max_size=200)))
+    elif kind == "truncated":
+        path.write_text(text[: data.draw(st.integers(0, len(text) - 1))])
+    elif kind == "wrong-shaped array":
+        values = doc["runs"][0]["trajectory"]["values"]
+        q = next(iter(values))
+        values[q] = [[1.0, 2.0, 3.0]]
+        path.write_text(json.dumps(doc))
+    elif kind == "run deleted":
+        doc["runs"] = doc["runs"][1:]
+        path.write_text(json.dumps(doc))
+    elif kind == "value edited":
+        values = doc["runs"][0]["trajectory"]["values"]
+        q = next(iter(values))
+        values[q][-1][-1] = data.draw(st.floats(allow_nan=False, allow_infinity=False))
+        path.write_text(json.dumps(doc))
+    elif kind == "schema":
+        doc["schema"] = data.draw(st.one_of(st.integers(), st.text(max_size=3), st.none()))
+        path.write_text(json.dumps(doc))
+    elif kind == "key edited":
+        key = data.draw(st.sampled_from(sorted(doc)))
+        doc[key] = data.draw(anything)
+        path.write_text(json.dumps(doc))
+    elif kind == "deleted":
+        path.unlink()
+
+
+DAMAGES = (
+    "empty list",
+    "null",
+    "no runs",
+    "random bytes",
+    "truncated",
+    "wrong-shaped array",
+    "run deleted",
+    "value edited",
+    "schema",
+    "key edited",
+    "deleted",
+)
+
+
+@budget(4, expensive=True)
+@given(data=st.data())
+def test_fuzz_damaged_case_records(tmp_path_factory, counts, finished_study, data):
+    """A resume over damaged case records: exit 0, a warning naming each damaged file, the
+    damaged cases recomputed, tables complete and finite."""
+    c = counts("damaged_case_records")
+    study, done = finished_study
+    tmp = tmp_path_factory.mktemp("damaged")
+    out = tmp / "out"
+    shutil.copytree(done, out)
+    files = sorted((out / "cases").glob("*.json"))
+    victims = data.draw(st.lists(st.sampled_from(files), min_size=1, max_size=2, unique=True))
+    changed, deleted = [], []
+    for path in victims:
+        before = path.read_bytes()
+        damage_record(path, data.draw(st.sampled_from(DAMAGES)), data)
+        if not path.is_file():
+            deleted.append(path)
+        elif path.read_bytes() != before:
+            changed.append(path)
+    argv = ["study", study, "--out", out, "--no-progress", "--no-report", "--workers", "1"]
+    code, stdout, stderr = run_cli(argv, c)
+    assert code == 0, stderr
+    assert stdout.startswith(f"fz: {len(changed) + len(deleted)} cases run"), stdout
+    for path in changed + deleted:
+        assert path.is_file(), f"{path.name} was not recomputed"
+    for path in changed:  # a deleted file is simply missing; a damaged one is named
+        assert str(path) in stderr and "recomputing" in stderr, stderr
+    cases = pd.read_csv(out / "cases.csv")
+    assert sorted(cases["case"]) == ["n=2", "n=3"]
+    traj = pd.read_csv(out / "trajectories.csv")
+    assert set(traj["case"]) == {"n=2", "n=3"}
+    assert set(traj["model"]) == {"reduced", "pub"}
+    assert np.all(np.isfinite(traj["value"].to_numpy(float)))
+
+
+TABLE_DAMAGES = ("delete", "empty", "random bytes", "drop column", "truncate", "unknown case")
+
+
+@budget(6, expensive=True)
+@given(data=st.data())
+def test_fuzz_damaged_tables(tmp_path_factory, counts, finished_study, data):
+    """`rodval report` over damaged tables: exit 0, or exit 2 with one line naming the file."""
+    c = counts("damaged_tables")
+    _, done = finished_study
+    tmp = tmp_path_factory.mktemp("tables")
+    out = tmp / "out"
+    shutil.copytree(done, out)
+    name = data.draw(st.sampled_from(["cases", "trajectories", "discrepancies", "runtime"]))
+    path = out / f"{name}.csv"
+    kind = data.draw(st.sampled_from(TABLE_DAMAGES))
+    df = pd.read_csv(path)
+    if kind == "delete":
+        path.unlink()
+    elif kind == "empty":
+        path.write_text("")
+    elif kind == "random bytes":
+        path.write_bytes(data.draw(st.binary(max_size=100)))
+    elif kind == "drop column":
+        df.drop(columns=[data.draw(st.sampled_from(list(df.columns)))]).to_csv(path, index=False)
+    elif kind == "truncate":
+        text = path.read_text()
+        path.write_text(text[: data.draw(st.integers(0, len(text)))])
+    elif kind == "unknown case":
+        df.loc[0, "case"] = "ghost"
+        df.to_csv(path, index=False)
+    code, _, stderr = run_cli(["report", out], c)
+    if code == 2:
+        assert f"{name}.csv" in stderr or str(out) in stderr, stderr
