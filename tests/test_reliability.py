@@ -93,13 +93,6 @@ def test_huge_initial_state_ends_with_a_status(model, method, key, value):
     assert np.all(np.isfinite(tr.values["phi"]))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="driver: a _Stop raised while scipy's solver is constructed (its first "
-    "evaluations) escapes _ScipyRun._segment's try and integrate() records it as "
-    "'model error' ('_Stop: diverged: ...') instead of its own status (-3 diverged); "
-    "fix in rodval/solvers/driver.py (not this worktree's file)",
-)
 @pytest.mark.parametrize("method", ["DOP853", "RK45"])
 def test_huge_initial_rate_is_reported_as_divergence_not_model_error(method):
     tr = simulate(SMALL.with_(initial=InitialState(dphi=1e160)), "full", method=method)

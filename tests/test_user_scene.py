@@ -212,3 +212,26 @@ def test_compare_two_runs(boom, tmp_path, capsys):
     assert list(table["quantity"]) == ["phi", "dphi", "alpha", "beta"]
     assert (table["max_abs"] < 1e-2).all() and (table["max_abs"] > 0).all()
     assert (tmp_path / "cmp" / "histories.png").stat().st_size > 10_000
+
+
+def test_runs_report_whether_they_stayed_within_small_bending():
+    """Both models rest on small bending angles: every run reports its largest |alpha|,
+    |beta| and whether it stayed within SMALL_BENDING_RAD, also when alpha, beta were not
+    asked for. At EI = 1e-3 the reduced model returns bending angles of ~1e4 rad: flagged."""
+    from rodval.core.trajectory import SMALL_BENDING_RAD
+
+    scene = paper_scene(times=[0.5, 1.0], outputs=("phi",))
+    for model in ("full", "reduced"):
+        ok = simulate(scene, model)
+        assert ok.stats.small_bending is True and 0 < ok.stats.max_bending < 0.01
+    soft = simulate(paper_scene(times=[0.5, 1.0], outputs=("phi",), EI=1e-3), "reduced")
+    assert soft.stats.small_bending is False and soft.stats.max_bending > 100 * SMALL_BENDING_RAD
+    asked = simulate(paper_scene(times=[0.5, 1.0]), "reduced")
+    assert asked.stats.max_bending == pytest.approx(
+        max(np.abs(asked["alpha"]).max(), np.abs(asked["beta"]).max())
+    )
+
+
+def test_dense_paths_are_refused_above_the_memory_limit():
+    with pytest.raises(ValueError, match="dense matrices.*RODVAL_MAX_MEMORY_GB"):
+        simulate(paper_scene(20000, times=[1.0]), "full", method="Radau")

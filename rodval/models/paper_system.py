@@ -176,6 +176,16 @@ class PaperSystem(OdeSystem):
         """q' = [phi'; alpha'; beta'] (3n) as the model's equations see it at state y."""
         raise NotImplementedError
 
+    def max_bending(self, times: np.ndarray, Y: np.ndarray) -> float | None:
+        """max |alpha|, |beta| (rad) over the states Y (the reduced model recovers them, O(n)
+        per state)."""
+        largest = 0.0
+        for t, y in zip(times, Y):
+            with self._mode_at(t):  # the mode (locked hinges, stops) in effect at t
+                alpha, beta = self.bending(np.array([t]), y[None, :])[:2]
+            largest = max(largest, float(np.max(np.abs(alpha))), float(np.max(np.abs(beta))))
+        return largest
+
     def energy(self, t: float, y: np.ndarray) -> float:
         """E = T + Pi (J) at one state (the same energy ``observe`` reports)."""
         Y = y[None, :]

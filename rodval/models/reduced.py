@@ -42,14 +42,62 @@ class ReducedSystem(PaperSystem):
         super().__init__(scene, coefficients, kernel)
         i = self.initial
         self.y0 = np.concatenate([i["phi"], i["dphi"]])
+        self._scratch: np.ndarray | None = None
+        self._bending_seen = 0.0
+        self._gamma = np.zeros(2 * self.n)
+        self._work = np.zeros(reduced_banded.sweep_work_size(self.n))
         self.use_kernel()
 
     def kernel_constants(self):
         return reduced_banded.banded_constants(self.cc, self.chain)
 
     def compiled_scratch(self) -> np.ndarray:
-        """Work space of ``reduced_banded.reduced_rhs`` (allocated once per run, O(n))."""
-        return np.zeros((1, 1, reduced_banded.rhs_work_size(self.n)))
+        """Work space of ``reduced_banded.reduced_rhs`` (one per system, O(n)); its last slot
+        holds the largest |alpha|, |beta| the compiled solves met."""
+        if self._scratch is None:
+            self._scratch = np.zeros((1, 1, reduced_banded.rhs_work_size(self.n)))
+        return self._scratch
+
+    def rhs(self, t, y):
+        """The compiled O(n) solve gives gamma with phi'': it is kept for the small-bending
+        check (``max_bending``) at no extra cost."""
+        if self.kernel != "numba" or self.locked:
+            return super().rhs(t, y)
+        n = self.n
+        sums = self.loads.suffix_sums(t)
+        SX, SY = (self._no_load, self._no_load) if sums is None else sums
+        out = np.empty_like(y)
+        out[:n] = y[n:]
+        reduced_banded.reduced_solve_work(
+            self.V,
+            y[:n],
+            y[n:],
+            sums is not None,
+            np.ascontiguousarray(SX),
+            np.ascontiguousarray(SY),
+            self.damped,
+            out[n:],
+            self._gamma,
+            self._work,
+            reduced_banded.METHOD_AUTO,
+        )
+        self._bending_seen = reduced_banded.track_bending(self._gamma, self._bending_seen)
+        return out
+
+    def reset(self) -> None:
+        super().reset()
+        self._bending_seen = 0.0
+        if self._scratch is not None:
+            self._scratch[0, 0, -1] = 0.0
+
+    def max_bending(self, times, Y):
+        """The largest |alpha|, |beta| (rad) the O(n) solves met during the run (every
+        evaluation: no recovery at output times); with the numpy kernel, or once a hinge has
+        locked, over the output times (recovered in the mode in effect at each)."""
+        if self.kernel == "numba" and not self._history:
+            compiled = self._scratch[0, 0, -1] if self._scratch is not None else 0.0
+            return float(max(self._bending_seen, compiled))
+        return super().max_bending(times, Y)
 
     # The dense reference (kernel="numpy") and the analytic Jacobian: O(n^2) memory, O(n^3)
     # set-up, built only when one of them asks.

@@ -627,15 +627,26 @@ def reduced_accel(Cst, y, has_load, SX, SY, damped, out):
 
 @njit(cache=True)
 def rhs_work_size(n):
-    """Length of ``reduced_rhs``'s work space: load sums (2n), gamma (2n), the sweep (19n)."""
-    return 4 * n + sweep_work_size(n)
+    """Length of ``reduced_rhs``'s work space: load sums (2n), gamma (2n), the sweep (19n),
+    and one slot for the largest |gamma| seen (``track_bending``)."""
+    return 4 * n + sweep_work_size(n) + 1
+
+
+@njit(cache=True)
+def track_bending(gamma, seen):
+    """max(seen, max |gamma|): the largest bending angle (rad) met by the solves of a run."""
+    for v in gamma:
+        if abs(v) > seen:
+            seen = abs(v)
+    return seen
 
 
 @njit(RHS_SIGNATURE, cache=True)
 def reduced_rhs(t, y, P, S, M, L, out):
     """y' of the reduced model (compiled integrators' right-hand side, loads from table L);
     O(n) time and memory per evaluation, no allocation: ``M[0, 0]`` is its work space
-    (``rhs_work_size``; ``ReducedSystem.compiled_scratch``)."""
+    (``rhs_work_size``; ``ReducedSystem.compiled_scratch``), whose last slot keeps the largest
+    |alpha|, |beta| of the solves (the run's small-bending check, at no extra solve)."""
     half = y.shape[0] // 2
     out[:half] = y[half:]
     work = M[0, 0]
@@ -653,6 +664,7 @@ def reduced_rhs(t, y, P, S, M, L, out):
         S[0] != 0.0,
         out[half:],
         gamma,
-        work[4 * half :],
+        work[4 * half : work.shape[0] - 1],
         METHOD_AUTO,
     )
+    work[-1] = track_bending(gamma, work[-1])

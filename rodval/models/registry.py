@@ -10,7 +10,8 @@ import importlib
 from typing import Any
 
 from rodval.core.contract import Model
-from rodval.core.scene import Scene
+from rodval.core.resources import check_run_memory, dense_path
+from rodval.core.scene import Scene, trajectory_quantities
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.core.trajectory import Trajectory
 
@@ -81,4 +82,13 @@ def simulate(
             f"give integrator settings either as settings= or as keywords, not "
             f"both (got settings= and {', '.join(sorted(integ))})"
         )
-    return get_model(model, **options).simulate(scene, settings)
+    m = get_model(model, **options)
+    check_run_memory(
+        scene.n,
+        scene.times.size,
+        trajectory_quantities(scene.outputs),
+        model=m.name,
+        dense=dense_path(m.name, m.options(), settings.method),
+        what=f"scene {scene.name!r} with model {m.name!r}",
+    )
+    return m.simulate(scene, settings)

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rodval.core.trajectory import Trajectory
+from rodval.core.trajectory import SMALL_BENDING_RAD, Trajectory
 from rodval.report.figures import (
     plot_configurations,
     plot_deployment,
@@ -127,6 +127,15 @@ def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[st
             "Failed runs:\n",
             to_markdown(failed[["case", "model", "status", "t_reached", "message"]]),
         ]
+    if "small_bending" in runtime:
+        outside = runtime[runtime["small_bending"].astype(str) == "False"]
+        lines.append(
+            f"Model validity: {len(outside)} run(s) left the small-bending assumption the "
+            f"paper models rest on (largest |alpha|, |beta| above {SMALL_BENDING_RAD:g} rad)."
+            + (" Their results are not those of the models' premise:\n" if len(outside) else "\n")
+        )
+        if len(outside):
+            lines.append(to_markdown(outside[["case", "model", "max_bending", "status"]]))
     lines.append(f"## Discrepancies against `{ref}`\n")
     lines.append(
         "Largest absolute difference over all output times and rods (`max_abs`; rad, "

@@ -36,7 +36,7 @@ from rodval.core.status import (
     STATUS_FAILED,
     STATUS_WALL,
 )
-from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.core.trajectory import SMALL_BENDING_RAD, SolverStats, Trajectory
 from rodval.solvers.audit import PowerLedger, audit_quantities
 from rodval.solvers.events import EventMonitor
 from rodval.solvers.guard import DivergenceGuard
@@ -188,9 +188,14 @@ class _ScipyRun:
         """Step from a towards b; returns (state, time reached, where to restart): b at the
         segment's end, the event time after a jump."""
         s = self.settings
-        solver = self.cls(
-            self.fun, a, y, b, rtol=s.rtol, atol=s.atol, max_step=s.max_step, **self.extra
-        )
+        try:  # scipy evaluates fun (and may choose the first step) while it is set up
+            solver = self.cls(
+                self.fun, a, y, b, rtol=s.rtol, atol=s.atol, max_step=s.max_step, **self.extra
+            )
+        except _Stop as stop:
+            self.stats.status, self.stats.message = stop.status, str(stop)
+            self.stats.nfev = self.nfev
+            return y, a, b
         t_now = a
         try:
             while solver.status == "running":
@@ -241,6 +246,42 @@ class _ScipyRun:
         self.stats.nfev = self.nfev
         self.stats.njev += int(solver.njev)
         self.stats.nlu += int(solver.nlu)
+
+
+def _finite_prefix(times: np.ndarray, observed: dict, stats: SolverStats):
+    """The output times up to the first one where an observed value is not finite: a run
+    never returns NaN; if it had reported success, it is a divergence."""
+    bad = [
+        int(np.argmax(~np.isfinite(v).all(axis=1)))
+        for v, _ in observed.values()
+        if not np.isfinite(v).all()
+    ]
+    if not bad:
+        return times, observed
+    cut = min(bad)
+    if stats.status == 0:
+        stats.status = STATUS_DIVERGED
+        stats.message = f"diverged: non-finite outputs at t = {times[cut]:.6g} s"
+        stats.t_reached = float(times[cut - 1]) if cut else 0.0
+    return times[:cut], {q: (v[:cut], k) for q, (v, k) in observed.items()}
+
+
+def _bending_validity(
+    system: OdeSystem, times: np.ndarray, Y: np.ndarray, observed: dict, stats: SolverStats
+) -> None:
+    """``stats.max_bending`` and ``stats.small_bending`` from the observed alpha, beta, or
+    from the system when the scene did not ask for them."""
+    if "alpha" in observed and "beta" in observed:
+        values = [observed["alpha"][0], observed["beta"][0]]
+        largest = max((float(np.max(np.abs(v))) for v in values if v.size), default=None)
+    else:
+        try:
+            largest = system.max_bending(times, Y) if times.size else None
+        except Exception:  # noqa: BLE001 - a measure of validity must not fail the run
+            largest = None
+    if largest is not None:
+        stats.max_bending = largest
+        stats.small_bending = bool(largest <= SMALL_BENDING_RAD)
 
 
 def integrate(
@@ -307,6 +348,8 @@ def integrate(
             STATUS_ERROR,
             f"observation failed: {type(exc).__name__}: {exc}",
         )
+    reached, observed = _finite_prefix(reached, observed, stats)
+    _bending_validity(system, reached, out.Y[: reached.size], observed, stats)
     stats.wall_s = time.perf_counter() - start
     return Trajectory(
         model=model,

@@ -133,6 +133,11 @@ class OdeSystem(ABC):
         """(P_ext, P_diss) (W): power of the applied loads and power taken out by dampers."""
         raise NotImplementedError
 
+    def max_bending(self, times: np.ndarray, Y: np.ndarray) -> float | None:
+        """Largest |bending angle| (rad) over states Y, or None for a model without bending
+        coordinates (the driver's small-bending check)."""
+        return None
+
     def event_functions(self) -> tuple[EventSpec, ...]:
         """The system's state events in its current mode (none by default)."""
         return ()

@@ -96,6 +96,8 @@ def runtime_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFra
                     "nsteps": st.nsteps,
                     "t_reached": st.t_reached,
                     "energy_residual": st.energy_residual,
+                    "max_bending": st.max_bending,
+                    "small_bending": st.small_bending,
                     "status": STATUS_MESSAGES[st.status],
                     "message": st.message,
                 }
