@@ -471,7 +471,8 @@ class PaperSystem(OdeSystem):
         self, t: float, y: np.ndarray, locked: tuple[int, ...], new: tuple[int, ...]
     ) -> tuple[np.ndarray, dict]:
         """The state after the plastic lock of the latches ``new`` with ``locked`` (all held
-        after it) and the event's data: angular impulses (N m s, hinge-moment sign), joint
+        after it) and the event's data: angular impulses (N m s, on the outboard rod k+1,
+        counter-clockwise positive: the convention of every model's event records), joint
         linear impulses (N s), kinetic energy before and after (J)."""
         hinges = np.array([self.latches[j].hinge for j in locked], dtype=np.int64)
         angles = np.array([self.latches[j].angle for j in locked])
@@ -480,7 +481,7 @@ class PaperSystem(OdeSystem):
         y_new, mu = self.plastic_jump(y, hinges, angles)
         T1 = self.kinetic_energy(t, y_new)
         S = self.momenta(y_new) - P0
-        impulses = [float(-m) for m in mu]
+        impulses = [float(m) for m in mu]  # A^T mu: +mu on the outboard rod's coordinates
         return y_new, {
             "hinge": self.latches[new[0]].hinge,
             "hinges": [self.latches[j].hinge for j in new],
