@@ -69,23 +69,34 @@ def plot_configurations(
     """
     fig, ax = _figure(figsize=(7, 6))
     colours = colormaps["viridis"](np.linspace(0, 0.9, len(times)))
-    for (label, traj), ls in zip(trajectories.items(), LINESTYLES * 4):
+    for traj, ls in zip(trajectories.values(), LINESTYLES * 4):
         for t, c in zip(times, colours):
             if not np.any(np.abs(traj.times - t) < 1e-9):
                 continue  # a failed run may not have reached t
             x, y = chain_nodes(traj, t, l)
-            ax.plot(x, y, ls, color=c, marker="o", ms=3, label=f"{label}, t = {t:.4g} s")
+            ax.plot(x, y, ls, color=c, marker="o", ms=3)
     ax.plot([0], [0], "k^", ms=10)
     _min_height(ax, 0.3)
     ax.set_aspect("equal")
     ax.set_xlabel("x, m")
     ax.set_ylabel("y, m")
     ax.grid(alpha=0.3)
-    ax.legend(
+    # two compact legends: colour = time, line style = model (not one entry per pair)
+    from matplotlib.lines import Line2D
+
+    by_time = [Line2D([], [], color=c, marker="o", ms=3) for c in colours]
+    by_model = [Line2D([], [], color="k", ls=ls) for _, ls in zip(trajectories, LINESTYLES * 4)]
+    first = ax.legend(
+        by_time,
+        [f"t = {t:.4g} s" for t in times],
         fontsize=7,
-        ncol=1 + len(trajectories) * len(times) // 12,
         loc="upper left",
-        bbox_to_anchor=(1.02, 1.0),
+        title="time",
+        title_fontsize=7,
+    )
+    ax.add_artist(first)
+    ax.legend(
+        by_model, list(trajectories), fontsize=7, loc="lower right", title="model", title_fontsize=7
     )
     if title:
         ax.set_title(title)
@@ -167,6 +178,9 @@ def _lines(
         ax.set_xticks(sorted(df[x].unique()))  # label the grid values themselves
         ax.xaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
         ax.xaxis.set_minor_locator(ticker.NullLocator())
+    elif not df.empty and df[x].nunique() <= 12:
+        ax.set_xticks(sorted(df[x].unique()))  # the grid values (integers for n)
+        ax.xaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     if logy and not df.empty:
         ax.set_yscale("log")
     for model, part in df.groupby("model", sort=False):
@@ -186,8 +200,14 @@ def _lines(
             )
 
 
+def axis_label(x: str) -> str:
+    """The axis label of a study parameter: its name in the study file, with its unit."""
+    return {"n": "n (rods)", "horizon": "horizon t_end, s"}.get(x, x)
+
+
 def _finish(fig, axes, path: Path, title: str) -> Path:
-    axes[0].legend(fontsize=7)
+    handles, _ = axes[0].get_legend_handles_labels()
+    axes[0].legend(fontsize=7, ncol=2 if len(handles) > 6 else 1)
     fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -216,7 +236,7 @@ def plot_discrepancy_vs(
     for ax, q in zip(axes, quantities):
         _lines(ax, ok[ok["quantity"] == q], x, metric, others, styles, logx)
         ax.set_title(f"{q}, {UNITS.get(q, '')}")
-        ax.set_xlabel(x)
+        ax.set_xlabel(axis_label(x))
         ax.set_ylabel(metric)
         ax.grid(alpha=0.3, which="both")
     return _finish(fig, axes, path, f"Discrepancy ({metric}) against {x}")
@@ -234,7 +254,7 @@ def plot_runtime_vs(
     ok = runtime[runtime["status"] == "success"]
     fig, ax = _figure(figsize=(6.5, 4.5))
     _lines(ax, ok, x, "wall_s", others, model_styles(models), logx)
-    ax.set_xlabel(x)
+    ax.set_xlabel(axis_label(x))
     ax.set_ylabel("integration wall time, s")
     ax.grid(alpha=0.3, which="both")
     return _finish(fig, [ax], path, f"Run time against {x}")
@@ -266,7 +286,7 @@ def plot_speedup_vs(
     fig, ax = _figure(figsize=(6.5, 4.5))
     _lines(ax, speed, x, "speedup", others, model_styles(models), logx)
     ax.axhline(1.0, color="k", lw=0.8)
-    ax.set_xlabel(x)
+    ax.set_xlabel(axis_label(x))
     ax.set_ylabel(f"speed-up: wall time of {reference} / of model")
     ax.grid(alpha=0.3, which="both")
     return _finish(fig, [ax], path, f"Speed-up relative to {reference} against {x}")

@@ -39,14 +39,19 @@ SAFETY, MIN_FACTOR, MAX_FACTOR, ERROR_EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
 
 @njit(cache=True, inline="always")
 def _combine(out, base, K, coef, count, h):
-    """out = base + h * sum_{j < count} coef[j] K[j], as loops (no temporary arrays)."""
+    """out = base + h * sum_{j < count} coef[j] K[j], as contiguous loops over K's rows (no
+    temporary arrays; ``out`` must not alias ``base`` or K)."""
     N = out.shape[0]
     for i in range(N):
-        acc = 0.0
-        for j in range(count):
-            if coef[j] != 0.0:
-                acc += coef[j] * K[j, i]
-        out[i] = base[i] + h * acc
+        out[i] = 0.0
+    for j in range(count):
+        c = coef[j]
+        if c != 0.0:
+            row = K[j]
+            for i in range(N):
+                out[i] += c * row[i]
+    for i in range(N):
+        out[i] = base[i] + h * out[i]
 
 
 @njit(cache=True)

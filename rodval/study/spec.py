@@ -270,10 +270,12 @@ def _check_model_options(name: str, options: dict, where: str, key: str) -> None
         raise _err(where, key, f"bad model option: {exc}") from None
 
 
-def _report_spec(table: Any, case_ids: list[str], where: str) -> ReportSpec:
+def _report_spec(table: Any, case_ids: list[str], where: str, demanding: str) -> ReportSpec:
+    """Default detail cases: the study's most demanding one (most rods x longest horizon),
+    then its first (the base of the grid), without repeats."""
     table = {} if table is None else table
     _check_keys(table, REPORT_KEYS, where, "report")
-    cases = table.get("cases", case_ids[:1])
+    cases = table.get("cases", list(dict.fromkeys([demanding, case_ids[0]])))
     if not isinstance(cases, list) or any(c not in case_ids for c in cases):
         raise _err(
             where, "report.cases", f"must be a list of case ids from {case_ids}, got {cases!r}"
@@ -414,7 +416,9 @@ def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpe
         )
     _check_file_names(ids, where)
     _check_resources(cases, where)
-    report = _report_spec(doc.get("report"), ids, where)
+    # the default detail case: the most demanding (most rods x longest horizon)
+    demanding = max(cases, key=lambda c: c.scene.n * c.scene.t_end).id
+    report = _report_spec(doc.get("report"), ids, where, demanding)
     return StudySpec(
         name=str(study.get("name", Path(where).stem)),
         description=str(study.get("description", "")),
