@@ -30,9 +30,9 @@ from rodval.models.kernels import (
     V_L,
     V_OUTER,
     V_PPDIAG,
-    _full_forces,
     _full_solve,
     _generator_solve,
+    full_accel,
 )
 from rodval.models.reduced_banded import _band_size, _forces, _solve_band, _solve_sweep
 
@@ -115,13 +115,7 @@ def full_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
     ``out``, their multipliers (N m, generalized force a_k lambda_k) into ``lam``; O(n m)."""
     n = V.shape[1]
     m = locks.shape[0]
-    c = np.cos(y[:n])
-    s = np.sin(y[:n])
-    fp = np.empty(n)
-    fa = np.empty(n)
-    fb = np.empty(n)
-    _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb)
-    _full_solve(V, c, s, fp, fa, fb, out)
+    full_accel(V, y, has_load, SX, SY, damped, out)  # the free accelerations, O(n)
     if m == 0:
         return
     U = np.empty((m, 3 * n))
