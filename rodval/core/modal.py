@@ -105,6 +105,35 @@ class Modes:
         y = np.concatenate([[0.0], np.cumsum(self.l * np.sin(self.phi0))])
         return x, y
 
+    def to_dict(self) -> dict:
+        """Plain JSON-ready form (case records); inverse of ``from_dict``."""
+        return {
+            "model": self.model,
+            "about": self.about,
+            "omega": self.omega.tolist(),
+            "damping": np.where(np.isfinite(self.damping), self.damping, -1.0).tolist(),
+            "dx": self.dx.tolist(),
+            "dy": self.dy.tolist(),
+            "hinge": self.hinge.tolist(),
+            "phi0": self.phi0.tolist(),
+            "l": self.l.tolist(),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Modes:
+        damping = np.asarray(d["damping"], float)
+        return cls(
+            model=d["model"],
+            about=d["about"],
+            omega=np.asarray(d["omega"], float),
+            damping=np.where(damping < 0, np.nan, damping),
+            dx=np.asarray(d["dx"], float).reshape(len(d["omega"]), -1),
+            dy=np.asarray(d["dy"], float).reshape(len(d["omega"]), -1),
+            hinge=np.asarray(d["hinge"], float).reshape(len(d["omega"]), -1),
+            phi0=np.asarray(d["phi0"], float),
+            l=np.asarray(d["l"], float),
+        )
+
     def frequencies_frame(self) -> pd.DataFrame:
         return pd.DataFrame(
             {

@@ -38,13 +38,21 @@ class RunRecord:
     label: str
     setup_s: float
     trajectory: Trajectory
+    #: the model's modes (``Modes.to_dict``) when the study asks for them, or why they failed
+    modes: dict[str, Any] | None = None
+    modes_error: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return {
+        out = {
             "label": self.label,
             "setup_s": self.setup_s,
             "trajectory": self.trajectory.to_dict(),
         }
+        if self.modes is not None:
+            out["modes"] = self.modes
+        if self.modes_error is not None:
+            out["modes_error"] = self.modes_error
+        return out
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> RunRecord:
@@ -52,6 +60,8 @@ class RunRecord:
             label=str(d["label"]),
             setup_s=float(d["setup_s"]),
             trajectory=Trajectory.from_dict(d["trajectory"]),
+            modes=d.get("modes"),
+            modes_error=d.get("modes_error"),
         )
 
     @property

@@ -38,7 +38,10 @@ from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.models import REGISTRY, get_model, model_class
 from rodval.study.store import MAX_NAME, case_file_name
 
-TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report"}
+TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report", "modes"}
+MODES_KEYS = {"count", "about"}
+#: Most modes a study may ask for per model.
+MAX_MODES = 200
 STUDY_KEYS = {"name", "description", "reference"}
 INTEGRATOR_KEYS = set(SETTING_NAMES)
 REPORT_KEYS = {"cases", "rods", "quantities", "times"}
@@ -75,15 +78,19 @@ class Case:
     models: tuple[ModelSpec, ...]
     reference: str
     where: str
+    #: ``{"count": k, "about": "initial" | "equilibrium"}`` when the study asks for modes.
+    modes: dict[str, Any] | None = None
 
     @property
     def fingerprint(self) -> str:
-        """Hash of everything that determines the case's results (scene, models, reference)."""
+        """Hash of everything that determines the case's results (scene, models, reference,
+        modes asked for)."""
         text = json.dumps(
             {
                 "scene": self.scene_dict,
                 "reference": self.reference,
                 "models": [m.as_dict() for m in self.models],
+                **({"modes": self.modes} if self.modes else {}),
             },
             sort_keys=True,
             default=repr,
@@ -97,7 +104,23 @@ class Case:
             "where": self.where,
             "scene": self.scene_dict,
             "models": [m.as_dict() for m in self.models],
+            "modes": self.modes,
         }
+
+
+def _modes_spec(table: Any, where: str) -> dict[str, Any] | None:
+    """The study's [modes] table: the first ``count`` modes (1..MAX_MODES, default 10) of
+    every model about ``about`` ("initial" or "equilibrium"), or None without the table."""
+    if table is None:
+        return None
+    _check_keys(table, MODES_KEYS, where, "modes")
+    count = table.get("count", 10)
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_MODES:
+        raise _err(where, "modes.count", f"must be an integer in 1..{MAX_MODES}, got {count!r}")
+    about = table.get("about", "initial")
+    if about not in ("initial", "equilibrium"):
+        raise _err(where, "modes.about", f"must be 'initial' or 'equilibrium', got {about!r}")
+    return {"count": count, "about": about}
 
 
 @dataclass(frozen=True)
@@ -373,6 +396,7 @@ def _build_case(doc: dict, combo: dict[str, Any], labels: dict[str, str], where:
         models=models,
         reference=case_doc["study"]["reference"],
         where=case_where,
+        modes=_modes_spec(case_doc.get("modes"), where),
     )
 
 

@@ -23,9 +23,12 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from rodval.analysis.metrics import METRICS
+from rodval.analysis.modes import pair_modes
+from rodval.core.modal import Modes
 from rodval.core.status import STATUS_MESSAGES
 from rodval.report.markdown import to_markdown
 from rodval.report.tables import axis_columns, trajectory_samples
@@ -171,7 +174,56 @@ def build_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd
     events = events_table(records, axes)
     if not events.empty:
         tables["events"] = events
+    if any(run.modes is not None or run.modes_error for rec in records for run in rec.runs):
+        tables.update(modes_tables(records, axes))
     return tables
+
+
+def modes_tables(records: list[CaseRecord], axes: dict[str, str]) -> dict[str, pd.DataFrame]:
+    """When the study asks for modes ([modes]): ``modes`` (case, model, mode, omega_rad_s,
+    f_hz, damping_ratio, or the modal analysis' error), ``mac`` (each model's modes paired by
+    shape with the reference's, ``rodval.analysis.modes.pair_modes``: mode of the reference,
+    both frequencies, rel_gap, mac) and ``mode_shapes`` (tidy: case, model, mode, kind,
+    k, value; kind node_dx/node_dy/hinge, and node_x0/node_y0 for the configuration, mode 0)."""
+    freq, mac, shapes = [], [], []
+    for rec in records:
+        base = _case_columns(rec, axes)
+        got = {r.label: Modes.from_dict(r.modes) for r in rec.runs if r.modes is not None}
+        for run in rec.runs:
+            if run.modes is None:
+                freq.append({**base, "model": run.label, "error": run.modes_error})
+                continue
+            m = got[run.label]
+            frame = m.frequencies_frame()
+            freq += [{**base, "model": run.label, **row} for row in frame.to_dict("records")]
+            x0, y0 = m.node_positions()
+            conf = pd.DataFrame(
+                {
+                    "mode": 0,
+                    "kind": ["node_x0"] * x0.size + ["node_y0"] * y0.size,
+                    "k": list(range(x0.size)) * 2,
+                    "value": np.concatenate([x0, y0]),
+                }
+            )
+            for part in (conf, m.modes_frame()):
+                part = part.assign(model=run.label)
+                for col, value in reversed(list(base.items())):
+                    part.insert(0, col, value)
+                shapes.append(part)
+        ref = got.get(rec.reference)
+        for label, m in got.items():
+            if ref is None or label == rec.reference:
+                continue
+            paired = pair_modes(ref, m)
+            mac += [
+                {**base, "model": label, "reference": rec.reference, **row}
+                for row in paired.to_dict("records")
+            ]
+    return {
+        "modes": pd.DataFrame(freq),
+        "mac": pd.DataFrame(mac),
+        "mode_shapes": pd.concat(shapes, ignore_index=True) if shapes else pd.DataFrame(),
+    }
 
 
 def write_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd.DataFrame]:
@@ -186,6 +238,9 @@ def write_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd
     (out / "runtime.md").write_text(to_markdown(tables["runtime"]))
     if "events" in tables:
         (out / "events.md").write_text(to_markdown(tables["events"], ".6g"))
+    for name in ("modes", "mac"):
+        if name in tables:
+            (out / f"{name}.md").write_text(to_markdown(tables[name], ".6g"))
     (out / "trajectories.md").write_text(
         to_markdown(trajectory_samples(tables["trajectories"], meta, tables["cases"]), ".6g")
     )

@@ -56,11 +56,29 @@ def iter_case(payload: dict[str, Any]) -> Iterator[dict[str, Any]]:
             yield failed_run(model, scene.name, STATUS_ERROR, f"{type(exc).__name__}: {exc}")
             continue
         total = time.perf_counter() - start
-        yield {
+        run = {
             "label": model["label"],
             "setup_s": max(total - traj.stats.wall_s, 0.0),
             "trajectory": traj.to_dict(),
         }
+        if payload.get("modes"):
+            run.update(case_modes(scene, model, payload["modes"]))
+        yield run
+
+
+def case_modes(scene, model: dict, spec: dict[str, Any]) -> dict[str, Any]:
+    """``{"modes": ...}`` (``Modes.to_dict``) of one model about the study's configuration,
+    or ``{"modes_error": message}``: a failed modal analysis never fails the run."""
+    from rodval.analysis.modes import model_modes
+
+    options = dict(model["options"])
+    if model["model"] != "exudyn":  # the native models' modal option is their variant
+        options = {"coefficients": options.get("coefficients", "printed")}
+    try:
+        m = model_modes(scene, model["model"], about=spec["about"], count=spec["count"], **options)
+    except Exception as exc:  # noqa: BLE001 - a failure is data
+        return {"modes_error": f"{type(exc).__name__}: {exc}"}
+    return {"modes": m.to_dict()}
 
 
 def warm_up() -> None:
