@@ -244,6 +244,11 @@ def pulse(node: int, Xbar: float = -150.0, Ybar: float = 1200.0, T: float = 1.0)
     )
 
 
+def _kinks(*times: float) -> tuple[float, ...]:
+    """The switching times that are breakpoints: finite and after t = 0 (s)."""
+    return tuple(b for b in times if math.isfinite(b) and b > 0)
+
+
 def _switch_times(kind: str, t_on: Any, t_off: Any) -> tuple[float, float]:
     t_on = _real(f"{kind} t_on", t_on, "s")
     t_off = _real_or_inf(f"{kind} t_off (s)", t_off)
@@ -259,7 +264,7 @@ def constant(
     load (t_on > 0) or a constant one."""
     X, Y = _real("constant X", X, "N"), _real("constant Y", Y, "N")
     t_on, t_off = _switch_times("constant", t_on, t_off)
-    bps = tuple(b for b in (t_on, t_off) if math.isfinite(b) and b > 0)
+    bps = _kinks(t_on, t_off)
     return NodalForce(
         node,
         Constant(X, t_on, t_off) if X else None,
@@ -294,7 +299,7 @@ def ramp(
     def law(v: float) -> PiecewiseLinear | None:
         return PiecewiseLinear(times, np.array([0.0, v]), hold=True) if v else None
 
-    bps = tuple(b for b in (t_on, t_full, t_off) if math.isfinite(b) and b > 0)
+    bps = _kinks(t_on, t_full, t_off)
     return NodalForce(
         node,
         law(X),
@@ -321,7 +326,7 @@ def harmonic(
     omega = _real("harmonic omega", omega, "rad/s", positive=True)
     phase = _real("harmonic phase", phase, "rad")
     t_on, t_off = _switch_times("harmonic", t_on, t_off)
-    bps = tuple(b for b in (t_on, t_off) if math.isfinite(b) and b > 0)
+    bps = _kinks(t_on, t_off)
     return NodalForce(
         node,
         Harmonic(X, omega, phase, t_on, t_off) if X else None,

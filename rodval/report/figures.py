@@ -144,12 +144,7 @@ def plot_time_histories(
             if r == len(quantities) - 1:
                 ax.set_xlabel("t, s")
     axes[0, 0].legend(fontsize=8)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    return path
+    return _save(fig, path, title)
 
 
 def _label(model: str, others: Sequence[str], key: tuple) -> str:
@@ -205,13 +200,20 @@ def axis_label(x: str) -> str:
     return {"n": "n (rods)", "horizon": "horizon t_end, s"}.get(x, x)
 
 
+def _save(fig: Figure, path: Path | str, title: str = "") -> Path:
+    """Title, tight layout and the PNG (110 dpi): the end of every report figure."""
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    return path
+
+
 def _finish(fig, axes, path: Path, title: str) -> Path:
     handles, _ = axes[0].get_legend_handles_labels()
     axes[0].legend(fontsize=7, ncol=2 if len(handles) > 6 else 1)
-    fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    return path
+    return _save(fig, path, title)
 
 
 def plot_discrepancy_vs(
@@ -401,12 +403,7 @@ def plot_deployment(
     ax.set_ylabel("tip y, m")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    return path
+    return _save(fig, path, title)
 
 
 def plot_scale(frame: pd.DataFrame, speedup: pd.DataFrame | None, path: Path) -> Path:
