@@ -9,13 +9,14 @@ revolute joints, hinge springs, point masses and load user functions). Then:
   scene's constant loads (``rodval.loads.constant``; other load laws are left out), its result
   written to the initial state (``updateInitialValues=True``).
 
-``exudyn.solver.ComputeODE2Eigenvalues`` linearizes there (mass matrix and ODE2 Jacobian of
-the static solver, so the axial force's geometric stiffness is included) and handles the
-joints' algebraic constraints as exudyn documents: projection of M and K onto the null space
-of the constraint Jacobian (SVD), eigenvectors mapped back to ODE2 coordinates. With hinge
-dampers (nu > 0) it is called again with ``computeComplexEigenvalues=True`` (the damping
-matrix from the ODE2 velocity Jacobian, same projection); each undamped mode is paired with the
-complex eigenvalue s (Im s > 0) of nearest |s|, damping ratio -Re(s) / |s|.
+exudyn's static solver gives the mass matrix, the ODE2 Jacobian (so the axial force's
+geometric stiffness is included), the velocity Jacobian (damping) and the constraint Jacobian
+there, as ``exudyn.solver.ComputeODE2Eigenvalues`` obtains them. The joints' constraints are
+eliminated on the exact 0/1 basis of ``rodval.core.eigen.coordinate_null_space`` and the
+pencils solved by ``rodval.core.eigen`` (``_eigen``: the same digits on every BLAS kernel,
+docs/modes.md); eigenvectors are mapped back to ODE2 coordinates. With hinge dampers
+(nu > 0) each undamped mode is paired with the complex eigenvalue s (Im s > 0) of nearest |s|,
+damping ratio -Re(s) / |s|.
 
 The measures are taken by definition from the eigenvectors, independently of the paper's
 equations: node k (k = 1..n) is the end node of rod k's beam (node 0 the pinned root), its
@@ -31,22 +32,84 @@ largest beam-node displacement.
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg
 
 from reference_models.exudyn_chain import ExudynModel
+from rodval.core.eigen import (
+    angular_frequencies,
+    coordinate_null_space,
+    quadratic_eigenvalues,
+    symmetric_pencil,
+)
 from rodval.core.modal import ABOUT, Equilibrium, Modes, constant_loads, normalize_shapes
 from rodval.core.scene import Scene
 
 #: Elongation/displacement ratio above which an exudyn mode counts as axial.
 AXIAL_TOL = 1e-3
 #: ExudynModel options changed for modal analysis (others: ExudynModel's DEFAULTS).
-#: EA = 1e8 N instead of 1e10: ComputeODE2Eigenvalues solves one dense problem whose spectrum
-#: runs up to the axial modes (omega^2 ~ EA / (m le^2)), and its round-off in the lowest
-#: (hinge) modes grows with EA: n = 8, 8 elements per rod, mode 1 = 0.0781417 (EA 1e8),
-#: 0.0781445 (1e9), 0.0781616 (1e10), 0.0777761 (1e11) rad/s against 0.0781421 natively.
+#: EA = 1e8 N instead of 1e10: exudyn's K carries round-off of eps |K| per entry, and the
+#: hinge modes are where the beams' axial and bending stiffness cancels, so their digits fall
+#: as EA grows: n = 8, 8 elements per rod, mode 1 = 0.078142096 (EA 1e8), 0.078142118 (1e9),
+#: 0.078142313 (1e10), 0.078143951 (1e11) rad/s against 0.0781421067 natively (docs/modes.md).
 #: About the straight state bending and stretching decouple, so the hinge and bending
 #: frequencies do not depend on EA otherwise (mode 9: 452.44309 rad/s for EA 1e8 to 1e11);
 #: under a load the static stretch is F / EA (3e-7 for 30 N).
 MODES_DEFAULTS = {"EA": 1e8, "elements": 8}
+
+
+def _linear_matrices(exu, mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(M, K, D, J) of the assembled system at its initial state, by exudyn's static solver as
+    ``exudyn.solver.ComputeODE2Eigenvalues`` obtains them: mass matrix, K = -d(ODE2 rhs)/dq,
+    D = -d(ODE2 rhs)/dq_t and the position-level constraint Jacobian J (rows: constraints)."""
+    sim = exu.SimulationSettings()
+    sim.staticSolver.verboseMode = 0
+    sim.solution.file.write = False
+    sim.solution.sensors.active = False
+    solver = exu.MainSolverStatic()
+    solver.InitializeSolver(mbs, sim)
+    n2, n1 = solver.GetODE2size(), solver.GetODE1size()
+    solver.ComputeMassMatrix(mbs)
+    M = np.array(solver.GetSystemMassMatrix(), float)
+    solver.ComputeJacobianODE2RHS(
+        mbs, scalarFactor_ODE2=-1, scalarFactor_ODE2_t=0, scalarFactor_ODE1=0
+    )
+    solver.ComputeJacobianAE(
+        mbs,
+        scalarFactor_ODE2=1.0,
+        scalarFactor_ODE2_t=0.0,
+        scalarFactor_ODE1=0.0,
+        velocityLevel=False,
+    )
+    jac = np.array(solver.GetSystemJacobian(), float)
+    K, J = jac[:n2, :n2], jac[:n2, n2 + n1 :].T
+    solver.ComputeJacobianODE2RHS(
+        mbs, scalarFactor_ODE2=0, scalarFactor_ODE2_t=-1, scalarFactor_ODE1=0
+    )
+    D = np.array(solver.GetSystemJacobian(), float)[:n2, :n2]
+    solver.FinalizeSolver(mbs, sim)
+    return M, K, D, J
+
+
+def _eigen(M, K, D, J, *, damped: bool):
+    """Undamped eigenvalues omega^2 (ascending) and eigenvectors in ODE2 coordinates of the
+    constrained system, the damped eigenvalues s (or None), and the null-space kind used.
+
+    The constraints (revolute joints: node positions equal or pinned) are eliminated with the
+    exact 0/1 basis of ``rodval.core.eigen.coordinate_null_space``; only if a constraint has
+    another form, the SVD basis exudyn uses. The pencils are solved by
+    ``rodval.core.eigen`` (direct and inverted): exudyn's own ``eigh`` on an SVD basis loses
+    the lowest mode's digits to the pencil's span (axial to hinge modes, 3.7e12 for the paper
+    chain) and to the basis' BLAS-dependent orientation."""
+    B = coordinate_null_space(J)
+    kind = "coordinates"
+    if B is None:
+        U, sv, _ = scipy.linalg.svd(J.T)
+        B = U[:, int(np.sum(sv > 1e-12)) :]
+        kind = "svd"
+    Mb, Kb = B.T @ M @ B, B.T @ K @ B
+    lam, X = symmetric_pencil(Kb, Mb)
+    s_damped = quadratic_eigenvalues(Mb, B.T @ D @ B, Kb)[0] if damped else None
+    return lam, B @ X, s_damped, kind
 
 
 def exudyn_modes(
@@ -99,16 +162,10 @@ def exudyn_modes(
             residual = float(solver.conv.residual) if solver is not None else float("nan")
             if not ok:
                 raise ValueError("exudyn static solve failed")
-        lam, V = exu.solver.ComputeODE2Eigenvalues(mbs, useAbsoluteValues=False)
-        s_damped = None
-        if np.any(scene.chain.nu > 0):
-            s_damped, _ = exu.solver.ComputeODE2Eigenvalues(
-                mbs, computeComplexEigenvalues=True, useAbsoluteValues=False
-            )
+        matrices = _linear_matrices(exu, mbs)
     finally:
         exu.config.printToConsole = console
-    lam = np.asarray(lam, float)
-    V = np.asarray(V, float)
+    lam, V, s_damped, basis = _eigen(*matrices, damped=bool(np.any(scene.chain.nu > 0)))
     cfg = exu.ConfigurationType.Initial
     q_all = np.asarray(mbs.systemData.GetODE2Coordinates(configuration=cfg))
 
@@ -148,9 +205,7 @@ def exudyn_modes(
     hinge = root.copy()
     hinge[:, 1:] -= end[:, :-1]
     dx, dy, hinge = normalize_shapes(dx, dy, hinge)
-    tiny = 1e-13 * np.max(np.abs(lam)) if lam.size else 0.0
-    lam = np.where(np.abs(lam) <= tiny, 0.0, lam)
-    omega = np.sign(lam) * np.sqrt(np.abs(lam))
+    omega = angular_frequencies(lam)
     zeta = np.full(omega.size, np.nan)
     if s_damped is None:
         zeta[omega > 0] = 0.0
@@ -192,6 +247,7 @@ def exudyn_modes(
         info={
             "node_positions": ends,
             "axial_modes_dropped": int(axial.sum()),
+            "null_space": basis,
             "options": model.options(),
         },
     )

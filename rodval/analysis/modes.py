@@ -30,7 +30,9 @@ full model's, condensed).
 Frequencies and damping
 -----------------------
 Undamped: the generalized eigenproblem (K + K_L) x = omega^2 M x. For the full model with the
-kinematic ("printed") coefficients M is symmetric positive definite: ``scipy.linalg.eigh``.
+kinematic ("printed") coefficients M is symmetric positive definite:
+``rodval.core.eigen.symmetric_pencil`` (direct and inverted pencil, each eigenvalue from the
+one that carries it: the same digits on every BLAS kernel).
 The reduced model's M_r = M_pp - K_pg B^-1 M_gp is not symmetric (a quasi-static
 condensation, not a Galerkin projection: asymmetry ~1e-5 of its largest entry at n = 3..8),
 and neither is the full M with the ``published`` erratum; both take the general path below.
@@ -49,9 +51,10 @@ the runs' spectra one-to-one. n = 10 and 32 (all eigenvalues) and 64 (all 192) a
 mpmath at 40 digits (tests/test_modes.py, docs/modes.md).
 
 Damped (nu > 0): the quadratic eigenproblem (s^2 M + s C + K + K_L) x = 0 as a first-order
-state-space problem; each undamped mode is paired (Hungarian, on the MAC of the displacement
-parts) with an eigenvalue s of positive imaginary part, and the damping ratio is
-zeta = -Re(s) / |s|. Modes with omega = 0 (free rigid rotation) have no damping ratio (NaN).
+state-space problem (``rodval.core.eigen.quadratic_eigenvalues``, inverted); each undamped
+mode is paired (Hungarian, on the MAC of the displacement parts) with an eigenvalue s of
+positive imaginary part, and the damping ratio is zeta = -Re(s) / |s|. Modes with omega = 0
+(free rigid rotation) have no damping ratio (NaN).
 
 Mode shapes
 -----------
@@ -77,6 +80,7 @@ import pandas as pd
 import scipy.linalg
 from scipy.optimize import linear_sum_assignment
 
+from rodval.core.eigen import angular_frequencies, quadratic_eigenvalues, symmetric_pencil
 from rodval.core.modal import (
     ABOUT,
     Equilibrium,
@@ -100,6 +104,8 @@ MODELS = ("full", "reduced")
 RHO = (1.0, 2.0, 4.0, 0.5, 3.0, 8.0)
 #: Relative size of an imaginary part (to the largest |eigenvalue|) still taken as round-off.
 IMAG_TOL = 1e-9
+#: Relative size (to the largest |eigenvalue|) below which a QZ eigenvalue is a zero mode.
+ZERO_TOL = 1e-13
 
 
 # -- loads and statics ------------------------------------------------------------------------
@@ -295,24 +301,15 @@ def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors
 def eigen(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors: bool = True):
     """omega^2 (real, ascending) and the eigenvectors (columns) of K x = omega^2 M x."""
     if np.allclose(M, M.T, rtol=0, atol=1e-13 * np.max(np.abs(M))):
-        if vectors:
-            lam, X = scipy.linalg.eigh(K, M)
-        else:
-            lam, X = scipy.linalg.eigh(K, M, eigvals_only=True), None
-        return lam, X
+        return symmetric_pencil(K, M, vectors=vectors)
     lam, X, _ = _general_eig(K, M, chain, model, vectors)
     if np.max(np.abs(lam.imag)) > IMAG_TOL * np.max(np.abs(lam)):
         raise ValueError("linearized system has complex eigenvalues (non-oscillatory modes)")
     order = np.argsort(lam.real)
-    return lam.real[order], (None if X is None else np.real_if_close(X[:, order], tol=1e8).real)
-
-
-def _omega(lam: np.ndarray) -> np.ndarray:
-    """omega = sqrt(lam); a negative lam (unstable, buckled) gives -sqrt(-lam); |lam| below
-    round-off of the spectrum gives 0."""
-    tiny = 1e-13 * np.max(np.abs(lam)) if lam.size else 0.0
-    lam = np.where(np.abs(lam) <= tiny, 0.0, lam)
-    return np.sign(lam) * np.sqrt(np.abs(lam))
+    # QZ's absolute round-off is ~eps |lam|_max: below 1e-13 of it an eigenvalue is a zero mode
+    lam = lam.real[order]
+    lam = np.where(np.abs(lam) <= ZERO_TOL * np.max(np.abs(lam)), 0.0, lam)
+    return lam, (None if X is None else np.real_if_close(X[:, order], tol=1e8).real)
 
 
 def natural_frequencies(
@@ -372,18 +369,13 @@ def mac_matrix(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 def _damping_ratios(M, C, K, X, omega) -> np.ndarray:
     """zeta_i of the quadratic eigenproblem, paired with the undamped modes X (columns)."""
-    N = M.shape[0]
     zeta = np.full(omega.size, np.nan)
     if not np.any(C):
         zeta[omega > 0] = 0.0
         return zeta
-    A = np.zeros((2 * N, 2 * N))
-    A[:N, N:] = np.eye(N)
-    A[N:, :N] = -np.linalg.solve(M, K)
-    A[N:, N:] = -np.linalg.solve(M, C)
-    s, V = scipy.linalg.eig(A)
+    s, V = quadratic_eigenvalues(M, C, K)
     up = s.imag > 0
-    s, Z = s[up], V[:N, up]
+    s, Z = s[up], V[:, up]
     keep = omega > 0
     if not np.any(keep) or s.size == 0:
         return zeta
@@ -433,7 +425,7 @@ def modes(
         raise ValueError(f"count must be >= 1, got {count}")
     count = min(count, N)
     lam, X = lam[:count], X[:, :count]
-    omega = _omega(lam)
+    omega = angular_frequencies(lam)
     zeta = _damping_ratios(M, C, K, X, omega)
     dx, dy, hinge = _shapes(chain, model, q0[:n], X, lam, coefficients=coefficients)
     return Modes(
