@@ -54,6 +54,7 @@ from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED
 from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.core.validity import Check, step_resolution
 
 ELEMENTS = ("cable2d",)
 SOLVERS = ("generalized-alpha", "trapezoidal")
@@ -596,7 +597,7 @@ class ExudynModel(Model):
                 "locked hinge's relative rate oscillates from step to step after the lock"
             )
 
-    def simulate(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
+    def run(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
         """Run the scene. Of the native integrator ``settings`` only ``blowup_factor`` applies;
         any other non-default field raises ValueError before any work (``check_settings``): the
         exudyn integrator is set by this model's options, recorded in ``trajectory.settings``
@@ -715,6 +716,15 @@ class ExudynModel(Model):
             )
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         return self._trajectory(scene, times, observed, stats, run_info, events)
+
+    def validity_checks(self, scene: Scene, trajectory: Trajectory) -> list[Check]:
+        """The energy balance (where audited) and the time-step resolution: the largest rod
+        rotation per step seen against ``max_rotation_per_step`` (the beam itself is
+        geometrically exact: no small-bending assumption)."""
+        seen = trajectory.settings.get("max_rotation_per_step_seen")
+        return super().validity_checks(scene, trajectory) + step_resolution(
+            seen, self.max_rotation_per_step
+        )
 
     def _records(self, built: _Built):
         """Recorded times (s); per (rod, local node), arrays q, v, a (nt, 4) up to the first

@@ -218,7 +218,7 @@ def test_runs_report_whether_they_stayed_within_small_bending():
     """Both models rest on small bending angles: every run reports its largest |alpha|,
     |beta| and whether it stayed within SMALL_BENDING_RAD, also when alpha, beta were not
     asked for. At EI = 1e-3 the reduced model returns bending angles of ~1e4 rad: flagged."""
-    from rodval.core.trajectory import SMALL_BENDING_RAD
+    from rodval.core.validity import SMALL_BENDING_RAD
 
     scene = paper_scene(times=[0.5, 1.0], outputs=("phi",))
     for model in ("full", "reduced"):

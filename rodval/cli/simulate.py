@@ -18,6 +18,7 @@ from rodval.cli.options import (
 )
 from rodval.core.scene_file import read_scene_document, scene_from_dict, with_horizon
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
+from rodval.core.validity import describe
 from rodval.models import REGISTRY, model_class, simulate
 from rodval.report.run_files import read_run_record, write_run
 from rodval.solvers.progress import progress_bar
@@ -83,7 +84,8 @@ def run(args) -> int:
         traj = simulate(scene, model, settings=IntegratorSettings(**settings_kw), **options)
     write_run(traj, scene, args.out)
     print(
-        f"{traj.model}: {traj.stats.message}, method {traj.settings.get('method')}, "
+        f"{traj.model}: {traj.stats.message}, {describe(traj.stats.valid, traj.stats.validity)}, "
+        f"method {traj.settings.get('method')}, "
         f"t_reached = {traj.stats.t_reached:g} s, nfev = {traj.stats.nfev}, "
         f"wall = {traj.stats.wall_s:.3f} s -> {args.out}"
     )

@@ -2,7 +2,9 @@
 
 Models are registered by name (``rodval.models.registry``); a run never raises for a failed
 integration (the Trajectory's stats say how it ended), but a bad option or a setting the
-model cannot honour is a ValueError raised before any work.
+model cannot honour is a ValueError raised before any work. After every run the model judges
+its own validity (``validity_checks``, ``rodval.core.validity``): ``stats.valid`` and
+``stats.validity``, whatever path ran it (the CLI, the API, a study worker).
 """
 
 from __future__ import annotations
@@ -13,16 +15,33 @@ from typing import Any, ClassVar
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.trajectory import Trajectory
+from rodval.core.validity import ENERGY_RESIDUAL_BOUND, Check, energy_balance, verdict
 
 
 class Model(ABC):
-    """A named model of the chain. Subclasses set ``name`` and implement ``simulate``."""
+    """A named model of the chain. Subclasses set ``name`` and implement ``run``; callers use
+    ``simulate`` (the run, then the model's verdict on its assumptions)."""
 
     name: ClassVar[str]
+    #: Largest energy-audit residual of a valid run of this model (``rodval.core.validity``).
+    energy_residual_bound: ClassVar[float] = ENERGY_RESIDUAL_BOUND
+
+    def simulate(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
+        """Run the scene and judge the run's validity; never raise for a failed integration
+        (report it in the stats)."""
+        trajectory = self.run(scene, settings)
+        stats = trajectory.stats
+        stats.valid, stats.validity = verdict(self.validity_checks(scene, trajectory))
+        return trajectory
 
     @abstractmethod
-    def simulate(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
+    def run(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
         """Run the scene; never raise for a failed integration (report it in the stats)."""
+
+    def validity_checks(self, scene: Scene, trajectory: Trajectory) -> list[Check]:
+        """The checks of this model's assumptions on a run of ``scene`` (over the output times
+        it reached). By default the energy balance where the run was audited."""
+        return energy_balance(trajectory.stats.energy_residual, self.energy_residual_bound)
 
     def options(self) -> dict[str, Any]:
         """Model options (recorded in ``Trajectory.options``)."""

@@ -3,16 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from rodval.core.status import STATUS_SUCCESS
-
-#: The paper models keep only first-order terms in the bending angles alpha, beta (sin a ~ a,
-#: products with rates dropped): at 0.2 rad the first neglected terms are about 2 % (1 - cos)
-#: of the kept ones. A run whose bending exceeds it is flagged (``SolverStats.small_bending``).
-SMALL_BENDING_RAD = 0.2
 
 
 @dataclass
@@ -34,10 +30,15 @@ class SolverStats:
     #: Largest |alpha|, |beta| (rad) over the output times reached, for models with bending
     #: angles; None otherwise.
     max_bending: float | None = None
-    #: Whether ``max_bending`` stayed within ``SMALL_BENDING_RAD``, the small-bending
-    #: assumption both paper models rest on (None when not measured). A run outside it is
-    #: not a failure of the integration, but its results are not those of the models' premise.
+    #: Whether ``max_bending`` stayed within ``rodval.core.validity.SMALL_BENDING_RAD``, the
+    #: small-bending assumption both paper models rest on (None when not measured).
     small_bending: bool | None = None
+    #: The model's verdict on its own assumptions (``rodval.core.validity``): whether every
+    #: check held (None: nothing could be checked), independent of ``status``: a run can reach
+    #: t_end and be invalid.
+    valid: bool | None = None
+    #: Every check made: assumption, figure, bound, unit, holds, reason.
+    validity: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -57,6 +58,8 @@ class SolverStats:
             "energy_residual": self.energy_residual,
             "max_bending": self.max_bending,
             "small_bending": self.small_bending,
+            "valid": self.valid,
+            "validity": [dict(c) for c in self.validity],
         }
 
 

@@ -10,6 +10,8 @@ import numpy as np
 
 from rodval.core.loads import LoadSet, load_table
 from rodval.core.scene import Scene, hinge_angles
+from rodval.core.trajectory import Trajectory
+from rodval.core.validity import Check, small_bending
 from rodval.models import deployment
 from rodval.models.paper_matrices import (
     VARIANTS,
@@ -549,3 +551,10 @@ class PaperModel(OdeModel):
 
     def system(self, scene: Scene) -> PaperSystem:
         return self.system_class(scene, self.coefficients, self.kernel)
+
+    def validity_checks(self, scene: Scene, trajectory: Trajectory) -> list[Check]:
+        """The energy balance (where audited) and the small-bending assumption of the paper's
+        first-order kinematics (largest |alpha|, |beta| over the output times reached)."""
+        return super().validity_checks(scene, trajectory) + small_bending(
+            trajectory.stats.max_bending
+        )

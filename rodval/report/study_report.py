@@ -13,7 +13,8 @@ import numpy as np
 import pandas as pd
 
 from rodval.core.modal import Modes
-from rodval.core.trajectory import SMALL_BENDING_RAD, Trajectory
+from rodval.core.trajectory import Trajectory
+from rodval.core.validity import ENERGY_RESIDUAL_BOUND, SMALL_BENDING_RAD
 from rodval.report.figures import (
     plot_configurations,
     plot_deployment,
@@ -120,24 +121,25 @@ def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[st
     ref = meta["reference"]
     lines = []
     failed = runtime[runtime["status"] != "success"]
+    invalid = runtime[runtime["valid"].astype(str) == "False"] if "valid" in runtime else failed[:0]
     lines.append(
         f"## Outcome\n\n{runtime['case'].nunique()} cases, {len(runtime)} model runs, "
-        f"{len(failed)} failed.\n"
+        f"{len(failed)} failed, {len(invalid)} invalid.\n"
     )
     if not failed.empty:
         lines += [
             "Failed runs:\n",
             to_markdown(failed[["case", "model", "status", "t_reached", "message"]]),
         ]
-    if "small_bending" in runtime:
-        outside = runtime[runtime["small_bending"].astype(str) == "False"]
-        lines.append(
-            f"Model validity: {len(outside)} run(s) left the small-bending assumption the "
-            f"paper models rest on (largest |alpha|, |beta| above {SMALL_BENDING_RAD:g} rad)."
-            + (" Their results are not those of the models' premise:\n" if len(outside) else "\n")
-        )
-        if len(outside):
-            lines.append(to_markdown(outside[["case", "model", "max_bending", "status"]]))
+    lines.append(
+        "Validity: a run is invalid when it broke an assumption of its model (small bending, "
+        f"largest |alpha|, |beta| <= {SMALL_BENDING_RAD:g} rad, in the paper models; an "
+        f"energy-audit residual <= {ENERGY_RESIDUAL_BOUND:g} where audited; see "
+        "docs/stability.md), whether or not it reached its end; its results are not those of "
+        "the model's premise." + (" Invalid runs:\n" if len(invalid) else "\n")
+    )
+    if len(invalid):
+        lines.append(to_markdown(invalid[["case", "model", "status", "invalid_because"]]))
     lines.append(f"## Discrepancies against `{ref}`\n")
     lines.append(
         "Largest absolute difference over all output times and rods (`max_abs`; rad, "

@@ -36,7 +36,8 @@ from rodval.core.status import (
     STATUS_FAILED,
     STATUS_WALL,
 )
-from rodval.core.trajectory import SMALL_BENDING_RAD, SolverStats, Trajectory
+from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.core.validity import SMALL_BENDING_RAD
 from rodval.solvers.audit import PowerLedger, audit_quantities
 from rodval.solvers.events import EventMonitor
 from rodval.solvers.guard import DivergenceGuard

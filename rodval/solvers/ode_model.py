@@ -23,7 +23,7 @@ class OdeModel(Model):
     def system(self, scene: Scene) -> OdeSystem:
         """Build the ODE system of ``scene`` (all scene-constant work happens here)."""
 
-    def simulate(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
+    def run(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
         """Build the system and integrate it. A failure while building it (its constants,
         its first evaluation) is reported like a failure during integration: status
         ``model error``, the message, t_reached = 0."""

@@ -30,6 +30,7 @@ from rodval.analysis.metrics import METRICS
 from rodval.analysis.modes import pair_modes
 from rodval.core.modal import Modes
 from rodval.core.status import STATUS_MESSAGES
+from rodval.core.validity import broken
 from rodval.report.markdown import to_markdown
 from rodval.report.tables import axis_columns, trajectory_samples
 from rodval.study.records import CaseRecord, DamagedRecord, read_case
@@ -101,6 +102,8 @@ def runtime_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFra
                     "energy_residual": st.energy_residual,
                     "max_bending": st.max_bending,
                     "small_bending": st.small_bending,
+                    "valid": st.valid,
+                    "invalid_because": "; ".join(broken(st.validity)),
                     "status": STATUS_MESSAGES[st.status],
                     "message": st.message,
                 }

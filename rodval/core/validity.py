@@ -1,0 +1,115 @@
+"""Validity of a run: the assumptions a model rests on, checked against what the run did.
+
+A run can reach t_end and still be invalid: its results are then not those of the model's
+premise (a paper model bent far beyond small angles, an energy balance that does not close).
+Success (how the integration ended, ``SolverStats.status``) and validity (``SolverStats.valid``,
+``SolverStats.validity``) are separate. Each model states its checks
+(``rodval.core.contract.Model.validity_checks``); each check carries its figure and bound, so a
+verdict always says why.
+
+Checks defined here (the one place their bounds live):
+
+* ``small_bending``: the paper models keep only first-order terms in the bending angles alpha,
+  beta (sin a ~ a, products with rates dropped): at 0.2 rad the first neglected terms are about
+  2 % (1 - cos) of the kept ones. Figure: the largest |alpha|, |beta| over the output times (rad).
+* ``energy_balance``: where the scene asks for "energy", the audit residual
+  max |E - E(0) - W_ext + D| / max(max E, max |W_ext|) (``rodval.solvers.audit``). The paper
+  models' own residual is 5e-5 .. 2e-3 on the paper's chain (first-order kinematics,
+  docs/stability.md); a run beyond 1e-2 has left the regime the model describes (the 10x load:
+  2.4e-2 .. 6.6e-2; EI = 1e3: 2.2e-2 .. 3.9e-2) or its integration went wrong.
+* ``step_resolution`` (exudyn): the largest rotation of a rod per time step (rad) against the
+  model's ``max_rotation_per_step``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+#: Largest bending angle (rad) within the paper models' small-bending assumption.
+SMALL_BENDING_RAD = 0.2
+#: Largest relative energy-audit residual of a valid run (see the module docstring).
+ENERGY_RESIDUAL_BOUND = 1e-2
+
+
+@dataclass(frozen=True)
+class Check:
+    """One assumption checked on one run: ``figure`` (in ``unit``) must not exceed ``bound``.
+    A non-finite figure breaks the assumption."""
+
+    assumption: str
+    figure: float
+    bound: float
+    unit: str
+    what: str
+
+    @property
+    def holds(self) -> bool:
+        return math.isfinite(self.figure) and self.figure <= self.bound
+
+    def reason(self) -> str:
+        """One phrase: '<what> <figure> <unit> > <bound> <unit> (<assumption>)'."""
+        unit = f" {self.unit}" if self.unit else ""
+        sign = "<=" if self.holds else ">"
+        return (
+            f"{self.what} {self.figure:.3g}{unit} {sign} {self.bound:g}{unit} ({self.assumption})"
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "assumption": self.assumption,
+            "figure": self.figure if math.isfinite(self.figure) else None,
+            "bound": self.bound,
+            "unit": self.unit,
+            "holds": self.holds,
+            "reason": self.reason(),
+        }
+
+
+def small_bending(max_bending: float | None) -> list[Check]:
+    """The small-bending check of a run whose largest |alpha|, |beta| is ``max_bending`` (rad);
+    none when it was not measured."""
+    if max_bending is None:
+        return []
+    return [
+        Check(
+            "small bending", float(max_bending), SMALL_BENDING_RAD, "rad", "largest bending angle"
+        )
+    ]
+
+
+def energy_balance(residual: float | None, bound: float = ENERGY_RESIDUAL_BOUND) -> list[Check]:
+    """The energy-balance check of an audited run (relative residual); none when not audited."""
+    if residual is None:
+        return []
+    return [Check("energy balance", float(residual), bound, "", "energy-audit residual")]
+
+
+def step_resolution(rotation: float | None, bound: float) -> list[Check]:
+    """The time-step resolution check of a fixed-step run: the largest rotation of a rod in one
+    step (rad) against ``bound``; none when not measured."""
+    if rotation is None:
+        return []
+    return [Check("step resolution", float(rotation), bound, "rad", "largest rotation per step")]
+
+
+def verdict(checks: list[Check]) -> tuple[bool | None, list[dict[str, Any]]]:
+    """(valid, validity): valid is None when nothing could be checked, else whether every
+    check holds; validity lists every check with its figure, bound and reason."""
+    if not checks:
+        return None, []
+    return all(c.holds for c in checks), [c.as_dict() for c in checks]
+
+
+def broken(validity: list[dict[str, Any]]) -> list[str]:
+    """The reasons of the checks that do not hold."""
+    return [c["reason"] for c in validity if not c["holds"]]
+
+
+def describe(valid: bool | None, validity: list[dict[str, Any]]) -> str:
+    """The verdict in a few words, for summary lines: 'valid', 'validity not checked' or
+    'INVALID: <reason>; <reason>'."""
+    if valid is None:
+        return "validity not checked"
+    return "valid" if valid else "INVALID: " + "; ".join(broken(validity))
