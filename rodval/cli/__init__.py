@@ -12,7 +12,7 @@ import traceback
 import warnings
 
 #: Subcommand modules, in the order ``rodval --help`` lists them.
-COMMANDS = ("reproduce", "simulate", "compare", "study", "report", "bench", "modes")
+COMMANDS = ("reproduce", "simulate", "compare", "study", "report", "bench", "modes", "animate")
 
 
 class CliError(Exception):

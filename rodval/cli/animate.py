@@ -1,0 +1,55 @@
+"""rodval animate RUN [RUN ...] --out FILE.gif|mp4: the chain's motion from run folders of
+`rodval simulate`, several runs overlaid, time, locks and stop contacts marked."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from rodval.cli.options import positive_int
+from rodval.core.scene_file import scene_from_dict
+from rodval.report.animation import MAX_FPS, MAX_FRAMES, animate_runs
+from rodval.report.run_files import read_run, read_run_record
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "animate",
+        help="animate runs (GIF or MP4)",
+        description="Write the chain's motion of one or more `rodval simulate` run folders to "
+        "FILE (.gif with Pillow, .mp4 with the ffmpeg program), the runs overlaid in one frame "
+        "each, the time in the title, each latch marked on its hinge node from its lock on, "
+        "stop contacts marked at their times. Nodes from the runs' x, y outputs, else from "
+        "phi and the rod lengths.",
+    )
+    p.add_argument("runs", metavar="RUN", type=Path, nargs="+", help="run folder(s)")
+    p.add_argument("--out", required=True, type=Path, help="FILE.gif or FILE.mp4")
+    p.add_argument(
+        "--fps",
+        type=positive_int("--fps"),
+        default=20,
+        help=f"frames per second (default 20, at most {MAX_FPS})",
+    )
+    p.add_argument(
+        "--frames",
+        type=positive_int("--frames"),
+        default=200,
+        help=f"most frames, evenly spaced over the output times (default 200, 2..{MAX_FRAMES})",
+    )
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    runs, lengths = {}, {}
+    for folder in args.runs:
+        traj = read_run(folder)
+        label = f"{folder.name} ({traj.model})"
+        if label in runs:
+            label = f"{folder} ({traj.model})"
+        scene = scene_from_dict(read_run_record(folder / "run.json")["scene"], where=str(folder))
+        runs[label], lengths[label] = traj, scene.chain.l
+    done = animate_runs(runs, lengths, args.out, fps=args.fps, frames=args.frames)
+    print(
+        f"{done.frames} frames, {len(done.events)} events marked, "
+        f"t = {done.times[0]:g}..{done.times[-1]:g} s -> {done.path}"
+    )
+    return 0
