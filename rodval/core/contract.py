@@ -26,10 +26,10 @@ class Model(ABC):
     #: Largest energy-audit residual of a valid run of this model (``rodval.core.validity``).
     energy_residual_bound: ClassVar[float] = ENERGY_RESIDUAL_BOUND
 
-    def simulate(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
-        """Run the scene and judge the run's validity; never raise for a failed integration
-        (report it in the stats)."""
-        trajectory = self.run(scene, settings)
+    def simulate(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
+        """Run the scene (default integrator settings when None) and judge the run's validity;
+        never raise for a failed integration (report it in the stats)."""
+        trajectory = self.run(scene, IntegratorSettings() if settings is None else settings)
         stats = trajectory.stats
         stats.valid, stats.validity = verdict(self.validity_checks(scene, trajectory))
         return trajectory
