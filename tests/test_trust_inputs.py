@@ -9,7 +9,10 @@ import shutil
 import pytest
 from test_cli_errors import assert_refused, run_main
 
+from rodval import IntegratorSettings, Latch, paper_scene, tabulated
 from rodval.cli import main
+from rodval.core.scene_file import load_scene
+from rodval.core.settings import MIN_RTOL
 
 TINY = 'n = 2\nt_end = 0.05\ntimes = {start = 0.0, stop = 0.05, num = 11}\noutputs = ["phi"]\n'
 
@@ -90,3 +93,92 @@ def test_compare_refuses_a_run_json_of_wrong_types(runs, damaged, tmp_path, caps
     rec.write_text(json.dumps({**doc, "scene": [1, 2]}))
     proc = run_main(capsys, "compare", str(damaged), str(runs / "A"), "--out", str(tmp_path / "c"))
     assert_refused(proc, [str(rec), "'scene'", "table"])
+
+
+# -- item 2: nothing clamped, coerced or dropped silently -------------------------------------
+
+
+def test_rtol_below_what_the_integrators_honour_is_refused(tmp_path, capsys):
+    proc = run_main(capsys, "simulate", "paper", "--rtol", "1e-300", "--out", str(tmp_path))
+    assert_refused(proc, ["--rtol", "(0, 1)", "2.22e-14", "'1e-300'"])
+    assert not (tmp_path / "run.json").exists()
+    with pytest.raises(ValueError, match=r"^rtol must be .*2\.22e-14.*got 1e-300$"):
+        IntegratorSettings(rtol=1e-300)
+    assert IntegratorSettings(rtol=MIN_RTOL).rtol == MIN_RTOL  # the bound itself is honoured
+
+
+def test_unknown_setting_in_an_edited_run_json_is_refused(runs, tmp_path, capsys):
+    doc = json.loads((runs / "A" / "run.json").read_text())
+    doc["settings"]["rtoll"] = 1e-3
+    edited = tmp_path / "edited.json"
+    edited.write_text(json.dumps(doc))
+    proc = run_main(capsys, "simulate", str(edited), "--out", str(tmp_path / "out"))
+    assert_refused(proc, [str(edited), "'settings'", "unknown key 'rtoll'", "rtol", "atol"])
+    assert not (tmp_path / "out").exists()
+
+
+def test_unknown_top_level_key_in_an_edited_run_json_is_refused(runs, tmp_path, capsys):
+    doc = json.loads((runs / "A" / "run.json").read_text())
+    doc["modell"] = "reduced"
+    edited = tmp_path / "edited.json"
+    edited.write_text(json.dumps(doc))
+    proc = run_main(capsys, "simulate", str(edited), "--out", str(tmp_path / "out"))
+    assert_refused(proc, [str(edited), "unknown key 'modell'", "model", "scene"])
+
+
+def test_scene_name_must_be_a_string(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text("name = 123\n")
+    with pytest.raises(ValueError, match=r"s\.toml: name .*must be a string, got 123$"):
+        load_scene(path)
+    with pytest.raises(ValueError, match="^name .*must be a string"):
+        paper_scene(2).with_(name=123)
+
+
+@pytest.mark.parametrize("direction", [-1.0, 1.0, 0.5, "-1"])
+def test_latch_direction_must_be_the_integer_plus_or_minus_one(direction):
+    with pytest.raises(ValueError, match=r"^latch direction must be the integer \+1 or -1"):
+        Latch(hinge=1, angle=0.5, direction=direction)
+    assert Latch(hinge=1, angle=0.5, direction=-1).direction == -1
+
+
+def test_latch_direction_float_in_a_scene_file_is_refused(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text("n = 2\n[[latches]]\nhinge = 1\nangle = -0.5\ndirection = -1.0\n")
+    with pytest.raises(ValueError, match=r"s\.toml.*latch direction.*got -1\.0$"):
+        load_scene(path)
+
+
+def test_tabulated_load_file_with_a_column_named_twice_is_refused(tmp_path):
+    csv = tmp_path / "f.csv"
+    csv.write_text("t,X,X\n0,1,2\n1,3,4\n")
+    with pytest.raises(ValueError, match=r"f\.csv: column 'X' named twice"):
+        tabulated(node=1, file=str(csv))
+
+
+@pytest.mark.parametrize("times", ["0,,0.1", "0,0.1,", ",0.1"])
+def test_times_with_an_empty_item_are_refused(times, tmp_path, capsys):
+    proc = run_main(capsys, "simulate", "paper", "--times", times, "--out", str(tmp_path))
+    assert_refused(proc, ["--times", "empty item", repr(times)])
+
+
+def test_coefficients_given_twice_are_refused(tmp_path, capsys):
+    proc = run_main(
+        capsys,
+        "simulate",
+        "paper",
+        "--coefficients",
+        "published",
+        "--set",
+        "coefficients=printed",
+        "--out",
+        str(tmp_path),
+    )
+    assert_refused(proc, ["--coefficients published", "coefficients=printed", "conflict"])
+    assert not (tmp_path / "run.json").exists()
+
+
+def test_a_set_key_given_twice_is_refused(tmp_path, capsys):
+    args = ["--set", "kernel=numba", "--set", "kernel=numpy", "--out", str(tmp_path)]
+    proc = run_main(capsys, "simulate", "paper", *args)
+    assert_refused(proc, ["--set kernel", "twice", "kernel='numba'", "kernel='numpy'"])

@@ -248,8 +248,15 @@ class Latch:
         ):
             raise ValueError(f"latch hinge must be an integer >= 0, got {self.hinge!r}")
         _finite("latch angle", self.angle, "rad")
-        if self.direction not in (None, 1, -1) or isinstance(self.direction, bool):
-            raise ValueError(f"latch direction must be +1, -1 or None, got {self.direction!r}")
+        if self.direction is not None and (
+            isinstance(self.direction, bool)
+            or not isinstance(self.direction, numbers.Integral)
+            or self.direction not in (1, -1)
+        ):
+            raise ValueError(
+                f"latch direction must be the integer +1 or -1, or omitted (None), "
+                f"got {self.direction!r}"
+            )
 
 
 @dataclass(frozen=True)
@@ -341,6 +348,8 @@ class Scene:
     stops: tuple[Stop, ...] = ()
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise ValueError(f"name (the scene's label) must be a string, got {self.name!r}")
         if not isinstance(self.chain, Chain):
             raise ValueError(f"chain must be a rodval.Chain, got {type(self.chain).__name__}")
         n = self.chain.n

@@ -177,7 +177,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
             times=_times(d.get("times"), float(t_end), where),
             outputs=tuple(outputs),
             initial=InitialState(**init_spec),
-            name=str(d.get("name", scene.name)),
+            name=d.get("name", scene.name),
         )
     except ValueError as exc:
         msg = str(exc)

@@ -24,6 +24,8 @@ RUN_KEYS = ("scene", "model", "options", "settings", "stats")
 RUN_KEY_TYPES = {"scene": dict, "model": str, "options": dict, "settings": dict, "stats": dict}
 #: run.json's record of trajectory.csv: {"bytes": size, "sha256": hex digest}.
 DIGEST_KEY = "trajectory_csv"
+#: The keys a run.json may hold besides ``RUN_KEYS``.
+OPTIONAL_KEYS = ("events", "provenance", DIGEST_KEY)
 
 
 def file_digest(data: bytes) -> dict[str, Any]:
@@ -76,6 +78,7 @@ def read_run_record(path: Path) -> dict[str, Any]:
     missing = [k for k in RUN_KEYS if not isinstance(rec, dict) or k not in rec]
     if missing:
         raise ValueError(f"{path}: not a run.json of rodval simulate (no {missing[0]!r})")
+    check_keys(rec, (*RUN_KEYS, *OPTIONAL_KEYS), str(path))
     for key, kind in RUN_KEY_TYPES.items():
         if not isinstance(rec[key], kind):
             raise ValueError(
