@@ -7,8 +7,10 @@ import json
 import shutil
 
 import pytest
+from study_helpers import write_study
 from test_cli_errors import assert_refused, run_main
 
+import rodval
 from rodval import IntegratorSettings, Latch, paper_scene, tabulated
 from rodval.cli import main
 from rodval.core.scene_file import load_scene
@@ -182,3 +184,101 @@ def test_a_set_key_given_twice_is_refused(tmp_path, capsys):
     args = ["--set", "kernel=numba", "--set", "kernel=numpy", "--out", str(tmp_path)]
     proc = run_main(capsys, "simulate", "paper", *args)
     assert_refused(proc, ["--set kernel", "twice", "kernel='numba'", "kernel='numpy'"])
+
+
+# -- item 3: the Python API checks its arguments up front ---------------------------------
+
+
+@pytest.fixture(scope="module")
+def traj():
+    return rodval.simulate(rodval.paper_scene(2, t_end=0.05, times=[0.0, 0.05]), "reduced")
+
+
+@pytest.mark.parametrize("swap", [False, True])
+def test_compare_refuses_what_is_not_a_trajectory(traj, swap):
+    args = ("x", traj) if swap else (traj, "x")
+    name = "traj" if swap else "reference"
+    with pytest.raises(ValueError, match=rf"^{name} must be a rodval\.Trajectory .*got str 'x'$"):
+        rodval.compare(*args)
+
+
+def test_compare_refuses_a_bare_string_of_quantities(traj):
+    # 'phi' used to be read as the quantities 'p', 'h', 'i'
+    with pytest.raises(ValueError, match=r"^quantities must be a list .*got 'phi'$"):
+        rodval.compare(traj, traj, "phi")
+    assert list(rodval.compare(traj, traj, ["phi"])["quantity"]) == ["phi"]
+
+
+def test_unknown_quantity_names_it_and_the_available_ones(traj):
+    with pytest.raises(KeyError, match=r"'gamma' .*available: phi, dphi") as info:
+        traj["gamma"]
+    assert isinstance(info.value, ValueError)  # one-line CLI errors catch it too
+    assert str(info.value).startswith("quantity 'gamma'")
+    with pytest.raises(KeyError, match="'gamma'"):
+        traj.at("gamma", 0.0, 1)
+
+
+def test_at_a_time_that_is_not_an_output_time_is_named(traj):
+    with pytest.raises(ValueError, match=r"^t = 0\.3 s is not an output time"):
+        traj.at("phi", 0.3, 1)
+    with pytest.raises(ValueError, match=r"^k = 7 is not a label of 'phi' \(allowed: 1, 2\)$"):
+        traj.at("phi", 0.05, 7)
+
+
+def test_with_an_unknown_field_names_it_and_the_allowed_ones():
+    scene = rodval.paper_scene(2)
+    with pytest.raises(ValueError, match=r"^Scene\.with_: unknown field 'foo' \(allowed: .*t_end"):
+        scene.with_(foo=1)
+    with pytest.raises(ValueError, match=r"^Chain\.with_: unknown field 'foo' \(allowed: .*EI"):
+        scene.chain.with_(foo=1)
+    assert scene.with_(t_end=3.0).t_end == 3.0
+
+
+def test_run_study_takes_a_str_path(tmp_path):
+    path = write_study(tmp_path, grid="")
+    out = str(tmp_path / "out")
+    run = rodval.run_study(str(path), out, workers=1, progress=False, report=False)
+    tables = rodval.read_study_tables(out)
+    assert run.out == tmp_path / "out" and len(run.ran) == 2
+    assert len(tables["cases"]) == 2
+
+
+@pytest.mark.parametrize(
+    "call, words",
+    [
+        (lambda: rodval.run_study(123, "out"), "^spec must be a study"),
+        (lambda: rodval.run_study("nope.toml", 5), "study file 'nope.toml' does not exist"),
+        (lambda: rodval.load_study(123), r"^path must be a path \(str or pathlib.Path\), got int"),
+        (lambda: rodval.read_study_tables(1), r"^out must be a path .*got int 1$"),
+        (lambda: rodval.modes("paper", "full"), r"^scene must be a rodval\.Scene"),
+        (lambda: rodval.modes(rodval.paper_scene(2), "full", count="3"), r"^count .*integer >= 1"),
+        (lambda: rodval.modes(rodval.paper_scene(2), "full", count=2.7), r"^count .*got 2\.7$"),
+        (lambda: rodval.paper_scene(2, times=5), r"^times \(output times\) must be a 1-D"),
+    ],
+    ids=[
+        "run_study(123)",
+        "run_study(out=5)",
+        "load_study",
+        "tables",
+        "modes",
+        "count",
+        "2.7",
+        "times",
+    ],
+)
+def test_api_entry_points_refuse_wrong_types_in_one_line(call, words):
+    with pytest.raises(ValueError, match=words) as info:
+        call()
+    assert "\n" not in str(info.value)
+
+
+def test_modes_about_equilibrium_of_a_chain_with_a_free_hinge(tmp_path, capsys):
+    scene = tmp_path / "free.toml"
+    scene.write_text(
+        "n = 3\n[chain]\nkappa = [100.0, 0.0, 100.0]\n"
+        '[[loads]]\ntype = "constant"\nnode = "last"\nY = 50.0\n'
+    )
+    args = ["modes", str(scene), "--about", "equilibrium", "--out", str(tmp_path / "m")]
+    proc = run_main(capsys, *args)
+    assert_refused(proc, ["no stiffness (kappa = 0)", "hinge(s) [1]", "--about initial"])
+    assert "Singular matrix" not in proc.stderr

@@ -17,12 +17,8 @@ from rodval.cli.options import (
     positive_float,
     time_list,
 )
-from rodval.core.scene_file import (
-    check_keys,
-    read_scene_document,
-    scene_from_dict,
-    with_horizon,
-)
+from rodval.core.checks import check_keys
+from rodval.core.scene_file import read_scene_document, scene_from_dict, with_horizon
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.models import REGISTRY, model_class, simulate
 from rodval.report.run_files import read_run_record, write_run

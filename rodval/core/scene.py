@@ -20,11 +20,12 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
 
+from rodval.core.checks import check_keys
 from rodval.core.loads import NodalForce
 from rodval.core.resources import check_run_memory
 
@@ -161,7 +162,8 @@ class Chain:
         return {k: getattr(self, k).tolist() for k in self.FIELDS}
 
     def with_(self, **changes) -> Chain:
-        """A copy with some fields replaced (scalars broadcast)."""
+        """A copy with some fields replaced (scalars broadcast); an unknown field is refused."""
+        check_keys(changes, self.FIELDS, "Chain.with_", noun="field")
         d = {k: getattr(self, k) for k in self.FIELDS}
         d.update(changes)
         return Chain(**d, _n=self.n)
@@ -447,7 +449,8 @@ class Scene:
         return np.array(sorted(bps))
 
     def with_(self, **changes) -> Scene:
-        """A copy with fields replaced (validated again)."""
+        """A copy with fields replaced (validated again); an unknown field is refused."""
+        check_keys(changes, (f.name for f in fields(self)), "Scene.with_", noun="field")
         return replace(self, **changes)
 
     def wants(self, *quantities: str) -> bool:
@@ -476,7 +479,7 @@ def paper_scene(
         chain=chain,
         loads=(pulse(node),),
         t_end=t_end,
-        times=None if times is None else np.asarray(list(times), float),
+        times=times,
         outputs=tuple(outputs),
         name=f"paper-n{n}",
     )

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from rodval.core.checks import check_keys
 from rodval.core.loads import LOAD_FACTORIES
 from rodval.core.scene import (
     DEFAULT_NUM_TIMES,
@@ -48,18 +49,6 @@ STOP_KEYS = ("hinge", "angle", "side", "stiffness", "damping")
 CHAIN_KEYS = set(Chain.FIELDS)
 INITIAL_KEYS = {"phi", "dphi", "alpha", "beta", "dalpha", "dbeta"}
 TIMES_KEYS = {"start", "stop", "num"}
-
-
-def check_keys(d: Any, allowed: set[str] | tuple[str, ...], where: str) -> None:
-    """ValueError naming ``where`` unless ``d`` is a dict (a table) whose keys are all in
-    ``allowed``; the message names the first unknown key and lists the allowed ones."""
-    if not isinstance(d, dict):
-        raise ValueError(f"{where}: expected a table, got {type(d).__name__}")
-    unknown = sorted(set(d) - set(allowed))
-    if unknown:
-        raise ValueError(
-            f"{where}: unknown key {unknown[0]!r} (allowed: {', '.join(sorted(allowed))})"
-        )
 
 
 def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:

@@ -14,9 +14,10 @@ from typing import Any
 
 import pandas as pd
 
+from rodval.core.checks import check_keys
 from rodval.core.provenance import provenance
 from rodval.core.scene import Scene
-from rodval.core.scene_file import check_keys, scene_to_dict
+from rodval.core.scene_file import scene_to_dict
 from rodval.core.trajectory import SolverStats, Trajectory
 
 RUN_KEYS = ("scene", "model", "options", "settings", "stats")
