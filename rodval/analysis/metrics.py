@@ -29,6 +29,7 @@ from collections.abc import Iterable
 import numpy as np
 import pandas as pd
 
+from rodval.core.checks import check_type
 from rodval.core.scene import trajectory_quantities
 from rodval.core.status import STATUS_MESSAGES
 from rodval.core.trajectory import Trajectory
@@ -104,8 +105,15 @@ def discrepancies(
     """One row per quantity: quantity, max_abs, rms, final_abs, max_rel, k_at_max, t_at_max.
 
     ``quantities`` defaults to those both trajectories hold; a quantity missing from either
-    is a ValueError.
+    is a ValueError. Arguments of another type are refused up front (ValueError).
     """
+    check_type("traj", traj, Trajectory, "a rodval.Trajectory (what simulate returns)")
+    check_type("reference", reference, Trajectory, "a rodval.Trajectory (what simulate returns)")
+    if isinstance(quantities, str) or not isinstance(quantities, Iterable | None):
+        raise ValueError(
+            f"quantities must be a list of quantity names such as ['phi'] or None (all), "
+            f"got {quantities!r}"
+        )
     qs = common_quantities(traj, reference) if quantities is None else tuple(quantities)
     missing = [q for q in qs if q not in traj.values or q not in reference.values]
     if missing:

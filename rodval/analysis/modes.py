@@ -75,11 +75,14 @@ on 1 - MAC), not by index; ``compare_modes`` tabulates several models against a 
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 import pandas as pd
 import scipy.linalg
 from scipy.optimize import linear_sum_assignment
 
+from rodval.core.checks import check_type
 from rodval.core.eigen import angular_frequencies, quadratic_eigenvalues, symmetric_pencil
 from rodval.core.modal import (
     ABOUT,
@@ -168,7 +171,10 @@ def static_equilibrium(
                     break
                 J = K.copy()
                 J[:n, :n] += load_stiffness(chain.l, q[:n], args[0], args[1])
-                q = q - np.linalg.solve(J, R)
+                try:
+                    q = q - np.linalg.solve(J, R)
+                except np.linalg.LinAlgError:  # singular: no Newton step; try more load steps
+                    q = np.full_like(q, np.nan)
                 total += 1
                 if not np.all(np.isfinite(q)):
                     break
@@ -182,6 +188,34 @@ def static_equilibrium(
         steps *= 2
     R = static_residual(chain, q, SX, SY, rest, K=K)
     return Equilibrium(q, total, steps // 2, float(np.max(np.abs(R))), False)
+
+
+def no_equilibrium(chain: Chain, eq: Equilibrium) -> str:
+    """Why ``static_equilibrium`` found none, in one line: hinges without stiffness
+    (kappa = 0) that the loads do not hold leave the chain free to turn there (a singular
+    stiffness, no unique equilibrium); otherwise Newton's method did not converge."""
+    free = [int(k) for k in np.flatnonzero(chain.kappa == 0)]
+    if free:
+        return (
+            f"static equilibrium not found: hinge(s) {free} have no stiffness (kappa = 0), so "
+            "where the loads do not hold them the chain turns freely and its stiffness is "
+            "singular (no unique equilibrium, or none Newton's method reaches from the initial "
+            "state); give those hinges kappa > 0, start nearer an equilibrium ([initial] phi), "
+            "or linearize about the initial state (about='initial', --about initial)"
+        )
+    return (
+        f"static equilibrium not found (max |R| = {eq.residual:.3g} N m after "
+        f"{eq.iterations} Newton iterations and {eq.load_steps} load steps)"
+    )
+
+
+def check_arguments(scene: Scene, count: int | None) -> None:
+    """Types before any work: a Scene, and ``count`` an integer >= 1 or None (ValueError)."""
+    check_type("scene", scene, Scene, "a rodval.Scene (e.g. rodval.paper_scene())")
+    if count is not None and (
+        isinstance(count, bool) or not isinstance(count, numbers.Integral) or count < 1
+    ):
+        raise ValueError(f"count (number of modes) must be an integer >= 1 or None, got {count!r}")
 
 
 # -- linear matrices ---------------------------------------------------------------------------
@@ -398,6 +432,7 @@ def modes(
     """Linearized modes of the native ``model`` ("full" or "reduced") about the scene's
     initial state or its static equilibrium under its constant loads (see module docstring).
     ``count``: the lowest ``count`` modes (default all); ``rest``: hinge rest angles (rad)."""
+    check_arguments(scene, count)
     if model not in MODELS:
         raise ValueError(f"model must be one of {MODELS}, got {model!r}")
     if about not in ABOUT:
@@ -412,18 +447,12 @@ def modes(
         eq = static_equilibrium(chain, SX, SY, q0=q0, rest=rest)
         eq.loads = loads
         if not eq.converged:
-            raise ValueError(
-                f"static equilibrium not found (max |R| = {eq.residual:.3g} N m "
-                f"after {eq.iterations} Newton iterations)"
-            )
+            raise ValueError(no_equilibrium(chain, eq))
         q0 = eq.q
     M, C, K = linear_system(chain, model, q0, coefficients, SX, SY)
     lam, X = eigen(K, M, chain, model)
     N = lam.size
-    count = N if count is None else int(count)
-    if count < 1:
-        raise ValueError(f"count must be >= 1, got {count}")
-    count = min(count, N)
+    count = N if count is None else min(count, N)
     lam, X = lam[:count], X[:, :count]
     omega = angular_frequencies(lam)
     zeta = _damping_ratios(M, C, K, X, omega)
@@ -454,6 +483,7 @@ def model_modes(
 ) -> Modes:
     """``modes`` for "full"/"reduced", ``reference_models.exudyn_modes.exudyn_modes`` for
     "exudyn" (``options``: ExudynModel options)."""
+    check_arguments(scene, count)
     if model == "exudyn":
         try:
             from reference_models.exudyn_modes import exudyn_modes

@@ -1,14 +1,17 @@
 """rodval compare A B --out DIR: discrepancies of run A against run B (two `rodval simulate`
-output folders of the same scene: same output times and k labels)."""
+output folders of the same scene: same output times and k labels). Runs of different scenes
+are refused, naming the scene keys that differ, unless ``--allow-different-scenes``."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from rodval.analysis.metrics import discrepancies
+from rodval.cli import CliError
+from rodval.core.scene_file import scene_differences
 from rodval.report.figures import plot_time_histories
 from rodval.report.markdown import to_markdown
-from rodval.report.run_files import read_run
+from rodval.report.run_files import read_run, read_run_record
 
 
 def register(sub) -> None:
@@ -22,10 +25,24 @@ def register(sub) -> None:
     p.add_argument("a", metavar="A", type=Path, help="run folder to compare")
     p.add_argument("b", metavar="B", type=Path, help="reference run folder")
     p.add_argument("--out", required=True, type=Path, help="output folder")
+    p.add_argument(
+        "--allow-different-scenes",
+        action="store_true",
+        help="compare runs whose scenes differ (chain, loads, horizon, ...: refused "
+        "otherwise); the table then mixes a model's error with the change of scene",
+    )
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
+    differ = scene_differences(
+        read_run_record(args.a / "run.json")["scene"], read_run_record(args.b / "run.json")["scene"]
+    )
+    if differ and not args.allow_different_scenes:
+        raise CliError(
+            f"{args.a} and {args.b} are runs of different scenes ({', '.join(differ)} differ); "
+            "give --allow-different-scenes to compare them anyway"
+        )
     a, b = read_run(args.a), read_run(args.b)
     table = discrepancies(a, b)
     args.out.mkdir(parents=True, exist_ok=True)

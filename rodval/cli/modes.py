@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rodval.cli.options import add_model_options, positive_int
+from rodval.cli.options import add_model_options, positive_int, set_options
 from rodval.core.scene_file import load_scene
 from rodval.report.figures import plot_modes
 
@@ -65,7 +65,7 @@ def run(args) -> int:
         if bad or not compare:
             raise ValueError(f"--compare models must be from {MODEL_CHOICES}, got {args.compare!r}")
     scene = load_scene(args.scene)
-    options = dict(args.options)
+    options = set_options(args.options)
     if options and args.model != "exudyn" and not args.compare:
         raise ValueError(f"--set applies to the exudyn model only, got {sorted(options)}")
     m = model_modes(

@@ -5,22 +5,30 @@ from __future__ import annotations
 import argparse
 import math
 
-from rodval.core.settings import DEFAULTS, METHODS
+from rodval.core.settings import DEFAULTS, METHODS, MIN_RTOL, RTOL_RANGE
 
 
-def positive_float(name: str, *, finite: bool = True, below: float = math.inf):
-    """Parser of a number > 0 (and < ``below``) for option ``name``; finite unless
-    ``finite=False``."""
-    allowed = "a finite number > 0" if finite else "a number > 0 (inf allowed)"
-    if below < math.inf:
-        allowed = f"a number in (0, {below:g})"
+def positive_float(
+    name: str,
+    *,
+    finite: bool = True,
+    below: float = math.inf,
+    least: float = 0.0,
+    allowed: str | None = None,
+):
+    """Parser of a number > 0, >= ``least`` and < ``below`` for option ``name``; finite unless
+    ``finite=False``. ``allowed`` words the range in messages (default: from the bounds)."""
+    if allowed is None:
+        allowed = "a finite number > 0" if finite else "a number > 0 (inf allowed)"
+        if below < math.inf:
+            allowed = f"a number in (0, {below:g})"
 
     def parse(text: str) -> float:
         try:
             v = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{name} must be {allowed}, got {text!r}") from None
-        if not (0 < v < below) or (finite and math.isinf(v)):
+        if not (0 < v < below and v >= least) or (finite and math.isinf(v)):
             raise argparse.ArgumentTypeError(f"{name} must be {allowed}, got {text!r}")
         return v
 
@@ -43,14 +51,20 @@ def positive_int(name: str):
 
 
 def time_list(text: str) -> list[float]:
+    """--times t1,t2,...: seconds, finite, >= 0, strictly increasing; no empty item."""
+    items = [t.strip() for t in text.split(",")]
+    if not any(items):
+        raise argparse.ArgumentTypeError("--times must list at least one time")
+    if not all(items):
+        raise argparse.ArgumentTypeError(
+            f"--times must be comma-separated seconds like 0.5,1,2 with no empty item, got {text!r}"
+        )
     try:
-        values = [float(t) for t in text.split(",") if t.strip()]
+        values = [float(t) for t in items]
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"--times must be comma-separated seconds like 0.5,1,2, got {text!r}"
         ) from None
-    if not values:
-        raise argparse.ArgumentTypeError("--times must list at least one time")
     if any(v < 0 or not math.isfinite(v) for v in values):
         raise argparse.ArgumentTypeError(f"--times must be finite and >= 0 s, got {text!r}")
     if any(b <= a for a, b in zip(values, values[1:])):
@@ -87,9 +101,9 @@ def add_integrator_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--rtol",
-        type=positive_float("--rtol", below=1.0),
+        type=positive_float("--rtol", below=1.0, least=MIN_RTOL, allowed=RTOL_RANGE),
         default=d["rtol"],
-        help=f"relative tolerance in (0, 1) (default {d['rtol']:g})",
+        help=f"relative tolerance: {RTOL_RANGE} (default {d['rtol']:g})",
     )
     p.add_argument(
         "--atol",
@@ -150,3 +164,30 @@ def add_model_options(p: argparse.ArgumentParser, *, coefficients_default: str |
         help="model option, e.g. elements=8 for exudyn (repeatable); the allowed "
         "keys of each model: docs/scene_file.md",
     )
+
+
+def set_options(pairs: list[tuple[str, object]]) -> dict[str, object]:
+    """The ``--set KEY=VALUE`` pairs as a dict; a key given twice is refused (ValueError), never
+    one of its values winning silently."""
+    out: dict[str, object] = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(
+                f"--set {key} given twice ({key}={out[key]!r} and {key}={value!r}); give it once"
+            )
+        out[key] = value
+    return out
+
+
+def model_options(args: argparse.Namespace) -> dict[str, object]:
+    """The model options of ``add_model_options``: the --set pairs and --coefficients (when
+    given); --coefficients together with --set coefficients=... is refused (ValueError)."""
+    options = set_options(args.options)
+    if args.coefficients is not None:
+        if "coefficients" in options:
+            raise ValueError(
+                f"--coefficients {args.coefficients} and --set coefficients="
+                f"{options['coefficients']} conflict: give the coefficient variant once"
+            )
+        options["coefficients"] = args.coefficients
+    return options

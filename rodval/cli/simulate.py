@@ -13,15 +13,21 @@ from rodval.cli.options import (
     add_integrator_options,
     add_model_options,
     integrator_settings,
+    model_options,
     positive_float,
     time_list,
 )
+from rodval.core.checks import check_keys
 from rodval.core.scene_file import read_scene_document, scene_from_dict, with_horizon
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.core.validity import describe
 from rodval.models import REGISTRY, model_class, simulate
 from rodval.report.run_files import read_run_record, write_run
 from rodval.solvers.progress import progress_bar
+
+#: The keys of a run.json's settings a rerun reads: the settings, and the method asked for
+#: when "auto" chose one.
+RERUN_SETTINGS = (*SETTING_NAMES, "requested_method")
 
 
 def register(sub) -> None:
@@ -59,6 +65,7 @@ def run(args) -> int:
         settings_kw = {}
         if getattr(model_class(model), "USES_INTEGRATOR_SETTINGS", True):
             ran = previous["settings"]
+            check_keys(ran, RERUN_SETTINGS, f"{path} key 'settings'")
             settings_kw = {k: v for k, v in ran.items() if k in SETTING_NAMES}
             settings_kw["method"] = ran.get("requested_method", settings_kw.get("method"))
     else:
@@ -76,9 +83,7 @@ def run(args) -> int:
     )
     if args.times is not None:
         scene = scene.with_(times=args.times)
-    options.update(dict(args.options))
-    if args.coefficients:
-        options["coefficients"] = args.coefficients
+    options.update(model_options(args))
     settings_kw.update(integrator_settings(args))
     with progress_bar(scene.t_end, enabled=sys.stderr.isatty()):
         traj = simulate(scene, model, settings=IntegratorSettings(**settings_kw), **options)

@@ -410,6 +410,9 @@ def _read_history(path: Path) -> tuple[list[float], list[float] | None, list[flo
     unknown = sorted(set(head) - {"t", "X", "Y"})
     if unknown:
         raise ValueError(f"{path}: unknown column {unknown[0]!r} (allowed: t, X, Y)")
+    twice = sorted({c for c in head if head.count(c) > 1})
+    if twice:
+        raise ValueError(f"{path}: column {twice[0]!r} named twice (each of t, X, Y at most once)")
     try:
         data = np.array([[float(c) for c in r] for r in rows[1:] if r], dtype=float)
     except ValueError as exc:

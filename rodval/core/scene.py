@@ -20,11 +20,12 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
 
+from rodval.core.checks import check_keys
 from rodval.core.loads import NodalForce
 from rodval.core.resources import check_run_memory
 
@@ -161,7 +162,8 @@ class Chain:
         return {k: getattr(self, k).tolist() for k in self.FIELDS}
 
     def with_(self, **changes) -> Chain:
-        """A copy with some fields replaced (scalars broadcast)."""
+        """A copy with some fields replaced (scalars broadcast); an unknown field is refused."""
+        check_keys(changes, self.FIELDS, "Chain.with_", noun="field")
         d = {k: getattr(self, k) for k in self.FIELDS}
         d.update(changes)
         return Chain(**d, _n=self.n)
@@ -248,8 +250,15 @@ class Latch:
         ):
             raise ValueError(f"latch hinge must be an integer >= 0, got {self.hinge!r}")
         _finite("latch angle", self.angle, "rad")
-        if self.direction not in (None, 1, -1) or isinstance(self.direction, bool):
-            raise ValueError(f"latch direction must be +1, -1 or None, got {self.direction!r}")
+        if self.direction is not None and (
+            isinstance(self.direction, bool)
+            or not isinstance(self.direction, numbers.Integral)
+            or self.direction not in (1, -1)
+        ):
+            raise ValueError(
+                f"latch direction must be the integer +1 or -1, or omitted (None), "
+                f"got {self.direction!r}"
+            )
 
 
 @dataclass(frozen=True)
@@ -341,6 +350,8 @@ class Scene:
     stops: tuple[Stop, ...] = ()
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise ValueError(f"name (the scene's label) must be a string, got {self.name!r}")
         if not isinstance(self.chain, Chain):
             raise ValueError(f"chain must be a rodval.Chain, got {type(self.chain).__name__}")
         n = self.chain.n
@@ -438,7 +449,8 @@ class Scene:
         return np.array(sorted(bps))
 
     def with_(self, **changes) -> Scene:
-        """A copy with fields replaced (validated again)."""
+        """A copy with fields replaced (validated again); an unknown field is refused."""
+        check_keys(changes, (f.name for f in fields(self)), "Scene.with_", noun="field")
         return replace(self, **changes)
 
     def wants(self, *quantities: str) -> bool:
@@ -467,7 +479,7 @@ def paper_scene(
         chain=chain,
         loads=(pulse(node),),
         t_end=t_end,
-        times=None if times is None else np.asarray(list(times), float),
+        times=times,
         outputs=tuple(outputs),
         name=f"paper-n{n}",
     )

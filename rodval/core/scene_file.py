@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from rodval.core.checks import check_keys
 from rodval.core.loads import LOAD_FACTORIES
 from rodval.core.scene import (
     DEFAULT_NUM_TIMES,
@@ -50,21 +51,11 @@ INITIAL_KEYS = {"phi", "dphi", "alpha", "beta", "dalpha", "dbeta"}
 TIMES_KEYS = {"start", "stop", "num"}
 
 
-def _check_keys(d: dict, allowed: set[str], where: str) -> None:
-    if not isinstance(d, dict):
-        raise ValueError(f"{where}: expected a table, got {type(d).__name__}")
-    unknown = sorted(set(d) - allowed)
-    if unknown:
-        raise ValueError(
-            f"{where}: unknown key {unknown[0]!r} (allowed: {', '.join(sorted(allowed))})"
-        )
-
-
 def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
     if value is None:
         return None
     if isinstance(value, dict):
-        _check_keys(value, TIMES_KEYS, f"{where} key 'times'")
+        check_keys(value, TIMES_KEYS, f"{where} key 'times'")
         num = value.get("num", DEFAULT_NUM_TIMES)
         if isinstance(num, bool) or not isinstance(num, int):
             raise ValueError(
@@ -122,7 +113,7 @@ def _table_items(d: dict, key: str, cls: type, keys: tuple[str, ...], where: str
     out = []
     for i, spec in enumerate(items):
         place = f"{where} [[{key}]] #{i + 1}"
-        _check_keys(spec, set(keys), place)
+        check_keys(spec, set(keys), place)
         try:
             out.append(cls(**spec))
         except TypeError as exc:
@@ -135,7 +126,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
 
     Every error is a ValueError that names ``where`` (a file name) and the offending key.
     """
-    _check_keys(d, TOP_KEYS, where)
+    check_keys(d, TOP_KEYS, where)
     base = d.get("base", "paper")
     if base not in BASES:
         raise ValueError(f"{where} key 'base': must be one of {BASES}, got {base!r}")
@@ -148,7 +139,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
             raise ValueError(f"key 't_end' (horizon) must be a number > 0 s, got {t_end!r}")
         scene = paper_scene(n, t_end=float(t_end))
         chain_spec = d.get("chain", {})
-        _check_keys(chain_spec, CHAIN_KEYS, f"{where} [chain]")
+        check_keys(chain_spec, CHAIN_KEYS, f"{where} [chain]")
         chain = (
             Chain(**{**scene.chain.as_dict(), **chain_spec}, _n=n) if chain_spec else scene.chain
         )
@@ -160,7 +151,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
                 _load(s, n, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"])
             )
         init_spec = d.get("initial", {})
-        _check_keys(init_spec, INITIAL_KEYS, f"{where} [initial]")
+        check_keys(init_spec, INITIAL_KEYS, f"{where} [initial]")
         outputs = d.get("outputs", scene.outputs)
         if isinstance(outputs, str) or not isinstance(outputs, (list, tuple)):
             raise ValueError(f"key 'outputs' must be a list from {QUANTITIES}, got {outputs!r}")
@@ -175,7 +166,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
             times=_times(d.get("times"), float(t_end), where),
             outputs=tuple(outputs),
             initial=InitialState(**init_spec),
-            name=str(d.get("name", scene.name)),
+            name=d.get("name", scene.name),
         )
     except ValueError as exc:
         msg = str(exc)
@@ -236,3 +227,21 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "latches": [dataclasses.asdict(latch) for latch in scene.latches],
         "stops": [dataclasses.asdict(stop) for stop in scene.stops],
     }
+
+
+#: Keys of a scene dict that label a scene without changing what is simulated.
+LABEL_KEYS = ("name",)
+
+
+def scene_differences(a: dict[str, Any], b: dict[str, Any]) -> list[str]:
+    """The keys in which two scene dicts (``scene_to_dict``) differ, dotted for the tables
+    (``"chain.EI"``, ``"initial.phi"``, ``"loads"``), sorted; labels (``LABEL_KEYS``) aside.
+    Empty when both describe the same simulation."""
+    out = []
+    for key in sorted((set(a) | set(b)) - set(LABEL_KEYS)):
+        va, vb = a.get(key), b.get(key)
+        if isinstance(va, dict) and isinstance(vb, dict):
+            out += [f"{key}.{k}" for k in sorted(set(va) | set(vb)) if va.get(k) != vb.get(k)]
+        elif va != vb:
+            out.append(key)
+    return out

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import sys
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
@@ -23,6 +24,14 @@ AUTO = "auto"
 #: Every method name accepted by IntegratorSettings (simulate, CLI, studies).
 METHODS = (AUTO,) + SCIPY_METHODS + COMPILED_METHODS
 IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+#: The smallest relative tolerance the integrators honour: 100 machine epsilons (scipy's
+#: solve_ivp raises any smaller rtol to it; below it no step can meet the tolerance).
+MIN_RTOL = 100 * sys.float_info.epsilon
+#: The allowed rtol, for messages.
+RTOL_RANGE = (
+    f"a number in (0, 1), at least {MIN_RTOL:.3g} (> 0 is not enough: the integrators cannot "
+    "honour less than 100 machine epsilons)"
+)
 
 
 @dataclass(frozen=True)
@@ -30,8 +39,9 @@ class IntegratorSettings:
     """Integrator choice for ODE models.
 
     method : one of ``METHODS``; default "auto" (see ``AUTO``).
-    rtol, atol : relative tolerance in (0, 1) and absolute tolerance > 0, finite (absolute in
-        the state's units: rad, rad/s).
+    rtol, atol : relative tolerance in [MIN_RTOL, 1) (``MIN_RTOL`` = 2.22e-14: the smallest
+        the integrators honour) and absolute tolerance > 0, finite (absolute in the state's
+        units: rad, rad/s).
     max_step : largest step (s), > 0; inf means unbounded.
     first_step : initial step (s), > 0, or None to let the integrator choose.
 
@@ -75,8 +85,8 @@ class IntegratorSettings:
             "min_step_fraction",
         ):
             _number(name, getattr(self, name))
-        if not (0 < self.rtol < 1):
-            raise ValueError(f"rtol must be a number > 0 and < 1, got {self.rtol!r}")
+        if not (MIN_RTOL <= self.rtol < 1):
+            raise ValueError(f"rtol must be {RTOL_RANGE}, got {self.rtol!r}")
         if not (0 < self.atol < math.inf):
             raise ValueError(f"atol must be a finite number > 0, got {self.atol!r}")
         for name in ("max_step", "max_wall_s"):

@@ -63,6 +63,14 @@ class SolverStats:
         }
 
 
+class UnknownQuantity(KeyError, ValueError):
+    """A quantity a trajectory does not hold (a KeyError for ``traj[q]``, a ValueError for
+    rodval's one-line error reporting); its message names it and the available ones."""
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
 @dataclass
 class Trajectory:
     """Requested quantities of one run.
@@ -93,6 +101,13 @@ class Trajectory:
         return self.stats.success
 
     def __getitem__(self, quantity: str) -> np.ndarray:
+        """Values (nt, nk) of ``quantity``; UnknownQuantity (a KeyError) naming it and the
+        available quantities when the run does not hold it."""
+        if quantity not in self.values:
+            raise UnknownQuantity(
+                f"quantity {quantity!r} is not in this trajectory (available: "
+                f"{', '.join(self.values) or 'none'}; a scene's outputs choose them)"
+            )
         return self.values[quantity]
 
     @property
@@ -100,10 +115,24 @@ class Trajectory:
         return tuple(self.values)
 
     def at(self, quantity: str, t: float, k: int) -> float:
-        """Value of ``quantity`` for index k at output time t (exact match of t)."""
-        i = int(np.flatnonzero(np.isclose(self.times, t, rtol=0, atol=1e-12))[0])
-        j = int(np.flatnonzero(self.k_index[quantity] == k)[0])
-        return float(self.values[quantity][i, j])
+        """Value of ``quantity`` for index k at output time t (s, exact match of t within
+        1e-12 s); ValueError naming t or k when the trajectory has no such output time or
+        label, UnknownQuantity for a quantity it does not hold."""
+        values = self[quantity]
+        i = np.flatnonzero(np.isclose(self.times, t, rtol=0, atol=1e-12))
+        if i.size == 0:
+            raise ValueError(
+                f"t = {t!r} s is not an output time of this trajectory "
+                f"({self.times.size} times in [{self.times.min(initial=0):g}, "
+                f"{self.times.max(initial=0):g}] s; the scene's times choose them)"
+            )
+        j = np.flatnonzero(self.k_index[quantity] == k)
+        if j.size == 0:
+            raise ValueError(
+                f"k = {k!r} is not a label of {quantity!r} "
+                f"(allowed: {', '.join(map(str, self.k_index[quantity]))})"
+            )
+        return float(values[i[0], j[0]])
 
     def to_dict(self) -> dict:
         """Plain JSON-ready form (lists and numbers); inverse of ``from_dict``."""

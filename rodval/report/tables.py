@@ -13,6 +13,7 @@ from typing import Any
 import pandas as pd
 
 from rodval.analysis.metrics import METRICS
+from rodval.core.checks import as_path
 
 TABLES = ("cases", "trajectories", "discrepancies", "runtime")
 FIXED = (
@@ -91,9 +92,11 @@ def axis_columns(meta: dict[str, Any]) -> dict[str, str]:
     return cols
 
 
-def read_tables(out: Path) -> dict[str, pd.DataFrame]:
-    """The study tables in ``out``, checked: every file present, readable as CSV and with the
-    columns the report needs. ValueError naming the file and what is wrong otherwise."""
+def read_tables(out: str | Path) -> dict[str, pd.DataFrame]:
+    """The study tables in the folder ``out`` (str or Path), checked: every file present,
+    readable as CSV and with the columns the report needs. ValueError naming the file and
+    what is wrong otherwise."""
+    out = as_path("out", out)
     tables = {}
     for name in TABLES:
         path = out / f"{name}.csv"

@@ -18,13 +18,14 @@ import numpy as np
 from tqdm import tqdm
 
 from rodval.analysis.metrics import compare_runs
+from rodval.core.checks import as_path, check_type
 from rodval.core.provenance import provenance
 from rodval.core.scene_file import scene_to_dict
 from rodval.core.status import STATUS_CRASHED, STATUS_DIVERGED, STATUS_TIMEOUT
 from rodval.core.trajectory import Trajectory
 from rodval.study.records import CaseRecord, DamagedRecord, RunRecord, read_case
 from rodval.study.schedule import BACKENDS, default_workers, run_dask, run_processes
-from rodval.study.spec import Case, StudySpec
+from rodval.study.spec import Case, StudySpec, load_study
 from rodval.study.store import StudyStore, write_json_atomic, write_text_atomic
 
 RETRIED = (STATUS_TIMEOUT, STATUS_CRASHED)
@@ -108,7 +109,7 @@ class StudyRun:
 
 
 def run_study(
-    spec: StudySpec,
+    spec: StudySpec | str | Path,
     out: str | Path,
     *,
     workers: int | None = None,
@@ -120,7 +121,8 @@ def run_study(
     report: bool = True,
     fresh: bool = False,
 ) -> StudyRun:
-    """Run the cases of ``spec`` not yet on disk in ``out``, then write tables and report.
+    """Run the cases of ``spec`` (a study, or the path of a study file) not yet on disk in
+    ``out``, then write tables and report.
 
     workers: parallel cases for the processes backend (default: all cores).
     case_timeout: seconds after which a case's unfinished runs are stopped (None: no limit).
@@ -131,6 +133,10 @@ def run_study(
     Every argument is checked before any work; a second run on the same folder at the same
     time is refused (``FolderBusy``).
     """
+    if isinstance(spec, str | Path):
+        spec = load_study(spec)
+    check_type("spec", spec, StudySpec, "a study (rodval.load_study) or a study file's path")
+    out = as_path("out", out)
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
     if backend == "dask" and not scheduler:

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from rodval.core.checks import as_path
 from rodval.core.resources import (
     STATE_PER_ROD,
     check_run_memory,
@@ -502,8 +503,8 @@ def _check_resources(cases: tuple[Case, ...], where: str) -> None:
 
 
 def load_study(path: str | Path) -> StudySpec:
-    """Read and validate a study file."""
-    path = Path(path)
+    """Read and validate a study file (``path``: str or Path)."""
+    path = as_path("path", path)
     if not path.is_file():
         raise ValueError(f"study file {str(path)!r} does not exist")
     try:
