@@ -139,12 +139,15 @@ def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[st
         if len(outside):
             lines.append(to_markdown(outside[["case", "model", "max_bending", "status"]]))
     lines.append(f"## Discrepancies against `{ref}`\n")
-    lines.append(
-        "Largest absolute difference over all output times and rods (`max_abs`; rad, "
-        "rad/s) and the same relative to each reference rod's largest value "
-        "(`max_rel`); see `discrepancies.csv` for rms, final value and where the "
-        "maximum occurs.\n"
-    )
+    if len(meta["models"]) == 1:
+        lines.append(f"The study has one model (`{ref}`): nothing to compare.\n")
+    else:
+        lines.append(
+            "Largest absolute difference over all output times and rods (`max_abs`; rad, "
+            "rad/s) and the same relative to each reference rod's largest value "
+            "(`max_rel`); see `discrepancies.csv` for rms, final value and where the "
+            "maximum occurs.\n"
+        )
     for model, part in disc.groupby("model", sort=False):
         ok = part[part["status"] == "ok"]
         lines.append(f"### `{model}` against `{ref}`\n")
@@ -192,22 +195,21 @@ def _param_figures(
             and tables["cases"][x].min() > 0
             and tables["cases"][x].max() / tables["cases"][x].min() >= 8
         )
-        d = plot_discrepancy_vs(
-            tables["discrepancies"],
-            x,
-            others,
-            labels,
-            fig_dir / f"discrepancy_vs_{x}.png",
-            logx=logx,
-        )
+        lines.append(f"### Against {x}\n")
+        if not tables["discrepancies"].empty:
+            d = plot_discrepancy_vs(
+                tables["discrepancies"],
+                x,
+                others,
+                labels,
+                fig_dir / f"discrepancy_vs_{x}.png",
+                logx=logx,
+            )
+            lines.append(f"![discrepancy against {x}](figures/{d.name})\n")
         r = plot_runtime_vs(
             tables["runtime"], x, others, labels, fig_dir / f"runtime_vs_{x}.png", logx=logx
         )
-        lines += [
-            f"### Against {x}\n",
-            f"![discrepancy against {x}](figures/{d.name})\n",
-            f"![run time against {x}](figures/{r.name})\n",
-        ]
+        lines.append(f"![run time against {x}](figures/{r.name})\n")
         if not speed.empty:
             s = plot_speedup_vs(
                 speed, x, others, labels, ref, fig_dir / f"speedup_vs_{x}.png", logx=logx

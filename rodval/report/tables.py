@@ -119,6 +119,8 @@ def read_tables(out: Path) -> dict[str, pd.DataFrame]:
             raise ValueError(
                 f"{path}: column {missing[0]!r} is missing (needed: {', '.join(REQUIRED[name])})"
             )
+        if df.empty:  # a header only (e.g. no model pairs): typed, nothing to check
+            df = df.astype({col: float for col in NUMERIC.get(name, ())})
         for col in NUMERIC.get(name, ()):
             if not pd.api.types.is_numeric_dtype(df[col]):
                 bad = next((v for v in df[col] if pd.isna(pd.to_numeric(v, errors="coerce"))), None)
