@@ -45,3 +45,46 @@ def test_single_model_study_finishes_with_tables_and_a_report(single):
     assert pd.read_csv(out / "discrepancies.csv").empty
     report = (out / "report.md").read_text()
     assert "nothing to compare" in report and "one model" in report
+
+
+# --------------------------------------------------------- 2. --fresh removes only its own
+
+
+def test_fresh_refuses_a_folder_that_is_not_a_study_folder(tmp_path, capsys):
+    """Issue: `rodval study FILE --out DIR --fresh` emptied any folder (a user's thesis.tex was
+    deleted). A folder with files but no study.json is refused, exit 2, one line naming --out;
+    nothing in it is touched and nothing is added."""
+    study = write_study(tmp_path, models=ONE_MODEL, grid="scene.t_end = [0.1]")
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "thesis.tex").write_text("\\documentclass{article}")
+    argv = ["study", str(study), "--out", str(mine), "--fresh", "--no-progress"]
+    assert main(argv) == 2
+    line = one_line(capsys)
+    assert "--out" in line and "not a study folder" in line and "thesis.tex" in line, line
+    assert sorted(p.name for p in mine.iterdir()) == ["thesis.tex"]
+    assert (mine / "thesis.tex").read_text() == "\\documentclass{article}"
+
+
+def test_fresh_on_a_study_folder_keeps_the_users_files(single, tmp_path):
+    """--fresh on a study folder removes what the study wrote (records, tables, report,
+    figures) and keeps the files a user put there, also inside cases/ and figures/."""
+    import shutil
+
+    _, finished = single
+    out = tmp_path / "out"
+    shutil.copytree(finished, out)
+    own = [out / "notes.txt", out / "cases" / "README", out / "figures" / "sketch.png"]
+    for path in own:
+        path.write_text("mine")
+    old_records = sorted(p.name for p in (out / "cases").glob("*.json"))
+    assert len(old_records) == 2
+    other = write_study(tmp_path, "other.toml", models=ONE_MODEL, grid="scene.t_end = [0.2]")
+    other.write_text(other.read_text().replace('name = "tiny"', 'name = "other"'))
+    argv = ["study", str(other), "--out", str(out), "--fresh", "--no-progress", "--no-report"]
+    assert main(argv) == 0
+    assert all(path.read_text() == "mine" for path in own)
+    records = sorted(p.name for p in (out / "cases").glob("*.json"))
+    assert records == ["n=2,t_end=0.2.json", "n=3,t_end=0.2.json"]
+    assert not (out / "report.md").exists()  # the old study's report is gone
+    assert sorted(p.name for p in (out / "figures").iterdir()) == ["sketch.png"]

@@ -49,7 +49,10 @@ def register(sub) -> None:
         "--scheduler", metavar="ADDR", help="dask scheduler address, e.g. tcp://host:8786"
     )
     p.add_argument(
-        "--fresh", action="store_true", help="empty DIR first (needed when DIR holds another study)"
+        "--fresh",
+        action="store_true",
+        help="first remove what the study in DIR wrote (needed when DIR holds another study); "
+        "files of your own there are kept, and a folder that is not a study folder is refused",
     )
     p.add_argument(
         "--report",

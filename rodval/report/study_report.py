@@ -25,7 +25,7 @@ from rodval.report.figures import (
     speedups,
 )
 from rodval.report.markdown import to_markdown
-from rodval.report.tables import axis_columns, read_tables, trajectory_samples
+from rodval.report.tables import FIGURES, axis_columns, read_tables, trajectory_samples
 
 
 def varying_params(cases: pd.DataFrame, params: list[str]) -> list[str]:
@@ -536,7 +536,7 @@ def build_report(out: str | Path) -> Path:
     prov = _read_json(out / "provenance.json", ("machine", "packages"))
     tables = read_tables(out)
     params = ["n", "horizon", *axis_columns(meta).values()]
-    fig_dir = out / "figures"
+    fig_dir = out / FIGURES
     fig_dir.mkdir(exist_ok=True)
     lines = _header(meta, prov)
     lines += _summary_tables(meta, tables, params)

@@ -15,6 +15,11 @@ import pandas as pd
 from rodval.analysis.metrics import METRICS
 
 TABLES = ("cases", "trajectories", "discrepancies", "runtime")
+#: Every table a study may write (``<name>.csv``, some also ``<name>.md``): the four above,
+#: and events and modes tables when runs record them.
+ALL_TABLES = (*TABLES, "events", "modes", "mac", "mode_shapes")
+#: The report's figure folder in a study folder (the PNG files report.md links).
+FIGURES = "figures"
 FIXED = (
     "case",
     "n",
