@@ -88,3 +88,44 @@ def test_fresh_on_a_study_folder_keeps_the_users_files(single, tmp_path):
     assert records == ["n=2,t_end=0.2.json", "n=3,t_end=0.2.json"]
     assert not (out / "report.md").exists()  # the old study's report is gone
     assert sorted(p.name for p in (out / "figures").iterdir()) == ["sketch.png"]
+
+
+# ------------------------------------------- 3. report settings checked when the file is read
+
+
+@pytest.mark.parametrize(
+    "report, words",
+    [
+        ("rods = [1, 99]", "key 'report.rods': rod 99 is beyond the chain of report case "
+         "'n=2,t_end=0.1' (n = 2); allowed: 1..2 or \"last\""),
+        ('quantities = ["phi", "x"]', "key 'report.quantities': must be a list of quantities "
+         "every report case outputs (phi, dphi, alpha, beta), got ['phi', 'x']"),
+        ("times = [0.05, 5.0]", "key 'report.times': must be a list of times in 0..0.1 s"),
+    ],
+)  # fmt: skip
+def test_report_settings_are_refused_before_any_case_runs(tmp_path, capsys, report, words):
+    """Issue: [report] rods beyond n, a quantity not among the outputs and times beyond t_end
+    failed only after every case had run. They are refused when the study file is read: exit
+    2, one line naming the key and what is allowed, no output folder."""
+    study = write_study(tmp_path, models=ONE_MODEL, grid="scene.t_end = [0.1, 0.2]")
+    study.write_text(study.read_text() + f"\n[report]\n{report}\n")
+    out = tmp_path / "out"
+    assert main(["study", str(study), "--out", str(out), "--no-progress"]) == 2
+    line = one_line(capsys)
+    assert str(study) in line and words in line, line
+    assert not out.exists()
+
+
+def test_report_rods_and_times_are_checked_against_the_report_cases_only(tmp_path):
+    """The rule: rods within the chain and times within the horizon of every report case
+    (the cases the report draws); other cases of the grid do not restrict them."""
+    from rodval.study import load_study
+
+    study = write_study(tmp_path, models=ONE_MODEL, grid="scene.t_end = [0.1, 0.2]")
+    study.write_text(
+        study.read_text()
+        + '\n[report]\ncases = ["n=3,t_end=0.2"]\nrods = [3]\ntimes = [0.2]\n'
+        + 'quantities = ["dphi"]\n'
+    )
+    rep = load_study(study).report
+    assert (rep.rods, rep.times, rep.quantities) == ((3,), (0.2,), ("dphi",))

@@ -123,6 +123,10 @@ def _modes_spec(table: Any, where: str) -> dict[str, Any] | None:
     return {"count": count, "about": about}
 
 
+#: The quantities the report draws when [report] does not say (those the cases output).
+DEFAULT_REPORT_QUANTITIES = ("phi", "dphi", "alpha", "beta")
+
+
 @dataclass(frozen=True)
 class ReportSpec:
     """What the report draws. ``rods``: rod numbers >= 1 or "last"; ``times``: configuration
@@ -130,7 +134,7 @@ class ReportSpec:
 
     cases: tuple[str, ...]
     rods: tuple[int | str, ...] = (1, "last")
-    quantities: tuple[str, ...] = ("phi", "dphi", "alpha", "beta")
+    quantities: tuple[str, ...] = DEFAULT_REPORT_QUANTITIES
     times: tuple[float, ...] | None = None
 
     def as_dict(self) -> dict[str, Any]:
@@ -293,16 +297,21 @@ def _check_model_options(name: str, options: dict, where: str, key: str) -> None
         raise _err(where, key, f"bad model option: {exc}") from None
 
 
-def _report_spec(table: Any, case_ids: list[str], where: str, demanding: str) -> ReportSpec:
-    """Default detail cases: the study's most demanding one (most rods x longest horizon),
-    then its first (the base of the grid), without repeats."""
+def _report_spec(table: Any, cases: tuple[Case, ...], where: str) -> ReportSpec:
+    """The [report] table, checked against the cases it draws (``report.cases``, by default
+    the study's most demanding case, most rods x longest horizon, then its first): every rod
+    number within every report case's chain, every quantity among every report case's outputs,
+    every time within every report case's horizon (s)."""
     table = {} if table is None else table
     _check_keys(table, REPORT_KEYS, where, "report")
-    cases = table.get("cases", list(dict.fromkeys([demanding, case_ids[0]])))
-    if not isinstance(cases, list) or any(c not in case_ids for c in cases):
+    by_id = {c.id: c for c in cases}
+    demanding = max(cases, key=lambda c: c.scene.n * c.scene.t_end).id
+    ids = table.get("cases", list(dict.fromkeys([demanding, cases[0].id])))
+    if not isinstance(ids, list) or any(c not in by_id for c in ids):
         raise _err(
-            where, "report.cases", f"must be a list of case ids from {case_ids}, got {cases!r}"
+            where, "report.cases", f"must be a list of case ids from {list(by_id)}, got {ids!r}"
         )
+    drawn = [by_id[c] for c in ids]
     rods = table.get("rods", [1, "last"])
     if (
         not isinstance(rods, list)
@@ -315,27 +324,53 @@ def _report_spec(table: Any, case_ids: list[str], where: str, demanding: str) ->
         raise _err(
             where, "report.rods", f'must be a list of rod numbers >= 1 or "last", got {rods!r}'
         )
-    quantities = table.get("quantities", ["phi", "dphi", "alpha", "beta"])
+    shortest = min(drawn, key=lambda c: c.scene.n)
+    beyond = [r for r in rods if r != "last" and r > shortest.scene.n]
+    if beyond:
+        raise _err(
+            where,
+            "report.rods",
+            f"rod {beyond[0]} is beyond the chain of report case {shortest.id!r} "
+            f'(n = {shortest.scene.n}); allowed: 1..{shortest.scene.n} or "last"',
+        )
+    outputs = [
+        q for q in QUANTITIES if all(q in trajectory_quantities(c.scene.outputs) for c in drawn)
+    ]
+    quantities = table.get(
+        "quantities", [q for q in DEFAULT_REPORT_QUANTITIES if q in outputs] or outputs
+    )
     if (
         not isinstance(quantities, list)
         or not quantities
-        or any(q not in QUANTITIES for q in quantities)
+        or any(q not in outputs for q in quantities)
     ):
         raise _err(
-            where, "report.quantities", f"must be a list from {QUANTITIES}, got {quantities!r}"
+            where,
+            "report.quantities",
+            f"must be a list of quantities every report case outputs ({', '.join(outputs)}), "
+            f"got {quantities!r}",
         )
     times = table.get("times")
+    horizon = min(c.scene.t_end for c in drawn)
     if times is not None and (
         not isinstance(times, list)
         or not times
         or any(
-            isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t < 0
+            isinstance(t, bool)
+            or not isinstance(t, (int, float))
+            or not math.isfinite(t)
+            or not 0 <= t <= horizon
             for t in times
         )
     ):
-        raise _err(where, "report.times", f"must be a list of times >= 0 s, got {times!r}")
+        raise _err(
+            where,
+            "report.times",
+            f"must be a list of times in 0..{horizon:g} s (the shortest horizon of the report "
+            f"cases), got {times!r}",
+        )
     return ReportSpec(
-        cases=tuple(cases),
+        cases=tuple(ids),
         rods=tuple(rods),
         quantities=tuple(quantities),
         times=None if times is None else tuple(float(t) for t in times),
@@ -440,9 +475,7 @@ def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpe
         )
     _check_file_names(ids, where)
     _check_resources(cases, where)
-    # the default detail case: the most demanding (most rods x longest horizon)
-    demanding = max(cases, key=lambda c: c.scene.n * c.scene.t_end).id
-    report = _report_spec(doc.get("report"), ids, where, demanding)
+    report = _report_spec(doc.get("report"), cases, where)
     return StudySpec(
         name=str(study.get("name", Path(where).stem)),
         description=str(study.get("description", "")),
