@@ -129,3 +129,67 @@ def test_report_rods_and_times_are_checked_against_the_report_cases_only(tmp_pat
     )
     rep = load_study(study).report
     assert (rep.rods, rep.times, rep.quantities) == ((3,), (0.2,), ("dphi",))
+
+
+# ------------------------------------------------------------- 4. the grid's size, at once
+
+
+def test_a_4_million_case_grid_is_refused_at_once(tmp_path, capsys):
+    """Issue: a grid of 4 million cases gave no answer for minutes (every case was built
+    first). Its size is computed before it is expanded and refused in well under a second,
+    one line naming the size, the limit and how to raise it."""
+    import time
+
+    from rodval.study import load_study
+    from rodval.study.spec import MAX_CASES
+
+    t_end = ", ".join(f"{0.1 + i * 1e-4:.4f}" for i in range(2000))
+    kappa = ", ".join(str(10 + i) for i in range(1000))
+    grid = f"scene.t_end = [{t_end}]\nscene.chain.kappa = [{kappa}]"
+    study = write_study(tmp_path, models=ONE_MODEL, grid=grid)
+    start = time.perf_counter()
+    with pytest.raises(ValueError) as info:
+        load_study(study)
+    assert time.perf_counter() - start < 1.0
+    assert f"key 'grid': 4000000 cases, more than the limit of {MAX_CASES}" in str(info.value)
+    out = tmp_path / "out"
+    assert main(["study", str(study), "--out", str(out)]) == 2
+    line = one_line(capsys)
+    assert "4000000 cases" in line and "--max-cases N" in line, line
+    assert not out.exists()
+
+
+def test_the_limit_can_be_raised_and_the_number_of_cases_is_announced(tmp_path, capsys):
+    """--max-cases sets the limit (a 4-case grid over a limit of 3 is refused); within the
+    limit the number of cases is printed before they are checked and run."""
+    from rodval.study import load_study
+
+    study = write_study(tmp_path, models=ONE_MODEL, grid="scene.t_end = [0.1, 0.2]")
+    with pytest.raises(ValueError, match="4 cases, more than the limit of 3"):
+        load_study(study, max_cases=3)
+    assert len(load_study(study, max_cases=4).cases) == 4
+    with pytest.raises(ValueError, match="max_cases must be an integer >= 1, got 0"):
+        load_study(study, max_cases=0)
+    out = tmp_path / "out"
+    assert main(["study", str(study), "--out", str(out), "--max-cases", "3"]) == 2
+    assert "more than the limit of 3" in one_line(capsys)
+    with pytest.raises(SystemExit) as exit_info:
+        main(["study", str(study), "--out", str(out), "--max-cases", "0"])
+    assert exit_info.value.code == 2
+    assert "--max-cases must be an integer >= 1" in one_line(capsys)
+    announced = []
+    load_study(study, announce=announced.append)
+    assert announced == [4]
+
+
+def test_the_cli_announces_the_number_of_cases_on_stdout(tmp_path, capsys):
+    """The announcement goes to stdout before the cases are checked (so a bad case is still
+    one line on stderr), and not with --no-progress."""
+    study = write_study(tmp_path, models=ONE_MODEL, grid="scene.t_end = [0.1, -1.0]")
+    out = str(tmp_path / "out")
+    assert main(["study", str(study), "--out", out]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == f"{study}: 4 cases; checking them before any runs\n"
+    assert len(captured.err.strip().splitlines()) == 1 and "t_end" in captured.err
+    assert main(["study", str(study), "--out", out, "--no-progress"]) == 2
+    assert capsys.readouterr().out == ""

@@ -21,6 +21,7 @@ import json
 import math
 import re
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -40,6 +41,10 @@ from rodval.study.store import MAX_NAME, case_file_name
 
 TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report", "modes"}
 MODES_KEYS = {"count", "about"}
+#: Most cases a study grid may have by default: every case is built and checked before any
+#: runs (about 1-3 ms each on the 2-core machine, so ~1 min at the limit); raise it with
+#: ``max_cases`` (CLI ``--max-cases N``).
+MAX_CASES = 20_000
 #: Most modes a study may ask for per model.
 MAX_MODES = 200
 STUDY_KEYS = {"name", "description", "reference"}
@@ -435,8 +440,34 @@ def _build_case(doc: dict, combo: dict[str, Any], labels: dict[str, str], where:
     )
 
 
-def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpec:
-    """Parse and validate a study document (the TOML as a dict); see the module docstring."""
+def grid_size(grids: list[dict[str, list[Any]]]) -> int:
+    """Number of cases of a grid: the sum over its ``[[grid]]`` tables of the product of
+    their axes' lengths (one case for a study without a grid), without expanding it."""
+    return sum(math.prod(len(values) for values in sub.values()) for sub in grids)
+
+
+def _check_max_cases(max_cases: Any) -> int:
+    if isinstance(max_cases, bool) or not isinstance(max_cases, int) or max_cases < 1:
+        raise ValueError(f"max_cases must be an integer >= 1, got {max_cases!r}")
+    return max_cases
+
+
+def study_from_dict(
+    doc: dict,
+    where: str = "study",
+    text: str = "",
+    *,
+    max_cases: int = MAX_CASES,
+    announce: Callable[[int], None] | None = None,
+) -> StudySpec:
+    """Parse and validate a study document (the TOML as a dict); see the module docstring.
+
+    max_cases: most cases the grid may have (``MAX_CASES`` by default); its size is computed
+    before it is expanded, and a larger grid is refused at once.
+    announce: called with the number of cases once it is known, before the cases are built
+    and checked (which takes about 1-3 ms per case).
+    """
+    max_cases = _check_max_cases(max_cases)
     _check_keys(doc, TOP_KEYS, where, "")
     study = doc.setdefault("study", {})
     _check_keys(study, STUDY_KEYS, where, "study")
@@ -454,6 +485,17 @@ def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpe
         raise _err(where, "scene", "must be a table")
     grid = doc.get("grid")
     grids = [_grid_axes(g, doc, where) for g in (grid if isinstance(grid, list) else [grid])]
+    size = grid_size(grids)
+    if size > max_cases:
+        raise _err(
+            where,
+            "grid",
+            f"{size} cases, more than the limit of {max_cases} (every case is built and "
+            "checked before any runs); split the study, or raise the limit with "
+            "--max-cases N (Python: max_cases=N)",
+        )
+    if announce is not None:
+        announce(size)
     axes: dict[str, list[Any]] = {}
     for sub in grids:  # [[grid]]: the union of several grids' cartesian products
         for path, values in sub.items():
@@ -534,8 +576,14 @@ def _check_resources(cases: tuple[Case, ...], where: str) -> None:
         raise ValueError(f"{where}: {exc}") from None
 
 
-def load_study(path: str | Path) -> StudySpec:
-    """Read and validate a study file."""
+def load_study(
+    path: str | Path,
+    *,
+    max_cases: int = MAX_CASES,
+    announce: Callable[[int], None] | None = None,
+) -> StudySpec:
+    """Read and validate a study file (``max_cases``, ``announce``: see study_from_dict)."""
+    max_cases = _check_max_cases(max_cases)
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"study file {str(path)!r} does not exist")
@@ -544,4 +592,4 @@ def load_study(path: str | Path) -> StudySpec:
         doc = tomllib.loads(text)
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
-    return study_from_dict(doc, where=str(path), text=text)
+    return study_from_dict(doc, where=str(path), text=text, max_cases=max_cases, announce=announce)
