@@ -193,3 +193,79 @@ def test_the_cli_announces_the_number_of_cases_on_stdout(tmp_path, capsys):
     assert len(captured.err.strip().splitlines()) == 1 and "t_end" in captured.err
     assert main(["study", str(study), "--out", out, "--no-progress"]) == 2
     assert capsys.readouterr().out == ""
+
+
+# ---------------------------------------------------------- 5. damaged and truncated tables
+
+
+@pytest.fixture(scope="module")
+def paired(tmp_path_factory):
+    """A finished two-model study (two cases; tables and report written)."""
+    tmp = tmp_path_factory.mktemp("paired")
+    study = write_study(tmp, grid="scene.t_end = [0.1]")
+    out = tmp / "out"
+    argv = ["study", str(study), "--out", str(out), "--no-progress", "--workers", "1"]
+    assert main(argv) == 0
+    return out
+
+
+def _copy(finished, tmp_path):
+    import shutil
+
+    out = tmp_path / "out"
+    shutil.copytree(finished, out)
+    return out
+
+
+def _cut_bytes(path, fraction: float) -> None:
+    data = path.read_bytes()
+    path.write_bytes(data[: int(len(data) * fraction)])
+
+
+def _cut_rows(path, fraction: float) -> None:
+    lines = path.read_text().splitlines(keepends=True)
+    path.write_text("".join(lines[: max(2, int(len(lines) * fraction))]))
+
+
+def _nan_max_abs(path, quantity: str = "phi") -> None:
+    df = pd.read_csv(path)
+    df.loc[df["quantity"] == quantity, "max_abs"] = float("nan")
+    df.to_csv(path, index=False)
+
+
+@pytest.mark.parametrize(
+    "table, damage, words",
+    [
+        ("discrepancies", lambda p: _cut_bytes(p, 0.3), "the file is truncated or was edited"),
+        ("discrepancies", lambda p: _cut_rows(p, 0.5), "the file is truncated or was edited"),
+        ("runtime", lambda p: _cut_bytes(p, 0.3), "the file is truncated or was edited"),
+        ("runtime", lambda p: _cut_rows(p, 0.7), "the file is truncated or was edited"),
+        ("discrepancies", _nan_max_abs, "max_abs is NaN although status is 'ok'"),
+    ],
+    ids=[
+        "cut to 30 % of its bytes",
+        "cut at a row",
+        "runtime cut",
+        "runtime cut at a row",
+        "NaN max_abs",
+    ],
+)
+def test_damaged_tables_are_refused_in_one_line(paired, tmp_path, capsys, table, damage, words):
+    """Issue: `rodval report` accepted a discrepancies.csv cut to 30 % of its bytes; a NaN in
+    max_abs gave `internal error: KeyError`. Exit 2, one line naming the file and what is
+    wrong."""
+    out = _copy(paired, tmp_path)
+    damage(out / f"{table}.csv")
+    assert main(["report", str(out)]) == 2
+    line = one_line(capsys)
+    assert f"{out / table}.csv" in line and words in line, line
+
+
+def test_tables_without_their_manifest_are_refused(paired, tmp_path, capsys):
+    """Tables that cannot be checked against what the study wrote (no tables.json) are
+    refused with the way to rewrite them."""
+    out = _copy(paired, tmp_path)
+    (out / "tables.json").unlink()
+    assert main(["report", str(out)]) == 2
+    line = one_line(capsys)
+    assert "tables.json is missing" in line and "rodval study FILE --out" in line, line

@@ -29,7 +29,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from rodval.report.tables import ALL_TABLES, FIGURES
+from rodval.report.tables import ALL_TABLES, FIGURES, MANIFEST
 
 #: Name of the temporary file of an atomic write (``write_text_atomic``): ``.<name>.<pid>.tmp``.
 TEMPORARY = re.compile(r"\..+\.\d+\.tmp")
@@ -125,10 +125,10 @@ class StudyStore:
 
     def study_files(self, meta: dict[str, Any]) -> list[Path]:
         """The files the study described by ``meta`` (its study.json) wrote into the folder:
-        study.json, study.toml, provenance.json, the tables (``<name>.csv`` and ``.md``),
-        report.md, the figures report.md links, the records of its cases and the temporary
+        study.json, study.toml, provenance.json, the tables (``<name>.csv`` and ``.md``) and
+        their manifest, report.md, the figures report.md links, the records of its cases and the temporary
         files of interrupted atomic writes. ``--fresh`` removes these and nothing else."""
-        top = ["study.json", "study.toml", "provenance.json", "report.md"]
+        top = ["study.json", "study.toml", "provenance.json", "report.md", MANIFEST]
         top += [f"{name}.{ext}" for name in ALL_TABLES for ext in ("csv", "md")]
         files = [self.out / name for name in top]
         report = self.out / "report.md"
