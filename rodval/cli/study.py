@@ -84,7 +84,8 @@ def run(args) -> int:
 
     def announce(size: int) -> None:
         if args.progress:
-            print(f"{args.file}: {size} cases; checking them before any runs", flush=True)
+            cases = f"{size} case" + ("s" if size != 1 else "")
+            print(f"{args.file}: {cases}; checking them before any runs", flush=True)
 
     spec = load_study(args.file, max_cases=args.max_cases or MAX_CASES, announce=announce)
     if args.backend == "dask" and not args.scheduler:
