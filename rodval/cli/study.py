@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from rodval.cli.options import positive_float, positive_int
+from rodval.study.spec import MAX_CASES
 
 
 def register(sub) -> None:
@@ -49,7 +50,10 @@ def register(sub) -> None:
         "--scheduler", metavar="ADDR", help="dask scheduler address, e.g. tcp://host:8786"
     )
     p.add_argument(
-        "--fresh", action="store_true", help="empty DIR first (needed when DIR holds another study)"
+        "--fresh",
+        action="store_true",
+        help="first remove what the study in DIR wrote (needed when DIR holds another study); "
+        "files of your own there are kept, and a folder that is not a study folder is refused",
     )
     p.add_argument(
         "--report",
@@ -58,7 +62,19 @@ def register(sub) -> None:
         help="write report.md and figures/ after the tables (default); --no-report: tables "
         "only (`rodval report DIR` writes it later)",
     )
-    p.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
+    p.add_argument(
+        "--max-cases",
+        type=positive_int("--max-cases"),
+        metavar="N",
+        help=f"refuse a grid of more than N cases (default {MAX_CASES}); every case is built "
+        "and checked before any runs",
+    )
+    p.add_argument(
+        "--no-progress",
+        dest="progress",
+        action="store_false",
+        help="no progress bar and no announcement of the number of cases",
+    )
     p.set_defaults(func=run)
 
 
@@ -66,7 +82,12 @@ def run(args) -> int:
     from rodval.study import load_study, run_study
     from rodval.study.store import StudyStore
 
-    spec = load_study(args.file)
+    def announce(size: int) -> None:
+        if args.progress:
+            cases = f"{size} case" + ("s" if size != 1 else "")
+            print(f"{args.file}: {cases}; checking them before any runs", flush=True)
+
+    spec = load_study(args.file, max_cases=args.max_cases or MAX_CASES, announce=announce)
     if args.backend == "dask" and not args.scheduler:
         raise ValueError("--backend dask needs --scheduler ADDR")
     signal.signal(signal.SIGTERM, signal.default_int_handler)

@@ -26,7 +26,7 @@ from rodval.report.figures import (
     speedups,
 )
 from rodval.report.markdown import to_markdown
-from rodval.report.tables import axis_columns, read_tables, trajectory_samples
+from rodval.report.tables import FIGURES, axis_columns, read_tables, trajectory_samples
 
 
 def varying_params(cases: pd.DataFrame, params: list[str]) -> list[str]:
@@ -141,12 +141,15 @@ def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[st
     if len(invalid):
         lines.append(to_markdown(invalid[["case", "model", "status", "invalid_because"]]))
     lines.append(f"## Discrepancies against `{ref}`\n")
-    lines.append(
-        "Largest absolute difference over all output times and rods (`max_abs`; rad, "
-        "rad/s) and the same relative to each reference rod's largest value "
-        "(`max_rel`); see `discrepancies.csv` for rms, final value and where the "
-        "maximum occurs.\n"
-    )
+    if len(meta["models"]) == 1:
+        lines.append(f"The study has one model (`{ref}`): nothing to compare.\n")
+    else:
+        lines.append(
+            "Largest absolute difference over all output times and rods (`max_abs`; rad, "
+            "rad/s) and the same relative to each reference rod's largest value "
+            "(`max_rel`); see `discrepancies.csv` for rms, final value and where the "
+            "maximum occurs.\n"
+        )
     for model, part in disc.groupby("model", sort=False):
         ok = part[part["status"] == "ok"]
         lines.append(f"### `{model}` against `{ref}`\n")
@@ -194,22 +197,21 @@ def _param_figures(
             and tables["cases"][x].min() > 0
             and tables["cases"][x].max() / tables["cases"][x].min() >= 8
         )
-        d = plot_discrepancy_vs(
-            tables["discrepancies"],
-            x,
-            others,
-            labels,
-            fig_dir / f"discrepancy_vs_{x}.png",
-            logx=logx,
-        )
+        lines.append(f"### Against {x}\n")
+        if not tables["discrepancies"].empty:
+            d = plot_discrepancy_vs(
+                tables["discrepancies"],
+                x,
+                others,
+                labels,
+                fig_dir / f"discrepancy_vs_{x}.png",
+                logx=logx,
+            )
+            lines.append(f"![discrepancy against {x}](figures/{d.name})\n")
         r = plot_runtime_vs(
             tables["runtime"], x, others, labels, fig_dir / f"runtime_vs_{x}.png", logx=logx
         )
-        lines += [
-            f"### Against {x}\n",
-            f"![discrepancy against {x}](figures/{d.name})\n",
-            f"![run time against {x}](figures/{r.name})\n",
-        ]
+        lines.append(f"![run time against {x}](figures/{r.name})\n")
         if not speed.empty:
             s = plot_speedup_vs(
                 speed, x, others, labels, ref, fig_dir / f"speedup_vs_{x}.png", logx=logx
@@ -536,7 +538,7 @@ def build_report(out: str | Path) -> Path:
     prov = _read_json(out / "provenance.json", ("machine", "packages"))
     tables = read_tables(out)
     params = ["n", "horizon", *axis_columns(meta).values()]
-    fig_dir = out / "figures"
+    fig_dir = out / FIGURES
     fig_dir.mkdir(exist_ok=True)
     lines = _header(meta, prov)
     lines += _summary_tables(meta, tables, params)

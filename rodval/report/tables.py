@@ -7,6 +7,8 @@ a study folder needs (the report, ``rodval report``), so it lies below the study
 
 from __future__ import annotations
 
+import hashlib
+import json
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +18,11 @@ from rodval.analysis.metrics import METRICS
 from rodval.core.checks import as_path
 
 TABLES = ("cases", "trajectories", "discrepancies", "runtime")
+#: Every table a study may write (``<name>.csv``, some also ``<name>.md``): the four above,
+#: and events and modes tables when runs record them.
+ALL_TABLES = (*TABLES, "events", "modes", "mac", "mode_shapes")
+#: The report's figure folder in a study folder (the PNG files report.md links).
+FIGURES = "figures"
 FIXED = (
     "case",
     "n",
@@ -94,8 +101,9 @@ def axis_columns(meta: dict[str, Any]) -> dict[str, str]:
 
 def read_tables(out: str | Path) -> dict[str, pd.DataFrame]:
     """The study tables in the folder ``out`` (str or Path), checked: every file present,
-    readable as CSV and with the columns the report needs. ValueError naming the file and
-    what is wrong otherwise."""
+    readable as CSV and with the columns the report needs, consistent (cases, complete
+    trajectories, a value of each metric for every comparison made) and the very files the
+    study wrote (``MANIFEST``). ValueError naming the file and what is wrong otherwise."""
     out = as_path("out", out)
     tables = {}
     for name in TABLES:
@@ -122,6 +130,8 @@ def read_tables(out: str | Path) -> dict[str, pd.DataFrame]:
             raise ValueError(
                 f"{path}: column {missing[0]!r} is missing (needed: {', '.join(REQUIRED[name])})"
             )
+        if df.empty:  # a header only (e.g. no model pairs): typed, nothing to check
+            df = df.astype({col: float for col in NUMERIC.get(name, ())})
         for col in NUMERIC.get(name, ()):
             if not pd.api.types.is_numeric_dtype(df[col]):
                 bad = next((v for v in df[col] if pd.isna(pd.to_numeric(v, errors="coerce"))), None)
@@ -139,7 +149,78 @@ def read_tables(out: str | Path) -> dict[str, pd.DataFrame]:
         if unknown:
             raise ValueError(f"{out / (name + '.csv')}: case {unknown[0]!r} is not in cases.csv")
     _check_trajectories(tables["trajectories"], out / "trajectories.csv")
+    _check_compared(tables["discrepancies"], out / "discrepancies.csv")
+    check_manifest(out)
     return tables
+
+
+#: Beside the tables: each CSV table's size and SHA-256 as the study wrote it
+#: (``rodval.study.tables.write_tables``), so that a truncated or edited table is refused.
+MANIFEST = "tables.json"
+#: The discrepancy metrics every comparison that was made (status "ok") has a value of
+#: (max_rel may be NaN: a reference that is identically zero has no relative scale).
+COMPARED = ("max_abs", "rms", "final_abs")
+
+
+def table_digest(path: Path) -> dict[str, Any]:
+    """A file's size (bytes) and SHA-256 (hex), as the manifest records them."""
+    sha = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            sha.update(block)
+    return {"bytes": path.stat().st_size, "sha256": sha.hexdigest()}
+
+
+def check_manifest(out: Path) -> None:
+    """Every table the manifest lists is the file the study wrote (same size and SHA-256);
+    ValueError naming the file and what is wrong otherwise."""
+    path = out / MANIFEST
+    rewrite = (
+        f"run `rodval study FILE --out {out}` again to rewrite the tables from the case records"
+    )
+    if not path.is_file():
+        raise ValueError(
+            f"{path} is missing, so the tables cannot be checked against what the study "
+            f"wrote; {rewrite}"
+        )
+    try:
+        manifest = json.loads(path.read_text())
+        wrote = {str(name): (int(e["bytes"]), str(e["sha256"])) for name, e in manifest.items()}
+    except (OSError, UnicodeDecodeError, ValueError, TypeError, KeyError, AttributeError) as exc:
+        raise ValueError(f"{path}: unreadable ({type(exc).__name__}: {exc}); {rewrite}") from None
+    missing = [name for name in TABLES if name not in wrote]
+    if missing:
+        raise ValueError(f"{path}: table {missing[0]!r} is not listed; {rewrite}")
+    for name, (size, sha) in wrote.items():
+        table = out / f"{name}.csv"
+        if not table.is_file():
+            raise ValueError(f"{table} is missing (the study wrote it); {rewrite}")
+        got = table_digest(table)
+        if got["bytes"] != size:
+            raise ValueError(
+                f"{table}: {got['bytes']} bytes, the study wrote {size} (the file is "
+                f"truncated or was edited); {rewrite}"
+            )
+        if got["sha256"] != sha:
+            raise ValueError(
+                f"{table}: checksum mismatch with what the study wrote (the file was edited "
+                f"or damaged); {rewrite}"
+            )
+
+
+def _check_compared(disc: pd.DataFrame, path: Path) -> None:
+    """A comparison that was made (status "ok") has a value of each COMPARED metric; one
+    that could not be made says why in its status."""
+    made = disc[disc["status"] == "ok"]
+    for col in COMPARED:
+        bad = made[made[col].isna()]
+        if not bad.empty:
+            row = bad.iloc[0]
+            raise ValueError(
+                f"{path}: case {row['case']!r}, model {row['model']!r}, {row['quantity']}: "
+                f"{col} is NaN although status is 'ok' (a comparison that could not be made "
+                "says why in its status; the table was edited or damaged)"
+            )
 
 
 #: Columns that must be numeric in each table.

@@ -129,7 +129,8 @@ def run_study(
     resume: reuse finished cases in ``out`` (False: run every case again).
     backend: "processes" or "dask" (then ``scheduler`` is the address of a running
     dask.distributed scheduler).
-    fresh: empty ``out`` first (needed when it holds another study).
+    fresh: first remove what the study in ``out`` wrote (needed when it holds another
+    study); refused for a folder with files but no study.json (not a study folder).
     Every argument is checked before any work; a second run on the same folder at the same
     time is refused (``FolderBusy``).
     """
@@ -148,6 +149,8 @@ def run_study(
         raise ValueError(f"case_timeout must be > 0 s or None, got {case_timeout!r}")
     start = time.perf_counter()
     store = StudyStore(out)
+    if fresh:
+        store.check_fresh()
     warnings: list[str] = []
     with store.lock():
         store.claim(study_meta(spec), fresh=fresh)

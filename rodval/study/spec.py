@@ -21,6 +21,7 @@ import json
 import math
 import re
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -41,6 +42,10 @@ from rodval.study.store import MAX_NAME, case_file_name
 
 TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report", "modes"}
 MODES_KEYS = {"count", "about"}
+#: Most cases a study grid may have by default: every case is built and checked before any
+#: runs (about 1-3 ms each on the 2-core machine, so ~1 min at the limit); raise it with
+#: ``max_cases`` (CLI ``--max-cases N``).
+MAX_CASES = 20_000
 #: Most modes a study may ask for per model.
 MAX_MODES = 200
 STUDY_KEYS = {"name", "description", "reference"}
@@ -124,6 +129,10 @@ def _modes_spec(table: Any, where: str) -> dict[str, Any] | None:
     return {"count": count, "about": about}
 
 
+#: The quantities the report draws when [report] does not say (those the cases output).
+DEFAULT_REPORT_QUANTITIES = ("phi", "dphi", "alpha", "beta")
+
+
 @dataclass(frozen=True)
 class ReportSpec:
     """What the report draws. ``rods``: rod numbers >= 1 or "last"; ``times``: configuration
@@ -131,7 +140,7 @@ class ReportSpec:
 
     cases: tuple[str, ...]
     rods: tuple[int | str, ...] = (1, "last")
-    quantities: tuple[str, ...] = ("phi", "dphi", "alpha", "beta")
+    quantities: tuple[str, ...] = DEFAULT_REPORT_QUANTITIES
     times: tuple[float, ...] | None = None
 
     def as_dict(self) -> dict[str, Any]:
@@ -294,16 +303,21 @@ def _check_model_options(name: str, options: dict, where: str, key: str) -> None
         raise _err(where, key, f"bad model option: {exc}") from None
 
 
-def _report_spec(table: Any, case_ids: list[str], where: str, demanding: str) -> ReportSpec:
-    """Default detail cases: the study's most demanding one (most rods x longest horizon),
-    then its first (the base of the grid), without repeats."""
+def _report_spec(table: Any, cases: tuple[Case, ...], where: str) -> ReportSpec:
+    """The [report] table, checked against the cases it draws (``report.cases``, by default
+    the study's most demanding case, most rods x longest horizon, then its first): every rod
+    number within every report case's chain, every quantity among every report case's outputs,
+    every time within every report case's horizon (s)."""
     table = {} if table is None else table
     _check_keys(table, REPORT_KEYS, where, "report")
-    cases = table.get("cases", list(dict.fromkeys([demanding, case_ids[0]])))
-    if not isinstance(cases, list) or any(c not in case_ids for c in cases):
+    by_id = {c.id: c for c in cases}
+    demanding = max(cases, key=lambda c: c.scene.n * c.scene.t_end).id
+    ids = table.get("cases", list(dict.fromkeys([demanding, cases[0].id])))
+    if not isinstance(ids, list) or any(c not in by_id for c in ids):
         raise _err(
-            where, "report.cases", f"must be a list of case ids from {case_ids}, got {cases!r}"
+            where, "report.cases", f"must be a list of case ids from {list(by_id)}, got {ids!r}"
         )
+    drawn = [by_id[c] for c in ids]
     rods = table.get("rods", [1, "last"])
     if (
         not isinstance(rods, list)
@@ -316,27 +330,53 @@ def _report_spec(table: Any, case_ids: list[str], where: str, demanding: str) ->
         raise _err(
             where, "report.rods", f'must be a list of rod numbers >= 1 or "last", got {rods!r}'
         )
-    quantities = table.get("quantities", ["phi", "dphi", "alpha", "beta"])
+    shortest = min(drawn, key=lambda c: c.scene.n)
+    beyond = [r for r in rods if r != "last" and r > shortest.scene.n]
+    if beyond:
+        raise _err(
+            where,
+            "report.rods",
+            f"rod {beyond[0]} is beyond the chain of report case {shortest.id!r} "
+            f'(n = {shortest.scene.n}); allowed: 1..{shortest.scene.n} or "last"',
+        )
+    outputs = [
+        q for q in QUANTITIES if all(q in trajectory_quantities(c.scene.outputs) for c in drawn)
+    ]
+    quantities = table.get(
+        "quantities", [q for q in DEFAULT_REPORT_QUANTITIES if q in outputs] or outputs
+    )
     if (
         not isinstance(quantities, list)
         or not quantities
-        or any(q not in QUANTITIES for q in quantities)
+        or any(q not in outputs for q in quantities)
     ):
         raise _err(
-            where, "report.quantities", f"must be a list from {QUANTITIES}, got {quantities!r}"
+            where,
+            "report.quantities",
+            f"must be a list of quantities every report case outputs ({', '.join(outputs)}), "
+            f"got {quantities!r}",
         )
     times = table.get("times")
+    horizon = min(c.scene.t_end for c in drawn)
     if times is not None and (
         not isinstance(times, list)
         or not times
         or any(
-            isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t < 0
+            isinstance(t, bool)
+            or not isinstance(t, (int, float))
+            or not math.isfinite(t)
+            or not 0 <= t <= horizon
             for t in times
         )
     ):
-        raise _err(where, "report.times", f"must be a list of times >= 0 s, got {times!r}")
+        raise _err(
+            where,
+            "report.times",
+            f"must be a list of times in 0..{horizon:g} s (the shortest horizon of the report "
+            f"cases), got {times!r}",
+        )
     return ReportSpec(
-        cases=tuple(cases),
+        cases=tuple(ids),
         rods=tuple(rods),
         quantities=tuple(quantities),
         times=None if times is None else tuple(float(t) for t in times),
@@ -401,8 +441,34 @@ def _build_case(doc: dict, combo: dict[str, Any], labels: dict[str, str], where:
     )
 
 
-def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpec:
-    """Parse and validate a study document (the TOML as a dict); see the module docstring."""
+def grid_size(grids: list[dict[str, list[Any]]]) -> int:
+    """Number of cases of a grid: the sum over its ``[[grid]]`` tables of the product of
+    their axes' lengths (one case for a study without a grid), without expanding it."""
+    return sum(math.prod(len(values) for values in sub.values()) for sub in grids)
+
+
+def _check_max_cases(max_cases: Any) -> int:
+    if isinstance(max_cases, bool) or not isinstance(max_cases, int) or max_cases < 1:
+        raise ValueError(f"max_cases must be an integer >= 1, got {max_cases!r}")
+    return max_cases
+
+
+def study_from_dict(
+    doc: dict,
+    where: str = "study",
+    text: str = "",
+    *,
+    max_cases: int = MAX_CASES,
+    announce: Callable[[int], None] | None = None,
+) -> StudySpec:
+    """Parse and validate a study document (the TOML as a dict); see the module docstring.
+
+    max_cases: most cases the grid may have (``MAX_CASES`` by default); its size is computed
+    before it is expanded, and a larger grid is refused at once.
+    announce: called with the number of cases once it is known, before the cases are built
+    and checked (which takes about 1-3 ms per case).
+    """
+    max_cases = _check_max_cases(max_cases)
     _check_keys(doc, TOP_KEYS, where, "")
     study = doc.setdefault("study", {})
     _check_keys(study, STUDY_KEYS, where, "study")
@@ -420,6 +486,17 @@ def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpe
         raise _err(where, "scene", "must be a table")
     grid = doc.get("grid")
     grids = [_grid_axes(g, doc, where) for g in (grid if isinstance(grid, list) else [grid])]
+    size = grid_size(grids)
+    if size > max_cases:
+        raise _err(
+            where,
+            "grid",
+            f"{size} cases, more than the limit of {max_cases} (every case is built and "
+            "checked before any runs); split the study, or raise the limit with "
+            "--max-cases N (Python: max_cases=N)",
+        )
+    if announce is not None:
+        announce(size)
     axes: dict[str, list[Any]] = {}
     for sub in grids:  # [[grid]]: the union of several grids' cartesian products
         for path, values in sub.items():
@@ -441,9 +518,7 @@ def study_from_dict(doc: dict, where: str = "study", text: str = "") -> StudySpe
         )
     _check_file_names(ids, where)
     _check_resources(cases, where)
-    # the default detail case: the most demanding (most rods x longest horizon)
-    demanding = max(cases, key=lambda c: c.scene.n * c.scene.t_end).id
-    report = _report_spec(doc.get("report"), ids, where, demanding)
+    report = _report_spec(doc.get("report"), cases, where)
     return StudySpec(
         name=str(study.get("name", Path(where).stem)),
         description=str(study.get("description", "")),
@@ -502,9 +577,16 @@ def _check_resources(cases: tuple[Case, ...], where: str) -> None:
         raise ValueError(f"{where}: {exc}") from None
 
 
-def load_study(path: str | Path) -> StudySpec:
-    """Read and validate a study file (``path``: str or Path)."""
+def load_study(
+    path: str | Path,
+    *,
+    max_cases: int = MAX_CASES,
+    announce: Callable[[int], None] | None = None,
+) -> StudySpec:
+    """Read and validate a study file (``path``: str or Path; ``max_cases``, ``announce``: see
+    study_from_dict)."""
     path = as_path("path", path)
+    max_cases = _check_max_cases(max_cases)
     if not path.is_file():
         raise ValueError(f"study file {str(path)!r} does not exist")
     try:
@@ -512,4 +594,4 @@ def load_study(path: str | Path) -> StudySpec:
         doc = tomllib.loads(text)
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
-    return study_from_dict(doc, where=str(path), text=text)
+    return study_from_dict(doc, where=str(path), text=text, max_cases=max_cases, announce=announce)

@@ -9,8 +9,10 @@ and ``figures/``.
   kernel when the process dies, so a killed run never leaves it stuck); a second run on the
   same folder is refused with a ``FolderBusy`` naming the holder's pid.
 * One study: a folder that holds another study (``study.json`` with a different name or
-  source, or a different grid) is refused unless ``fresh=True`` (``--fresh``), which empties
-  it first.
+  source, or a different grid) is refused unless ``fresh=True`` (``--fresh``), which first
+  removes what the study wrote (``study_files``) and nothing else. ``study.json`` is what
+  marks a study folder: ``--fresh`` on a folder with files but no ``study.json`` is refused,
+  and files a user put into a study folder are kept.
 * Case file names are bounded (``MAX_NAME``) whatever the grid: a readable prefix of the case
   id and a hash of the full id; the full parameters live in the record.
 """
@@ -22,11 +24,15 @@ import hashlib
 import json
 import os
 import re
-import shutil
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
+
+from rodval.report.tables import ALL_TABLES, FIGURES, MANIFEST
+
+#: Name of the temporary file of an atomic write (``write_text_atomic``): ``.<name>.<pid>.tmp``.
+TEMPORARY = re.compile(r"\..+\.\d+\.tmp")
 
 #: Longest case file name (characters, with ".json"): well below every file system's 255.
 MAX_NAME = 120
@@ -104,20 +110,55 @@ class StudyStore:
         finally:
             fh.close()
 
+    def check_fresh(self) -> None:
+        """Refuse ``--fresh`` on a folder that holds files but is not a study folder (no
+        study.json): only what a study wrote is ever removed (before the lock or any write)."""
+        if not self.out.is_dir() or self.meta() is not None:
+            return
+        other = sorted(p.name for p in self.out.iterdir() if p.name != ".lock")
+        if other:
+            raise ValueError(
+                f"--out {self.out}: not a study folder (no study.json; it holds {other[0]!r}"
+                f"{f' and {len(other) - 1} more' if len(other) > 1 else ''}), so --fresh "
+                "will not empty it; use a new or empty --out"
+            )
+
+    def study_files(self, meta: dict[str, Any]) -> list[Path]:
+        """The files the study described by ``meta`` (its study.json) wrote into the folder:
+        study.json, study.toml, provenance.json, the tables (``<name>.csv`` and ``.md``) and
+        their manifest, report.md, the figures report.md links, the records of its cases and the temporary
+        files of interrupted atomic writes. ``--fresh`` removes these and nothing else."""
+        top = ["study.json", "study.toml", "provenance.json", "report.md", MANIFEST]
+        top += [f"{name}.{ext}" for name in ALL_TABLES for ext in ("csv", "md")]
+        files = [self.out / name for name in top]
+        report = self.out / "report.md"
+        if report.is_file():
+            linked = re.findall(rf"\]\({FIGURES}/([^)/]+\.png)\)", report.read_text())
+            files += [self.out / FIGURES / name for name in linked]
+        cases = meta.get("cases")
+        if isinstance(cases, list):
+            ids = [c["id"] for c in cases if isinstance(c, dict) and "id" in c]
+            files += [self.case_path(str(cid)) for cid in ids]
+        for folder in (self.out, self.cases_dir):
+            if folder.is_dir():
+                files += [p for p in folder.glob(".*.tmp") if TEMPORARY.fullmatch(p.name)]
+        return files
+
     def claim(self, meta: dict[str, Any], *, fresh: bool) -> None:
         """Make the folder this study's: refuse a folder holding another study unless
-        ``fresh`` (then empty it); write study.json."""
+        ``fresh`` (then remove what that study wrote, ``study_files``); write study.json."""
         old = self.meta()
         if old is not None and not fresh and not same_study(old, meta):
             raise ValueError(
                 f"{self.out} holds another study ({old.get('name')!r} from "
                 f"{old.get('source')!r}); use another --out, or --fresh to start over there"
             )
-        if fresh:
-            for item in self.out.iterdir():
-                if item.name == ".lock":
-                    continue
-                shutil.rmtree(item) if item.is_dir() else item.unlink()
+        if fresh and old is not None:
+            for path in self.study_files(old):
+                path.unlink(missing_ok=True)
+            for folder in (self.cases_dir, self.out / FIGURES):
+                if folder.is_dir() and not any(folder.iterdir()):
+                    folder.rmdir()
         self.cases_dir.mkdir(parents=True, exist_ok=True)
         write_json_atomic(self.out / "study.json", meta)
 

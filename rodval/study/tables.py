@@ -32,10 +32,10 @@ from rodval.core.modal import Modes
 from rodval.core.status import STATUS_MESSAGES
 from rodval.core.validity import broken
 from rodval.report.markdown import to_markdown
-from rodval.report.tables import axis_columns, trajectory_samples
+from rodval.report.tables import MANIFEST, axis_columns, table_digest, trajectory_samples
 from rodval.study.records import CaseRecord, DamagedRecord, read_case
 from rodval.study.spec import StudySpec
-from rodval.study.store import StudyStore
+from rodval.study.store import StudyStore, write_json_atomic
 
 
 def _case_columns(rec: CaseRecord, axes: dict[str, str]) -> dict[str, Any]:
@@ -230,7 +230,9 @@ def modes_tables(records: list[CaseRecord], axes: dict[str, str]) -> dict[str, p
 
 
 def write_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd.DataFrame]:
-    """Write ``<table>.csv`` for every table and ``<table>.md`` for the readable ones."""
+    """Write ``<table>.csv`` for every table, ``<table>.md`` for the readable ones, and the
+    manifest of the CSV files (``rodval.report.tables.MANIFEST``: size and SHA-256 of each),
+    written last, so that a reader can tell a truncated or edited table."""
     out = Path(out)
     tables = build_tables(out, spec)
     for name, df in tables.items():
@@ -247,4 +249,5 @@ def write_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd
     (out / "trajectories.md").write_text(
         to_markdown(trajectory_samples(tables["trajectories"], meta, tables["cases"]), ".6g")
     )
+    write_json_atomic(out / MANIFEST, {name: table_digest(out / f"{name}.csv") for name in tables})
     return tables
