@@ -110,6 +110,15 @@ class IntegratorSettings:
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
 
+    def budget_message(self, budget: str, t: float) -> str:
+        """The message of a run stopped at time t (s) by its budget ``budget``
+        ("max_evaluations" or "max_wall_s"), with the budget's value."""
+        if budget == "max_wall_s":
+            used = f"wall-clock budget exhausted: max_wall_s = {self.max_wall_s:g} s"
+        else:
+            used = f"evaluation budget exhausted: max_evaluations = {self.max_evaluations}"
+        return f"{used} used (t = {t:.6g} s)"
+
     def with_(self, **changes: Any) -> IntegratorSettings:
         """A copy with fields replaced (validated again)."""
         return IntegratorSettings(**{**self.as_dict(), **changes})

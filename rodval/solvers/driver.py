@@ -147,17 +147,9 @@ class _ScipyRun:
     def fun(self, t: float, y: np.ndarray) -> np.ndarray:
         self.nfev += 1
         if self.nfev > self.settings.max_evaluations:
-            raise _Stop(
-                STATUS_BUDGET,
-                f"evaluation budget exhausted: max_evaluations = "
-                f"{self.settings.max_evaluations} used (t = {t:.6g} s)",
-            )
+            raise _Stop(STATUS_BUDGET, self.settings.budget_message("max_evaluations", t))
         if time.perf_counter() > self.deadline:
-            raise _Stop(
-                STATUS_WALL,
-                f"wall-clock budget exhausted: max_wall_s = "
-                f"{self.settings.max_wall_s:g} s used (t = {t:.6g} s)",
-            )
+            raise _Stop(STATUS_WALL, self.settings.budget_message("max_wall_s", t))
         if not np.all(np.isfinite(y)):
             raise _Stop(
                 STATUS_DIVERGED, f"diverged: non-finite state in a step attempt at t = {t:.6g} s"
