@@ -9,10 +9,16 @@ import numpy as np
 import pytest
 from test_reliability import TimeLimit
 
-from rodval import Scene, paper_scene, simulate
+from rodval import InitialState, Scene, paper_scene, simulate
 from rodval.cli import main
 from rodval.core.loads import LOAD_COLUMNS, LoadSet, load_sums, load_table, tabulated
-from rodval.core.status import STATUS_WALL
+from rodval.core.status import (
+    STATUS_BLOWUP,
+    STATUS_DIVERGED,
+    STATUS_FAILED,
+    STATUS_WALL,
+    numerical_failure,
+)
 
 # ------------------------------------------------- 1. the wall-clock budget of compiled runs
 
@@ -74,3 +80,45 @@ def test_a_long_tabulated_history_ends_by_its_wall_budget(long_history):
     assert 0 < tr.stats.t_reached < 2.0
     # bisection, not a scan: the scan managed ~1000 evaluations in 2 s, bisection ~3e5
     assert tr.stats.nfev > 20_000
+
+
+# --------------------------------------- 2. numerical exceptions inside a run are statuses
+
+SMALL = paper_scene(3, t_end=0.1, times=[0.0, 0.05, 0.1])
+
+
+@pytest.mark.parametrize("model", ["full", "reduced"])
+@pytest.mark.parametrize("method", ["auto", "DOP853", "Radau"])
+@pytest.mark.parametrize("key", ["phi", "dphi"])
+def test_a_huge_initial_state_ends_as_diverged_not_as_an_exception(model, method, key):
+    """Was: "model error: ZeroDivisionError: division by zero" (compiled DOP853's initial
+    step) and "ValueError: array must not contain infs or NaNs" (Radau's LU)."""
+    scene = SMALL.with_(initial=InitialState(**{key: 1e200}))
+    with TimeLimit(60):
+        tr = simulate(scene, model, method=method)
+    # diverged, or scipy's step-size failure ("Required step size ...", now with its time)
+    assert tr.stats.status in (STATUS_DIVERGED, STATUS_BLOWUP, STATUS_FAILED), tr.stats.message
+    assert "Error" not in tr.stats.message and "t = " in tr.stats.message
+    assert 0.0 <= tr.stats.t_reached < 0.1
+    assert all(np.isfinite(v).all() for v in tr.values.values())
+
+
+@pytest.mark.parametrize("method", ["auto", "DOP853", "Radau"])
+def test_a_chain_at_its_bounds_that_cannot_be_factored_is_a_failure_with_its_time(method):
+    """l = 1e12 m and EI = 1e-12 N m^2, both allowed: the reduced model's bending matrix is
+    not positive definite in float64. Was "model error" naming no time."""
+    scene = SMALL.with_(chain=SMALL.chain.with_(l=1e12, EI=1e-12))
+    tr = simulate(scene, "reduced", method=method)
+    assert tr.stats.status == STATUS_FAILED, tr.stats.message
+    assert tr.stats.message.startswith("numerical failure: LinAlgError: ")
+    assert "at t = 0 s" in tr.stats.message and tr.stats.t_reached == 0.0
+
+
+def test_numerical_failure_tells_arithmetic_from_matrices_from_model_errors():
+    assert numerical_failure(ZeroDivisionError("division by zero"), 0.25) == (
+        STATUS_DIVERGED,
+        "diverged: ZeroDivisionError: division by zero at t = 0.25 s",
+    )
+    status, message = numerical_failure(np.linalg.LinAlgError("singular matrix"), 1.5)
+    assert status == STATUS_FAILED and "singular matrix at t = 1.5 s" in message
+    assert numerical_failure(KeyError("phi"), 0.0) is None

@@ -20,6 +20,7 @@ from rodval.core.status import (
     STATUS_FAILED,
     STATUS_STALLED,
     STATUS_WALL,
+    numerical_failure,
 )
 from rodval.core.trajectory import SolverStats
 from rodval.solvers import dop853
@@ -83,7 +84,11 @@ def run_compiled(
             deadline=time.perf_counter() + settings.max_wall_s,
         )
     except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
-        stats.status, stats.message = STATUS_ERROR, f"{type(exc).__name__}: {exc}"
+        # raised by a model's kernel: the loop's time is lost, t_reached stays at the start
+        stats.status, stats.message = numerical_failure(exc, float(edges[0])) or (
+            STATUS_ERROR,
+            f"{type(exc).__name__}: {exc}",
+        )
         return 0
     stats.nfev += nfev
     stats.nsteps += nsteps

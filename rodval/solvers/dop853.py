@@ -9,8 +9,11 @@ a first-class numba function of type ``RHS_TYPE`` called with the form's arrays,
 imports no model and is compiled (and cached on disk) once for every model.
 
 Cost: 12 right-hand-side evaluations per accepted step (+3 on steps holding output times), and
-O(N) work per stage combination. The wall-clock budget reads the clock (a call back into
-Python, ~1 us) once every ``WALL_CHECK_EVALUATIONS`` evaluations, not on every step.
+O(N) work per stage combination. Arithmetic is IEEE (numba's numpy error model): a huge
+state gives inf or NaN, never an exception, and the run ends as ``NON_FINITE`` at the time it
+reached (a division by zero in the initial-step choice raised ZeroDivisionError). The
+wall-clock budget reads the clock (a call back into Python, ~1 us) once every
+``WALL_CHECK_EVALUATIONS`` evaluations, not on every step.
 """
 
 from __future__ import annotations
@@ -46,7 +49,7 @@ WALL_CHECK_EVALUATIONS = 100
 SAFETY, MIN_FACTOR, MAX_FACTOR, ERROR_EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _combine(out, base, K, coef, count, h):
     """out = base + h * sum_{j < count} coef[j] K[j], as contiguous loops over K's rows (no
     temporary arrays; ``out`` must not alias ``base`` or K)."""
@@ -63,7 +66,7 @@ def _combine(out, base, K, coef, count, h):
         out[i] = base[i] + h * out[i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _rms(x):
     return np.sqrt(np.mean(x * x))
 
@@ -76,7 +79,7 @@ def _now():
     return now
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, tmp, f1):
     """scipy's select_initial_step (Hairer, Sec. II.4) for order 7; uses one evaluation."""
     scale = atol + np.abs(y0) * rtol
@@ -123,7 +126,7 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
 )
 
 
-@njit(_RUN_SIGNATURE, cache=True)
+@njit(_RUN_SIGNATURE, cache=True, error_model="numpy")
 def run(
     rhs,
     mechanics,
