@@ -5,13 +5,16 @@ work."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
-from test_reliability import TimeLimit
+from test_reliability import TimeLimit, one_line_error
 
 from rodval import InitialState, Scene, paper_scene, simulate
 from rodval.cli import main
 from rodval.core.loads import LOAD_COLUMNS, LoadSet, load_sums, load_table, tabulated
+from rodval.core.scene import Stop
 from rodval.core.status import (
     STATUS_BLOWUP,
     STATUS_DIVERGED,
@@ -122,3 +125,37 @@ def test_numerical_failure_tells_arithmetic_from_matrices_from_model_errors():
     status, message = numerical_failure(np.linalg.LinAlgError("singular matrix"), 1.5)
     assert status == STATUS_FAILED and "singular matrix at t = 1.5 s" in message
     assert numerical_failure(KeyError("phi"), 0.0) is None
+
+
+# ------------------------------------------------ 3. stop numbers: their names, their range
+
+
+@pytest.mark.parametrize(
+    "changes, words",
+    [
+        ({"stiffness": 1e300}, "stop stiffness (N m/rad) must lie in [1e-12, 1e+12]"),
+        ({"stiffness": 1e-300}, "stop stiffness (N m/rad) must lie in [1e-12, 1e+12]"),
+        ({"damping": 1e300}, "stop damping (N m s/rad) must lie in [0, 1e+12]"),
+        ({"stiffness": -1.0}, "stop stiffness (N m/rad) must be > 0"),
+        ({"damping": "1"}, "stop damping (N m s/rad) must be a real number"),
+    ],
+)
+def test_stop_numbers_are_refused_with_their_name_and_range(changes, words):
+    """Was: stiffness = 1e300 accepted, then "observation failed: ... kappa (hinge
+    stiffness) must lie in [0, 1e+12]" after the run."""
+    with pytest.raises(ValueError, match=re.escape(words)):
+        Stop(hinge=1, angle=0.5, **changes)
+
+
+def test_an_acting_stop_keeps_its_hinge_within_the_chain_bounds(tmp_path, capsys):
+    chain = SMALL.chain.with_(kappa=1e12)
+    with pytest.raises(ValueError, match=re.escape("stop stiffness + kappa of hinge 1")):
+        SMALL.with_(chain=chain, stops=(Stop(1, 0.0, side="lower", stiffness=1e12),))
+    scene_file = tmp_path / "stop.toml"
+    scene_file.write_text("n = 3\n[[stops]]\nhinge = 1\nangle = 0.5\nstiffness = 1e300\n")
+    with TimeLimit(30):
+        code = main(["simulate", str(scene_file), "--out", str(tmp_path / "o")])
+    assert code == 2
+    line = one_line_error(capsys)
+    assert "stop stiffness (N m/rad) must lie in [1e-12, 1e+12]" in line and "kappa" not in line
+    assert not (tmp_path / "o").exists()
