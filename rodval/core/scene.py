@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from rodval.core.loads import NodalForce
-from rodval.core.resources import check_run_memory
+from rodval.core.resources import check_rods, check_run_memory
 
 #: Quantities a scene may ask for. "x"/"y" are node positions (k = 0..n); "energy" yields
 #: kinetic, potential and total energy (k = 0).
@@ -156,6 +156,7 @@ class Chain:
             n = sizes[0] if sizes else 1
         if n < 1:
             raise ValueError(f"n (number of rods) must be >= 1, got {n}")
+        check_rods(n)  # before any n-sized array
         set_ = object.__setattr__
         set_(self, "l", _as_rod_array("l (rod length)", l, n, positive=True))
         set_(self, "m", _as_rod_array("m (mass per length)", m, n, positive=True))

@@ -23,6 +23,10 @@ AUTO = "auto"
 #: Every method name accepted by IntegratorSettings (simulate, CLI, studies).
 METHODS = (AUTO,) + SCIPY_METHODS + COMPILED_METHODS
 IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+#: Largest count (evaluations, steps) a setting may ask for: 2**53, exact as a double and far
+#: inside the compiled loop's int64 counters (a larger one failed at run time with numba's
+#: "No matching definition" or OverflowError).
+MAX_COUNT = 2**53
 
 
 @dataclass(frozen=True)
@@ -96,8 +100,8 @@ class IntegratorSettings:
             raise ValueError(f"min_step_fraction must be in [0, 1), got {self.min_step_fraction!r}")
         for name in ("stall_steps", "max_evaluations"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 1:
-                raise ValueError(f"{name} must be an integer >= 1, got {v!r}")
+            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or not 1 <= v <= MAX_COUNT:
+                raise ValueError(f"{name} must be an integer in [1, {MAX_COUNT}], got {v!r}")
 
     @property
     def compiled(self) -> bool:
