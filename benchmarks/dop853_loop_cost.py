@@ -14,6 +14,7 @@ import time
 import numpy as np
 from numba import njit
 
+from rodval.core.loads import LOAD_COLUMNS
 from rodval.solvers import dop853
 from rodval.solvers.signature import RHS_SIGNATURE
 from rodval.solvers.system import CompiledForm
@@ -38,7 +39,9 @@ def measure(n: int, repeats: int = 3) -> None:
     P = np.ones((1, n))
     y0 = np.zeros(2 * n)
     y0[:n] = 0.1
-    form = CompiledForm(oscillators, P, np.zeros(1), np.zeros((0, 0, 0)), np.zeros((0, 9)))
+    form = CompiledForm(
+        oscillators, P, np.zeros(1), np.zeros((0, 0, 0)), np.zeros((0, len(LOAD_COLUMNS)))
+    )
     times = np.linspace(0, 2, 21)
     Y = np.empty((21, 2 * n))
     guard = np.array([0.0, np.inf, 0.0, 0.0])

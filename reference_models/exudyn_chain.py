@@ -52,7 +52,13 @@ import numpy as np
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
-from rodval.core.status import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED
+from rodval.core.status import (
+    STATUS_BLOWUP,
+    STATUS_DIVERGED,
+    STATUS_ERROR,
+    STATUS_FAILED,
+    numerical_failure,
+)
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.core.validity import Check, step_resolution
 
@@ -614,7 +620,11 @@ class ExudynModel(Model):
             sim = self._settings(scene.t_end)
             guard = _Guard(built, scene, self.elements, self.EA, factor, self.max_rotation_per_step)
         except Exception as exc:  # noqa: BLE001 - a failed build is data
-            stats.status, stats.message = STATUS_ERROR, f"build failed: {type(exc).__name__}: {exc}"
+            status, message = numerical_failure(exc, 0.0) or (
+                STATUS_ERROR,
+                f"{type(exc).__name__}: {exc}",
+            )
+            stats.status, stats.message = status, f"build failed: {message}"
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         ti = sim.timeIntegration
         run_info.update(steps_planned=int(ti.numberOfSteps), step_used=float(ti.initialStepSize))
@@ -912,12 +922,11 @@ class _Guard:
                     )
                     return False
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
-            self.verdict = (
+            status, message = numerical_failure(exc, t) or (
                 STATUS_ERROR,
-                (f"divergence check failed at t = {t:.6g} s: {type(exc).__name__}: {exc}"),
-                t,
-                True,
+                f"divergence check failed at t = {t:.6g} s: {type(exc).__name__}: {exc}",
             )
+            self.verdict = (status, message, t, True)
             return False
         return True
 

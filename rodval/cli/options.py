@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from rodval.core.settings import DEFAULTS, METHODS, MIN_RTOL, RTOL_RANGE
+from rodval.core.settings import DEFAULTS, MAX_COUNT, METHODS, MIN_RTOL, RTOL_RANGE
 
 
 def positive_float(
@@ -36,15 +36,17 @@ def positive_float(
 
 
 def positive_int(name: str):
+    """A parser of an integer count in [1, MAX_COUNT] for option ``name``."""
+
     def parse(text: str) -> int:
         try:
             v = int(text)
         except ValueError:
+            v = 0
+        if not 1 <= v <= MAX_COUNT:
             raise argparse.ArgumentTypeError(
-                f"{name} must be an integer >= 1, got {text!r}"
-            ) from None
-        if v < 1:
-            raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1, got {text!r}")
+                f"{name} must be an integer in [1, {MAX_COUNT}], got {text!r}"
+            )
         return v
 
     return parse

@@ -27,7 +27,7 @@ import numpy as np
 
 from rodval.core.checks import check_keys
 from rodval.core.loads import NodalForce
-from rodval.core.resources import check_run_memory
+from rodval.core.resources import check_rods, check_run_memory
 
 #: Quantities a scene may ask for. "x"/"y" are node positions (k = 0..n); "energy" yields
 #: kinetic, potential and total energy (k = 0).
@@ -85,6 +85,15 @@ def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndar
         arr = np.full(n, float(arr))
     if arr.shape != (n,):
         raise ValueError(f"{name} must be a scalar or have length n = {n}, got shape {arr.shape}")
+    _check_bounds(name, arr, positive)
+    arr.setflags(write=False)
+    return arr
+
+
+def _check_bounds(name: str, arr: np.ndarray, positive: bool | None) -> None:
+    """The bounds of the chain's data on a float array: finite; ``positive`` True: in
+    [MIN_POSITIVE, MAX_MAGNITUDE], False: in [0, MAX_MAGNITUDE], None: any finite value.
+    ValueError naming ``name`` and the allowed range."""
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} must be finite, got {arr.tolist()}")
     if positive is True and np.any(arr <= 0):
@@ -101,8 +110,15 @@ def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndar
             f"{name} must lie in {allowed} (SI units; beyond that the models' arithmetic "
             f"overflows or underflows), got {bad:g}"
         )
-    arr.setflags(write=False)
-    return arr
+
+
+def _bounded_number(name: str, value: Any, *, positive: bool | None) -> float:
+    """A real number within the chain's bounds (``_check_bounds``); ``name`` with its unit."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be a real number, got {value!r}")
+    v = float(value)
+    _check_bounds(name, np.array([v]), positive)
+    return v
 
 
 @dataclass(frozen=True, eq=False)
@@ -141,6 +157,7 @@ class Chain:
             n = sizes[0] if sizes else 1
         if n < 1:
             raise ValueError(f"n (number of rods) must be >= 1, got {n}")
+        check_rods(n)  # before any n-sized array
         set_ = object.__setattr__
         set_(self, "l", _as_rod_array("l (rod length)", l, n, positive=True))
         set_(self, "m", _as_rod_array("m (mass per length)", m, n, positive=True))
@@ -284,8 +301,27 @@ class Stop:
         _finite("stop angle", self.angle, "rad")
         if self.side not in ("upper", "lower"):
             raise ValueError(f"stop side must be 'upper' or 'lower', got {self.side!r}")
-        _finite("stop stiffness", self.stiffness, "N m/rad", positive=True)
-        _finite("stop damping", self.damping, "N m s/rad", positive=False)
+        # an acting stop adds its stiffness to kappa and its damping to nu: the same bounds
+        _bounded_number("stop stiffness (N m/rad)", self.stiffness, positive=True)
+        _bounded_number("stop damping (N m s/rad)", self.damping, positive=False)
+
+
+def _check_acting_stops(chain: Chain, stops: tuple[Stop, ...]) -> None:
+    """An acting stop adds its stiffness to its hinge's kappa and its damping to nu: the sums
+    (all of a hinge's stops acting at once) must stay within the chain's bounds."""
+    for field_name, attr, unit in (
+        ("kappa", "stiffness", "N m/rad"),
+        ("nu", "damping", "N m s/rad"),
+    ):
+        total = getattr(chain, field_name).copy()
+        for st in stops:
+            total[st.hinge] += getattr(st, attr)
+        for st in stops:
+            _check_bounds(
+                f"stop {attr} + {field_name} of hinge {st.hinge} ({unit})",
+                total[st.hinge : st.hinge + 1],
+                positive=False,
+            )
 
 
 #: Output times when a scene gives none, and the most a scene may ask for.
@@ -419,6 +455,7 @@ class Scene:
                     )
                 _index(f"{label[:-1] if label == 'stops' else 'latch'} hinge", item.hinge, n)
             object.__setattr__(self, label, items)
+        _check_acting_stops(self.chain, self.stops)
         hinges = [latch.hinge for latch in self.latches]
         if len(set(hinges)) != len(hinges):
             raise ValueError(f"at most one latch per hinge, got hinges {hinges}")

@@ -137,7 +137,9 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
         t_end = d.get("t_end", 2.0)
         if isinstance(t_end, bool) or not isinstance(t_end, (int, float)):
             raise ValueError(f"key 't_end' (horizon) must be a number > 0 s, got {t_end!r}")
-        scene = paper_scene(n, t_end=float(t_end))
+        # the base's chain, loads and outputs; its output times are the file's (one here, so
+        # that memory is checked once, on the scene's own times)
+        scene = paper_scene(n, t_end=float(t_end), times=[float(t_end)])
         chain_spec = d.get("chain", {})
         check_keys(chain_spec, CHAIN_KEYS, f"{where} [chain]")
         chain = (

@@ -32,6 +32,10 @@ RTOL_RANGE = (
     f"a number in (0, 1), at least {MIN_RTOL:.3g} (> 0 is not enough: the integrators cannot "
     "honour less than 100 machine epsilons)"
 )
+#: Largest count (evaluations, steps) a setting may ask for: 2**53, exact as a double and far
+#: inside the compiled loop's int64 counters (a larger one failed at run time with numba's
+#: "No matching definition" or OverflowError).
+MAX_COUNT = 2**53
 
 
 @dataclass(frozen=True)
@@ -106,8 +110,8 @@ class IntegratorSettings:
             raise ValueError(f"min_step_fraction must be in [0, 1), got {self.min_step_fraction!r}")
         for name in ("stall_steps", "max_evaluations"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 1:
-                raise ValueError(f"{name} must be an integer >= 1, got {v!r}")
+            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or not 1 <= v <= MAX_COUNT:
+                raise ValueError(f"{name} must be an integer in [1, {MAX_COUNT}], got {v!r}")
 
     @property
     def compiled(self) -> bool:
@@ -119,6 +123,15 @@ class IntegratorSettings:
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
+
+    def budget_message(self, budget: str, t: float) -> str:
+        """The message of a run stopped at time t (s) by its budget ``budget``
+        ("max_evaluations" or "max_wall_s"), with the budget's value."""
+        if budget == "max_wall_s":
+            used = f"wall-clock budget exhausted: max_wall_s = {self.max_wall_s:g} s"
+        else:
+            used = f"evaluation budget exhausted: max_evaluations = {self.max_evaluations}"
+        return f"{used} used (t = {t:.6g} s)"
 
     def with_(self, **changes: Any) -> IntegratorSettings:
         """A copy with fields replaced (validated again)."""

@@ -6,6 +6,8 @@ raises for a failed integration, it ends with one of these codes, a message and 
 
 from __future__ import annotations
 
+import numpy as np
+
 STATUS_SUCCESS = 0
 STATUS_FAILED = -1  # the integrator gave up (step size too small, singular matrix, ...)
 STATUS_ERROR = -2  # the model raised an exception
@@ -29,3 +31,19 @@ STATUS_MESSAGES = {
 STATUS_BUDGET = -8  # the run used up its evaluation budget (settings.max_evaluations)
 STATUS_WALL = -9  # the run used up its wall-clock budget (settings.max_wall_s)
 STATUS_MESSAGES.update({-8: "evaluation budget exhausted", -9: "wall-clock budget exhausted"})
+
+
+def numerical_failure(exc: BaseException, t: float) -> tuple[int, str] | None:
+    """(status, message) of a run stopped at time t (s) by ``exc`` when it is a numerical
+    failure, None for any other exception (a model error). Arithmetic that left float64 (a
+    division by zero, an overflow; huge states) is ``STATUS_DIVERGED``; a matrix that cannot
+    be factored (singular, not positive definite; chains at the extremes of their bounds) is
+    ``STATUS_FAILED``. The message names the exception and the time."""
+    if isinstance(exc, (ZeroDivisionError, OverflowError, FloatingPointError)):
+        return STATUS_DIVERGED, f"diverged: {type(exc).__name__}: {exc} at t = {t:.6g} s"
+    if isinstance(exc, np.linalg.LinAlgError):
+        return STATUS_FAILED, (
+            f"numerical failure: {type(exc).__name__}: {exc} at t = {t:.6g} s "
+            "(a matrix of the model could not be factored)"
+        )
+    return None

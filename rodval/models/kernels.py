@@ -20,8 +20,8 @@ exploited (``kernel="numba"``, the default):
 Argument conventions: ``full_accel(V, y, has_load, SX, SY, damped, out)`` for the Python-side
 right-hand side (whose loads may be any callable); ``full_rhs`` and ``*_mechanics`` have the
 compiled integrators' type ``rodval.solvers.signature.RHS_TYPE`` (loads from the compiled load
-table, ``rodval.core.loads.load_sums``). ``V`` holds rows of length-n vectors (layout ``V_*``
-below), ``S = [damped]``.
+table, ``rodval.core.loads.load_sums``, O(log rows) per evaluation). ``V`` holds rows of
+length-n vectors (layout ``V_*`` below), ``S = [damped]``.
 """
 
 from __future__ import annotations

@@ -443,7 +443,7 @@ def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out
     """phi'' (rad/s^2, n) into ``ddphi_out`` and gamma = [alpha; beta] (rad, 2n) into
     ``gamma_out`` of the reduced model at state (phi, phi') (module docstring: the sweep, with
     the banded LU as fallback). ``Cst`` from ``banded_constants``; SX, SY are the load suffix
-    sums (N, see kernels.load_sums), used when ``has_load``; ``damped`` adds the hinge
+    sums (N, see loads.load_sums), used when ``has_load``; ``damped`` adds the hinge
     dampers. O(n) time and memory per evaluation. Returns False if the system is singular
     (outputs then hold NaN)."""
     work = np.empty(sweep_work_size(phi.shape[0]))  # the fallback allocates its own

@@ -6,6 +6,8 @@ no model. ``run_compiled`` is called by the driver (``rodval.solvers.driver``).
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from rodval.core.scene import Scene
@@ -17,6 +19,8 @@ from rodval.core.status import (
     STATUS_ERROR,
     STATUS_FAILED,
     STATUS_STALLED,
+    STATUS_WALL,
+    numerical_failure,
 )
 from rodval.core.trajectory import SolverStats
 from rodval.solvers import dop853
@@ -29,7 +33,6 @@ _CODES = {
         "Required step size is less than spacing between numbers.",
     ),
     dop853.NON_FINITE: (STATUS_DIVERGED, "diverged: non-finite state"),
-    dop853.BUDGET: (STATUS_BUDGET, "evaluation budget exhausted: max_evaluations"),
     dop853.BLOWUP: (
         STATUS_BLOWUP,
         "energy blow-up: kinetic energy > blowup_factor x budget E(0) + W+",
@@ -38,6 +41,11 @@ _CODES = {
         STATUS_STALLED,
         "step size collapse: stall_steps consecutive steps shorter than min_step_fraction x t_end",
     ),
+}
+#: Codes of the budgets: status and the setting named in the message.
+_BUDGETS = {
+    dop853.BUDGET: (STATUS_BUDGET, "max_evaluations"),
+    dop853.WALL: (STATUS_WALL, "max_wall_s"),
 }
 
 
@@ -73,16 +81,22 @@ def run_compiled(
             guard,
             settings.stall_steps,
             Y,
+            deadline=time.perf_counter() + settings.max_wall_s,
         )
     except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
-        stats.status, stats.message = STATUS_ERROR, f"{type(exc).__name__}: {exc}"
+        # raised by a model's kernel: the loop's time is lost, t_reached stays at the start
+        stats.status, stats.message = numerical_failure(exc, float(edges[0])) or (
+            STATUS_ERROR,
+            f"{type(exc).__name__}: {exc}",
+        )
         return 0
     stats.nfev += nfev
     stats.nsteps += nsteps
     stats.t_reached = t
-    if code != dop853.OK:
+    if code in _BUDGETS:
+        stats.status, budget = _BUDGETS[code]
+        stats.message = settings.budget_message(budget, t)
+    elif code != dop853.OK:
         stats.status, message = _CODES[code]
         stats.message = f"{message} (t = {t:.6g} s)"
-        if code == dop853.BUDGET:
-            stats.message = f"{message} = {settings.max_evaluations} used (t = {t:.6g} s)"
     return n_out

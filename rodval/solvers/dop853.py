@@ -9,13 +9,20 @@ a first-class numba function of type ``RHS_TYPE`` called with the form's arrays,
 imports no model and is compiled (and cached on disk) once for every model.
 
 Cost: 12 right-hand-side evaluations per accepted step (+3 on steps holding output times), and
-O(N) work per stage combination.
+O(N) work per stage combination. Arithmetic is IEEE (numba's numpy error model): a huge
+state gives inf or NaN, never an exception, and the run ends as ``NON_FINITE`` at the time it
+reached (a division by zero in the initial-step choice raised ZeroDivisionError). The
+wall-clock budget reads the clock (a call back into Python, ~1 us) once every
+``WALL_CHECK_EVALUATIONS`` evaluations, not on every step.
 """
 
 from __future__ import annotations
 
+import math
+import time
+
 import numpy as np
-from numba import njit, types
+from numba import njit, objmode, types
 from scipy.integrate._ivp import dop853_coefficients as dc
 
 from rodval.solvers.signature import F1 as _F1
@@ -32,12 +39,17 @@ _E5 = np.ascontiguousarray(dc.E5)
 _D = np.ascontiguousarray(dc.D)
 
 #: Return codes of ``run``.
-OK, STEP_TOO_SMALL, NON_FINITE, BUDGET, BLOWUP, STALLED = 0, 1, 2, 3, 4, 5
+OK, STEP_TOO_SMALL, NON_FINITE, BUDGET, BLOWUP, STALLED, WALL = 0, 1, 2, 3, 4, 5, 6
+
+#: Evaluations between two reads of the clock for the wall-clock budget: the read costs about
+#: one evaluation of the smallest system, so this keeps it below 1 % of a run, and the run
+#: overshoots its budget by at most this many evaluations (milliseconds up to n ~ 1e3).
+WALL_CHECK_EVALUATIONS = 100
 
 SAFETY, MIN_FACTOR, MAX_FACTOR, ERROR_EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _combine(out, base, K, coef, count, h):
     """out = base + h * sum_{j < count} coef[j] K[j], as contiguous loops over K's rows (no
     temporary arrays; ``out`` must not alias ``base`` or K)."""
@@ -54,12 +66,20 @@ def _combine(out, base, K, coef, count, h):
         out[i] = base[i] + h * out[i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _rms(x):
     return np.sqrt(np.mean(x * x))
 
 
 @njit(cache=True)
+def _now():
+    """``time.perf_counter()`` (s), read from inside the compiled loop."""
+    with objmode(now="float64"):
+        now = time.perf_counter()
+    return now
+
+
+@njit(cache=True, error_model="numpy")
 def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, tmp, f1):
     """scipy's select_initial_step (Hairer, Sec. II.4) for order 7; uses one evaluation."""
     scale = atol + np.abs(y0) * rtol
@@ -95,6 +115,7 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
     types.int64,
     _F1,
     types.int64,
+    types.float64,
     _F2,
     _F1,
     _F1,
@@ -105,7 +126,7 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
 )
 
 
-@njit(_RUN_SIGNATURE, cache=True)
+@njit(_RUN_SIGNATURE, cache=True, error_model="numpy")
 def run(
     rhs,
     mechanics,
@@ -124,6 +145,7 @@ def run(
     max_nfev,
     guard,
     stall_steps,
+    deadline,
     A,
     B,
     C,
@@ -134,7 +156,9 @@ def run(
 ):
     """Integrate from edges[0] to edges[-1], restarting at each interior edge (breakpoint),
     writing the state at ``times`` into Y. ``first_step`` <= 0 selects it automatically; the
-    run stops with ``BUDGET`` once ``max_nfev`` evaluations are used.
+    run stops with ``BUDGET`` once ``max_nfev`` evaluations are used, and with ``WALL`` once
+    ``time.perf_counter()`` passes ``deadline`` (s; inf: no limit), read before the first
+    step attempt and then every ``WALL_CHECK_EVALUATIONS`` evaluations.
 
     The divergence guard of ``rodval.solvers.guard`` after every accepted step: ``STALLED``
     after ``stall_steps`` consecutive steps shorter than guard[0] (s); when ``guarded``,
@@ -157,6 +181,8 @@ def run(
     nfev = 0
     nsteps = 0
     n_short = 0
+    timed = deadline < np.inf
+    next_clock = 0
     mech = np.zeros(2)
     w_plus = 0.0
     p_prev = 0.0
@@ -188,6 +214,10 @@ def run(
                     return n_out, nfev, nsteps, STEP_TOO_SMALL, t
                 if nfev >= max_nfev:
                     return n_out, nfev, nsteps, BUDGET, t
+                if timed and nfev >= next_clock:
+                    next_clock = nfev + WALL_CHECK_EVALUATIONS
+                    if _now() > deadline:
+                        return n_out, nfev, nsteps, WALL, t
                 t_new = t + h_abs
                 if t_new > t_bound:
                     t_new = t_bound
@@ -281,9 +311,11 @@ def integrate_compiled(
     guard: np.ndarray,
     stall_steps: int,
     Y: np.ndarray,
+    deadline: float = math.inf,
 ) -> tuple[int, int, int, int, float]:
     """Run ``run`` on a CompiledForm with scipy's DOP853 coefficients (see ``run``; without
-    ``form.mechanics`` or with guard[1] = inf there is no blow-up check)."""
+    ``form.mechanics`` or with guard[1] = inf there is no blow-up check; ``deadline``: a
+    ``time.perf_counter()`` value, s)."""
     guarded = form.mechanics is not None and bool(np.isfinite(guard[1]))
     mechanics = form.mechanics if form.mechanics is not None else form.rhs
     n_out, nfev, nsteps, code, t = run(
@@ -304,6 +336,7 @@ def integrate_compiled(
         max_nfev,
         np.asarray(guard, float),
         stall_steps,
+        float(deadline),
         _A,
         _B,
         _C,

@@ -35,6 +35,7 @@ from rodval.core.status import (
     STATUS_ERROR,
     STATUS_FAILED,
     STATUS_WALL,
+    numerical_failure,
 )
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.core.validity import SMALL_BENDING_RAD
@@ -141,24 +142,16 @@ class _ScipyRun:
         self.deadline = time.perf_counter() + settings.max_wall_s
         self.extra: dict[str, Any] = {}
         if settings.implicit and system.has_jacobian:
-            self.extra["jac"] = system.jacobian
+            self.extra["jac"] = self.jac
         if settings.first_step is not None:
             self.extra["first_step"] = settings.first_step
 
     def fun(self, t: float, y: np.ndarray) -> np.ndarray:
         self.nfev += 1
         if self.nfev > self.settings.max_evaluations:
-            raise _Stop(
-                STATUS_BUDGET,
-                f"evaluation budget exhausted: max_evaluations = "
-                f"{self.settings.max_evaluations} used (t = {t:.6g} s)",
-            )
+            raise _Stop(STATUS_BUDGET, self.settings.budget_message("max_evaluations", t))
         if time.perf_counter() > self.deadline:
-            raise _Stop(
-                STATUS_WALL,
-                f"wall-clock budget exhausted: max_wall_s = "
-                f"{self.settings.max_wall_s:g} s used (t = {t:.6g} s)",
-            )
+            raise _Stop(STATUS_WALL, self.settings.budget_message("max_wall_s", t))
         if not np.all(np.isfinite(y)):
             raise _Stop(
                 STATUS_DIVERGED, f"diverged: non-finite state in a step attempt at t = {t:.6g} s"
@@ -166,10 +159,21 @@ class _ScipyRun:
         try:
             f = self.system.rhs(t, y)
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
-            raise _Stop(STATUS_ERROR, f"{type(exc).__name__}: {exc}") from exc
+            raise _Stop(*_failure(exc, t)) from exc
         if not np.all(np.isfinite(f)):
             raise _Stop(STATUS_DIVERGED, f"diverged: non-finite derivative at t = {t:.6g} s")
         return f
+
+    def jac(self, t: float, y: np.ndarray) -> np.ndarray:
+        """The system's Jacobian for implicit methods; a non-finite one stops the run as
+        diverged (scipy's LU refused it with "array must not contain infs or NaNs")."""
+        try:
+            J = self.system.jacobian(t, y)
+        except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
+            raise _Stop(*_failure(exc, t)) from exc
+        if not np.all(np.isfinite(J)):
+            raise _Stop(STATUS_DIVERGED, f"diverged: non-finite Jacobian at t = {t:.6g} s")
+        return J
 
     def run(self, y: np.ndarray, edges: np.ndarray) -> float:
         """Integrate from edges[0]; returns the time reached."""
@@ -197,13 +201,18 @@ class _ScipyRun:
             self.stats.status, self.stats.message = stop.status, str(stop)
             self.stats.nfev = self.nfev
             return y, a, b
+        except Exception as exc:  # e.g. a singular iteration matrix while scipy sets up
+            self.stats.status, self.stats.message = _numerical_or_raise(exc, a)
+            self.stats.nfev = self.nfev
+            return y, a, b
         t_now = a
         try:
             while solver.status == "running":
                 msg = solver.step()
                 self.stats.nsteps += 1
                 if solver.status == "failed":
-                    self.stats.status, self.stats.message = STATUS_FAILED, str(msg)
+                    self.stats.status = STATUS_FAILED
+                    self.stats.message = f"{msg} (t = {solver.t:.6g} s)"
                     break
                 verdict = self.guard.check(solver.t_old, solver.t, solver.y)
                 if verdict:
@@ -239,6 +248,8 @@ class _ScipyRun:
                     return y_new, t_event, t_event
         except _Stop as stop:
             self.stats.status, self.stats.message = stop.status, str(stop)
+        except Exception as exc:  # e.g. a singular iteration matrix inside scipy's step
+            self.stats.status, self.stats.message = _numerical_or_raise(exc, solver.t)
         self._count(solver)
         return solver.y.copy(), t_now, b
 
@@ -247,6 +258,29 @@ class _ScipyRun:
         self.stats.nfev = self.nfev
         self.stats.njev += int(solver.njev)
         self.stats.nlu += int(solver.nlu)
+
+
+def _failure(exc: Exception, t: float) -> tuple[int, str]:
+    """(status, message) of an exception raised at time t (s) inside a run: a numerical
+    failure (``rodval.core.status.numerical_failure``) or a model error."""
+    return numerical_failure(exc, t) or (STATUS_ERROR, f"{type(exc).__name__}: {exc}")
+
+
+#: numpy's refusal of a non-finite matrix (``asarray_chkfinite``, scipy's LU): inside a step it
+#: means the iteration matrix overflowed (Radau with phi = 1e200: a step size of 0).
+_NON_FINITE_MATRIX = "array must not contain infs or NaNs"
+
+
+def _numerical_or_raise(exc: Exception, t: float) -> tuple[int, str]:
+    """A numerical failure's (status, message) at time t (s), a non-finite matrix refused by
+    scipy's linear algebra included; any other exception raised by scipy's solver propagates
+    (the run's outer handler reports it)."""
+    if isinstance(exc, ValueError) and _NON_FINITE_MATRIX in str(exc):
+        return STATUS_DIVERGED, f"diverged: non-finite iteration matrix at t = {t:.6g} s"
+    verdict = numerical_failure(exc, t)
+    if verdict is None:
+        raise exc
+    return verdict
 
 
 def _finite_prefix(times: np.ndarray, observed: dict, stats: SolverStats):
@@ -331,7 +365,7 @@ def integrate(
             t_now = scipy_run.run(y, edges)
             events = scipy_run.events
     except Exception as exc:  # noqa: BLE001 - e.g. the model's energy at y0: a run never raises
-        stats.status, stats.message = STATUS_ERROR, f"{type(exc).__name__}: {exc}"
+        stats.status, stats.message = _failure(exc, t_now)
     stats.t_reached = float(t_now)
     if stats.status == 0:
         stats.message = "reached t_end"
@@ -345,10 +379,8 @@ def integrate(
             observed.update(audited)
     except Exception as exc:  # noqa: BLE001
         observed = {}
-        stats.status, stats.message = (
-            STATUS_ERROR,
-            f"observation failed: {type(exc).__name__}: {exc}",
-        )
+        status, message = _failure(exc, stats.t_reached)
+        stats.status, stats.message = status, f"observation failed: {message}"
     reached, observed = _finite_prefix(reached, observed, stats)
     _bending_validity(system, reached, out.Y[: reached.size], observed, stats)
     stats.wall_s = time.perf_counter() - start

@@ -24,7 +24,13 @@ import math
 import numpy as np
 
 from rodval.core.settings import IntegratorSettings
-from rodval.core.status import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_ERROR, STATUS_STALLED
+from rodval.core.status import (
+    STATUS_BLOWUP,
+    STATUS_DIVERGED,
+    STATUS_ERROR,
+    STATUS_STALLED,
+    numerical_failure,
+)
 from rodval.solvers.system import OdeSystem
 
 #: Absolute slack of the energy budget (J): below it no energy counts as a blow-up (a chain
@@ -71,7 +77,7 @@ class DivergenceGuard:
             p = self._positive_power(t1, y)
             E = self.system.kinetic_energy(t1, y)
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
-            return (
+            return numerical_failure(exc, t1) or (
                 STATUS_ERROR,
                 f"energy check failed at t = {t1:.6g} s: {type(exc).__name__}: {exc}",
             )

@@ -10,7 +10,7 @@ import numpy as np
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
-from rodval.core.status import STATUS_ERROR
+from rodval.core.status import STATUS_ERROR, numerical_failure
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.solvers.driver import integrate
 from rodval.solvers.system import OdeSystem
@@ -26,14 +26,19 @@ class OdeModel(Model):
     def run(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
         """Build the system and integrate it. A failure while building it (its constants,
         its first evaluation) is reported like a failure during integration: status
-        ``model error``, the message, t_reached = 0."""
+        ``model error`` (or a numerical failure's, ``rodval.core.status.numerical_failure``),
+        the message, t_reached = 0."""
         start = time.perf_counter()
         try:
             system = self.system(scene)
         except Exception as exc:  # noqa: BLE001 - failures are data
+            status, message = numerical_failure(exc, 0.0) or (
+                STATUS_ERROR,
+                f"{type(exc).__name__}: {exc}",
+            )
             stats = SolverStats(
-                status=STATUS_ERROR,
-                message=f"model set-up failed: {type(exc).__name__}: {exc}",
+                status=status,
+                message=f"model set-up failed: {message}",
                 wall_s=time.perf_counter() - start,
             )
             return Trajectory(
