@@ -159,3 +159,101 @@ def test_an_acting_stop_keeps_its_hinge_within_the_chain_bounds(tmp_path, capsys
     line = one_line_error(capsys)
     assert "stop stiffness (N m/rad) must lie in [1e-12, 1e+12]" in line and "kappa" not in line
     assert not (tmp_path / "o").exists()
+
+
+# ------------------------------------------- 5. memory from the scene's times, huge n, counts
+
+
+def _scene_file(tmp_path, text):
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    return path
+
+
+def test_memory_is_checked_on_the_scene_files_own_output_times(tmp_path):
+    """n = 1e6 with 2 output times needs ~0.2 GB of outputs: it was refused as the paper
+    grid's '201 output times, 16.1 GB' before the file's times replaced the base's."""
+    from rodval.core.resources import estimate_run_bytes
+    from rodval.core.scene_file import load_scene
+
+    path = _scene_file(
+        tmp_path,
+        'base = "paper"\nn = 1000000\nt_end = 0.001\ntimes = [0.0, 0.001]\noutputs = ["phi"]\n',
+    )
+    scene = load_scene(path)
+    assert scene.n == 1_000_000 and scene.times.size == 2
+    est = estimate_run_bytes(scene.n, scene.times.size, ("phi",), model="full")
+    assert est["total"] < 1e9  # 2 x (6 + 1) x 1e6 doubles = 0.11 GB
+
+
+def test_a_chain_too_large_for_memory_is_refused_before_any_rod_array(tmp_path, capsys):
+    """n = 1e8 allocated 6.6 GB over 48 s before its refusal; now the check comes first, so
+    refusing it allocates (almost) nothing: peak traced memory < 1 MB, not 8e8 bytes."""
+    import tracemalloc
+
+    from rodval import Chain
+
+    tracemalloc.start()
+    with pytest.raises(ValueError, match=r"n = 100000000 rods would need at least .* GB") as info:
+        Chain.uniform(100_000_000)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 1e6
+    assert "RODVAL_MAX_MEMORY_GB" in str(info.value)
+    path = _scene_file(tmp_path, 'base = "paper"\nn = 100000000\n')
+    assert main(["simulate", str(path), "--model", "reduced", "--out", str(tmp_path / "o")]) == 2
+    assert "n = 100000000 rods" in one_line_error(capsys)
+
+
+def test_a_count_beyond_int64_is_refused_by_the_parser_and_the_settings(tmp_path, capsys):
+    """A huge --max-evaluations passed the parser and failed at run time in numba."""
+    from test_cli_errors import assert_refused, run_main
+
+    from rodval.core.settings import IntegratorSettings
+
+    huge = "99999999999999999999999"
+    proc = run_main(capsys, "simulate", "paper", "--max-evaluations", huge, "--out", str(tmp_path))
+    assert_refused(proc, ["--max-evaluations", "[1, 9007199254740992]", repr(huge)])
+    with pytest.raises(ValueError, match=r"max_evaluations must be an integer in \[1, "):
+        IntegratorSettings(max_evaluations=2**70)
+
+
+# ------------------------------------------------------------- 6. tabulated-load CSV files
+
+
+@pytest.mark.parametrize(
+    "content, words",
+    [
+        (b"t,X,Y\n0,1,0\n0.1,2\n", r"bad\.csv: row 3 has 2 cells, the header names 3 \(t, X, Y\)"),
+        (b"t,X\n0,1\n0.1,abc\n", r"bad\.csv: row 3, column X: 'abc' is not a number"),
+        (b"t,X\n\xff\xfe\x00\x01", r"bad\.csv: not a text CSV file \(byte 4 is not UTF-8"),
+        (b"t,X\n0,\x00\n", r"bad\.csv: not a text CSV file \(it holds NUL bytes\)"),
+    ],
+    ids=["ragged", "word", "binary", "nul"],
+)
+def test_a_damaged_load_history_is_named_with_its_row_and_column(tmp_path, capsys, content, words):
+    """A ragged CSV gave numpy's 'setting an array element with a sequence'; a binary one was
+    reported against the scene file."""
+    (tmp_path / "bad.csv").write_bytes(content)
+    path = _scene_file(
+        tmp_path, 'base = "paper"\n[[loads]]\ntype = "tabulated"\nnode = 8\nfile = "bad.csv"\n'
+    )
+    assert main(["simulate", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert re.search(words, one_line_error(capsys))
+
+
+def test_a_load_file_is_found_beside_the_scene_file_from_any_folder(tmp_path, monkeypatch):
+    """A relative ``file`` is relative to the scene file that names it, not to the folder the
+    command runs in: the same history acts as with an absolute path."""
+    from rodval.core.scene_file import load_scene
+
+    (tmp_path / "f.csv").write_text("t,X,Y\n0,0,0\n0.1,5,0\n0.2,0,0\n")
+    rel = _scene_file(
+        tmp_path, 'base = "paper"\n[[loads]]\ntype = "tabulated"\nnode = 8\nfile = "f.csv"\n'
+    )
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    scene = load_scene(rel)
+    force = scene.loads[-1]
+    assert force.fx(0.05) == pytest.approx(2.5, rel=1e-15)  # halfway up the linear ramp to 5 N

@@ -417,10 +417,21 @@ def _samples(where: str, values: Any) -> np.ndarray:
 
 
 def _read_history(path: Path) -> tuple[list[float], list[float] | None, list[float] | None]:
+    """The columns t, X, Y of a tabulated-load CSV file (header row naming them, one number
+    per column on every later row); ValueError naming the file, and the row and column of the
+    first bad cell, for anything else (a binary file, a ragged row, a word among numbers)."""
     if not path.is_file():
         raise ValueError(f"tabulated load file {str(path)!r} does not exist")
-    with path.open(newline="") as fh:
-        rows = list(csv.reader(fh))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(
+            f"{path}: not a text CSV file (byte {exc.start} is not UTF-8 text); a tabulated load "
+            "file is text: a header row t, X, Y and one row of numbers per sample"
+        ) from None
+    if "\x00" in text:
+        raise ValueError(f"{path}: not a text CSV file (it holds NUL bytes)")
+    rows = [r for r in csv.reader(text.splitlines()) if r]
     if not rows or "t" not in [c.strip() for c in rows[0]]:
         raise ValueError(f"{path}: the first row must name the columns t, X, Y")
     head = [c.strip() for c in rows[0]]
@@ -430,12 +441,20 @@ def _read_history(path: Path) -> tuple[list[float], list[float] | None, list[flo
     twice = sorted({c for c in head if head.count(c) > 1})
     if twice:
         raise ValueError(f"{path}: column {twice[0]!r} named twice (each of t, X, Y at most once)")
-    try:
-        data = np.array([[float(c) for c in r] for r in rows[1:] if r], dtype=float)
-    except ValueError as exc:
-        raise ValueError(f"{path}: {exc}") from None
-    if data.ndim != 2 or data.shape[1] != len(head):
-        raise ValueError(f"{path}: every row must have {len(head)} numbers")
+    data = np.empty((len(rows) - 1, len(head)))
+    for i, row in enumerate(rows[1:]):
+        if len(row) != len(head):
+            raise ValueError(
+                f"{path}: row {i + 2} has {len(row)} cells, the header names {len(head)} "
+                f"({', '.join(head)}); every row must have one number per column"
+            )
+        for j, cell in enumerate(row):
+            try:
+                data[i, j] = float(cell)
+            except ValueError:
+                raise ValueError(
+                    f"{path}: row {i + 2}, column {head[j]}: {cell.strip()!r} is not a number"
+                ) from None
     col = {name: data[:, i].tolist() for i, name in enumerate(head)}
     return col["t"], col.get("X"), col.get("Y")
 

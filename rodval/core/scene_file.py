@@ -187,7 +187,25 @@ def read_scene_document(source: str | Path) -> dict[str, Any]:
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
     data.setdefault("name", path.stem)
-    return data
+    return anchor_load_files(data, path.parent)
+
+
+def anchor_load_files(doc: dict[str, Any], folder: Path) -> dict[str, Any]:
+    """``doc`` with each load's relative ``file`` taken relative to ``folder`` (the folder of
+    the file that names it), so that a scene or study file finds its tabulated histories
+    wherever it is run from. Anything else is left for scene_from_dict to check."""
+    loads = doc.get("loads")
+    if not isinstance(loads, list):
+        return doc
+    anchored = [
+        {**load, "file": str(folder / load["file"])}
+        if isinstance(load, dict)
+        and isinstance(load.get("file"), str)
+        and not Path(load["file"]).is_absolute()
+        else load
+        for load in loads
+    ]
+    return {**doc, "loads": anchored}
 
 
 def load_scene(source: str | Path) -> Scene:

@@ -110,7 +110,11 @@ class IntegratorSettings:
             raise ValueError(f"min_step_fraction must be in [0, 1), got {self.min_step_fraction!r}")
         for name in ("stall_steps", "max_evaluations"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or not 1 <= v <= MAX_COUNT:
+            if (
+                isinstance(v, bool)
+                or not isinstance(v, numbers.Integral)
+                or not 1 <= v <= MAX_COUNT
+            ):
                 raise ValueError(f"{name} must be an integer in [1, {MAX_COUNT}], got {v!r}")
 
     @property

@@ -35,7 +35,7 @@ from rodval.core.resources import (
     output_values,
 )
 from rodval.core.scene import QUANTITIES, Scene, trajectory_quantities
-from rodval.core.scene_file import scene_from_dict
+from rodval.core.scene_file import anchor_load_files, scene_from_dict
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.models import REGISTRY, get_model, model_class
 from rodval.study.store import MAX_NAME, case_file_name
@@ -594,4 +594,6 @@ def load_study(
         doc = tomllib.loads(text)
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
+    if isinstance(doc.get("scene"), dict):
+        doc["scene"] = anchor_load_files(doc["scene"], path.parent)
     return study_from_dict(doc, where=str(path), text=text, max_cases=max_cases, announce=announce)
