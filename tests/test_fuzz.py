@@ -67,7 +67,8 @@ class Counts:
 
     def __init__(self, name: str):
         self.name = name
-        self.examples = self.tracebacks = self.hangs = self.nonfinite = 0
+        self.examples = self.tracebacks = self.hangs = self.nonfinite = self.ignored = 0
+        self.late = 0
         self.exits: dict[int, int] = {}
         self.start = self.last = time.perf_counter()
 
@@ -81,6 +82,9 @@ class Counts:
             "tracebacks": self.tracebacks,
             "hangs": self.hangs,
             "nonfinite_successes": self.nonfinite,
+            "ignored_inputs": self.ignored,
+            "silent_wrong": self.nonfinite + self.ignored,
+            "late_refusals": self.late,
             "exit_codes": {str(k): v for k, v in sorted(self.exits.items())},
             "wall_s": round(self.last - self.start, 1),
         }
@@ -315,6 +319,13 @@ def write_scene(tmp: Path, doc: dict, raw: bytes | None = None) -> Path:
     return path
 
 
+def claims_success(stats) -> bool:
+    """A run's stats (SolverStats or run.json's dict) claim a correct result: status 0 and
+    not ``valid = false`` (a missing ``valid`` is unknown: the status alone counts)."""
+    get = stats.get if isinstance(stats, dict) else lambda k, d=None: getattr(stats, k, d)
+    return get("status") == 0 and get("valid", None) is not False
+
+
 def check_run(out: Path, code: int) -> int:
     """A run that reports success has finite outputs only; returns 1 for a silent
     non-finite success."""
@@ -322,7 +333,7 @@ def check_run(out: Path, code: int) -> int:
     if code not in (0, 1) or not run.is_file():
         return 0
     rec = json.loads(run.read_text())
-    if rec["stats"]["status"] != 0:
+    if not claims_success(rec["stats"]):
         return 0
     df = pd.read_csv(out / "trajectory.csv")
     values = df.select_dtypes("number").to_numpy()
@@ -688,3 +699,282 @@ def test_fuzz_damaged_tables(tmp_path_factory, counts, finished_study, data):
     code, _, stderr = run_cli(["report", out], c)
     if code == 2:
         assert f"{name}.csv" in stderr or str(out) in stderr, stderr
+
+
+# ----------------------------------------------------------------------------- trust review
+# Inputs a trust review found broken: stops and latches, tabulated-load CSV files, edited
+# run.json files, the Python API, `rodval compare` and `rodval report` over damaged inputs.
+# Besides tracebacks and hangs these count *silently wrong* results: a run that claims
+# success (``claims_success``) with non-finite outputs, or one that ignored an input.
+
+#: Python's own messages: an exit-2 line made of one of them is an exception that slipped
+#: past the checks (counted as a traceback), not a refusal naming the key.
+INTERNAL_PHRASES = (
+    "Unknown format code",
+    "inhomogeneous",
+    "unsupported operand",
+    "not subscriptable",
+    "has no attribute",
+    "object is not",
+    "codec can't decode",
+    "math domain error",
+    "division by zero",
+    "index out of",
+    "NoneType",
+    "argument must be",
+)
+
+
+def refusal_is_clear(stderr: str, c: Counts) -> None:
+    """An exit-2 line says what is wrong in rodval's words, not Python's."""
+    leaked = [p for p in INTERNAL_PHRASES if p in stderr]
+    if leaked:
+        c.tracebacks += 1
+        raise AssertionError(f"a Python-internal message as refusal ({leaked[0]!r}): {stderr}")
+
+
+def refused_late(stdout: str, c: Counts) -> None:
+    """A ValueError about the input is raised before any work (exit 2), not reported as a
+    run that failed at set-up or at its first observation (exit 1, "ValueError" in the
+    status line: the check ran inside the model, naming the model's parameter)."""
+    if "ValueError" in stdout:
+        c.late += 1
+        raise AssertionError(f"input error reported as a failed run, not refused: {stdout}")
+
+
+def small_scene(draw, *, n_max: int = 4) -> dict:
+    """A small valid scene document (n <= n_max, t_end <= 0.3 s) that moves."""
+    n = draw(st.integers(1, n_max))
+    doc = {
+        "n": n,
+        "t_end": draw(st.floats(0.01, 0.3)),
+        "times": {"num": draw(st.integers(1, 6))},
+        "outputs": ["phi", "dphi"],
+    }
+    if draw(st.booleans()):
+        doc["initial"] = {"dphi": draw(st.floats(-3.0, 3.0))}
+    return doc
+
+
+BAD_HINGES = st.sampled_from([-1, 1.0, 0.5, "1", True, 1e300, -1.0, [1]])
+BAD_ANGLES = st.sampled_from([math.nan, math.inf, -math.inf, 1e300, "0.1", True, [0.1]])
+GOOD_ANGLES = st.one_of(st.floats(-3.2, 3.2), st.sampled_from([0.0, 0.01, -0.01]))
+
+
+@st.composite
+def table_spec(draw, good: dict, bad: dict, extra: str) -> dict:
+    """A table of good values, or one with a few bad values, missing keys, a foreign key."""
+    spec = {k: draw(v) for k, v in good.items()}
+    if draw(st.booleans()):
+        return spec
+    for key in draw(st.sets(st.sampled_from(sorted(bad)), min_size=1, max_size=2)):
+        spec[key] = draw(bad[key])
+    for key in list(spec):
+        if draw(st.integers(0, 6)) == 0:  # a missing key
+            del spec[key]
+    if draw(st.integers(0, 9)) == 0:
+        spec[extra] = 1
+    return spec
+
+
+def latch_table(n):
+    good = {
+        "hinge": st.integers(0, n - 1),
+        "angle": GOOD_ANGLES,
+        "direction": st.sampled_from([1, -1]),
+    }
+    bad = {
+        "hinge": st.one_of(st.integers(n, n + 2), BAD_HINGES),
+        "angle": BAD_ANGLES,
+        "direction": st.sampled_from([-1.0, 1.0, 0, 2, "up", "+1", True, False, 1e300, [1]]),
+    }
+    return table_spec(good, bad, "stiffness")
+
+
+def stop_table(n):
+    good = {
+        "hinge": st.integers(0, n - 1),
+        "angle": GOOD_ANGLES,
+        "side": st.sampled_from(["upper", "lower"]),
+        "stiffness": st.floats(1e-3, 1e7),
+        "damping": st.floats(0.0, 1e3),
+    }
+    bad = {
+        "hinge": st.one_of(st.integers(n, n + 2), BAD_HINGES),
+        "angle": BAD_ANGLES,
+        "side": st.sampled_from(["UPPER", "", "up", 1, -1.0, True]),
+        "stiffness": st.sampled_from([1e300, 1e200, 0.0, -1.0, math.nan, math.inf, "1e4", True]),
+        "damping": st.sampled_from([-1.0, 1e300, math.nan, math.inf, "0", False]),
+    }
+    return table_spec(good, bad, "direction")
+
+
+@st.composite
+def stops_latches_doc(draw) -> dict:
+    doc = small_scene(draw)
+    n = doc["n"]
+    doc["latches"] = draw(st.lists(latch_table(n), max_size=2))
+    doc["stops"] = draw(st.lists(stop_table(n), max_size=3))
+    if draw(st.integers(0, 9)) == 0:
+        doc[draw(st.sampled_from(["latches", "stops"]))] = draw(anything)
+    return doc
+
+
+def read_record(out: Path) -> dict | None:
+    path = out / "run.json"
+    return json.loads(path.read_text()) if path.is_file() else None
+
+
+@budget(4)
+@given(
+    doc=stops_latches_doc(),
+    model=st.sampled_from(["full", "reduced"]),
+    method=st.sampled_from([None, None, "RK45", "Radau", "DOP853-numba"]),
+)
+def test_fuzz_stops_and_latches(tmp_path_factory, counts, doc, model, method):
+    """Random [[stops]] / [[latches]] (valid and invalid hinges, angles, sides, directions,
+    stiffness, damping, missing keys) through `rodval simulate`: exit 0/1 with a status line
+    and finite outputs, or 2 with one clear line; a run keeps every stop and latch it was
+    given, on the hinge it was given."""
+    c = counts("stops_and_latches")
+    tmp = tmp_path_factory.mktemp("stops")
+    path = write_scene(tmp, doc)
+    argv = ["simulate", path, "--model", model, "--out", tmp / "out", *BUDGET]
+    if method:
+        argv += ["--method", method]
+    code, stdout, stderr = run_cli(argv, c)
+    if code == 2:
+        refusal_is_clear(stderr, c)
+        return
+    assert stdout.strip(), stderr
+    bad = check_run(tmp / "out", code)
+    c.nonfinite += bad
+    assert not bad, f"success with non-finite outputs: {doc}"
+    refused_late(stdout, c)
+    rec = read_record(tmp / "out")
+    if rec is None or not claims_success(rec["stats"]):
+        return
+    for key in ("latches", "stops"):
+        given_ = doc.get(key, [])
+        kept = rec["scene"].get(key, [])
+        lost = len(kept) != len(given_) or any(
+            not isinstance(s, dict) or s.get("hinge") != g.get("hinge") or s["hinge"] >= doc["n"]
+            for s, g in zip(kept, given_, strict=False)
+        )
+        if lost:
+            c.ignored += 1
+            raise AssertionError(f"success that dropped or moved {key}: {given_} -> {kept}")
+        for s, g in zip(kept, given_, strict=False):
+            for k, v in g.items():
+                if type(s.get(k)) is not type(v) or s.get(k) != v:
+                    c.ignored += 1
+                    raise AssertionError(f"{key} {k} = {v!r} ran as {s.get(k)!r}: {doc}")
+
+
+@st.composite
+def history_csv(draw) -> tuple[bytes, str, dict | None]:
+    """(bytes of a tabulated-load CSV file, what was done to it, its columns when they are
+    all valid: what a run must use)."""
+    kind = draw(
+        st.sampled_from(
+            [
+                "good",
+                "good",
+                "good",
+                "empty",
+                "binary",
+                "header only",
+                "ragged",
+                "duplicate",
+                "non-monotonic",
+                "non-finite",
+                "text cell",
+                "huge",
+                "bad header",
+                "blank lines",
+            ]
+        )  # fmt: skip
+    )
+    if kind == "empty":
+        return b"", kind, None
+    if kind == "binary":
+        return draw(st.binary(min_size=1, max_size=60)), kind, None
+    head = draw(st.sampled_from([["t", "X", "Y"], ["t", "X"], ["t", "Y"], ["Y", "t", "X"]]))
+    if kind == "duplicate":
+        head = draw(st.sampled_from([["t", "X", "X"], ["t", "Y", "Y"], ["t", "t", "X"]]))
+    elif kind == "bad header":
+        head = draw(st.sampled_from([["T", "X"], ["t", "X", "Z"], ["t", ""], [" t ", " X "]]))
+    rows = draw(st.integers(2, 12)) if kind != "huge" else draw(st.integers(10_000, 200_000))
+    if kind == "header only":
+        rows = 0
+    t = np.cumsum(np.full(rows, 0.3 / max(rows - 1, 1))) - 0.3 / max(rows - 1, 1)
+    if kind != "huge":
+        t = np.cumsum(draw(st.lists(st.floats(1e-3, 0.1), min_size=rows, max_size=rows)))
+        t -= t[0] if rows and draw(st.booleans()) else 0.0
+    cols = {name: t if name == "t" else np.sin(5 * t) * draw(st.floats(-500, 500)) for name in head}
+    table = np.column_stack([cols[h] for h in head]) if rows else np.zeros((0, len(head)))
+    cells = [[repr(float(v)) for v in row] for row in table]
+    if kind == "non-monotonic" and rows >= 2:
+        i, j = draw(st.integers(1, rows - 1)), head.index("t")
+        if draw(st.booleans()):
+            cells[i][j] = cells[i - 1][j]  # a repeated time
+        else:
+            cells[i], cells[i - 1] = cells[i - 1], cells[i]  # times out of order
+    elif kind == "non-finite" and rows:
+        i, j = draw(st.integers(0, rows - 1)), draw(st.integers(0, len(head) - 1))
+        cells[i][j] = draw(st.sampled_from(["nan", "inf", "-inf", "NaN", "1e999"]))
+    elif kind == "text cell" and rows:
+        i, j = draw(st.integers(0, rows - 1)), draw(st.integers(0, len(head) - 1))
+        cells[i][j] = draw(st.sampled_from(["", "x", "1,5", "0x10", " ", "1_0"]))
+    elif kind == "ragged" and rows:
+        i = draw(st.integers(0, rows - 1))
+        cells[i] = cells[i][:-1] if draw(st.booleans()) else [*cells[i], "1.0"]
+    lines = [",".join(head)] + [",".join(r) for r in cells]
+    if kind == "blank lines":
+        lines.insert(draw(st.integers(1, len(lines))), draw(st.sampled_from(["", ",,", " "])))
+    expected = cols if kind in ("good", "huge", "blank lines") and rows >= 2 else None
+    return ("\n".join(lines) + "\n").encode(), kind, expected
+
+
+@budget(4)
+@given(
+    doc=st.composite(lambda draw: small_scene(draw, n_max=3))(),
+    history=history_csv(),
+    node=st.sampled_from(["last", 1, 1]),
+    model=st.sampled_from(["full", "reduced"]),
+)
+def test_fuzz_tabulated_load_files(tmp_path_factory, counts, doc, history, node, model):
+    """A scene whose [[loads]] is a tabulated load read from a random CSV file (ragged rows,
+    duplicate or unknown headers, binary garbage, non-monotonic t, NaN/inf, text cells, up to
+    200 000 rows, empty files): exit 0/1 with finite outputs, or 2 with one clear line; a run
+    that succeeds used every sample of the file (the run record holds them) and a file with a
+    duplicated column (which one is the force?) is never accepted."""
+    c = counts("tabulated_load_files")
+    tmp = tmp_path_factory.mktemp("tabulated")
+    raw, kind, expected = history
+    csv_path = tmp / "history.csv"
+    csv_path.write_bytes(raw)
+    doc = {**doc, "loads": [{"type": "tabulated", "node": node, "file": str(csv_path)}]}
+    path = write_scene(tmp, doc)
+    argv = ["simulate", path, "--model", model, "--out", tmp / "out", *BUDGET]
+    code, stdout, stderr = run_cli(argv, c)
+    if code == 2:
+        refusal_is_clear(stderr, c)
+        return
+    assert stdout.strip(), stderr
+    bad = check_run(tmp / "out", code)
+    c.nonfinite += bad
+    assert not bad, f"success with non-finite outputs: {kind}"
+    refused_late(stdout, c)
+    rec = read_record(tmp / "out")
+    if rec is None:
+        return
+    if kind == "duplicate":
+        c.ignored += 1
+        raise AssertionError(f"a file with a duplicated column ran: {raw[:40]!r}")
+    load = rec["scene"]["loads"][0]
+    for name, given_ in (expected or {}).items():
+        used = np.asarray(load.get(name, []), float)
+        if used.shape != given_.shape or not np.array_equal(used, given_):
+            c.ignored += 1
+            raise AssertionError(f"column {name} of a {kind} file not used as given")
