@@ -978,3 +978,170 @@ def test_fuzz_tabulated_load_files(tmp_path_factory, counts, doc, history, node,
         if used.shape != given_.shape or not np.array_equal(used, given_):
             c.ignored += 1
             raise AssertionError(f"column {name} of a {kind} file not used as given")
+
+
+RUN_SCENE = {
+    "n": 2,
+    "t_end": 0.05,
+    "times": {"num": 3},
+    "outputs": ["phi", "dphi"],
+    "initial": {"dphi": 0.5},
+    "stops": [{"hinge": 1, "angle": 0.02, "side": "upper", "stiffness": 1e3, "damping": 1.0}],
+}
+
+
+@pytest.fixture(scope="module")
+def finished_runs(tmp_path_factory):
+    """Run folders of `rodval simulate` (made once per module): the tiny scene with the
+    reduced model, with its published coefficients, and with the full model; the same
+    scene with another EI; a scene with another n."""
+    tmp = tmp_path_factory.mktemp("runs")
+    scenes = {
+        "base": RUN_SCENE,
+        "other_EI": {**RUN_SCENE, "chain": {"EI": 1e3}},
+        "other_n": {**RUN_SCENE, "n": 3},
+    }
+    runs = {}
+    for label, doc, extra in (
+        ("reduced", "base", []),
+        ("published", "base", ["--coefficients", "published"]),
+        ("other_EI", "other_EI", []),
+        ("other_n", "other_n", []),
+    ):
+        path = tmp / f"{doc}.toml"
+        path.write_text(to_toml(scenes[doc]))
+        out = tmp / label
+        argv = ["simulate", path, "--model", "reduced", "--out", out, *BUDGET, *extra]
+        assert main([str(a) for a in argv]) == 0
+        runs[label] = out
+    return runs
+
+
+#: Sections of run.json that are inputs of a rerun (the others record how a run ended).
+RUN_INPUTS = ("scene", "model", "options", "settings")
+#: Inputs a rerun derives rather than reads: the method that ran (the rerun asks for
+#: ``requested_method`` again).
+DERIVED = {("settings", "method")}
+
+
+def leaves(doc, prefix=()):
+    """Paths of every value in a JSON document (dict keys and list indices)."""
+    if isinstance(doc, dict) and doc:
+        for k, v in doc.items():
+            yield from leaves(v, (*prefix, k))
+    elif isinstance(doc, list) and doc:
+        for i, v in enumerate(doc):
+            yield from leaves(v, (*prefix, i))
+    else:
+        yield prefix
+
+
+def containers(doc, prefix=()):
+    """Paths of every dict in a JSON document."""
+    if isinstance(doc, dict):
+        yield prefix
+        for k, v in doc.items():
+            yield from containers(v, (*prefix, k))
+    elif isinstance(doc, list):
+        for i, v in enumerate(doc):
+            yield from containers(v, (*prefix, i))
+
+
+def at(doc, path):
+    for p in path:
+        doc = doc[p]
+    return doc
+
+
+def same(a, b) -> bool:
+    """JSON values equal, NaN equal to NaN, a bool never equal to a number or a string."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, bool) or isinstance(b, bool):
+        return type(a) is type(b) and a == b
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return a == b or (math.isnan(a) and math.isnan(b))
+    return type(a) is type(b) and a == b
+
+
+@st.composite
+def leaf_value(draw, old):
+    """A new value for a leaf: a nearby value of its own type, or anything."""
+    if draw(st.booleans()):
+        return draw(anything)
+    if isinstance(old, bool):
+        return not old
+    if isinstance(old, (int, float)):
+        return type(old)(old * draw(st.sampled_from([0.5, 2, -1, 0, 1e6])))
+    if isinstance(old, str):
+        return draw(st.sampled_from([old.upper(), old + " ", "", "RK45", "published", "numpy"]))
+    return draw(anything)
+
+
+@st.composite
+def run_record_edit(draw, rec: dict, text: str):
+    """(edited run.json text, what was done, the edited path or None, the value put there)."""
+    kind = draw(st.sampled_from(["unknown key", "value", "value", "delete", "truncate", "record"]))
+    if kind == "truncate":
+        return text[: draw(st.integers(0, len(text) - 2))], kind, None, None
+    doc = json.loads(text)
+    section = draw(st.sampled_from(RUN_INPUTS if kind != "record" else ("stats", "events")))
+    if kind == "unknown key":
+        where = draw(st.sampled_from([(), *containers(rec[section], (section,))]))
+        key = draw(st.sampled_from(["rtoll", "bogus", "Rtol", "kernal", "EI_"]))
+        value = draw(st.sampled_from([1, 1e-3, "x", True]))
+        at(doc, where)[key] = value
+        return json.dumps(doc), kind, (*where, key), value
+    paths = [p for p in leaves(rec[section], (section,)) if p]
+    if kind == "delete":
+        path = draw(st.sampled_from(paths))
+        parent = at(doc, path[:-1])
+        if isinstance(parent, dict):
+            del parent[path[-1]]
+        else:
+            parent.pop(path[-1])
+        return json.dumps(doc), kind, None, None
+    path = draw(st.sampled_from(paths))
+    value = draw(leaf_value(at(rec, path)))
+    at(doc, path[:-1])[path[-1]] = value
+    return json.dumps(doc), kind, path, value
+
+
+@budget(5)
+@given(data=st.data())
+def test_fuzz_edited_run_records(tmp_path_factory, counts, finished_runs, data):
+    """`rodval simulate RUN/run.json` over a run.json with random edits (unknown keys such as
+    "rtoll" anywhere, wrong types, out-of-range values, deleted keys, truncation, edited
+    stats): exit 0/1 with finite outputs, or 2 with one clear line; a rerun that succeeds
+    used every input it was given (an edited input is in its own run.json as edited, an
+    unknown key is refused rather than dropped)."""
+    c = counts("edited_run_records")
+    tmp = tmp_path_factory.mktemp("rerun")
+    text = (finished_runs["reduced"] / "run.json").read_text()
+    rec = json.loads(text)
+    edited, kind, path, value = data.draw(run_record_edit(rec, text))
+    (tmp / "run.json").write_text(edited)
+    code, stdout, stderr = run_cli(["simulate", tmp / "run.json", "--out", tmp / "out"], c)
+    if code == 2:
+        refusal_is_clear(stderr, c)
+        return
+    assert stdout.strip(), stderr
+    bad = check_run(tmp / "out", code)
+    c.nonfinite += bad
+    assert not bad, f"success with non-finite outputs: {kind} {path} = {value!r}"
+    refused_late(stdout, c)
+    new = read_record(tmp / "out")
+    if new is None or path is None or path[0] not in RUN_INPUTS or path[:2] in DERIVED:
+        return
+    if kind == "unknown key" or path[0] not in RUN_INPUTS:
+        c.ignored += 1
+        raise AssertionError(f"unknown key {'.'.join(map(str, path))} = {value!r} ignored")
+    try:
+        ran = at(new, path)
+    except (KeyError, IndexError, TypeError):
+        ran = "<missing>"
+    if not same(ran, value):
+        c.ignored += 1
+        raise AssertionError(f"{'.'.join(map(str, path))} = {value!r} ran as {ran!r}")
