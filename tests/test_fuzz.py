@@ -33,6 +33,7 @@ import os
 import shutil
 import signal
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -1145,3 +1146,226 @@ def test_fuzz_edited_run_records(tmp_path_factory, counts, finished_runs, data):
     if not same(ran, value):
         c.ignored += 1
         raise AssertionError(f"{'.'.join(map(str, path))} = {value!r} ran as {ran!r}")
+
+
+def run_api(fn, kwargs: dict, c: Counts, names: tuple[str, ...], shown: str = ""):
+    """``fn(**kwargs)`` under the time limit: its result, or None when it raised a
+    ValueError/TypeError/KeyError whose message is one line naming the parameter (one of
+    ``names``); any other exception is a traceback."""
+    c.examples += 1
+    old = signal.signal(signal.SIGALRM, _alarm)
+    signal.setitimer(signal.ITIMER_REAL, LIMIT_S)
+    start = time.perf_counter()
+    call = f"{getattr(fn, '__qualname__', fn)}({shown or kwargs!r})"
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            result = fn(**kwargs)
+    except Hang:
+        c.hangs += 1
+        raise AssertionError(f"hang: {call}") from None
+    except (ValueError, TypeError, KeyError) as exc:
+        msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else str(exc)
+        msg = str(msg)
+        named = any(n.lower() in msg.lower().replace(" ", "_") for n in names)
+        if len(msg.strip().splitlines()) != 1 or not (named or any(n in msg for n in names)):
+            c.tracebacks += 1
+            raise AssertionError(
+                f"{call}: {type(exc).__name__} not naming {names[0]!r} on one line: {msg!r}"
+            ) from exc
+        c.exits[2] = c.exits.get(2, 0) + 1
+        return None
+    except Exception as exc:  # noqa: BLE001 - counted, then reported
+        c.tracebacks += 1
+        raise AssertionError(f"{call}: {type(exc).__name__}: {exc}") from exc
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+        c.last = time.perf_counter()
+    if time.perf_counter() - start > LIMIT_S:
+        c.hangs += 1
+        raise AssertionError(f"hang: {call}")
+    c.exits[0] = c.exits.get(0, 0) + 1
+    return result
+
+
+BAD_VALUES = st.sampled_from(
+    [
+        None,
+        True,
+        0,
+        -1,
+        1.5,
+        math.nan,
+        math.inf,
+        1e300,
+        "",
+        "x",
+        "phi",
+        b"x",
+        [],
+        [1, 2],
+        {},
+        {"a": 1},
+        object(),
+        np.float64(math.nan),
+        np.array([1.0, 2.0]),
+        np.int64(2),
+        1j,
+        slice(None),
+        ("phi", 1),
+    ]  # fmt: skip
+)
+
+#: Words a message may use for a parameter (besides its name).
+ALIASES = {
+    "traj": ("trajector",),
+    "reference": ("trajector",),
+    "quantities": ("quantit",),
+    "quantity": ("quantit",),
+    "path": ("study", "file"),
+    "out": ("folder", "director", "study"),
+    "spec": ("study",),
+    "name": ("model",),
+    "model": ("model",),
+}
+
+
+@pytest.fixture(scope="module")
+def api_objects(tmp_path_factory, finished_study):
+    import rodval
+
+    scene = rodval.paper_scene(2, t_end=0.05, times=[0.0, 0.025, 0.05], outputs=("phi", "dphi"))
+    settings_ = rodval.IntegratorSettings(max_evaluations=50000, max_wall_s=2.0)
+    other = rodval.paper_scene(2, t_end=0.05, times=[0.0, 0.025, 0.05], outputs=("phi", "dphi"),
+                               EI=1e3)  # fmt: skip
+    study_path, study_out = finished_study
+    junk = tmp_path_factory.mktemp("junk") / "junk.bin"
+    junk.write_bytes(b"\x80\x00garbage")
+    return {
+        "rodval": rodval,
+        "scene": scene,
+        "settings": settings_,
+        "traj": rodval.simulate(scene, "reduced", settings=settings_),
+        "traj_pub": rodval.simulate(scene, "reduced", settings=settings_, coefficients="published"),
+        "traj_other": rodval.simulate(other, "reduced", settings=settings_),
+        "study_path": study_path,
+        "study_out": study_out,
+        "junk": junk,
+        "tmp": tmp_path_factory.mktemp("api"),
+    }
+
+
+def api_call(o: dict, name: str):
+    """(function, good keyword arguments, pools of values per parameter, keywords the
+    function does not know) of one public entry point."""
+    rv = o["rodval"]
+    paths = st.sampled_from([str(o["junk"]), o["junk"].parent, "missing.toml", o["study_out"]])
+    fields = ("chain", "loads", "t_end", "times", "outputs", "initial", "name", "latches", "stops")
+    table = {
+        "simulate": (
+            rv.simulate,
+            {"scene": o["scene"], "model": "reduced", "settings": o["settings"]},
+            {"model": st.sampled_from(["nope", "Full", "exudyn "]), "kernel": st.just("x"),
+             "coefficients": st.just("x"), "rtol": st.just(1e-3), "settings": st.just({})},
+            ("bogus",),
+        ),
+        "compare": (
+            rv.compare,
+            {"traj": o["traj"], "reference": o["traj_pub"]},
+            {"reference": st.just(o["traj_other"]),
+             "quantities": st.sampled_from([["z"], "phi", ["phi", "phi"], [1], ()])},
+            (),
+        ),
+        "modes": (
+            rv.modes,
+            {"scene": o["scene"], "model": "reduced"},
+            {"about": st.sampled_from(["x", "final"]), "count": st.sampled_from([0, 100, 2.0]),
+             "coefficients": st.just("x")},
+            ("bogus",),
+        ),
+        "Scene.with_": (o["scene"].with_, {}, {k: BAD_VALUES for k in fields}, ("n", "bogus")),
+        "Trajectory.__getitem__": (
+            lambda quantity: o["traj"][quantity],
+            {"quantity": "phi"},
+            {"quantity": st.sampled_from(["z", "PHI", "alpha", "energy"])},
+            (),
+        ),
+        "load_study": (rv.load_study, {"path": o["study_path"]}, {"path": paths}, ()),
+        "read_study_tables": (rv.read_study_tables, {"out": o["study_out"]}, {"out": paths}, ()),
+        "run_study": (
+            rv.run_study,
+            {"spec": rv.load_study(o["study_path"]), "out": o["tmp"] / "study", "workers": 1,
+             "progress": False, "report": False},
+            {"workers": st.sampled_from([0, 2.5]), "case_timeout": st.sampled_from([0, -1.0]),
+             "backend": st.sampled_from(["mpi", "dask "]), "out": st.just(o["junk"])},
+            ("bogus",),
+        ),
+        "paper_scene": (
+            rv.paper_scene,
+            {"n": 2, "t_end": 0.05},
+            {"times": st.just([0.1, 0.0]), "load_node": st.sampled_from([0, 3]),
+             "outputs": st.just(["z"])},
+            ("bogus", "rtol"),
+        ),
+        "IntegratorSettings": (
+            rv.IntegratorSettings,
+            {},
+            {k: BAD_VALUES for k in ("method", "rtol", "atol", "max_step", "first_step",
+                                      "max_evaluations", "max_wall_s", "blowup_factor",
+                                      "min_step_fraction", "stall_steps")},
+            ("rtoll",),
+        ),
+        "get_model": (
+            rv.get_model, {"name": "reduced"}, {"name": st.just("nope")}, ("bogus", "rtoll")
+        ),
+    }  # fmt: skip
+    return table[name]
+
+
+API_NAMES = ("simulate", "compare", "modes", "Scene.with_", "Trajectory.__getitem__",
+             "load_study", "read_study_tables", "run_study", "paper_scene",
+             "IntegratorSettings", "get_model")  # fmt: skip
+
+
+@budget(25)
+@given(name=st.sampled_from(API_NAMES), data=st.data())
+def test_fuzz_python_api(counts, api_objects, name, data):
+    """The public API (`rodval.__all__`) called with one or two parameters of a wrong type or
+    value (or an unknown keyword): it succeeds, or raises ValueError/TypeError/KeyError with a
+    one-line message naming the parameter (anything else, e.g. AttributeError or IndexError
+    from deep inside, counts as a traceback), never hangs; a success with an unknown keyword
+    (ignored), a comparison of two different scenes, or a run claiming success with
+    non-finite values is silently wrong."""
+    c = counts("python_api")
+    fn, kwargs, pools, unknown = api_call(api_objects, name)
+    kwargs = dict(kwargs)
+    params = sorted(set(pools) | set(kwargs) - {"progress", "report"})
+    changed = []
+    for _ in range(data.draw(st.integers(1, 2))):
+        key = data.draw(st.sampled_from([*params, *unknown]))
+        pool = pools.get(key, BAD_VALUES)
+        kwargs[key] = data.draw(st.one_of(pool, BAD_VALUES) if key in pools else BAD_VALUES)
+        changed.append(key)
+    names = tuple(n for k in changed for n in (k, *ALIASES.get(k, ())))
+    if name == "Trajectory.__getitem__":  # a mapping's KeyError names the key itself
+        names += (repr(kwargs["quantity"]),)
+    names += tuple(  # a message may name a path or name by its value
+        str(v) for k in changed if isinstance(v := kwargs[k], (str, Path)) and len(str(v)) >= 3
+    )
+    shown = ", ".join(f"{k}={kwargs[k]!r:.60}" for k in changed)
+    result = run_api(fn, kwargs, c, names, shown)
+    if result is None:
+        return
+    if any(k in unknown for k in changed):
+        c.ignored += 1
+        raise AssertionError(f"{name}: unknown keyword accepted: {shown}")
+    if name == "compare" and kwargs["reference"] is api_objects["traj_other"]:
+        c.ignored += 1
+        raise AssertionError("compare: runs of two different scenes compared without a word")
+    stats = getattr(result, "stats", None)
+    if stats is not None and claims_success(stats):
+        values = [np.asarray(v, float) for v in result.values.values()]
+        bad = int(not all(np.all(np.isfinite(v)) for v in values))
+        c.nonfinite += bad
+        assert not bad, f"{name}({shown}): success with non-finite values"
