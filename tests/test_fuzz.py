@@ -33,6 +33,7 @@ import os
 import shutil
 import signal
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -67,7 +68,8 @@ class Counts:
 
     def __init__(self, name: str):
         self.name = name
-        self.examples = self.tracebacks = self.hangs = self.nonfinite = 0
+        self.examples = self.tracebacks = self.hangs = self.nonfinite = self.ignored = 0
+        self.late = 0
         self.exits: dict[int, int] = {}
         self.start = self.last = time.perf_counter()
 
@@ -81,6 +83,9 @@ class Counts:
             "tracebacks": self.tracebacks,
             "hangs": self.hangs,
             "nonfinite_successes": self.nonfinite,
+            "ignored_inputs": self.ignored,
+            "silent_wrong": self.nonfinite + self.ignored,
+            "late_refusals": self.late,
             "exit_codes": {str(k): v for k, v in sorted(self.exits.items())},
             "wall_s": round(self.last - self.start, 1),
         }
@@ -315,6 +320,13 @@ def write_scene(tmp: Path, doc: dict, raw: bytes | None = None) -> Path:
     return path
 
 
+def claims_success(stats) -> bool:
+    """A run's stats (SolverStats or run.json's dict) claim a correct result: status 0 and
+    not ``valid = false`` (a missing ``valid`` is unknown: the status alone counts)."""
+    get = stats.get if isinstance(stats, dict) else lambda k, d=None: getattr(stats, k, d)
+    return get("status") == 0 and get("valid", None) is not False
+
+
 def check_run(out: Path, code: int) -> int:
     """A run that reports success has finite outputs only; returns 1 for a silent
     non-finite success."""
@@ -322,7 +334,7 @@ def check_run(out: Path, code: int) -> int:
     if code not in (0, 1) or not run.is_file():
         return 0
     rec = json.loads(run.read_text())
-    if rec["stats"]["status"] != 0:
+    if not claims_success(rec["stats"]):
         return 0
     df = pd.read_csv(out / "trajectory.csv")
     values = df.select_dtypes("number").to_numpy()
@@ -688,3 +700,672 @@ def test_fuzz_damaged_tables(tmp_path_factory, counts, finished_study, data):
     code, _, stderr = run_cli(["report", out], c)
     if code == 2:
         assert f"{name}.csv" in stderr or str(out) in stderr, stderr
+
+
+# ----------------------------------------------------------------------------- trust review
+# Inputs a trust review found broken: stops and latches, tabulated-load CSV files, edited
+# run.json files, the Python API, `rodval compare` and `rodval report` over damaged inputs.
+# Besides tracebacks and hangs these count *silently wrong* results: a run that claims
+# success (``claims_success``) with non-finite outputs, or one that ignored an input.
+
+#: Python's own messages: an exit-2 line made of one of them is an exception that slipped
+#: past the checks (counted as a traceback), not a refusal naming the key.
+INTERNAL_PHRASES = (
+    "Unknown format code",
+    "inhomogeneous",
+    "unsupported operand",
+    "not subscriptable",
+    "has no attribute",
+    "object is not",
+    "codec can't decode",
+    "math domain error",
+    "division by zero",
+    "index out of",
+    "NoneType",
+    "argument must be",
+)
+
+
+def refusal_is_clear(stderr: str, c: Counts) -> None:
+    """An exit-2 line says what is wrong in rodval's words, not Python's."""
+    leaked = [p for p in INTERNAL_PHRASES if p in stderr]
+    if leaked:
+        c.tracebacks += 1
+        raise AssertionError(f"a Python-internal message as refusal ({leaked[0]!r}): {stderr}")
+
+
+def refused_late(stdout: str, c: Counts) -> None:
+    """A ValueError about the input is raised before any work (exit 2), not reported as a
+    run that failed at set-up or at its first observation (exit 1, "ValueError" in the
+    status line: the check ran inside the model, naming the model's parameter)."""
+    if "ValueError" in stdout:
+        c.late += 1
+        raise AssertionError(f"input error reported as a failed run, not refused: {stdout}")
+
+
+def small_scene(draw, *, n_max: int = 4) -> dict:
+    """A small valid scene document (n <= n_max, t_end <= 0.3 s) that moves."""
+    n = draw(st.integers(1, n_max))
+    doc = {
+        "n": n,
+        "t_end": draw(st.floats(0.01, 0.3)),
+        "times": {"num": draw(st.integers(1, 6))},
+        "outputs": ["phi", "dphi"],
+    }
+    if draw(st.booleans()):
+        doc["initial"] = {"dphi": draw(st.floats(-3.0, 3.0))}
+    return doc
+
+
+BAD_HINGES = st.sampled_from([-1, 1.0, 0.5, "1", True, 1e300, -1.0, [1]])
+BAD_ANGLES = st.sampled_from([math.nan, math.inf, -math.inf, 1e300, "0.1", True, [0.1]])
+GOOD_ANGLES = st.one_of(st.floats(-3.2, 3.2), st.sampled_from([0.0, 0.01, -0.01]))
+
+
+@st.composite
+def table_spec(draw, good: dict, bad: dict, extra: str) -> dict:
+    """A table of good values, or one with a few bad values, missing keys, a foreign key."""
+    spec = {k: draw(v) for k, v in good.items()}
+    if draw(st.booleans()):
+        return spec
+    for key in draw(st.sets(st.sampled_from(sorted(bad)), min_size=1, max_size=2)):
+        spec[key] = draw(bad[key])
+    for key in list(spec):
+        if draw(st.integers(0, 6)) == 0:  # a missing key
+            del spec[key]
+    if draw(st.integers(0, 9)) == 0:
+        spec[extra] = 1
+    return spec
+
+
+def latch_table(n):
+    good = {
+        "hinge": st.integers(0, n - 1),
+        "angle": GOOD_ANGLES,
+        "direction": st.sampled_from([1, -1]),
+    }
+    bad = {
+        "hinge": st.one_of(st.integers(n, n + 2), BAD_HINGES),
+        "angle": BAD_ANGLES,
+        "direction": st.sampled_from([-1.0, 1.0, 0, 2, "up", "+1", True, False, 1e300, [1]]),
+    }
+    return table_spec(good, bad, "stiffness")
+
+
+def stop_table(n):
+    good = {
+        "hinge": st.integers(0, n - 1),
+        "angle": GOOD_ANGLES,
+        "side": st.sampled_from(["upper", "lower"]),
+        "stiffness": st.floats(1e-3, 1e7),
+        "damping": st.floats(0.0, 1e3),
+    }
+    bad = {
+        "hinge": st.one_of(st.integers(n, n + 2), BAD_HINGES),
+        "angle": BAD_ANGLES,
+        "side": st.sampled_from(["UPPER", "", "up", 1, -1.0, True]),
+        "stiffness": st.sampled_from([1e300, 1e200, 0.0, -1.0, math.nan, math.inf, "1e4", True]),
+        "damping": st.sampled_from([-1.0, 1e300, math.nan, math.inf, "0", False]),
+    }
+    return table_spec(good, bad, "direction")
+
+
+@st.composite
+def stops_latches_doc(draw) -> dict:
+    doc = small_scene(draw)
+    n = doc["n"]
+    doc["latches"] = draw(st.lists(latch_table(n), max_size=2))
+    doc["stops"] = draw(st.lists(stop_table(n), max_size=3))
+    if draw(st.integers(0, 9)) == 0:
+        doc[draw(st.sampled_from(["latches", "stops"]))] = draw(anything)
+    return doc
+
+
+def read_record(out: Path) -> dict | None:
+    path = out / "run.json"
+    return json.loads(path.read_text()) if path.is_file() else None
+
+
+@budget(4)
+@given(
+    doc=stops_latches_doc(),
+    model=st.sampled_from(["full", "reduced"]),
+    method=st.sampled_from([None, None, "RK45", "Radau", "DOP853-numba"]),
+)
+def test_fuzz_stops_and_latches(tmp_path_factory, counts, doc, model, method):
+    """Random [[stops]] / [[latches]] (valid and invalid hinges, angles, sides, directions,
+    stiffness, damping, missing keys) through `rodval simulate`: exit 0/1 with a status line
+    and finite outputs, or 2 with one clear line; a run keeps every stop and latch it was
+    given, on the hinge it was given."""
+    c = counts("stops_and_latches")
+    tmp = tmp_path_factory.mktemp("stops")
+    path = write_scene(tmp, doc)
+    argv = ["simulate", path, "--model", model, "--out", tmp / "out", *BUDGET]
+    if method:
+        argv += ["--method", method]
+    code, stdout, stderr = run_cli(argv, c)
+    if code == 2:
+        refusal_is_clear(stderr, c)
+        return
+    assert stdout.strip(), stderr
+    bad = check_run(tmp / "out", code)
+    c.nonfinite += bad
+    assert not bad, f"success with non-finite outputs: {doc}"
+    refused_late(stdout, c)
+    rec = read_record(tmp / "out")
+    if rec is None or not claims_success(rec["stats"]):
+        return
+    for key in ("latches", "stops"):
+        given_ = doc.get(key, [])
+        kept = rec["scene"].get(key, [])
+        lost = len(kept) != len(given_) or any(
+            not isinstance(s, dict) or s.get("hinge") != g.get("hinge") or s["hinge"] >= doc["n"]
+            for s, g in zip(kept, given_, strict=False)
+        )
+        if lost:
+            c.ignored += 1
+            raise AssertionError(f"success that dropped or moved {key}: {given_} -> {kept}")
+        for s, g in zip(kept, given_, strict=False):
+            for k, v in g.items():
+                if type(s.get(k)) is not type(v) or s.get(k) != v:
+                    c.ignored += 1
+                    raise AssertionError(f"{key} {k} = {v!r} ran as {s.get(k)!r}: {doc}")
+
+
+@st.composite
+def history_csv(draw) -> tuple[bytes, str, dict | None]:
+    """(bytes of a tabulated-load CSV file, what was done to it, its columns when they are
+    all valid: what a run must use)."""
+    kind = draw(
+        st.sampled_from(
+            [
+                "good",
+                "good",
+                "good",
+                "empty",
+                "binary",
+                "header only",
+                "ragged",
+                "duplicate",
+                "non-monotonic",
+                "non-finite",
+                "text cell",
+                "huge",
+                "bad header",
+                "blank lines",
+            ]
+        )  # fmt: skip
+    )
+    if kind == "empty":
+        return b"", kind, None
+    if kind == "binary":
+        return draw(st.binary(min_size=1, max_size=60)), kind, None
+    head = draw(st.sampled_from([["t", "X", "Y"], ["t", "X"], ["t", "Y"], ["Y", "t", "X"]]))
+    if kind == "duplicate":
+        head = draw(st.sampled_from([["t", "X", "X"], ["t", "Y", "Y"], ["t", "t", "X"]]))
+    elif kind == "bad header":
+        head = draw(st.sampled_from([["T", "X"], ["t", "X", "Z"], ["t", ""], [" t ", " X "]]))
+    rows = draw(st.integers(2, 12)) if kind != "huge" else draw(st.integers(10_000, 200_000))
+    if kind == "header only":
+        rows = 0
+    t = np.cumsum(np.full(rows, 0.3 / max(rows - 1, 1))) - 0.3 / max(rows - 1, 1)
+    if kind != "huge":
+        t = np.cumsum(draw(st.lists(st.floats(1e-3, 0.1), min_size=rows, max_size=rows)))
+        t -= t[0] if rows and draw(st.booleans()) else 0.0
+    cols = {name: t if name == "t" else np.sin(5 * t) * draw(st.floats(-500, 500)) for name in head}
+    table = np.column_stack([cols[h] for h in head]) if rows else np.zeros((0, len(head)))
+    cells = [[repr(float(v)) for v in row] for row in table]
+    if kind == "non-monotonic" and rows >= 2:
+        i, j = draw(st.integers(1, rows - 1)), head.index("t")
+        if draw(st.booleans()):
+            cells[i][j] = cells[i - 1][j]  # a repeated time
+        else:
+            cells[i], cells[i - 1] = cells[i - 1], cells[i]  # times out of order
+    elif kind == "non-finite" and rows:
+        i, j = draw(st.integers(0, rows - 1)), draw(st.integers(0, len(head) - 1))
+        cells[i][j] = draw(st.sampled_from(["nan", "inf", "-inf", "NaN", "1e999"]))
+    elif kind == "text cell" and rows:
+        i, j = draw(st.integers(0, rows - 1)), draw(st.integers(0, len(head) - 1))
+        cells[i][j] = draw(st.sampled_from(["", "x", "1,5", "0x10", " ", "1_0"]))
+    elif kind == "ragged" and rows:
+        i = draw(st.integers(0, rows - 1))
+        cells[i] = cells[i][:-1] if draw(st.booleans()) else [*cells[i], "1.0"]
+    lines = [",".join(head)] + [",".join(r) for r in cells]
+    if kind == "blank lines":
+        lines.insert(draw(st.integers(1, len(lines))), draw(st.sampled_from(["", ",,", " "])))
+    expected = cols if kind in ("good", "huge", "blank lines") and rows >= 2 else None
+    return ("\n".join(lines) + "\n").encode(), kind, expected
+
+
+@budget(4)
+@given(
+    doc=st.composite(lambda draw: small_scene(draw, n_max=3))(),
+    history=history_csv(),
+    node=st.sampled_from(["last", 1, 1]),
+    model=st.sampled_from(["full", "reduced"]),
+)
+def test_fuzz_tabulated_load_files(tmp_path_factory, counts, doc, history, node, model):
+    """A scene whose [[loads]] is a tabulated load read from a random CSV file (ragged rows,
+    duplicate or unknown headers, binary garbage, non-monotonic t, NaN/inf, text cells, up to
+    200 000 rows, empty files): exit 0/1 with finite outputs, or 2 with one clear line; a run
+    that succeeds used every sample of the file (the run record holds them) and a file with a
+    duplicated column (which one is the force?) is never accepted."""
+    c = counts("tabulated_load_files")
+    tmp = tmp_path_factory.mktemp("tabulated")
+    raw, kind, expected = history
+    csv_path = tmp / "history.csv"
+    csv_path.write_bytes(raw)
+    doc = {**doc, "loads": [{"type": "tabulated", "node": node, "file": str(csv_path)}]}
+    path = write_scene(tmp, doc)
+    argv = ["simulate", path, "--model", model, "--out", tmp / "out", *BUDGET]
+    code, stdout, stderr = run_cli(argv, c)
+    if code == 2:
+        refusal_is_clear(stderr, c)
+        return
+    assert stdout.strip(), stderr
+    bad = check_run(tmp / "out", code)
+    c.nonfinite += bad
+    assert not bad, f"success with non-finite outputs: {kind}"
+    refused_late(stdout, c)
+    rec = read_record(tmp / "out")
+    if rec is None:
+        return
+    if kind == "duplicate":
+        c.ignored += 1
+        raise AssertionError(f"a file with a duplicated column ran: {raw[:40]!r}")
+    load = rec["scene"]["loads"][0]
+    for name, given_ in (expected or {}).items():
+        used = np.asarray(load.get(name, []), float)
+        if used.shape != given_.shape or not np.array_equal(used, given_):
+            c.ignored += 1
+            raise AssertionError(f"column {name} of a {kind} file not used as given")
+
+
+RUN_SCENE = {
+    "n": 2,
+    "t_end": 0.05,
+    "times": {"num": 3},
+    "outputs": ["phi", "dphi"],
+    "initial": {"dphi": 0.5},
+    "stops": [{"hinge": 1, "angle": 0.02, "side": "upper", "stiffness": 1e3, "damping": 1.0}],
+}
+
+
+@pytest.fixture(scope="module")
+def finished_runs(tmp_path_factory):
+    """Run folders of `rodval simulate` (made once per module): the tiny scene with the
+    reduced model, with its published coefficients, and with the full model; the same
+    scene with another EI; a scene with another n."""
+    tmp = tmp_path_factory.mktemp("runs")
+    scenes = {
+        "base": RUN_SCENE,
+        "other_EI": {**RUN_SCENE, "chain": {"EI": 1e3}},
+        "other_n": {**RUN_SCENE, "n": 3},
+    }
+    runs = {}
+    for label, doc, extra in (
+        ("reduced", "base", []),
+        ("published", "base", ["--coefficients", "published"]),
+        ("other_EI", "other_EI", []),
+        ("other_n", "other_n", []),
+    ):
+        path = tmp / f"{doc}.toml"
+        path.write_text(to_toml(scenes[doc]))
+        out = tmp / label
+        argv = ["simulate", path, "--model", "reduced", "--out", out, *BUDGET, *extra]
+        assert main([str(a) for a in argv]) == 0
+        runs[label] = out
+    return runs
+
+
+#: Sections of run.json that are inputs of a rerun (the others record how a run ended).
+RUN_INPUTS = ("scene", "model", "options", "settings")
+#: Inputs a rerun derives rather than reads: the method that ran (the rerun asks for
+#: ``requested_method`` again).
+DERIVED = {("settings", "method")}
+
+
+def leaves(doc, prefix=()):
+    """Paths of every value in a JSON document (dict keys and list indices)."""
+    if isinstance(doc, dict) and doc:
+        for k, v in doc.items():
+            yield from leaves(v, (*prefix, k))
+    elif isinstance(doc, list) and doc:
+        for i, v in enumerate(doc):
+            yield from leaves(v, (*prefix, i))
+    else:
+        yield prefix
+
+
+def containers(doc, prefix=()):
+    """Paths of every dict in a JSON document."""
+    if isinstance(doc, dict):
+        yield prefix
+        for k, v in doc.items():
+            yield from containers(v, (*prefix, k))
+    elif isinstance(doc, list):
+        for i, v in enumerate(doc):
+            yield from containers(v, (*prefix, i))
+
+
+def at(doc, path):
+    for p in path:
+        doc = doc[p]
+    return doc
+
+
+def same(a, b) -> bool:
+    """JSON values equal, NaN equal to NaN, a bool never equal to a number or a string."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, bool) or isinstance(b, bool):
+        return type(a) is type(b) and a == b
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return a == b or (math.isnan(a) and math.isnan(b))
+    return type(a) is type(b) and a == b
+
+
+@st.composite
+def leaf_value(draw, old):
+    """A new value for a leaf: a nearby value of its own type, or anything."""
+    if draw(st.booleans()):
+        return draw(anything)
+    if isinstance(old, bool):
+        return not old
+    if isinstance(old, (int, float)):
+        return type(old)(old * draw(st.sampled_from([0.5, 2, -1, 0, 1e6])))
+    if isinstance(old, str):
+        return draw(st.sampled_from([old.upper(), old + " ", "", "RK45", "published", "numpy"]))
+    return draw(anything)
+
+
+@st.composite
+def run_record_edit(draw, rec: dict, text: str):
+    """(edited run.json text, what was done, the edited path or None, the value put there)."""
+    kind = draw(st.sampled_from(["unknown key", "value", "value", "delete", "truncate", "record"]))
+    if kind == "truncate":
+        return text[: draw(st.integers(0, len(text) - 2))], kind, None, None
+    doc = json.loads(text)
+    section = draw(st.sampled_from(RUN_INPUTS if kind != "record" else ("stats", "events")))
+    if kind == "unknown key":
+        where = draw(st.sampled_from([(), *containers(rec[section], (section,))]))
+        key = draw(st.sampled_from(["rtoll", "bogus", "Rtol", "kernal", "EI_"]))
+        value = draw(st.sampled_from([1, 1e-3, "x", True]))
+        at(doc, where)[key] = value
+        return json.dumps(doc), kind, (*where, key), value
+    paths = [p for p in leaves(rec[section], (section,)) if p]
+    if kind == "delete":
+        path = draw(st.sampled_from(paths))
+        parent = at(doc, path[:-1])
+        if isinstance(parent, dict):
+            del parent[path[-1]]
+        else:
+            parent.pop(path[-1])
+        return json.dumps(doc), kind, None, None
+    path = draw(st.sampled_from(paths))
+    value = draw(leaf_value(at(rec, path)))
+    at(doc, path[:-1])[path[-1]] = value
+    return json.dumps(doc), kind, path, value
+
+
+@budget(5)
+@given(data=st.data())
+def test_fuzz_edited_run_records(tmp_path_factory, counts, finished_runs, data):
+    """`rodval simulate RUN/run.json` over a run.json with random edits (unknown keys such as
+    "rtoll" anywhere, wrong types, out-of-range values, deleted keys, truncation, edited
+    stats): exit 0/1 with finite outputs, or 2 with one clear line; a rerun that succeeds
+    used every input it was given (an edited input is in its own run.json as edited, an
+    unknown key is refused rather than dropped)."""
+    c = counts("edited_run_records")
+    tmp = tmp_path_factory.mktemp("rerun")
+    text = (finished_runs["reduced"] / "run.json").read_text()
+    rec = json.loads(text)
+    edited, kind, path, value = data.draw(run_record_edit(rec, text))
+    (tmp / "run.json").write_text(edited)
+    code, stdout, stderr = run_cli(["simulate", tmp / "run.json", "--out", tmp / "out"], c)
+    if code == 2:
+        refusal_is_clear(stderr, c)
+        return
+    assert stdout.strip(), stderr
+    bad = check_run(tmp / "out", code)
+    c.nonfinite += bad
+    assert not bad, f"success with non-finite outputs: {kind} {path} = {value!r}"
+    refused_late(stdout, c)
+    new = read_record(tmp / "out")
+    if new is None or path is None or path[0] not in RUN_INPUTS or path[:2] in DERIVED:
+        return
+    if kind == "unknown key" or path[0] not in RUN_INPUTS:
+        c.ignored += 1
+        raise AssertionError(f"unknown key {'.'.join(map(str, path))} = {value!r} ignored")
+    try:
+        ran = at(new, path)
+    except (KeyError, IndexError, TypeError):
+        ran = "<missing>"
+    if not same(ran, value):
+        c.ignored += 1
+        raise AssertionError(f"{'.'.join(map(str, path))} = {value!r} ran as {ran!r}")
+
+
+def run_api(fn, kwargs: dict, c: Counts, names: tuple[str, ...], shown: str = ""):
+    """``fn(**kwargs)`` under the time limit: its result, or None when it raised a
+    ValueError/TypeError/KeyError whose message is one line naming the parameter (one of
+    ``names``); any other exception is a traceback."""
+    c.examples += 1
+    old = signal.signal(signal.SIGALRM, _alarm)
+    signal.setitimer(signal.ITIMER_REAL, LIMIT_S)
+    start = time.perf_counter()
+    call = f"{getattr(fn, '__qualname__', fn)}({shown or kwargs!r})"
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            result = fn(**kwargs)
+    except Hang:
+        c.hangs += 1
+        raise AssertionError(f"hang: {call}") from None
+    except (ValueError, TypeError, KeyError) as exc:
+        msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else str(exc)
+        msg = str(msg)
+        named = any(n.lower() in msg.lower().replace(" ", "_") for n in names)
+        if len(msg.strip().splitlines()) != 1 or not (named or any(n in msg for n in names)):
+            c.tracebacks += 1
+            raise AssertionError(
+                f"{call}: {type(exc).__name__} not naming {names[0]!r} on one line: {msg!r}"
+            ) from exc
+        c.exits[2] = c.exits.get(2, 0) + 1
+        return None
+    except Exception as exc:  # noqa: BLE001 - counted, then reported
+        c.tracebacks += 1
+        raise AssertionError(f"{call}: {type(exc).__name__}: {exc}") from exc
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+        c.last = time.perf_counter()
+    if time.perf_counter() - start > LIMIT_S:
+        c.hangs += 1
+        raise AssertionError(f"hang: {call}")
+    c.exits[0] = c.exits.get(0, 0) + 1
+    return result
+
+
+BAD_VALUES = st.sampled_from(
+    [
+        None,
+        True,
+        0,
+        -1,
+        1.5,
+        math.nan,
+        math.inf,
+        1e300,
+        "",
+        "x",
+        "phi",
+        b"x",
+        [],
+        [1, 2],
+        {},
+        {"a": 1},
+        object(),
+        np.float64(math.nan),
+        np.array([1.0, 2.0]),
+        np.int64(2),
+        1j,
+        slice(None),
+        ("phi", 1),
+    ]  # fmt: skip
+)
+
+#: Words a message may use for a parameter (besides its name).
+ALIASES = {
+    "traj": ("trajector",),
+    "reference": ("trajector",),
+    "quantities": ("quantit",),
+    "quantity": ("quantit",),
+    "path": ("study", "file"),
+    "out": ("folder", "director", "study"),
+    "spec": ("study",),
+    "name": ("model",),
+    "model": ("model",),
+}
+
+
+@pytest.fixture(scope="module")
+def api_objects(tmp_path_factory, finished_study):
+    import rodval
+
+    scene = rodval.paper_scene(2, t_end=0.05, times=[0.0, 0.025, 0.05], outputs=("phi", "dphi"))
+    settings_ = rodval.IntegratorSettings(max_evaluations=50000, max_wall_s=2.0)
+    other = rodval.paper_scene(2, t_end=0.05, times=[0.0, 0.025, 0.05], outputs=("phi", "dphi"),
+                               EI=1e3)  # fmt: skip
+    study_path, study_out = finished_study
+    junk = tmp_path_factory.mktemp("junk") / "junk.bin"
+    junk.write_bytes(b"\x80\x00garbage")
+    return {
+        "rodval": rodval,
+        "scene": scene,
+        "settings": settings_,
+        "traj": rodval.simulate(scene, "reduced", settings=settings_),
+        "traj_pub": rodval.simulate(scene, "reduced", settings=settings_, coefficients="published"),
+        "traj_other": rodval.simulate(other, "reduced", settings=settings_),
+        "study_path": study_path,
+        "study_out": study_out,
+        "junk": junk,
+        "tmp": tmp_path_factory.mktemp("api"),
+    }
+
+
+def api_call(o: dict, name: str):
+    """(function, good keyword arguments, pools of values per parameter, keywords the
+    function does not know) of one public entry point."""
+    rv = o["rodval"]
+    paths = st.sampled_from([str(o["junk"]), o["junk"].parent, "missing.toml", o["study_out"]])
+    fields = ("chain", "loads", "t_end", "times", "outputs", "initial", "name", "latches", "stops")
+    table = {
+        "simulate": (
+            rv.simulate,
+            {"scene": o["scene"], "model": "reduced", "settings": o["settings"]},
+            {"model": st.sampled_from(["nope", "Full", "exudyn "]), "kernel": st.just("x"),
+             "coefficients": st.just("x"), "rtol": st.just(1e-3), "settings": st.just({})},
+            ("bogus",),
+        ),
+        "compare": (
+            rv.compare,
+            {"traj": o["traj"], "reference": o["traj_pub"]},
+            {"reference": st.just(o["traj_other"]),
+             "quantities": st.sampled_from([["z"], "phi", ["phi", "phi"], [1], ()])},
+            (),
+        ),
+        "modes": (
+            rv.modes,
+            {"scene": o["scene"], "model": "reduced"},
+            {"about": st.sampled_from(["x", "final"]), "count": st.sampled_from([0, 100, 2.0]),
+             "coefficients": st.just("x")},
+            ("bogus",),
+        ),
+        "Scene.with_": (o["scene"].with_, {}, {k: BAD_VALUES for k in fields}, ("n", "bogus")),
+        "Trajectory.__getitem__": (
+            lambda quantity: o["traj"][quantity],
+            {"quantity": "phi"},
+            {"quantity": st.sampled_from(["z", "PHI", "alpha", "energy"])},
+            (),
+        ),
+        "load_study": (rv.load_study, {"path": o["study_path"]}, {"path": paths}, ()),
+        "read_study_tables": (rv.read_study_tables, {"out": o["study_out"]}, {"out": paths}, ()),
+        "run_study": (
+            rv.run_study,
+            {"spec": rv.load_study(o["study_path"]), "out": o["tmp"] / "study", "workers": 1,
+             "progress": False, "report": False},
+            {"workers": st.sampled_from([0, 2.5]), "case_timeout": st.sampled_from([0, -1.0]),
+             "backend": st.sampled_from(["mpi", "dask "]), "out": st.just(o["junk"])},
+            ("bogus",),
+        ),
+        "paper_scene": (
+            rv.paper_scene,
+            {"n": 2, "t_end": 0.05},
+            {"times": st.just([0.1, 0.0]), "load_node": st.sampled_from([0, 3]),
+             "outputs": st.just(["z"])},
+            ("bogus", "rtol"),
+        ),
+        "IntegratorSettings": (
+            rv.IntegratorSettings,
+            {},
+            {k: BAD_VALUES for k in ("method", "rtol", "atol", "max_step", "first_step",
+                                      "max_evaluations", "max_wall_s", "blowup_factor",
+                                      "min_step_fraction", "stall_steps")},
+            ("rtoll",),
+        ),
+        "get_model": (
+            rv.get_model, {"name": "reduced"}, {"name": st.just("nope")}, ("bogus", "rtoll")
+        ),
+    }  # fmt: skip
+    return table[name]
+
+
+API_NAMES = ("simulate", "compare", "modes", "Scene.with_", "Trajectory.__getitem__",
+             "load_study", "read_study_tables", "run_study", "paper_scene",
+             "IntegratorSettings", "get_model")  # fmt: skip
+
+
+@budget(25)
+@given(name=st.sampled_from(API_NAMES), data=st.data())
+def test_fuzz_python_api(counts, api_objects, name, data):
+    """The public API (`rodval.__all__`) called with one or two parameters of a wrong type or
+    value (or an unknown keyword): it succeeds, or raises ValueError/TypeError/KeyError with a
+    one-line message naming the parameter (anything else, e.g. AttributeError or IndexError
+    from deep inside, counts as a traceback), never hangs; a success with an unknown keyword
+    (ignored), a comparison of two different scenes, or a run claiming success with
+    non-finite values is silently wrong."""
+    c = counts("python_api")
+    fn, kwargs, pools, unknown = api_call(api_objects, name)
+    kwargs = dict(kwargs)
+    params = sorted(set(pools) | set(kwargs) - {"progress", "report"})
+    changed = []
+    for _ in range(data.draw(st.integers(1, 2))):
+        key = data.draw(st.sampled_from([*params, *unknown]))
+        pool = pools.get(key, BAD_VALUES)
+        kwargs[key] = data.draw(st.one_of(pool, BAD_VALUES) if key in pools else BAD_VALUES)
+        changed.append(key)
+    names = tuple(n for k in changed for n in (k, *ALIASES.get(k, ())))
+    if name == "Trajectory.__getitem__":  # a mapping's KeyError names the key itself
+        names += (repr(kwargs["quantity"]),)
+    names += tuple(  # a message may name a path or name by its value
+        str(v) for k in changed if isinstance(v := kwargs[k], (str, Path)) and len(str(v)) >= 3
+    )
+    shown = ", ".join(f"{k}={kwargs[k]!r:.60}" for k in changed)
+    result = run_api(fn, kwargs, c, names, shown)
+    if result is None:
+        return
+    if any(k in unknown for k in changed):
+        c.ignored += 1
+        raise AssertionError(f"{name}: unknown keyword accepted: {shown}")
+    if name == "compare" and kwargs["reference"] is api_objects["traj_other"]:
+        c.ignored += 1
+        raise AssertionError("compare: runs of two different scenes compared without a word")
+    stats = getattr(result, "stats", None)
+    if stats is not None and claims_success(stats):
+        values = [np.asarray(v, float) for v in result.values.values()]
+        bad = int(not all(np.all(np.isfinite(v)) for v in values))
+        c.nonfinite += bad
+        assert not bad, f"{name}({shown}): success with non-finite values"
