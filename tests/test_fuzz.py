@@ -667,13 +667,33 @@ def test_fuzz_damaged_case_records(tmp_path_factory, counts, finished_study, dat
     assert np.all(np.isfinite(traj["value"].to_numpy(float)))
 
 
-TABLE_DAMAGES = ("delete", "empty", "random bytes", "drop column", "truncate", "unknown case")
+TABLE_DAMAGES = (
+    "delete",
+    "empty",
+    "random bytes",
+    "drop column",
+    "truncate",
+    "unknown case",
+    "nan metric",
+    "truncate",
+)
+#: Numeric columns of each table where a NaN is injected ("nan metric").
+METRIC_COLUMNS = {
+    "discrepancies": ("max_abs", "rms", "final_abs", "max_rel"),
+    "runtime": ("wall_s", "nfev", "t_reached"),
+    "trajectories": ("value",),
+    "cases": ("horizon",),
+}
 
 
 @budget(6, expensive=True)
 @given(data=st.data())
 def test_fuzz_damaged_tables(tmp_path_factory, counts, finished_study, data):
-    """`rodval report` over damaged tables: exit 0, or exit 2 with one line naming the file."""
+    """`rodval report` over damaged tables (deleted, empty, random bytes, a column dropped,
+    truncated at a random byte offset, an unknown case, NaN injected in a metric column of a
+    run that succeeded): exit 0, or exit 2 with one line naming the file; a report built
+    over a table that lost data (truncated) or holds a NaN metric of a successful run without
+    a word naming the file is silently wrong."""
     c = counts("damaged_tables")
     _, done = finished_study
     tmp = tmp_path_factory.mktemp("tables")
@@ -683,6 +703,7 @@ def test_fuzz_damaged_tables(tmp_path_factory, counts, finished_study, data):
     path = out / f"{name}.csv"
     kind = data.draw(st.sampled_from(TABLE_DAMAGES))
     df = pd.read_csv(path)
+    lost = False  # data a report cannot show faithfully
     if kind == "delete":
         path.unlink()
     elif kind == "empty":
@@ -693,13 +714,24 @@ def test_fuzz_damaged_tables(tmp_path_factory, counts, finished_study, data):
         df.drop(columns=[data.draw(st.sampled_from(list(df.columns)))]).to_csv(path, index=False)
     elif kind == "truncate":
         text = path.read_text()
-        path.write_text(text[: data.draw(st.integers(0, len(text)))])
+        cut = data.draw(st.integers(0, len(text)))
+        path.write_text(text[:cut])
+        lost = cut <= len(text) - 2  # at least one character of data gone
     elif kind == "unknown case":
         df.loc[0, "case"] = "ghost"
         df.to_csv(path, index=False)
+    elif kind == "nan metric":
+        row = data.draw(st.integers(0, len(df) - 1))
+        df.loc[row, data.draw(st.sampled_from(METRIC_COLUMNS[name]))] = math.nan
+        df.to_csv(path, index=False)
+        lost = "status" not in df.columns or df.loc[row, "status"] in ("ok", 0, "0")
     code, _, stderr = run_cli(["report", out], c)
     if code == 2:
         assert f"{name}.csv" in stderr or str(out) in stderr, stderr
+        refusal_is_clear(stderr, c)
+    elif lost and f"{name}.csv" not in stderr:
+        c.ignored += 1
+        raise AssertionError(f"report over a {kind} {name}.csv without a word: exit {code}")
 
 
 # ----------------------------------------------------------------------------- trust review
@@ -1369,3 +1401,66 @@ def test_fuzz_python_api(counts, api_objects, name, data):
         bad = int(not all(np.all(np.isfinite(v)) for v in values))
         c.nonfinite += bad
         assert not bad, f"{name}({shown}): success with non-finite values"
+
+
+RUN_DAMAGES = ("none", "none", "truncate", "nan value", "delete table", "edit run.json")
+
+
+def damage_run(folder: Path, kind: str, data) -> bool:
+    """Damage a run folder in place; True when its trajectory lost or changed data."""
+    table = folder / "trajectory.csv"
+    if kind == "truncate":
+        text = table.read_text()
+        table.write_text(text[: data.draw(st.integers(0, len(text) - 2))])
+        return True
+    if kind == "nan value":
+        df = pd.read_csv(table)
+        df.loc[data.draw(st.integers(0, len(df) - 1)), "value"] = math.nan
+        df.to_csv(table, index=False)
+        return True
+    if kind == "delete table":
+        table.unlink()
+    elif kind == "edit run.json":
+        rec_path = folder / "run.json"
+        text = rec_path.read_text()
+        edited, *_ = data.draw(run_record_edit(json.loads(text), text))
+        rec_path.write_text(edited)
+    return False
+
+
+@budget(5)
+@given(data=st.data())
+def test_fuzz_compare_inputs(tmp_path_factory, counts, finished_runs, data):
+    """`rodval compare A B` over pairs of run folders, damaged (trajectory.csv truncated at a
+    random byte offset, a NaN value, the table deleted, run.json edited) or of different
+    scenes (another EI, another n): exit 0 or 2 with one clear line; a comparison of two
+    different scenes, or over a damaged trajectory without a word naming it, or with
+    non-finite metrics, is silently wrong."""
+    c = counts("compare_inputs")
+    tmp = tmp_path_factory.mktemp("compare")
+    labels = data.draw(st.lists(st.sampled_from(sorted(finished_runs)), min_size=2, max_size=2))
+    folders, damaged = [], []
+    for i, label in enumerate(labels):
+        folder = tmp / f"{'AB'[i]}-{label}"
+        shutil.copytree(finished_runs[label], folder)
+        if damage_run(folder, data.draw(st.sampled_from(RUN_DAMAGES)), data):
+            damaged.append(folder)
+        folders.append(folder)
+    code, _, stderr = run_cli(["compare", *folders, "--out", tmp / "out"], c)
+    if code == 2:
+        refusal_is_clear(stderr, c)
+        return
+    assert code == 0, stderr
+    scenes = {"other_EI" if "other_EI" in lb else "other_n" if "other_n" in lb else "base"
+              for lb in labels}  # fmt: skip
+    if len(scenes) > 1:
+        c.ignored += 1
+        raise AssertionError(f"compare of two different scenes {labels} succeeded")
+    for folder in damaged:
+        if str(folder) not in stderr:
+            c.ignored += 1
+            raise AssertionError(f"compare over a damaged {folder.name}/trajectory.csv: {stderr}")
+    table = pd.read_csv(tmp / "out" / "discrepancies.csv")
+    bad = int(not np.all(np.isfinite(table.select_dtypes("number").to_numpy(float))))
+    c.nonfinite += bad
+    assert not bad, f"compare {labels}: non-finite metrics"
