@@ -3,11 +3,13 @@
 The system is the one ``ExudynModel`` integrates (its ``assembled`` method: same mesh,
 revolute joints, hinge springs, point masses and load user functions). Then:
 
-* ``about="initial"``: the scene's initial state, without loads;
+* ``about="initial"``: the scene's initial state, without loads (``rodval.analysis.modes``
+  checks before any model runs that it is at rest in equilibrium);
 * ``about="equilibrium"``: exudyn's static solver (``exudyn.solver.SolveStatic``, load
   factor ramped over ``load_steps`` steps, Newton absolute tolerance scaled with EA) under the
-  scene's constant loads (``rodval.loads.constant``; other load laws are left out), its result
-  written to the initial state (``updateInitialValues=True``).
+  scene's static loads (``rodval.core.modal.static_loads``, each held as a constant nodal
+  force) and its hinge springs' rest angles, its result written to the initial state
+  (``updateInitialValues=True``).
 
 exudyn's static solver gives the mass matrix, the ODE2 Jacobian (so the axial force's
 geometric stiffness is included), the velocity Jacobian (damping) and the constraint Jacobian
@@ -41,7 +43,8 @@ from rodval.core.eigen import (
     quadratic_eigenvalues,
     symmetric_pencil,
 )
-from rodval.core.modal import ABOUT, Equilibrium, Modes, constant_loads, normalize_shapes
+from rodval.core.loads import constant
+from rodval.core.modal import ABOUT, Equilibrium, Modes, normalize_shapes, static_loads
 from rodval.core.scene import Scene
 
 #: Elongation/displacement ratio above which an exudyn mode counts as axial.
@@ -117,23 +120,33 @@ def exudyn_modes(
     *,
     about: str = "initial",
     count: int | None = None,
+    load_at: float | None = None,
     load_steps: int = 20,
     axial_tol: float = AXIAL_TOL,
     **options,
 ) -> Modes:
     """Modes of the exudyn beam model about the scene's initial state or its static
-    equilibrium (see module docstring); ``options``: ExudynModel options (elements, EA; the
-    defaults for modes are ``MODES_DEFAULTS``)."""
+    equilibrium under the static loads (``rodval.core.modal.static_loads`` at ``load_at``,
+    each held as a constant nodal force) and the hinge rest angles (see module docstring);
+    ``options``: ExudynModel options (elements, EA; the defaults for modes are
+    ``MODES_DEFAULTS``)."""
     import exudyn as exu
 
     if about not in ABOUT:
         raise ValueError(f"about must be one of {ABOUT}, got {about!r}")
     model = ExudynModel(**{**MODES_DEFAULTS, **options})
     n = scene.n
-    if about == "initial":
-        built_scene = scene.with_(loads=())
-    else:
-        built_scene = scene.with_(loads=tuple(f for f in scene.loads if f.name == "constant"))
+    loads = static_loads(scene, load_at) if about == "equilibrium" else None
+    held = (
+        ()
+        if loads is None
+        else tuple(
+            constant(k + 1, X=float(loads.X[k]), Y=float(loads.Y[k]))
+            for k in np.flatnonzero((loads.X != 0) | (loads.Y != 0))
+        )
+    )
+    built_scene = scene.with_(loads=held)
+    prestressed = bool(np.any(scene.chain.kappa * scene.chain.rest_angle != 0))
     _, mbs, nodes = model.assembled(built_scene)
     for row in nodes:
         for nd in row:
@@ -144,7 +157,8 @@ def exudyn_modes(
     eq = None
     residual = float("nan")
     try:
-        if about == "equilibrium" and built_scene.loads:
+        solved = about == "equilibrium" and (bool(held) or prestressed)
+        if solved:
             sim = exu.SimulationSettings()
             st = sim.staticSolver
             st.numberOfLoadSteps = int(load_steps)
@@ -227,11 +241,11 @@ def exudyn_modes(
         phi0 = ini["phi"] + (phi0 - ini["phi"] + np.pi) % (2 * np.pi) - np.pi
         eq = Equilibrium(
             q=np.concatenate([phi0, np.zeros(2 * n)]),
-            iterations=iters if built_scene.loads else 0,
+            iterations=iters if solved else 0,
             load_steps=int(load_steps),
-            residual=residual if built_scene.loads else 0.0,
+            residual=residual if solved else 0.0,
             converged=True,
-            loads=constant_loads(scene),
+            loads=loads,
         )
     return Modes(
         model="exudyn",

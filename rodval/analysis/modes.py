@@ -15,17 +15,21 @@ q = phi (n) with M_r(phi0), C_r, K_r + K_L (the bending rows condensed quasi-sta
 
 Configurations (``about``)
 --------------------------
-``initial``: the scene's initial state (loads ignored: free vibration about that shape).
-``equilibrium``: the static equilibrium under the scene's *constant* loads
-(``rodval.loads.constant``; other load laws are ignored and listed), found by Newton's method
-on the static residual
+``initial``: the scene's initial state (loads left out: free vibration about that shape). It
+must be at rest in equilibrium without loads (``check_at_rest``: zero rates, static residual
+of the hinge springs about their rest angles and the bending below ``AT_REST_RTOL``); a
+pre-stressed fold is refused unless ``allow_unbalanced=True`` (the residual is then
+recorded). A chain held by loads is linearized about its equilibrium (``equilibrium``).
+``equilibrium``: the static equilibrium under the scene's static loads
+(``rodval.core.modal.static_loads``: the loads that act for ever at their final value,
+windowed ones left out and named; or, with ``load_at``, every load at that instant) and the
+hinge rest angles, found by Newton's method on the static residual
 
     R(q) = K q - A^T (kappa * rest) - [Q(phi); 0; 0]
 
-(``static_residual``; ``rest``: hinge rest angles, zero today, one argument for the
-pre-stressed hinges to come) with its exact Jacobian K + K_L, and load stepping when the
-full step fails. The reduced model's equilibrium is the same phi (its bending rows are the
-full model's, condensed).
+(``static_residual``; ``rest``: the chain's hinge rest angles) with its exact Jacobian
+K + K_L, and load stepping when the full step fails. The reduced model's equilibrium is the
+same phi (its bending rows are the full model's, condensed).
 
 Frequencies and damping
 -----------------------
@@ -88,8 +92,8 @@ from rodval.core.modal import (
     ABOUT,
     Equilibrium,
     Modes,
-    constant_loads,
     normalize_shapes,
+    static_loads,
 )
 from rodval.core.scene import Chain, InitialState, Scene
 from rodval.models.paper_matrices import (
@@ -207,6 +211,50 @@ def no_equilibrium(chain: Chain, eq: Equilibrium) -> str:
         f"static equilibrium not found (max |R| = {eq.residual:.3g} N m after "
         f"{eq.iterations} Newton iterations and {eq.load_steps} load steps)"
     )
+
+
+#: Largest static residual of an initial state still taken as an equilibrium, relative to
+#: max |K q0| + max |A^T kappa rest| + max |Q| + 1 N m: a state written with 9 significant
+#: digits from an equilibrium (static_equilibrium converges to 1e-12 of the same scale)
+#: passes; a pre-stressed fold (residuals of order kappa x angle) does not.
+AT_REST_RTOL = 1e-8
+
+
+def check_at_rest(scene: Scene) -> float:
+    """The initial state's static residual max |R(q0)| (N m, ``static_residual`` with the
+    hinge rest angles and without loads, which the linearization about the initial state
+    leaves out), or ValueError when the state is not at rest in equilibrium (rates not zero,
+    or max |R| above ``AT_REST_RTOL`` of its scale): a linearization about a state the chain
+    immediately leaves describes no motion of the scene. A scene-level check, made before any
+    model's modal analysis. O(n^2) (the dense K of the paper's matrices)."""
+    chain, n = scene.chain, scene.n
+    ini = scene.initial.resolve(n)
+    moving = [k for k in ("dphi", "dalpha", "dbeta") if np.any(ini[k] != 0)]
+    if moving:
+        raise ValueError(
+            f"the initial state is not at rest ({', '.join(moving)} not zero), so there is no "
+            "configuration to vibrate about; linearize about the static equilibrium "
+            "(about='equilibrium', --about equilibrium) or pass allow_unbalanced=True "
+            "(--allow-unbalanced) to linearize about the initial positions anyway"
+        )
+    q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
+    K = stiffness_matrix(chain)
+    R = static_residual(chain, q0, rest=chain.rest_angle, K=K)
+    spring = hinge_matrix(n).T @ (chain.kappa * chain.rest_angle)
+    scale = np.max(np.abs(K @ q0)) + np.max(np.abs(spring)) + 1.0
+    worst = int(np.argmax(np.abs(R)))
+    residual = float(abs(R[worst]))
+    if residual > AT_REST_RTOL * scale:
+        row = ("phi", "alpha", "beta")[worst // n] + f"[{worst % n}]"
+        raise ValueError(
+            f"the initial state is not an equilibrium: static residual {residual:.3g} N m on "
+            f"{row} (hinge springs about their rest angles and bending; loads are left out "
+            "about the initial state), so the chain does not stay there; linearize about the "
+            "static equilibrium (about='equilibrium', --about equilibrium, which holds the "
+            "loads) or pass allow_unbalanced=True (--allow-unbalanced) to linearize about it "
+            "anyway"
+        )
+    return residual
 
 
 def check_arguments(scene: Scene, count: int | None) -> None:
@@ -427,24 +475,26 @@ def modes(
     about: str = "initial",
     count: int | None = None,
     coefficients: str = "printed",
-    rest=None,
+    load_at: float | None = None,
+    allow_unbalanced: bool = False,
 ) -> Modes:
     """Linearized modes of the native ``model`` ("full" or "reduced") about the scene's
-    initial state or its static equilibrium under its constant loads (see module docstring).
-    ``count``: the lowest ``count`` modes (default all); ``rest``: hinge rest angles (rad)."""
+    initial state at rest (``check_at_rest`` unless ``allow_unbalanced``) or its static
+    equilibrium under its static loads (``rodval.core.modal.static_loads``: the loads acting
+    for ever, or every load at ``load_at`` s) and hinge rest angles (see module docstring).
+    ``count``: the lowest ``count`` modes (default all)."""
     check_arguments(scene, count)
     if model not in MODELS:
         raise ValueError(f"model must be one of {MODELS}, got {model!r}")
-    if about not in ABOUT:
-        raise ValueError(f"about must be one of {ABOUT}, got {about!r}")
+    balance = check_configuration(scene, about, load_at, allow_unbalanced)
     chain, n = scene.chain, scene.n
     ini = scene.initial.resolve(n)
     q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
     eq, SX, SY = None, None, None
     if about == "equilibrium":
-        loads = constant_loads(scene)
+        loads = static_loads(scene, load_at)
         SX, SY = loads.SX, loads.SY
-        eq = static_equilibrium(chain, SX, SY, q0=q0, rest=rest)
+        eq = static_equilibrium(chain, SX, SY, q0=q0, rest=chain.rest_angle)
         eq.loads = loads
         if not eq.converged:
             raise ValueError(no_equilibrium(chain, eq))
@@ -468,8 +518,39 @@ def modes(
         phi0=q0[:n].copy(),
         l=chain.l.copy(),
         equilibrium=eq,
-        info={"coefficients": coefficients, "q0": q0},
+        info={"coefficients": coefficients, "q0": q0, **balance},
     )
+
+
+def check_configuration(
+    scene: Scene, about: str, load_at: float | None, allow_unbalanced: bool
+) -> dict[str, float]:
+    """The checks of what every model's modes are about, before any work: ``about`` among
+    ``ABOUT``; ``load_at`` (equilibrium only) a time >= 0 or None, and the scene's loads with a
+    static value (``static_loads``); for ``about="initial"`` the state at rest in equilibrium
+    (``check_at_rest``) unless ``allow_unbalanced``, whose residual is then returned as
+    ``{"unbalanced_residual_Nm": r}`` for the record."""
+    if about not in ABOUT:
+        raise ValueError(f"about must be one of {ABOUT}, got {about!r}")
+    if not isinstance(allow_unbalanced, bool):
+        raise ValueError(f"allow_unbalanced must be True or False, got {allow_unbalanced!r}")
+    if about == "equilibrium":
+        if allow_unbalanced:
+            raise ValueError("allow_unbalanced applies to about='initial' only")
+        static_loads(scene, load_at)
+        return {}
+    if load_at is not None:
+        raise ValueError(
+            "load_at applies to about='equilibrium' only (loads are left out about the "
+            "initial state)"
+        )
+    if not allow_unbalanced:
+        check_at_rest(scene)
+        return {}
+    ini = scene.initial.resolve(scene.n)
+    q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
+    R = static_residual(scene.chain, q0, rest=scene.chain.rest_angle)
+    return {"unbalanced_residual_Nm": float(np.max(np.abs(R)))}
 
 
 def model_modes(
@@ -479,25 +560,39 @@ def model_modes(
     about: str = "initial",
     count: int | None = None,
     coefficients: str = "printed",
+    load_at: float | None = None,
+    allow_unbalanced: bool = False,
     **options,
 ) -> Modes:
     """``modes`` for "full"/"reduced", ``reference_models.exudyn_modes.exudyn_modes`` for
-    "exudyn" (``options``: ExudynModel options)."""
+    "exudyn" (``options``: ExudynModel options); every model about the same configuration,
+    checked here once (``check_configuration``)."""
     check_arguments(scene, count)
     if model == "exudyn":
+        balance = check_configuration(scene, about, load_at, allow_unbalanced)
         try:
             from reference_models.exudyn_modes import exudyn_modes
         except ImportError as exc:
             raise ValueError(f"model 'exudyn' is not available: {exc}") from exc
         try:
-            return exudyn_modes(scene, about=about, count=count, **options)
+            m = exudyn_modes(scene, about=about, count=count, load_at=load_at, **options)
         except TypeError as exc:  # an unknown option name
             raise ValueError(
                 f"model 'exudyn' does not accept options {sorted(options)}: {exc}"
             ) from None
+        m.info.update(balance)
+        return m
     if options:
         raise ValueError(f"model {model!r} takes no options, got {sorted(options)}")
-    return modes(scene, model, about=about, count=count, coefficients=coefficients)
+    return modes(
+        scene,
+        model,
+        about=about,
+        count=count,
+        coefficients=coefficients,
+        load_at=load_at,
+        allow_unbalanced=allow_unbalanced,
+    )
 
 
 # -- pairing -----------------------------------------------------------------------------------
@@ -537,18 +632,28 @@ def compare_modes(
     count: int = 10,
     reference: str | None = None,
     computed: dict[str, Modes] | None = None,
+    load_at: float | None = None,
+    allow_unbalanced: bool = False,
     **exudyn_options,
 ) -> pd.DataFrame:
     """Side-by-side table of the lowest ``count`` modes of ``reference`` (default: the last of
     ``models``, e.g. exudyn) with the paired modes of the other models: columns mode,
     omega_<ref>, and per other model omega_<m>, gap_<m> (relative to the reference) and
-    mac_<m>. ``computed`` may pass Modes already computed (name -> Modes)."""
+    mac_<m>. ``computed`` may pass Modes already computed (name -> Modes); ``about``,
+    ``load_at``, ``allow_unbalanced``: see ``model_modes``."""
     models = tuple(models)
     reference = models[-1] if reference is None else reference
     got = dict(computed or {})
     for m in models:
         if m not in got:
-            got[m] = model_modes(scene, m, about=about, **(exudyn_options if m == "exudyn" else {}))
+            got[m] = model_modes(
+                scene,
+                m,
+                about=about,
+                load_at=load_at,
+                allow_unbalanced=allow_unbalanced,
+                **(exudyn_options if m == "exudyn" else {}),
+            )
     ref = got[reference]
     table = pd.DataFrame({"mode": np.arange(1, min(count, ref.count) + 1)})
     table[f"omega_{reference}"] = ref.omega[: len(table)]

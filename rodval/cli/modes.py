@@ -8,8 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from rodval.cli.options import add_model_options, positive_int, set_options
-from rodval.core.scene_file import load_scene
+from rodval.core.scene import Scene
+from rodval.core.scene_file import load_scene, scene_from_dict
 from rodval.report.figures import plot_modes
+from rodval.report.run_files import read_run_record
 
 MODEL_CHOICES = ("full", "reduced", "exudyn")
 #: Mode shapes drawn in modes.png.
@@ -19,16 +21,19 @@ def register(sub) -> None:
     p = sub.add_parser(
         "modes",
         help="natural frequencies and mode shapes about a configuration",
-        description="Linearize SCENE ('paper' or a TOML scene file) about its initial state or "
-        "its static equilibrium under its constant loads and write "
+        description="Linearize SCENE ('paper', a TOML scene file or the run.json of a run) "
+        "about its initial state at rest or its static equilibrium under its static loads "
+        "(the loads acting for ever, or every load at --load-at T) and write "
         "DIR/frequencies.csv (mode, omega_rad_s, f_hz, damping_ratio), DIR/modes.csv "
         "(mode, kind node_dx/node_dy/hinge, k, value; shapes normalized to a largest "
         "node displacement of 1), DIR/modes.png and DIR/modes.json. With --compare, "
         "also DIR/compare.csv: the modes of the other models paired with this "
         "model's by MAC (see docs/modes.md).",
     )
-    p.add_argument("scene", metavar="SCENE", help="'paper' or a TOML scene file")
-    p.add_argument("--model", default="full", choices=MODEL_CHOICES)
+    p.add_argument("scene", metavar="SCENE", help="'paper', a TOML scene file or a run.json")
+    p.add_argument(
+        "--model", choices=MODEL_CHOICES, help="model (default full; a run.json's own model)"
+    )
     p.add_argument("--out", required=True, type=Path, help="output folder")
     p.add_argument(
         "--count",
@@ -40,8 +45,22 @@ def register(sub) -> None:
         "--about",
         default="initial",
         choices=("initial", "equilibrium"),
-        help="linearize about the initial state (loads ignored) or the static "
-        "equilibrium under the scene's constant loads (default initial)",
+        help="linearize about the initial state (at rest in equilibrium; loads ignored) or "
+        "the static equilibrium under the scene's static loads and hinge rest angles "
+        "(default initial)",
+    )
+    p.add_argument(
+        "--load-at",
+        type=float,
+        metavar="T",
+        help="hold every load at its value at time T (s) for the equilibrium (default: the "
+        "loads that act for ever, windowed ones left out and named)",
+    )
+    p.add_argument(
+        "--allow-unbalanced",
+        action="store_true",
+        help="linearize about an initial state that is not an equilibrium (refused otherwise; "
+        "its static residual is recorded in modes.json)",
     )
     add_model_options(p, coefficients_default="printed")
     p.add_argument(
@@ -64,7 +83,8 @@ def run(args) -> int:
         bad = [x for x in compare if x not in MODEL_CHOICES]
         if bad or not compare:
             raise ValueError(f"--compare models must be from {MODEL_CHOICES}, got {args.compare!r}")
-    scene = load_scene(args.scene)
+    scene, model = _scene_and_model(args)
+    args.model = model
     options = set_options(args.options)
     if options and args.model != "exudyn" and not args.compare:
         raise ValueError(f"--set applies to the exudyn model only, got {sorted(options)}")
@@ -74,6 +94,8 @@ def run(args) -> int:
         about=args.about,
         count=args.count,
         coefficients=args.coefficients,
+        load_at=args.load_at,
+        allow_unbalanced=args.allow_unbalanced,
         **(options if args.model == "exudyn" else {}),
     )
     args.out.mkdir(parents=True, exist_ok=True)
@@ -87,6 +109,8 @@ def run(args) -> int:
         "coefficients": args.coefficients if m.model != "exudyn" else None,
         "options": m.info.get("options", {}),
         "count": m.count,
+        "load_at": args.load_at,
+        **({k: v for k, v in m.info.items() if k == "unbalanced_residual_Nm"}),
     }
     eq = m.equilibrium
     if eq is not None:
@@ -95,12 +119,17 @@ def run(args) -> int:
             "load_steps": eq.load_steps,
             "residual_Nm": eq.residual,
             "phi": eq.phi.tolist(),
-            "ignored_loads": list(eq.loads.ignored) if eq.loads else [],
+            "left_out_loads": list(eq.loads.ignored) if eq.loads else [],
         }
     lines = [f"{m.model} modes of {scene.name} about the {m.about} state -> {args.out}"]
+    if "unbalanced_residual_Nm" in m.info:
+        lines.append(
+            "the initial state is NOT an equilibrium (static residual "
+            f"{m.info['unbalanced_residual_Nm']:.3g} N m): linearized there as asked"
+        )
     if eq is not None:
         ign = (
-            f"; ignored loads: {', '.join(eq.loads.ignored)}"
+            f"; loads left out: {', '.join(eq.loads.ignored)}"
             if eq.loads and eq.loads.ignored
             else ""
         )
@@ -121,6 +150,8 @@ def run(args) -> int:
                     other,
                     about=args.about,
                     coefficients=args.coefficients,
+                    load_at=args.load_at,
+                    allow_unbalanced=args.allow_unbalanced,
                     **(options if other == "exudyn" else {}),
                 )
         order = tuple(x for x in models if x != args.model) + (args.model,)
@@ -138,3 +169,14 @@ def run(args) -> int:
     (args.out / "modes.json").write_text(json.dumps(record, indent=2, default=str))
     print("\n".join(lines))
     return 0
+
+
+def _scene_and_model(args) -> tuple[Scene, str]:
+    """The scene of SCENE ('paper', a TOML file, or a run.json: its recorded scene) and the
+    model: --model, else a run.json's own model (when it has modes), else "full"."""
+    path = Path(args.scene)
+    if path.suffix != ".json":
+        return load_scene(args.scene), args.model or "full"
+    record = read_run_record(path)
+    ran = record["model"] if record["model"] in MODEL_CHOICES else "full"
+    return scene_from_dict(record["scene"], where=str(path)), args.model or ran

@@ -15,37 +15,79 @@ import pandas as pd
 
 from rodval.core.scene import Scene
 
-#: What a model is linearised about: its initial state (loads ignored) or the static
-#: equilibrium under the scene's constant loads and hinge rest angles.
+#: What a model is linearised about: its initial state at rest (free vibration, loads
+#: ignored; it must be an equilibrium, see ``rodval.analysis.modes.check_at_rest``) or the
+#: static equilibrium under the scene's static loads (``static_loads``) and hinge rest angles.
 ABOUT = ("initial", "equilibrium")
+
+
+#: Load laws that settle to a constant when they act for ever (t_off = inf): their value
+#: after their last kink is the load a static equilibrium holds.
+SETTLING_LAWS = ("constant", "ramp")
 
 
 @dataclass(frozen=True)
 class ConstantLoads:
-    """Suffix sums SX, SY (N) of the scene's constant nodal loads and what was left out."""
+    """The nodal loads a static solve holds fixed: X, Y (N, per node 1..n, index k - 1),
+    their suffix sums SX, SY (N), the instant ``at`` they were taken at (s; None: the loads
+    that act for ever, see ``static_loads``), and the scene's loads left out, each with why."""
 
     SX: np.ndarray
     SY: np.ndarray
     ignored: tuple[str, ...] = ()
+    X: np.ndarray | None = None
+    Y: np.ndarray | None = None
+    at: float | None = None
 
     @property
     def any(self) -> bool:
         return bool(np.any(self.SX) or np.any(self.SY))
 
 
-def constant_loads(scene: Scene) -> ConstantLoads:
-    """The scene's constant loads (``rodval.loads.constant``) as suffix sums; loads with other
-    laws (pulse, callables) are ignored and named in ``ignored``."""
+def _force_at(f, t: float) -> tuple[float, float]:
+    return (float(f.fx(t)) if f.fx else 0.0, float(f.fy(t)) if f.fy else 0.0)
+
+
+def static_loads(scene: Scene, at: float | None = None) -> ConstantLoads:
+    """The loads a static equilibrium of ``scene`` holds fixed (one definition for every
+    model's ``about="equilibrium"``).
+
+    ``at = None``: the loads that act for ever. A load whose support ends (t_off < inf: a
+    pulse, a windowed step, a tabulated history) is left out and named with its end time; a
+    constant or ramp load acting for ever counts at its final value; any other load acting for
+    ever (harmonic, a Python callable) has no static value: ValueError asking for ``at``.
+    ``at = t`` (s, finite, >= 0): every load frozen at its value at t; loads not acting at t
+    are named. Cost O(loads + n)."""
     n = scene.n
     X, Y = np.zeros(n), np.zeros(n)
     ignored = []
+    if at is not None:
+        if isinstance(at, bool) or not isinstance(at, (int, float)) or not 0 <= at < np.inf:
+            raise ValueError(f"load_at must be a finite time >= 0 s, got {at!r}")
+        at = float(at)
     for f in scene.loads:
-        if f.name == "constant":
-            X[f.node - 1] += float(f.params.get("X", 0.0))
-            Y[f.node - 1] += float(f.params.get("Y", 0.0))
+        what = f"{f.name} load at node {f.node}"
+        if at is not None:
+            if not f.active(at):
+                ignored.append(f"{what} (not acting at t = {at:g} s)")
+                continue
+            fx, fy = _force_at(f, at)
+        elif f.support[1] < np.inf:
+            ignored.append(f"{what} (acts only until t = {f.support[1]:g} s)")
+            continue
+        elif f.name in SETTLING_LAWS:
+            fx, fy = _force_at(f, max((f.support[0], *f.breakpoints)))
         else:
-            ignored.append(f"{f.name} at node {f.node}")
-    return ConstantLoads(np.cumsum(X[::-1])[::-1], np.cumsum(Y[::-1])[::-1], tuple(ignored))
+            raise ValueError(
+                f"the {what} acts for ever without settling to a constant, so the scene has no "
+                "static equilibrium of its own; give load_at (--load-at T, s) to hold every "
+                "load at its value at time T"
+            )
+        X[f.node - 1] += fx
+        Y[f.node - 1] += fy
+    return ConstantLoads(
+        np.cumsum(X[::-1])[::-1], np.cumsum(Y[::-1])[::-1], tuple(ignored), X, Y, at
+    )
 
 
 @dataclass

@@ -329,8 +329,9 @@ def plot_work_precision(
 
 
 def plot_modes(m: Modes, path: Path, title: str = "", count: int = 4) -> Path:
-    """The first ``count`` mode shapes drawn on the chain (nodes displaced by a scale of 0.15
-    of the chain length times the normalized shape; hinge angles are in modes.csv)."""
+    """The first ``count`` mode shapes drawn on the chain: the configuration in metres, each
+    normalized shape (largest node displacement 1) drawn at 0.15 of the chain's span, which
+    the legend states (shapes have no unit of their own; hinge angles are in modes.csv)."""
     k = min(count, m.count)
     x0, y0 = m.node_positions()
     span = max(np.ptp(x0), np.ptp(y0), float(np.sum(m.l)) * 0.2)
@@ -339,7 +340,13 @@ def plot_modes(m: Modes, path: Path, title: str = "", count: int = 4) -> Path:
     for i, ax in enumerate(axes[:, 0]):
         ax.plot(x0, y0, "-o", color="0.7", ms=3, lw=1, label="configuration")
         ax.plot(
-            x0 + amp * m.dx[i], y0 + amp * m.dy[i], "-o", color="C0", ms=3, lw=1.5, label="mode"
+            x0 + amp * m.dx[i],
+            y0 + amp * m.dy[i],
+            "-o",
+            color="C0",
+            ms=3,
+            lw=1.5,
+            label=f"normalized shape (largest node displacement drawn as {amp:.3g} m)",
         )
         ys = np.concatenate([y0, y0 + amp * m.dy[i]])
         pad = 0.1 * max(np.ptp(ys), amp)

@@ -41,7 +41,7 @@ from rodval.models import REGISTRY, get_model, model_class
 from rodval.study.store import MAX_NAME, case_file_name
 
 TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report", "modes"}
-MODES_KEYS = {"count", "about"}
+MODES_KEYS = {"count", "about", "load_at", "allow_unbalanced"}
 #: Most cases a study grid may have by default: every case is built and checked before any
 #: runs (about 1-3 ms each on the 2-core machine, so ~1 min at the limit); raise it with
 #: ``max_cases`` (CLI ``--max-cases N``).
@@ -116,7 +116,8 @@ class Case:
 
 def _modes_spec(table: Any, where: str) -> dict[str, Any] | None:
     """The study's [modes] table: the first ``count`` modes (1..MAX_MODES, default 10) of
-    every model about ``about`` ("initial" or "equilibrium"), or None without the table."""
+    every model about ``about`` ("initial" or "equilibrium"), with ``load_at`` (s) and
+    ``allow_unbalanced`` as in ``rodval.modes``; None without the table."""
     if table is None:
         return None
     _check_keys(table, MODES_KEYS, where, "modes")
@@ -126,7 +127,17 @@ def _modes_spec(table: Any, where: str) -> dict[str, Any] | None:
     about = table.get("about", "initial")
     if about not in ("initial", "equilibrium"):
         raise _err(where, "modes.about", f"must be 'initial' or 'equilibrium', got {about!r}")
-    return {"count": count, "about": about}
+    load_at = table.get("load_at")
+    if load_at is not None and (
+        isinstance(load_at, bool)
+        or not isinstance(load_at, (int, float))
+        or not 0 <= load_at < math.inf
+    ):
+        raise _err(where, "modes.load_at", f"must be a finite time >= 0 s, got {load_at!r}")
+    unbalanced = table.get("allow_unbalanced", False)
+    if not isinstance(unbalanced, bool):
+        raise _err(where, "modes.allow_unbalanced", f"must be true or false, got {unbalanced!r}")
+    return {"count": count, "about": about, "load_at": load_at, "allow_unbalanced": unbalanced}
 
 
 #: The quantities the report draws when [report] does not say (those the cases output).

@@ -75,7 +75,15 @@ def case_modes(scene, model: dict, spec: dict[str, Any]) -> dict[str, Any]:
     if model["model"] != "exudyn":  # the native models' modal option is their variant
         options = {"coefficients": options.get("coefficients", "printed")}
     try:
-        m = model_modes(scene, model["model"], about=spec["about"], count=spec["count"], **options)
+        m = model_modes(
+            scene,
+            model["model"],
+            about=spec["about"],
+            count=spec["count"],
+            load_at=spec.get("load_at"),
+            allow_unbalanced=spec.get("allow_unbalanced", False),
+            **options,
+        )
     except Exception as exc:  # noqa: BLE001 - a failure is data
         return {"modes_error": f"{type(exc).__name__}: {exc}"}
     return {"modes": m.to_dict()}
