@@ -10,7 +10,9 @@ from rodval.analysis.modes import model_modes as modes
 from rodval.core.contract import Model
 from rodval.core.loads import NodalForce, constant, harmonic, pulse, ramp, tabulated
 from rodval.core.scene import TABLE1_TIMES, Chain, InitialState, Latch, Scene, Stop, paper_scene
+from rodval.core.scene_file import load_scene
 from rodval.core.settings import IntegratorSettings
+from rodval.core.status import Status
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.models import FullModel, ReducedModel, get_model, simulate
 from rodval.report.tables import read_tables as read_study_tables
@@ -31,6 +33,8 @@ __all__ = [
     "harmonic",
     "tabulated",
     "paper_scene",
+    "load_scene",
+    "Status",
     "TABLE1_TIMES",
     "Model",
     "FullModel",

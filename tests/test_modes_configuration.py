@@ -214,3 +214,38 @@ def test_exudyn_equilibrium_holds_the_rest_angles_and_the_load_at_an_instant():
         print("load_at", load_at, "node gap (m)", gap, "phi", native.equilibrium.phi)
         assert gap < 1e-3 * 2.0
         np.testing.assert_allclose(ex.omega[:3], native.omega[:3], rtol=1e-2)
+
+
+# ------------------------------------------------------------- API names and statuses (21)
+
+
+def test_status_reads_the_same_in_python_and_in_files(tmp_path):
+    """stats.status was 0 in Python and 'success' in runtime.csv: it is now a Status (an int,
+    as run.json stores it) whose text is the file's."""
+    import rodval
+    from rodval.core.status import STATUS_MESSAGES, Status
+
+    traj = rodval.simulate(paper_scene(t_end=0.05), "reduced")
+    assert traj.stats.status is Status.SUCCESS and traj.stats.status == 0
+    assert str(traj.stats.status) == "success" == STATUS_MESSAGES[0]
+    assert traj.stats.as_dict()["status"] == 0 and type(traj.stats.as_dict()["status"]) is int
+    stats = rodval.SolverStats(status=-9)
+    assert stats.status is Status.WALL and str(stats.status) == "wall-clock budget exhausted"
+    with pytest.raises(ValueError, match="-42 is not a valid Status"):
+        rodval.SolverStats(status=-42)
+
+
+def test_a_misspelt_setting_names_the_integrator_settings_and_the_nearest_name():
+    """simulate(..., max_wall=5) was refused with a list of model options only."""
+    import rodval
+
+    with pytest.raises(
+        ValueError, match=r"integrator settings: .*max_wall_s.*did you mean 'max_wall_s'\?$"
+    ):
+        rodval.simulate(paper_scene(t_end=0.05), "reduced", max_wall=5)
+
+
+def test_load_scene_is_exported():
+    import rodval
+
+    assert rodval.load_scene("paper").n == paper_scene().n

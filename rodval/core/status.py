@@ -6,16 +6,11 @@ raises for a failed integration, it ends with one of these codes, a message and 
 
 from __future__ import annotations
 
+from enum import IntEnum
+
 import numpy as np
 
-STATUS_SUCCESS = 0
-STATUS_FAILED = -1  # the integrator gave up (step size too small, singular matrix, ...)
-STATUS_ERROR = -2  # the model raised an exception
-STATUS_DIVERGED = -3  # NaN/inf in the state
-STATUS_TIMEOUT = -4  # a study runner stopped the run at its time limit
-STATUS_CRASHED = -5  # the process running the model died (e.g. a segfault in a library)
-STATUS_BLOWUP = -6  # energy grew beyond settings.blowup_factor x its physical budget
-STATUS_STALLED = -7  # step size collapsed below settings.min_step_fraction x t_end
+#: How a run ended, as text in files (runtime.csv, reports) and in ``str(Status.X)``.
 STATUS_MESSAGES = {
     0: "success",
     -1: "integration failed",
@@ -25,12 +20,45 @@ STATUS_MESSAGES = {
     -5: "worker crashed",
     -6: "diverged (energy blow-up)",
     -7: "stalled (step size collapse)",
+    -8: "evaluation budget exhausted",
+    -9: "wall-clock budget exhausted",
 }
 
 
-STATUS_BUDGET = -8  # the run used up its evaluation budget (settings.max_evaluations)
-STATUS_WALL = -9  # the run used up its wall-clock budget (settings.max_wall_s)
-STATUS_MESSAGES.update({-8: "evaluation budget exhausted", -9: "wall-clock budget exhausted"})
+class Status(IntEnum):
+    """How a run ended: an int (run.json and case records store the number, scipy's 0 and
+    -1 kept) whose ``str`` is the text files and reports show (``STATUS_MESSAGES``), so a
+    status reads the same in Python and in runtime.csv."""
+
+    SUCCESS = 0
+    FAILED = -1  # the integrator gave up (step size too small, singular matrix, ...)
+    ERROR = -2  # the model raised an exception
+    DIVERGED = -3  # NaN/inf in the state
+    TIMEOUT = -4  # a study runner stopped the run at its time limit
+    CRASHED = -5  # the process running the model died (e.g. a segfault in a library)
+    BLOWUP = -6  # energy grew beyond settings.blowup_factor x its physical budget
+    STALLED = -7  # step size collapsed below settings.min_step_fraction x t_end
+    BUDGET = -8  # the run used up its evaluation budget (settings.max_evaluations)
+    WALL = -9  # the run used up its wall-clock budget (settings.max_wall_s)
+
+    @property
+    def label(self) -> str:
+        return STATUS_MESSAGES[int(self)]
+
+    def __str__(self) -> str:
+        return self.label
+
+
+STATUS_SUCCESS = Status.SUCCESS
+STATUS_FAILED = Status.FAILED
+STATUS_ERROR = Status.ERROR
+STATUS_DIVERGED = Status.DIVERGED
+STATUS_TIMEOUT = Status.TIMEOUT
+STATUS_CRASHED = Status.CRASHED
+STATUS_BLOWUP = Status.BLOWUP
+STATUS_STALLED = Status.STALLED
+STATUS_BUDGET = Status.BUDGET
+STATUS_WALL = Status.WALL
 
 
 def numerical_failure(exc: BaseException, t: float) -> tuple[int, str] | None:

@@ -8,15 +8,16 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rodval.core.status import STATUS_SUCCESS
+from rodval.core.status import STATUS_SUCCESS, Status
 
 
 @dataclass
 class SolverStats:
     """Cost and outcome of one run. ``wall_s`` is the integration's own wall time (s), without
-    imports, model set-up or one-time compilation."""
+    imports, model set-up or one-time compilation. ``status`` is always a ``Status`` (an int
+    given to it is converted; ValueError for a number that is no status)."""
 
-    status: int = STATUS_SUCCESS
+    status: Status = STATUS_SUCCESS
     message: str = ""
     t_reached: float = 0.0
     nfev: int = 0
@@ -40,13 +41,18 @@ class SolverStats:
     #: Every check made: assumption, figure, bound, unit, holds, reason.
     validity: list[dict[str, Any]] = field(default_factory=list)
 
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name == "status":
+            value = Status(value)
+        object.__setattr__(self, name, value)
+
     @property
     def success(self) -> bool:
         return self.status == STATUS_SUCCESS
 
     def as_dict(self) -> dict:
         return {
-            "status": self.status,
+            "status": int(self.status),
             "success": self.success,
             "message": self.message,
             "t_reached": self.t_reached,

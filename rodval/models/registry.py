@@ -46,10 +46,28 @@ def get_model(name: str | Model, **options: Any) -> Model:
     allowed = tuple(getattr(cls, "OPTIONS", ()))
     unknown = sorted(set(options) - set(allowed))
     if unknown:
-        raise ValueError(
-            f"unknown {name} model option {unknown[0]!r} (allowed: {', '.join(allowed) or 'none'})"
-        )
+        raise ValueError(_unknown_keyword(name, unknown[0], allowed))
     return cls(**options)
+
+
+def _unknown_keyword(model: str, key: str, allowed: tuple[str, ...]) -> str:
+    """One line for an unknown keyword of ``simulate``/``get_model``: the model's options and
+    the integrator settings (both are keywords of ``simulate``), with the nearest name."""
+    import difflib
+
+    uses = getattr(model_class(model), "USES_INTEGRATOR_SETTINGS", True)
+    names = (*allowed, *(SETTING_NAMES if uses else ()))
+    near = difflib.get_close_matches(key, names, n=1, cutoff=0.6)
+    hint = f"; did you mean {near[0]!r}?" if near else ""
+    settings = (
+        f"; integrator settings: {', '.join(SETTING_NAMES)}"
+        if uses
+        else f"; the {model} model takes no integrator settings"
+    )
+    return (
+        f"unknown {model} model option {key!r} (model options: {', '.join(allowed) or 'none'}"
+        f"{settings}){hint}"
+    )
 
 
 def simulate(
