@@ -249,3 +249,40 @@ def test_load_scene_is_exported():
     import rodval
 
     assert rodval.load_scene("paper").n == paper_scene().n
+
+
+def test_wide_tables_on_request(tmp_path, capsys):
+    """Trajectory.to_frame(wide=True) and simulate --wide: one row per output time, one column
+    per quantity and index, the same numbers as the tidy table."""
+    import pandas as pd
+
+    import rodval
+
+    traj = rodval.simulate(paper_scene(t_end=0.1, times=[0.05, 0.1]), "full")
+    wide = traj.to_frame(wide=True)
+    assert list(wide.columns[:3]) == ["t", "phi[1]", "phi[2]"]  # rods k = 1..n
+    assert len(wide) == 2 and wide.shape[1] == 1 + sum(a.shape[1] for a in traj.values.values())
+    np.testing.assert_array_equal(wide["beta[8]"], traj["beta"][:, 7])
+    with pytest.raises(ValueError, match="^wide must be True or False"):
+        traj.to_frame(wide="yes")
+    out = tmp_path / "run"
+    assert (
+        main(
+            [
+                "simulate",
+                "paper",
+                "--t-end",
+                "0.1",
+                "--model",
+                "reduced",
+                "--wide",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
+    table = pd.read_csv(out / "trajectory_wide.csv")
+    tidy = pd.read_csv(out / "trajectory.csv")
+    phi3 = tidy[(tidy.quantity == "phi") & (tidy.k == 3)]["value"].to_numpy()
+    np.testing.assert_array_equal(table["phi[3]"].to_numpy(), phi3)

@@ -53,6 +53,12 @@ def register(sub) -> None:
     p.add_argument("--times", type=time_list, help="output times t1,t2,... (s), increasing")
     add_model_options(p, coefficients_default=None)
     p.add_argument("--out", required=True, type=Path, help="output folder")
+    p.add_argument(
+        "--wide",
+        action="store_true",
+        help="also write DIR/trajectory_wide.csv: one row per output time, a column t and "
+        "one column quantity[k] per quantity and index",
+    )
     p.set_defaults(func=run)
 
 
@@ -88,6 +94,8 @@ def run(args) -> int:
     with progress_bar(scene.t_end, enabled=sys.stderr.isatty()):
         traj = simulate(scene, model, settings=IntegratorSettings(**settings_kw), **options)
     write_run(traj, scene, args.out)
+    if args.wide:
+        traj.to_frame(wide=True).to_csv(args.out / "trajectory_wide.csv", index=False)
     print(
         f"{traj.model}: {traj.stats.message}, {describe(traj.stats.valid, traj.stats.validity)}, "
         f"method {traj.settings.get('method')}, "

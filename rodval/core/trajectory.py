@@ -195,8 +195,18 @@ class Trajectory:
             stats=SolverStats(),
         )
 
-    def to_frame(self) -> pd.DataFrame:
-        """Tidy table with columns t, quantity, k, value."""
+    def to_frame(self, wide: bool = False) -> pd.DataFrame:
+        """Tidy table with columns t, quantity, k, value; ``wide=True``: one row per output
+        time, a column t (s) and one column ``quantity[k]`` per quantity and index, in the
+        trajectory's order (units: ``rodval.core.scene.UNITS``)."""
+        if not isinstance(wide, bool):
+            raise ValueError(f"wide must be True or False, got {wide!r}")
+        if wide:
+            columns = {"t": self.times}
+            for q, arr in self.values.items():
+                for j, k in enumerate(self.k_index[q]):
+                    columns[f"{q}[{int(k)}]"] = arr[:, j]
+            return pd.DataFrame(columns)
         parts = []
         for q, arr in self.values.items():
             nt, nk = arr.shape
