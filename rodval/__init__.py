@@ -17,6 +17,7 @@ from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.models import FullModel, ReducedModel, get_model, simulate
 from rodval.report.tables import read_tables as read_study_tables
 from rodval.study import load_study, run_study
+from rodval.study.spec import StudySpec as Study
 
 __version__ = "0.2.0"
 
@@ -47,6 +48,7 @@ __all__ = [
     "compare",
     "modes",
     "load_study",
+    "Study",
     "run_study",
     "read_study_tables",
     "__version__",

@@ -109,7 +109,7 @@ class StudyRun:
 
 
 def run_study(
-    spec: StudySpec | str | Path,
+    spec: StudySpec | dict | str | Path,
     out: str | Path,
     *,
     workers: int | None = None,
@@ -121,8 +121,8 @@ def run_study(
     report: bool = True,
     fresh: bool = False,
 ) -> StudyRun:
-    """Run the cases of ``spec`` (a study, or the path of a study file) not yet on disk in
-    ``out``, then write tables and report.
+    """Run the cases of ``spec`` (a study, a study document as a dict (``StudySpec.from_dict``)
+    or the path of a study file) not yet on disk in ``out``, then write tables and report.
 
     workers: parallel cases for the processes backend (default: all cores).
     case_timeout: seconds after which a case's unfinished runs are stopped (None: no limit).
@@ -136,6 +136,8 @@ def run_study(
     """
     if isinstance(spec, str | Path):
         spec = load_study(spec)
+    elif isinstance(spec, dict):
+        spec = StudySpec.from_dict(spec)
     check_type("spec", spec, StudySpec, "a study (rodval.load_study) or a study file's path")
     out = as_path("out", out)
     if backend not in BACKENDS:

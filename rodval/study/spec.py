@@ -35,10 +35,11 @@ from rodval.core.resources import (
     output_values,
 )
 from rodval.core.scene import QUANTITIES, Scene, trajectory_quantities
-from rodval.core.scene_file import anchor_load_files, scene_from_dict
+from rodval.core.scene_file import anchor_load_files, scene_from_dict, scene_to_dict
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.models import REGISTRY, get_model, model_class
 from rodval.study.store import MAX_NAME, case_file_name
+from rodval.study.toml_text import toml_text
 
 TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report", "modes"}
 MODES_KEYS = {"count", "about", "load_at", "allow_unbalanced"}
@@ -163,6 +164,17 @@ class ReportSpec:
         }
 
 
+def _plain_document(doc: Any, where: str) -> dict[str, Any]:
+    """A deep copy of a study document (never changing the caller's dict), with a
+    ``rodval.Scene`` given as [scene] turned into its scene-file table (``scene_to_dict``)."""
+    if not isinstance(doc, dict):
+        raise ValueError(f"{where}: a study document must be a dict, got {type(doc).__name__}")
+    doc = copy.deepcopy(doc)
+    if isinstance(doc.get("scene"), Scene):
+        doc["scene"] = scene_to_dict(doc["scene"])
+    return doc
+
+
 @dataclass(frozen=True)
 class StudySpec:
     name: str
@@ -175,6 +187,18 @@ class StudySpec:
     labels: dict[str, str]  # grid path -> short label used in case ids and tables
     cases: tuple[Case, ...]
     report: ReportSpec
+
+    @classmethod
+    def from_dict(
+        cls, doc: dict[str, Any], *, name: str = "study", max_cases: int = MAX_CASES
+    ) -> StudySpec:
+        """A study built in Python: ``doc`` has the study file's tables as dicts ([scene] may
+        be a ``rodval.Scene``); ``name`` is its default name. It runs, resumes and reports
+        like the same study read from TOML, and ``study.toml`` beside its results is ``doc``
+        as TOML (``rodval.study.toml_text``), which ``load_study`` reads back."""
+        plain = _plain_document(doc, name)
+        plain.setdefault("study", {}).setdefault("name", name)
+        return study_from_dict(plain, where=name, text=toml_text(plain), max_cases=max_cases)
 
     def case(self, case_id: str) -> Case:
         for c in self.cases:
@@ -479,6 +503,7 @@ def study_from_dict(
     announce: called with the number of cases once it is known, before the cases are built
     and checked (which takes about 1-3 ms per case).
     """
+    doc = _plain_document(doc, where)
     max_cases = _check_max_cases(max_cases)
     _check_keys(doc, TOP_KEYS, where, "")
     study = doc.setdefault("study", {})
