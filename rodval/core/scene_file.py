@@ -17,6 +17,7 @@ import numpy as np
 
 from rodval.core.checks import check_keys
 from rodval.core.loads import LOAD_FACTORIES
+from rodval.core.profiles import resolve_profiles
 from rodval.core.scene import (
     DEFAULT_NUM_TIMES,
     MAX_TIMES,
@@ -142,6 +143,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
         scene = paper_scene(n, t_end=float(t_end), times=[float(t_end)])
         chain_spec = d.get("chain", {})
         check_keys(chain_spec, CHAIN_KEYS, f"{where} [chain]")
+        chain_spec = resolve_profiles(chain_spec, n, f"{where} [chain]")
         chain = (
             Chain(**{**scene.chain.as_dict(), **chain_spec}, _n=n) if chain_spec else scene.chain
         )
@@ -154,6 +156,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
             )
         init_spec = d.get("initial", {})
         check_keys(init_spec, INITIAL_KEYS, f"{where} [initial]")
+        init_spec = resolve_profiles(init_spec, n, f"{where} [initial]")
         outputs = d.get("outputs", scene.outputs)
         if isinstance(outputs, str) or not isinstance(outputs, (list, tuple)):
             raise ValueError(f"key 'outputs' must be a list from {QUANTITIES}, got {outputs!r}")

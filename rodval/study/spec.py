@@ -239,8 +239,33 @@ def _set_path(doc: dict, path: str, value: Any) -> None:
     node[last] = value
 
 
-def _format_value(v: Any) -> str:
-    """Compact text of a grid value for case ids: 8, 1e-06, inf, pulse(node=last,Xbar=-1500)."""
+#: Longest text of one grid value in a case id; a longer one (a list of per-rod values, a load
+#: table) is written as a label and a short hash of the value (its full value is in cases.csv).
+MAX_VALUE_TEXT = 24
+
+
+def case_value_text(v: Any) -> str:
+    """Compact text of a grid value for case ids and table columns: 8, 1e-06, inf,
+    pulse(node=last,Xbar=-1500); a text longer than ``MAX_VALUE_TEXT`` becomes a label and 8
+    hex digits of the value's SHA-256 (``list8-3fa2c1d0``, ``profile-...``, ``pulse-...``):
+    short, stable, and different for different values."""
+    text = _value_text(v)
+    if len(text) <= MAX_VALUE_TEXT:
+        return text
+    digest = hashlib.sha256(json.dumps(v, sort_keys=True, default=repr).encode()).hexdigest()
+    types = [x.get("type") for x in v if isinstance(x, dict)] if isinstance(v, list) else []
+    if types and all(isinstance(t, str) for t in types) and len(types) == len(v):
+        kind = re.sub(r"[^A-Za-z0-9+]", "", "+".join(types))[:12]
+    elif isinstance(v, list):
+        kind = f"list{len(v)}"
+    elif isinstance(v, dict):
+        kind = re.sub(r"[^A-Za-z0-9]", "", str(v.get("type", "profile")))[:12] or "table"
+    else:
+        kind = text[:12]
+    return f"{kind}-{digest[:8]}"
+
+
+def _value_text(v: Any) -> str:
     if isinstance(v, bool):
         return str(v).lower()
     if isinstance(v, float):
@@ -249,11 +274,11 @@ def _format_value(v: Any) -> str:
         kind = v.get("type", "")
         return (
             f"{kind}("
-            + ",".join(f"{k}={_format_value(x)}" for k, x in v.items() if k != "type")
+            + ",".join(f"{k}={_value_text(x)}" for k, x in v.items() if k != "type")
             + ")"
         )
     if isinstance(v, list):
-        return "+".join(_format_value(x) for x in v)
+        return "+".join(_value_text(x) for x in v)
     return re.sub(r"[^A-Za-z0-9._+-]", "-", str(v))
 
 
@@ -458,7 +483,7 @@ def _build_case(doc: dict, combo: dict[str, Any], labels: dict[str, str], where:
     case_doc = copy.deepcopy(doc)
     for path, value in combo.items():
         _set_path(case_doc, path, value)
-    cid = ",".join(f"{labels[p]}={_format_value(v)}" for p, v in combo.items()) or "base"
+    cid = ",".join(f"{labels[p]}={case_value_text(v)}" for p, v in combo.items()) or "base"
     case_where = where if not combo else f"{where} (case {cid})"
     scene_dict = case_doc.get("scene", {})
     scene_dict.setdefault("name", cid)

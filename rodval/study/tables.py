@@ -34,23 +34,35 @@ from rodval.core.validity import broken
 from rodval.report.markdown import to_markdown
 from rodval.report.tables import MANIFEST, axis_columns, table_digest, trajectory_samples
 from rodval.study.records import CaseRecord, DamagedRecord, read_case
-from rodval.study.spec import StudySpec
+from rodval.study.spec import StudySpec, case_value_text
 from rodval.study.store import StudyStore, write_json_atomic
 
 
-def _case_columns(rec: CaseRecord, axes: dict[str, str]) -> dict[str, Any]:
+def _case_columns(rec: CaseRecord, axes: dict[str, str], full: bool = False) -> dict[str, Any]:
+    """The columns that name a case: id, n, horizon and each grid value; a list or table
+    value as JSON when ``full`` (cases.csv), else as its short text (``case_value_text``)."""
     return {
         "case": rec.case,
         "n": rec.n,
         "horizon": rec.t_end,
-        **{col: rec.params.get(label) for label, col in axes.items()},
+        **{col: _grid_value(rec.params.get(label), full) for label, col in axes.items()},
     }
+
+
+def _grid_value(v: Any, full: bool) -> Any:
+    if not isinstance(v, (list, dict)):
+        return v
+    return json.dumps(v, sort_keys=True) if full else case_value_text(v)
 
 
 def cases_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFrame:
     return pd.DataFrame(
         [
-            {**_case_columns(r, axes), "l": json.dumps(r.lengths), "fingerprint": r.fingerprint}
+            {
+                **_case_columns(r, axes, full=True),
+                "l": json.dumps(r.lengths),
+                "fingerprint": r.fingerprint,
+            }
             for r in records
         ]
     )
