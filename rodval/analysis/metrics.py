@@ -31,6 +31,7 @@ import pandas as pd
 
 from rodval.core.checks import check_type
 from rodval.core.scene import trajectory_quantities
+from rodval.core.scene_file import scene_differences, scene_to_dict
 from rodval.core.status import STATUS_MESSAGES
 from rodval.core.trajectory import Trajectory
 
@@ -100,15 +101,25 @@ def check_comparable(traj: Trajectory, reference: Trajectory, quantities: Iterab
 
 
 def discrepancies(
-    traj: Trajectory, reference: Trajectory, quantities: Iterable[str] | None = None
+    traj: Trajectory,
+    reference: Trajectory,
+    quantities: Iterable[str] | None = None,
+    *,
+    allow_different_scenes: bool = False,
 ) -> pd.DataFrame:
     """One row per quantity: quantity, max_abs, rms, final_abs, max_rel, k_at_max, t_at_max.
 
     ``quantities`` defaults to those both trajectories hold; a quantity missing from either
-    is a ValueError. Arguments of another type are refused up front (ValueError).
+    is a ValueError. Two runs of different scenes (both known: ``Trajectory.scene``) are
+    refused, naming the scene keys that differ, unless ``allow_different_scenes`` (the table
+    then mixes a model's error with the change of scene). Arguments of another type are
+    refused up front (ValueError).
     """
     check_type("traj", traj, Trajectory, "a rodval.Trajectory (what simulate returns)")
     check_type("reference", reference, Trajectory, "a rodval.Trajectory (what simulate returns)")
+    check_type("allow_different_scenes", allow_different_scenes, bool, "True or False")
+    if not allow_different_scenes:
+        check_same_scene(traj, reference)
     if isinstance(quantities, str) or not isinstance(quantities, Iterable | None):
         raise ValueError(
             f"quantities must be a list of quantity names such as ['phi'] or None (all), "
@@ -129,6 +140,20 @@ def discrepancies(
         for q in qs
     ]
     return pd.DataFrame(rows, columns=["quantity", *METRICS])
+
+
+def check_same_scene(traj: Trajectory, reference: Trajectory) -> None:
+    """ValueError naming the differing scene keys (``scene_differences``) when both runs know
+    their scene and the scenes differ. O(n) (the scenes' arrays)."""
+    a, b = traj.scene, reference.scene
+    if a is None or b is None or a is b:
+        return
+    differ = scene_differences(scene_to_dict(a), scene_to_dict(b))
+    if differ:
+        raise ValueError(
+            f"traj and reference are runs of different scenes ({', '.join(differ)} differ); "
+            "pass allow_different_scenes=True to compare them anyway"
+        )
 
 
 def scaled_errors(values: np.ndarray, reference: np.ndarray) -> dict[str, float]:

@@ -86,7 +86,7 @@ import pandas as pd
 import scipy.linalg
 from scipy.optimize import linear_sum_assignment
 
-from rodval.core.checks import check_type
+from rodval.core.checks import check_choice, check_type
 from rodval.core.eigen import angular_frequencies, quadratic_eigenvalues, symmetric_pencil
 from rodval.core.modal import (
     ABOUT,
@@ -273,8 +273,7 @@ def linear_system(
     """(M, C, K + K_L) of the model linearized about q0 at rest (q0: phi (n) or
     [phi; alpha; beta] (3n); default straight). The bending coordinates of q0 do not enter
     (the first-order model's M depends on phi only and K is constant)."""
-    if model not in MODELS:
-        raise ValueError(f"model must be one of {MODELS}, got {model!r}")
+    check_choice("model", model, MODELS)
     n = chain.n
     phi0 = np.zeros(n) if q0 is None else np.asarray(q0, float)[:n]
     if phi0.shape != (n,):
@@ -484,8 +483,7 @@ def modes(
     for ever, or every load at ``load_at`` s) and hinge rest angles (see module docstring).
     ``count``: the lowest ``count`` modes (default all)."""
     check_arguments(scene, count)
-    if model not in MODELS:
-        raise ValueError(f"model must be one of {MODELS}, got {model!r}")
+    check_choice("model", model, MODELS)
     balance = check_configuration(scene, about, load_at, allow_unbalanced)
     chain, n = scene.chain, scene.n
     ini = scene.initial.resolve(n)
@@ -530,8 +528,7 @@ def check_configuration(
     static value (``static_loads``); for ``about="initial"`` the state at rest in equilibrium
     (``check_at_rest``) unless ``allow_unbalanced``, whose residual is then returned as
     ``{"unbalanced_residual_Nm": r}`` for the record."""
-    if about not in ABOUT:
-        raise ValueError(f"about must be one of {ABOUT}, got {about!r}")
+    check_choice("about", about, ABOUT)
     if not isinstance(allow_unbalanced, bool):
         raise ValueError(f"allow_unbalanced must be True or False, got {allow_unbalanced!r}")
     if about == "equilibrium":
@@ -568,6 +565,7 @@ def model_modes(
     "exudyn" (``options``: ExudynModel options); every model about the same configuration,
     checked here once (``check_configuration``)."""
     check_arguments(scene, count)
+    check_choice("model", model, (*MODELS, "exudyn"))
     if model == "exudyn":
         balance = check_configuration(scene, about, load_at, allow_unbalanced)
         try:

@@ -35,3 +35,13 @@ def as_path(name: str, value: Any) -> Path:
     """A str or os.PathLike argument as a Path (ValueError naming ``name`` otherwise)."""
     check_type(name, value, (str, Path), "a path (str or pathlib.Path)")
     return Path(value)
+
+
+def check_choice(name: str, value: Any, choices: Iterable[str]) -> str:
+    """``value`` when it is one of the strings ``choices``, else ValueError naming ``name`` and
+    the choices (an array, a number or None never reaches an ``in`` test that fails deep
+    inside with numpy's "truth value of an array is ambiguous")."""
+    choices = tuple(choices)
+    if not isinstance(value, str) or value not in choices:
+        raise ValueError(f"{name} must be one of {choices}, got {value!r:.60}")
+    return value

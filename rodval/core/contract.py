@@ -30,6 +30,7 @@ class Model(ABC):
         """Run the scene (default integrator settings when None) and judge the run's validity;
         never raise for a failed integration (report it in the stats)."""
         trajectory = self.run(scene, IntegratorSettings() if settings is None else settings)
+        trajectory.scene = scene
         stats = trajectory.stats
         stats.valid, stats.validity = verdict(self.validity_checks(scene, trajectory))
         return trajectory

@@ -75,7 +75,11 @@ def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndar
     """A length-n float array from a scalar or sequence of real numbers; ``positive``: True
     for > 0, False for >= 0 (both with bounded magnitudes: ``MAX_MAGNITUDE``,
     ``MIN_POSITIVE``), None for any finite value (angles, initial state)."""
-    raw = np.asarray(value) if not isinstance(value, (str, bytes, dict)) else np.asarray(None)
+    items = value if isinstance(value, (list, tuple)) else [value]
+    if any(isinstance(v, (bool, np.bool_, str, bytes, dict, list, tuple)) for v in items):
+        raw = np.asarray(None)  # a boolean, text or nested list among the numbers: refused
+    else:
+        raw = np.asarray(value)
     if raw.dtype.kind not in "iuf":  # strings, booleans, complex, objects: refused
         raise ValueError(
             f"{name} must be a real number or a list of n = {n} real numbers, got {value!r}"
@@ -427,6 +431,10 @@ class Scene:
         times = times.copy()
         times.setflags(write=False)
         object.__setattr__(self, "times", times)
+        if not isinstance(self.outputs, str | list | tuple):
+            raise ValueError(
+                f"outputs must be a non-empty subset of {QUANTITIES}, got {self.outputs!r:.60}"
+            )
         outputs = (self.outputs,) if isinstance(self.outputs, str) else tuple(self.outputs)
         bad = [q for q in outputs if q not in QUANTITIES]
         if bad or not outputs:

@@ -101,6 +101,10 @@ class Trajectory:
     #: State events in time order (e.g. latches locking), each a plain dict with "t" (s),
     #: "label" and the model's own measures.
     events: list = field(default_factory=list)
+    #: The rodval.Scene the run simulated (set by ``Model.simulate``; None for trajectories
+    #: read from files or records, whose scene is in run.json / the case record). ``compare``
+    #: refuses two runs of different scenes. Not part of equality or of ``to_dict``.
+    scene: Any = field(default=None, compare=False, repr=False)
 
     @property
     def success(self) -> bool:

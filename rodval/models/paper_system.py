@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from rodval.core.checks import check_choice
 from rodval.core.loads import LOAD_COLUMNS, LoadSet, load_table
 from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
@@ -50,9 +51,7 @@ class PaperSystem(OdeSystem):
     compiled_mechanics: Any
 
     def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
-        if kernel not in KERNELS:
-            raise ValueError(f"kernel must be one of {KERNELS}, got {kernel!r}")
-        self.kernel = kernel
+        self.kernel = check_choice("kernel", kernel, KERNELS)
         self.coefficients = coefficients
         chain = scene.chain
         #: the scene's chain; ``chain`` is the effective one of the current mode (active
@@ -544,12 +543,8 @@ class PaperModel(OdeModel):
     OPTIONS = ("coefficients", "kernel")
 
     def __init__(self, coefficients: str = "printed", kernel: str = "numba"):
-        if coefficients not in VARIANTS:
-            raise ValueError(f"coefficients must be one of {VARIANTS}, got {coefficients!r}")
-        if kernel not in KERNELS:
-            raise ValueError(f"kernel must be one of {KERNELS}, got {kernel!r}")
-        self.coefficients = coefficients
-        self.kernel = kernel
+        self.coefficients = check_choice("coefficients", coefficients, VARIANTS)
+        self.kernel = check_choice("kernel", kernel, KERNELS)
 
     def options(self):
         return {"coefficients": self.coefficients, "kernel": self.kernel}

@@ -86,6 +86,9 @@ def read_run_record(path: Path) -> dict[str, Any]:
                 f"{path}: key {key!r} must be a {'table' if kind is dict else 'string'}, "
                 f"got {rec[key]!r:.60}"
             )
+    events = rec.get("events", [])
+    if not isinstance(events, list) or not all(isinstance(e, dict) for e in events):
+        raise ValueError(f"{path}: key 'events' must be a list of tables, got {events!r:.60}")
     return rec
 
 

@@ -115,10 +115,14 @@ def read_tables(out: str | Path) -> dict[str, pd.DataFrame]:
             )
         try:
             df = pd.read_csv(path)
+        except UnicodeDecodeError as exc:
+            raise ValueError(
+                f"{path}: not a readable CSV table (byte {exc.start} is not UTF-8 text; the "
+                "file is damaged or not a table the study wrote)"
+            ) from None
         except (
             pd.errors.ParserError,
             pd.errors.EmptyDataError,
-            UnicodeDecodeError,
             ValueError,
         ) as exc:
             raise ValueError(

@@ -18,7 +18,7 @@ import numpy as np
 from tqdm import tqdm
 
 from rodval.analysis.metrics import compare_runs
-from rodval.core.checks import as_path, check_type
+from rodval.core.checks import as_path, check_choice, check_type
 from rodval.core.provenance import provenance
 from rodval.core.scene_file import scene_to_dict
 from rodval.core.status import STATUS_CRASHED, STATUS_DIVERGED, STATUS_TIMEOUT
@@ -140,15 +140,20 @@ def run_study(
         spec = StudySpec.from_dict(spec)
     check_type("spec", spec, StudySpec, "a study (rodval.load_study) or a study file's path")
     out = as_path("out", out)
-    if backend not in BACKENDS:
-        raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
+    check_choice("backend", backend, BACKENDS)
     if backend == "dask" and not scheduler:
         raise ValueError("backend 'dask' needs --scheduler ADDRESS of a running dask scheduler")
     workers = default_workers() if workers is None else workers
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
-    if case_timeout is not None and (isinstance(case_timeout, bool) or not case_timeout > 0):
-        raise ValueError(f"case_timeout must be > 0 s or None, got {case_timeout!r}")
+    if case_timeout is not None and (
+        isinstance(case_timeout, bool)
+        or not isinstance(case_timeout, int | float)
+        or not case_timeout > 0
+    ):
+        raise ValueError(f"case_timeout must be a number > 0 s or None, got {case_timeout!r:.60}")
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"out must be a folder, got the file {str(out)!r}")
     start = time.perf_counter()
     store = StudyStore(out)
     if fresh:
