@@ -26,6 +26,11 @@ from rodval.report.figures import (
     speedups,
 )
 from rodval.report.markdown import to_markdown
+from rodval.report.sample_stats import (
+    PERCENTILES,
+    discrepancy_percentiles,
+    lock_statistics,
+)
 from rodval.report.tables import FIGURES, axis_columns, read_tables, trajectory_samples
 
 
@@ -405,6 +410,34 @@ def _deployment_section(
     return lines
 
 
+def _sample_section(out: Path, meta: dict, tables: dict[str, pd.DataFrame]) -> list[str]:
+    """Percentiles over the samples of a ``[sample]`` study (``rodval.report.sample_stats``):
+    latch locking and lock times when the scenes have latches, and the discrepancies."""
+    sample = meta.get("sample")
+    if not sample:
+        return []
+    keys = ", ".join(f"`{k}` ({v['dist']})" for k, v in sample["keys"].items())
+    lines = [
+        "## Sample statistics\n",
+        f"{sample['count']} samples, {sample['design']} design, seed {sample['seed']}, of "
+        f"{keys}; percentiles {', '.join(str(p) for p in PERCENTILES)} over the samples.\n",
+    ]
+    models = [m["label"] for m in meta["models"]]
+    locks = lock_statistics(tables["cases"], read_events(out), models)
+    if not locks.empty:
+        lines.append("### Latches\n")
+        for model, part in locks.groupby("model", sort=False):
+            lines.append(
+                f"- `{model}`: every latch locked in {part['p_all_locked'].iloc[0]:.1%} "
+                "of the samples"
+            )
+        lines += ["", to_markdown(locks, floatfmt=".4g"), ""]
+    disc = discrepancy_percentiles(tables["discrepancies"])
+    if not disc.empty:
+        lines += ["### Discrepancies\n", to_markdown(disc, floatfmt=".3g"), ""]
+    return lines
+
+
 def _header(meta: dict, prov: dict) -> list[str]:
     models = pd.DataFrame(
         [
@@ -545,6 +578,7 @@ def build_report(out: str | Path) -> Path:
     figs = _param_figures(fig_dir, meta, tables, params)
     if figs:
         lines += ["## Discrepancy, run time and speed-up against the grid parameters\n", *figs]
+    lines += _sample_section(out, meta, tables)
     lines += _deployment_section(out, fig_dir, meta, tables)
     lines += _modes_section(out, fig_dir, meta)
     lines += ["## Time histories and configurations\n", *_case_figures(out, fig_dir, meta, tables)]

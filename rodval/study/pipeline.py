@@ -42,6 +42,7 @@ def study_meta(spec: StudySpec) -> dict[str, Any]:
         "axes": spec.axes,
         "labels": spec.labels,
         "report": spec.report.as_dict(),
+        **({"sample": spec.sample} if spec.sample else {}),
         "cases": [
             {"id": c.id, "params": c.params, "fingerprint": c.fingerprint} for c in spec.cases
         ],

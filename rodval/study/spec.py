@@ -38,10 +38,12 @@ from rodval.core.scene import QUANTITIES, Scene, trajectory_quantities
 from rodval.core.scene_file import anchor_load_files, scene_from_dict, scene_to_dict
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.models import REGISTRY, get_model, model_class
+from rodval.study.sampling import flatten_keys as _flatten_sample_keys
+from rodval.study.sampling import sample_columns
 from rodval.study.store import MAX_NAME, case_file_name
 from rodval.study.toml_text import toml_text
 
-TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "report", "modes"}
+TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "sample", "report", "modes"}
 MODES_KEYS = {"count", "about", "load_at", "allow_unbalanced"}
 #: Most cases a study grid may have by default: every case is built and checked before any
 #: runs (about 1-3 ms each on the 2-core machine, so ~1 min at the limit); raise it with
@@ -187,6 +189,9 @@ class StudySpec:
     labels: dict[str, str]  # grid path -> short label used in case ids and tables
     cases: tuple[Case, ...]
     report: ReportSpec
+    #: The [sample] table as drawn (design, count, seed, keys: path -> distribution), or
+    #: None for a grid study.
+    sample: dict[str, Any] | None = None
 
     @classmethod
     def from_dict(
@@ -232,11 +237,35 @@ def _flatten(d: dict, prefix: str = "") -> dict[str, Any]:
 
 
 def _set_path(doc: dict, path: str, value: Any) -> None:
-    *parents, last = path.split(".")
-    node = doc
-    for p in parents:
-        node = node.setdefault(p, {})
-    node[last] = value
+    """Set ``value`` at the dotted ``path`` of ``doc``, creating tables on the way; in a list
+    a segment is an index or ``*`` (every element: every latch). ValueError when the path
+    runs into a value that is neither a table nor a list."""
+    _set_parts(doc, path.split("."), value, path)
+
+
+def _set_parts(node: Any, parts: list[str], value: Any, path: str) -> None:
+    head, rest = parts[0], parts[1:]
+    if isinstance(node, list):
+        if head == "*":
+            index = range(len(node))
+        elif head.isdigit() and int(head) < len(node):
+            index = range(int(head), int(head) + 1)
+        else:
+            raise ValueError(f"{path}: {head!r} is not '*' or an index of a list of {len(node)}")
+        for i in index:
+            if rest:
+                _set_parts(node[i], rest, value, path)
+            else:
+                node[i] = value
+        return
+    if not isinstance(node, dict):
+        raise ValueError(f"{path}: {head!r} goes into {node!r:.40}, which is not a table or list")
+    if not rest:
+        node[head] = value
+        return
+    if node.get(head) is None:
+        node[head] = {}
+    _set_parts(node[head], rest, value, path)
 
 
 #: Longest text of one grid value in a case id; a longer one (a list of per-rod values, a load
@@ -456,22 +485,7 @@ def _grid_axes(grid: Any, doc: dict, where: str) -> dict[str, list[Any]]:
     axes = _flatten(grid)
     for path, values in axes.items():
         key = f"grid.{path}"
-        root, *rest = path.split(".")
-        if root not in GRID_ROOTS or not rest:
-            raise _err(
-                where,
-                key,
-                f"must be a path into {', '.join(GRID_ROOTS)} "
-                "(e.g. scene.n, scene.chain.EI, integrator.rtol, models.full.method)",
-            )
-        if root == "integrator" and (len(rest) != 1 or rest[0] not in INTEGRATOR_KEYS):
-            raise _err(where, key, f"integrator keys are {', '.join(sorted(INTEGRATOR_KEYS))}")
-        if root == "models" and (len(rest) != 2 or rest[0] not in doc.get("models", {})):
-            raise _err(
-                where,
-                key,
-                f"must be models.LABEL.KEY with LABEL one of {', '.join(doc.get('models', {}))}",
-            )
+        _check_axis_path(path, key, doc, where)
         if not isinstance(values, list) or not values:
             raise _err(where, key, f"must be a non-empty list of values, got {values!r}")
         if len({json.dumps(v, sort_keys=True) for v in values}) != len(values):
@@ -479,11 +493,38 @@ def _grid_axes(grid: Any, doc: dict, where: str) -> dict[str, list[Any]]:
     return axes
 
 
-def _build_case(doc: dict, combo: dict[str, Any], labels: dict[str, str], where: str) -> Case:
+def _check_axis_path(path: str, key: str, doc: dict, where: str) -> None:
+    """A grid or sample key is a path into the scene, the integrator or a model's table."""
+    root, *rest = path.split(".")
+    if root not in GRID_ROOTS or not rest:
+        raise _err(
+            where,
+            key,
+            f"must be a path into {', '.join(GRID_ROOTS)} "
+            "(e.g. scene.n, scene.chain.EI, integrator.rtol, models.full.method)",
+        )
+    if root == "integrator" and (len(rest) != 1 or rest[0] not in INTEGRATOR_KEYS):
+        raise _err(where, key, f"integrator keys are {', '.join(sorted(INTEGRATOR_KEYS))}")
+    if root == "models" and (len(rest) != 2 or rest[0] not in doc.get("models", {})):
+        raise _err(
+            where,
+            key,
+            f"must be models.LABEL.KEY with LABEL one of {', '.join(doc.get('models', {}))}",
+        )
+
+
+def _build_case(
+    doc: dict, combo: dict[str, Any], labels: dict[str, str], where: str, cid: str | None = None
+) -> Case:
+    """The case of ``doc`` with the grid or sample values ``combo`` (path -> value) set; its id
+    ``cid`` (default: the values' short texts)."""
     case_doc = copy.deepcopy(doc)
+    cid = cid or ",".join(f"{labels[p]}={case_value_text(v)}" for p, v in combo.items()) or "base"
     for path, value in combo.items():
-        _set_path(case_doc, path, value)
-    cid = ",".join(f"{labels[p]}={case_value_text(v)}" for p, v in combo.items()) or "base"
+        try:
+            _set_path(case_doc, path, value)
+        except ValueError as exc:
+            raise ValueError(f"{where} (case {cid}): {exc}") from None
     case_where = where if not combo else f"{where} (case {cid})"
     scene_dict = case_doc.get("scene", {})
     scene_dict.setdefault("name", cid)
@@ -511,6 +552,81 @@ def _check_max_cases(max_cases: Any) -> int:
     if isinstance(max_cases, bool) or not isinstance(max_cases, int) or max_cases < 1:
         raise ValueError(f"max_cases must be an integer >= 1, got {max_cases!r}")
     return max_cases
+
+
+def _grid_cases(
+    doc: dict, where: str, max_cases: int, announce: Callable[[int], None] | None
+) -> tuple[dict[str, list[Any]], dict[str, str], tuple[Case, ...]]:
+    """(axes, labels, cases) of the grid: the cartesian product of each [[grid]] table's
+    axes, the union over the tables; its size checked before it is expanded."""
+    grid = doc.get("grid")
+    grids = [_grid_axes(g, doc, where) for g in (grid if isinstance(grid, list) else [grid])]
+    size = grid_size(grids)
+    _check_size(size, "grid", where, max_cases, announce)
+    axes: dict[str, list[Any]] = {}
+    for sub in grids:  # [[grid]]: the union of several grids' cartesian products
+        for path, values in sub.items():
+            axes.setdefault(path, [])
+            axes[path] += [v for v in values if v not in axes[path]]
+    labels = _axis_labels(list(axes))
+    cases = tuple(
+        _build_case(doc, dict(zip(sub, combo)), labels, where)
+        for sub in grids
+        for combo in itertools.product(*sub.values())
+    )
+    return axes, labels, cases
+
+
+def _sample_cases(
+    doc: dict, where: str, max_cases: int, announce: Callable[[int], None] | None
+) -> tuple[dict[str, list[Any]], dict[str, str], tuple[Case, ...]]:
+    """(axes, labels, cases) of the [sample] table (``rodval.study.sampling``): one case per
+    sample, id ``sample=0001`` ..., the sampled values as its parameters (columns of
+    cases.csv and every table)."""
+    if "grid" in doc:
+        raise _err(where, "sample", "a study has a [grid] or a [sample], not both")
+    count = doc["sample"].get("count") if isinstance(doc["sample"], dict) else None
+    if isinstance(count, int) and not isinstance(count, bool):
+        _check_size(count, "sample.count", where, max_cases, announce)
+    columns = sample_columns(doc["sample"], where)
+    for path in columns:
+        _check_axis_path(path, f"sample.keys.{path}", doc, where)
+    labels = _axis_labels(list(columns))
+    width = len(str(count))
+    cases = tuple(
+        _build_case(
+            doc, {p: v[i] for p, v in columns.items()}, labels, where, f"sample={i + 1:0{width}d}"
+        )
+        for i in range(len(next(iter(columns.values()))))
+    )
+    return columns, labels, cases
+
+
+def _sample_meta(table: Any) -> dict[str, Any] | None:
+    """The [sample] table (already checked by ``sample_columns``) for study.json."""
+    if table is None:
+        return None
+    return {
+        "design": table.get("design", "sobol"),
+        "count": table["count"],
+        "seed": table["seed"],
+        "keys": {p: dict(v) for p, v in _flatten_sample_keys(table["keys"]).items()},
+    }
+
+
+def _check_size(
+    size: int, key: str, where: str, max_cases: int, announce: Callable[[int], None] | None
+) -> None:
+    if size > max_cases:
+        raise _err(
+            where,
+            key,
+            f"{size} cases, more than the limit of {max_cases} (every case is built and "
+            "checked before any runs); split the study, or raise the limit with "
+            "--max-cases N (Python: max_cases=N)",
+        )
+    if announce is not None:
+        announce(size)
 
 
 def study_from_dict(
@@ -545,30 +661,10 @@ def study_from_dict(
     study["reference"] = reference
     if "scene" in doc and not isinstance(doc["scene"], dict):
         raise _err(where, "scene", "must be a table")
-    grid = doc.get("grid")
-    grids = [_grid_axes(g, doc, where) for g in (grid if isinstance(grid, list) else [grid])]
-    size = grid_size(grids)
-    if size > max_cases:
-        raise _err(
-            where,
-            "grid",
-            f"{size} cases, more than the limit of {max_cases} (every case is built and "
-            "checked before any runs); split the study, or raise the limit with "
-            "--max-cases N (Python: max_cases=N)",
-        )
-    if announce is not None:
-        announce(size)
-    axes: dict[str, list[Any]] = {}
-    for sub in grids:  # [[grid]]: the union of several grids' cartesian products
-        for path, values in sub.items():
-            axes.setdefault(path, [])
-            axes[path] += [v for v in values if v not in axes[path]]
-    labels = _axis_labels(list(axes))
-    cases = tuple(
-        _build_case(doc, dict(zip(sub, combo)), labels, where)
-        for sub in grids
-        for combo in itertools.product(*sub.values())
-    )
+    if "sample" in doc:
+        axes, labels, cases = _sample_cases(doc, where, max_cases, announce)
+    else:
+        axes, labels, cases = _grid_cases(doc, where, max_cases, announce)
     ids = [c.id for c in cases]
     if len(set(ids)) != len(ids):
         raise _err(
@@ -591,6 +687,7 @@ def study_from_dict(
         labels=labels,
         cases=cases,
         report=report,
+        sample=_sample_meta(doc.get("sample")),
     )
 
 

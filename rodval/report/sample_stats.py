@@ -1,0 +1,79 @@
+"""Statistics of a sampled study (``[sample]``, ``rodval.study.sampling``): the distribution of
+each model's results over the samples, as engineers read a deployment's reliability.
+
+* ``lock_statistics``: per model, the probability that every latch locks (the fraction of
+  samples whose run recorded a lock of each latch of its scene) and, per hinge, the fraction
+  that locked and the percentiles of its lock time (s);
+* ``discrepancy_percentiles``: per model pair and quantity, percentiles of max_abs and rms
+  over the samples (the comparisons that were made).
+
+Percentiles are numpy's linear interpolation (``numpy.percentile``) at ``PERCENTILES``.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pandas as pd
+
+PERCENTILES = (5, 50, 95)
+
+
+def locked_hinges(label: str) -> list[int]:
+    """The hinges a lock event's label names ("latch hinge 2", "latch hinge 1, 3")."""
+    if not str(label).startswith("latch hinge"):
+        return []
+    return [int(h) for h in re.findall(r"\d+", str(label))]
+
+
+def lock_statistics(cases: pd.DataFrame, events: pd.DataFrame, models: list[str]) -> pd.DataFrame:
+    """One row per model and latched hinge: model, hinge, samples, locked (fraction),
+    p_all_locked (fraction of samples in which every latch of the scene locked, the same on
+    every row of a model), t_pP (lock time percentiles, s, over the samples where it locked),
+    t_min, t_max. ``cases`` needs columns case and latch_hinges (JSON list); O(events)."""
+    hinges_of = {
+        str(c): [int(h) for h in re.findall(r"\d+", str(hs))]
+        for c, hs in zip(cases["case"], cases.get("latch_hinges", pd.Series([""] * len(cases))))
+    }
+    samples = len(hinges_of)
+    rows = []
+    for model in models:
+        own = events[events["model"] == model] if not events.empty else events
+        times: dict[tuple[str, int], float] = {}
+        for case, label, t in zip(own.get("case", []), own.get("label", []), own.get("t", [])):
+            for h in locked_hinges(label):
+                times.setdefault((str(case), h), float(t))
+        every = sum(all((c, h) in times for h in hs) for c, hs in hinges_of.items() if hs)
+        latched = sorted({h for hs in hinges_of.values() for h in hs})
+        for h in latched:
+            with_h = [c for c, hs in hinges_of.items() if h in hs]
+            t = np.array([times[(c, h)] for c in with_h if (c, h) in times])
+            row = {
+                "model": model,
+                "hinge": h,
+                "samples": len(with_h),
+                "locked": len(t) / len(with_h),
+                "p_all_locked": every / samples if samples else np.nan,
+            }
+            for p in PERCENTILES:
+                row[f"t_p{p}"] = float(np.percentile(t, p)) if t.size else np.nan
+            row["t_min"] = float(t.min()) if t.size else np.nan
+            row["t_max"] = float(t.max()) if t.size else np.nan
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def discrepancy_percentiles(disc: pd.DataFrame) -> pd.DataFrame:
+    """Per model, reference and quantity: the number of samples compared and the percentiles
+    of max_abs and rms over them (rows whose comparison could not be made are left out)."""
+    ok = disc[disc["status"] == "ok"] if "status" in disc else disc
+    rows = []
+    for (model, ref, q), part in ok.groupby(["model", "reference", "quantity"], sort=False):
+        row = {"model": model, "reference": ref, "quantity": q, "samples": len(part)}
+        for metric in ("max_abs", "rms"):
+            vals = part[metric].astype(float).to_numpy()
+            for p in PERCENTILES:
+                row[f"{metric}_p{p}"] = float(np.percentile(vals, p))
+        rows.append(row)
+    return pd.DataFrame(rows)

@@ -1,0 +1,167 @@
+"""Sampling of uncertain parameters in a study (the ``[sample]`` table): a design of points in
+the unit cube (Sobol, Latin hypercube or plain random, ``scipy.stats.qmc``), seeded, mapped
+through each key's distribution. Every sample is one case; the same seed gives the same
+values, hence identical tables.
+
+    [sample]
+    design = "sobol"        # "sobol" (count a power of 2), "lhs" or "random"
+    count = 256
+    seed = 1
+    [sample.keys]
+    "scene.chain.kappa.rest" = { dist = "uniform", low = 30.0, high = 70.0 }
+    "scene.latches.*.angle" = { dist = "normal", mean = 0.0, std = 0.01, low = -0.03, high = 0.03 }
+    "scene.chain.nu.rest" = { dist = "lognormal", median = 0.05, sigma = 0.3 }
+
+Keys are paths into the study document like grid keys; ``*`` sets every element of a list
+(every latch), an integer one element. Distributions (values in the key's own unit):
+
+* ``uniform``: ``low``, ``high`` (low < high);
+* ``normal``: ``mean``, ``std`` > 0, optional ``low`` / ``high``: truncated there (the design's
+  points mapped through the truncated distribution's quantile function, so none is rejected);
+* ``lognormal``: ``median`` > 0 and ``sigma`` > 0 (of the logarithm), optional ``low`` /
+  ``high`` > 0 (truncated likewise).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+import numpy as np
+
+DESIGNS = ("sobol", "lhs", "random")
+SAMPLE_KEYS = {"design", "count", "seed", "keys"}
+#: Most samples a study may draw (each is a case).
+MAX_SAMPLES = 100_000
+#: Parameters of each distribution: required, optional.
+DISTRIBUTIONS = {
+    "uniform": (("low", "high"), ()),
+    "normal": (("mean", "std"), ("low", "high")),
+    "lognormal": (("median", "sigma"), ("low", "high")),
+}
+
+
+def _real(where: str, key: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+        raise ValueError(f"{where}: {key} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def check_distribution(where: str, spec: Any) -> dict[str, Any]:
+    """The distribution table ``spec`` checked (ValueError naming ``where`` and the key)."""
+    if not isinstance(spec, dict) or spec.get("dist") not in DISTRIBUTIONS:
+        raise ValueError(
+            f"{where}: must be a table with dist = one of {', '.join(DISTRIBUTIONS)}, "
+            f"got {spec!r:.80}"
+        )
+    required, optional = DISTRIBUTIONS[spec["dist"]]
+    unknown = sorted(set(spec) - {"dist", *required, *optional})
+    if unknown:
+        raise ValueError(
+            f"{where}: unknown key {unknown[0]!r} for dist = {spec['dist']!r} "
+            f"(allowed: {', '.join((*required, *optional))})"
+        )
+    missing = [k for k in required if k not in spec]
+    if missing:
+        raise ValueError(f"{where}: dist = {spec['dist']!r} needs {', '.join(missing)}")
+    p = {k: _real(where, k, spec[k]) for k in (*required, *optional) if k in spec}
+    lo, hi = p.get("low", -math.inf), p.get("high", math.inf)
+    if not lo < hi:
+        raise ValueError(f"{where}: low must be < high, got {lo:g} and {hi:g}")
+    if spec["dist"] == "normal" and not p["std"] > 0:
+        raise ValueError(f"{where}: std must be > 0, got {p['std']:g}")
+    if spec["dist"] == "lognormal":
+        for k in ("median", "sigma"):
+            if not p[k] > 0:
+                raise ValueError(f"{where}: {k} must be > 0, got {p[k]:g}")
+        if "low" in p and not p["low"] > 0:
+            raise ValueError(f"{where}: low must be > 0 for a lognormal, got {p['low']:g}")
+    return {"dist": spec["dist"], **p}
+
+
+def quantiles(spec: dict[str, Any], u: np.ndarray) -> np.ndarray:
+    """The values of the (checked) distribution ``spec`` at the unit-cube coordinates ``u``
+    (inverse transform; truncation by mapping u into the bounds' probability interval)."""
+    from scipy.stats import norm
+
+    if spec["dist"] == "uniform":
+        return spec["low"] + u * (spec["high"] - spec["low"])
+    if spec["dist"] == "normal":
+        mean, scale = spec["mean"], spec["std"]
+        to_z = lambda x: (x - mean) / scale  # noqa: E731 - a one-line change of variable
+    else:
+        mean, scale = math.log(spec["median"]), spec["sigma"]
+        to_z = lambda x: (math.log(x) - mean) / scale if x > 0 else -math.inf  # noqa: E731
+    a = norm.cdf(to_z(spec["low"])) if "low" in spec else 0.0
+    b = norm.cdf(to_z(spec["high"])) if "high" in spec else 1.0
+    z = mean + scale * norm.ppf(a + u * (b - a))
+    return z if spec["dist"] == "normal" else np.exp(z)
+
+
+def unit_design(design: str, count: int, dims: int, seed: int) -> np.ndarray:
+    """(count, dims) points in [0, 1)^dims of the named design, reproducible from ``seed``."""
+    from scipy.stats import qmc
+
+    if design == "sobol":
+        return qmc.Sobol(dims, scramble=True, seed=seed).random(count)
+    if design == "lhs":
+        return qmc.LatinHypercube(dims, seed=seed).random(count)
+    return np.random.default_rng(seed).random((count, dims))
+
+
+def flatten_keys(d: dict, prefix: str = "") -> dict[str, Any]:
+    """Dotted paths -> distribution tables (a table with ``dist`` ends a path)."""
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        path = f"{prefix}.{k}" if prefix else str(k)
+        if isinstance(v, dict) and "dist" not in v:
+            out.update(flatten_keys(v, path))
+        else:
+            out[path] = v
+    return out
+
+
+def sample_columns(table: Any, where: str) -> dict[str, list[float]]:
+    """The ``[sample]`` table checked and drawn: key path -> its ``count`` values, in sample
+    order. ValueError naming ``sample.<key>`` for anything wrong, before any case exists."""
+    if not isinstance(table, dict):
+        raise ValueError(f"{where} key 'sample': must be a table")
+    unknown = sorted(set(table) - SAMPLE_KEYS)
+    if unknown:
+        raise ValueError(
+            f"{where} key 'sample.{unknown[0]}': unknown key (allowed: "
+            f"{', '.join(sorted(SAMPLE_KEYS))})"
+        )
+    design = table.get("design", "sobol")
+    if design not in DESIGNS:
+        raise ValueError(f"{where} key 'sample.design': must be one of {DESIGNS}, got {design!r}")
+    count = table.get("count")
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_SAMPLES:
+        raise ValueError(
+            f"{where} key 'sample.count': must be an integer in 1..{MAX_SAMPLES}, got {count!r}"
+        )
+    if design == "sobol" and count & (count - 1):
+        raise ValueError(
+            f"{where} key 'sample.count': a Sobol design needs a power of 2 (its balance "
+            f"properties hold only then), got {count}; use {1 << (count.bit_length() - 1)} or "
+            f"{1 << count.bit_length()}, or design = 'lhs'"
+        )
+    seed = table.get("seed")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ValueError(
+            f"{where} key 'sample.seed': must be an integer >= 0 (the same seed gives the same "
+            f"samples), got {seed!r}"
+        )
+    keys = table.get("keys")
+    if not isinstance(keys, dict) or not keys:
+        raise ValueError(
+            f"{where} key 'sample.keys': must be a table of paths -> distributions, e.g. "
+            '"scene.chain.EI" = {dist = "uniform", low = 1e4, high = 2e4}'
+        )
+    specs = {
+        path: check_distribution(f"{where} key 'sample.keys.{path}'", spec)
+        for path, spec in flatten_keys(keys).items()
+    }
+    u = unit_design(design, count, len(specs), seed)
+    return {path: quantiles(spec, u[:, j]).tolist() for j, (path, spec) in enumerate(specs.items())}
