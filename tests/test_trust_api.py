@@ -116,3 +116,23 @@ def test_a_binary_table_is_refused_in_rodvals_words(tmp_path, capsys):
     proc = run_main(capsys, "report", str(res.out))
     assert_refused(proc, ["cases.csv", "byte 0 is not UTF-8 text"])
     assert "codec" not in proc.stderr
+
+
+def test_a_quantity_of_the_wrong_type_is_named():
+    traj = rodval.simulate(SCENE, "reduced")
+    with pytest.raises(KeyError, match=r"quantity \[\] is not in this trajectory"):
+        traj[[]]
+
+
+def test_a_first_step_beyond_the_horizon_is_refused_before_the_run():
+    """It failed at run time as 'ValueError: `first_step` exceeds bounds' reported as a
+    failed run (exit 1), i.e. an input error found after the work began."""
+    with pytest.raises(ValueError, match=r"^first_step must be at most the horizon t_end = 0.05 s"):
+        rodval.simulate(SCENE, "reduced", method="RK45", first_step=1.0)
+
+
+def test_run_json_records_the_method_asked_for_whatever_it_is(tmp_path):
+    """An explicit method was recorded only as 'method'; a rerun of an edited
+    requested_method then had nothing to compare with."""
+    traj = rodval.simulate(SCENE, "reduced", method="RK45")
+    assert traj.settings["requested_method"] == "RK45" == traj.settings["method"]

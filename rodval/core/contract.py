@@ -29,7 +29,9 @@ class Model(ABC):
     def simulate(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
         """Run the scene (default integrator settings when None) and judge the run's validity;
         never raise for a failed integration (report it in the stats)."""
-        trajectory = self.run(scene, IntegratorSettings() if settings is None else settings)
+        settings = IntegratorSettings() if settings is None else settings
+        settings.check_horizon(scene.t_end)
+        trajectory = self.run(scene, settings)
         trajectory.scene = scene
         stats = trajectory.stats
         stats.valid, stats.validity = verdict(self.validity_checks(scene, trajectory))

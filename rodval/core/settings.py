@@ -117,6 +117,15 @@ class IntegratorSettings:
             ):
                 raise ValueError(f"{name} must be an integer in [1, {MAX_COUNT}], got {v!r}")
 
+    def check_horizon(self, t_end: float) -> None:
+        """The settings against a scene's horizon t_end (s), before any work: a first step
+        beyond the horizon is refused (scipy failed on it at run time, as a failed run)."""
+        if self.first_step is not None and self.first_step > t_end:
+            raise ValueError(
+                f"first_step must be at most the horizon t_end = {t_end:g} s, got "
+                f"{self.first_step:g}"
+            )
+
     @property
     def compiled(self) -> bool:
         return self.method in COMPILED_METHODS

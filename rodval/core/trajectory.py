@@ -113,7 +113,7 @@ class Trajectory:
     def __getitem__(self, quantity: str) -> np.ndarray:
         """Values (nt, nk) of ``quantity``; UnknownQuantity (a KeyError) naming it and the
         available quantities when the run does not hold it."""
-        if quantity not in self.values:
+        if not isinstance(quantity, str) or quantity not in self.values:
             raise UnknownQuantity(
                 f"quantity {quantity!r} is not in this trajectory (available: "
                 f"{', '.join(self.values) or 'none'}; a scene's outputs choose them)"

@@ -65,7 +65,7 @@ def _unknown_keyword(model: str, key: str, allowed: tuple[str, ...]) -> str:
         else f"; the {model} model takes no integrator settings"
     )
     return (
-        f"unknown {model} model option {key!r} (model options: {', '.join(allowed) or 'none'}"
+        f"unknown {model} model option {key!r} (allowed: {', '.join(allowed) or 'none'}"
         f"{settings}){hint}"
     )
 

@@ -334,9 +334,8 @@ def integrate(
     """
     system.reset()
     method = choose_method(system, scene, settings)
-    ran = {**settings.as_dict(), "method": method}
-    if settings.method == AUTO:
-        ran["requested_method"] = AUTO
+    # the method that ran, and the one asked for (a rerun asks for it again)
+    ran = {**settings.as_dict(), "method": method, "requested_method": settings.method}
     form = system.compiled() if method in COMPILED_METHODS else None
     if form is not None:
         from rodval.solvers.compiled import run_compiled  # loads the compiled loop once
