@@ -102,3 +102,23 @@ def test_long_grid_values_get_a_short_stable_id_and_stay_whole_in_cases_csv():
 
     assert json.loads(_case_columns(Rec, {"EI": "EI"}, full=True)["EI"]) == long
     assert _case_columns(Rec, {"EI": "EI"})["EI"] == text
+
+
+def test_every_figure_title_fits_its_figure(tmp_path):
+    """Figure titles were cut at both edges by long case ids: a title is now wrapped to the
+    figure's width. Measured: the rendered title's extent lies within the figure's."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from rodval.report.figures import _figure, _save, fit_title
+
+    title = "case " + ",".join(f"EI{i}=1e4+{i}" for i in range(30)) + " against exudyn"
+    for width in (4.0, 7.0):
+        fig, ax = _figure(1, 1, figsize=(width, 3))
+        ax.plot([0, 1], [0, 1])
+        _save(fig, tmp_path / "f.png", title=title)
+        canvas = FigureCanvasAgg(fig)
+        canvas.draw()
+        box = fig._suptitle.get_window_extent(canvas.get_renderer())
+        assert box.x0 >= 0 and box.x1 <= fig.bbox.width, (box, fig.bbox.width)
+        assert fig._suptitle.get_text().count("\n") >= 1
+    assert fit_title("short", 7.0, 12) == "short"

@@ -7,6 +7,7 @@ pyplot: no GUI backend is ever selected, whatever the machine, and nothing happe
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -30,6 +31,27 @@ def _figure(nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
 
 
 LINESTYLES = ("-", "--", ":", "-.")
+#: Widest average glyph width of the default font, in units of the font size (DejaVu Sans:
+#: ~0.55 for lower case, ~0.64 for digits and capitals), and the part of the figure's width a
+#: title may take.
+GLYPH_WIDTH = 0.66
+TITLE_SHARE = 0.92
+
+
+def fit_title(text: str, width_in: float, fontsize: float) -> str:
+    """``text`` wrapped on word boundaries into lines that fit ``width_in`` inches at
+    ``fontsize`` points (``GLYPH_WIDTH`` per character, 72 points per inch, ``TITLE_SHARE`` of
+    the width): a title never
+    runs past its figure's edges; a word longer than a line is broken."""
+    per_line = max(int(TITLE_SHARE * width_in * 72 / (GLYPH_WIDTH * fontsize)), 10)
+    return "\n".join(textwrap.wrap(text, per_line, break_long_words=True)) if text else text
+
+
+def _title_size(which: str = "figure.titlesize") -> float:
+    from matplotlib import rcParams
+    from matplotlib.font_manager import FontProperties
+
+    return FontProperties(size=rcParams[which]).get_size_in_points()
 
 
 def chain_nodes(traj: Trajectory, t: float, l: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -99,7 +121,7 @@ def plot_configurations(
         by_model, list(trajectories), fontsize=7, loc="lower right", title="model", title_fontsize=7
     )
     if title:
-        ax.set_title(title)
+        ax.set_title(fit_title(title, fig.get_figwidth(), _title_size("axes.titlesize")))
     path = Path(path)
     fig.savefig(path, dpi=120, bbox_inches="tight")
     return path
@@ -203,7 +225,7 @@ def axis_label(x: str) -> str:
 def _save(fig: Figure, path: Path | str, title: str = "") -> Path:
     """Title, tight layout and the PNG (110 dpi): the end of every report figure."""
     if title:
-        fig.suptitle(title)
+        fig.suptitle(fit_title(title, fig.get_figwidth(), _title_size()))
     fig.tight_layout()
     path = Path(path)
     fig.savefig(path, dpi=110)
@@ -356,7 +378,7 @@ def plot_modes(m: Modes, path: Path, title: str = "", count: int = 4) -> Path:
     axes[-1, 0].set_xlabel("x (m)")
     axes[0, 0].legend(fontsize=7, loc="upper left")
     if title:
-        fig.suptitle(title, fontsize=10)
+        fig.suptitle(fit_title(title, fig.get_figwidth(), 10), fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     return path
