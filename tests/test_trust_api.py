@@ -58,6 +58,8 @@ def test_a_study_out_that_is_a_file_is_refused(tmp_path):
 def test_scene_outputs_none_and_modes_arrays_are_named():
     with pytest.raises(ValueError, match=r"^outputs must be a non-empty subset"):
         SCENE.with_(outputs=None)
+    with pytest.raises(ValueError, match=r"^outputs must be a non-empty subset"):
+        paper_scene(n=2, outputs=None)
     with pytest.raises(ValueError, match=r"^about must be one of"):
         rodval.modes(SCENE, "full", about=ARRAY)
     with pytest.raises(ValueError, match=r"^model must be one of"):

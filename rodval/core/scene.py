@@ -431,6 +431,10 @@ class Scene:
         times = times.copy()
         times.setflags(write=False)
         object.__setattr__(self, "times", times)
+        if isinstance(self.outputs, Iterable) and not isinstance(
+            self.outputs, str | list | tuple | dict
+        ):
+            object.__setattr__(self, "outputs", tuple(self.outputs))
         if not isinstance(self.outputs, str | list | tuple):
             raise ValueError(
                 f"outputs must be a non-empty subset of {QUANTITIES}, got {self.outputs!r:.60}"
@@ -525,7 +529,7 @@ def paper_scene(
         loads=(pulse(node),),
         t_end=t_end,
         times=times,
-        outputs=tuple(outputs),
+        outputs=outputs,  # checked by Scene: a non-empty subset of QUANTITIES
         name=f"paper-n{n}",
     )
 
