@@ -34,8 +34,9 @@ def test_model_options_of_the_wrong_type_are_named(kwargs, words):
 @pytest.mark.parametrize(
     "kwargs, words",
     [
-        ({"case_timeout": ARRAY}, r"^case_timeout must be a number > 0 s or None"),
-        ({"case_timeout": ""}, r"^case_timeout must be a number > 0 s or None"),
+        ({"case_timeout": ARRAY}, r"^case_timeout must be a finite number > 0 s or None"),
+        ({"case_timeout": ""}, r"^case_timeout must be a finite number > 0 s or None"),
+        ({"case_timeout": float("inf")}, r"^case_timeout must be a finite number > 0 s or None"),
         ({"backend": ARRAY}, r"^backend must be one of"),
     ],
 )

@@ -9,6 +9,7 @@ physics: comparisons come from ``rodval.analysis.metrics``.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -150,9 +151,11 @@ def run_study(
     if case_timeout is not None and (
         isinstance(case_timeout, bool)
         or not isinstance(case_timeout, int | float)
-        or not case_timeout > 0
+        or not 0 < case_timeout < math.inf
     ):
-        raise ValueError(f"case_timeout must be a number > 0 s or None, got {case_timeout!r:.60}")
+        raise ValueError(
+            f"case_timeout must be a finite number > 0 s or None (no limit), got {case_timeout!r:.60}"
+        )
     if out.exists() and not out.is_dir():
         raise ValueError(f"out must be a folder, got the file {str(out)!r}")
     start = time.perf_counter()
