@@ -286,3 +286,24 @@ def test_wide_tables_on_request(tmp_path, capsys):
     tidy = pd.read_csv(out / "trajectory.csv")
     phi3 = tidy[(tidy.quantity == "phi") & (tidy.k == 3)]["value"].to_numpy()
     np.testing.assert_array_equal(table["phi[3]"].to_numpy(), phi3)
+
+
+def test_the_compiled_loop_reports_progress_without_changing_the_run():
+    """A compiled run showed no progress until it ended: with a reporter set it now reports
+    the time reached every WALL_CHECK_EVALUATIONS evaluations; the trajectory is bit for bit
+    the one without reporting."""
+    import rodval
+    from rodval.solvers import progress
+
+    scene = paper_scene(times=[0.5, 1.0, 2.0])
+    quiet = rodval.simulate(scene, "full")
+    seen: list[float] = []
+    token = progress._reporter.set(seen.append)
+    try:
+        loud = rodval.simulate(scene, "full")
+    finally:
+        progress._reporter.reset(token)
+    assert loud.settings["method"] == "DOP853-numba"
+    assert len(seen) > 10 and seen == sorted(seen) and 0 < seen[-1] <= 2.0
+    for q in quiet.values:
+        np.testing.assert_array_equal(loud[q], quiet[q])

@@ -23,7 +23,7 @@ from rodval.core.status import (
     numerical_failure,
 )
 from rodval.core.trajectory import SolverStats
-from rodval.solvers import dop853
+from rodval.solvers import dop853, progress
 from rodval.solvers.guard import ENERGY_FLOOR_J
 from rodval.solvers.system import CompiledForm
 
@@ -82,6 +82,7 @@ def run_compiled(
             settings.stall_steps,
             Y,
             deadline=time.perf_counter() + settings.max_wall_s,
+            reporting=progress.reporting(),
         )
     except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
         # raised by a model's kernel: the loop's time is lost, t_reached stays at the start

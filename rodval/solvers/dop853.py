@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit, objmode, types
 from scipy.integrate._ivp import dop853_coefficients as dc
 
+from rodval.solvers.progress import report
 from rodval.solvers.signature import F1 as _F1
 from rodval.solvers.signature import F2 as _F2
 from rodval.solvers.signature import F3 as _F3
@@ -79,6 +80,16 @@ def _now():
     return now
 
 
+@njit(cache=True)
+def _report_and_now(t):
+    """Tell the progress reporter (``rodval.solvers.progress``) that the run reached t (s),
+    then read the clock; one call back into Python."""
+    with objmode(now="float64"):
+        report(t)
+        now = time.perf_counter()
+    return now
+
+
 @njit(cache=True, error_model="numpy")
 def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, tmp, f1):
     """scipy's select_initial_step (Hairer, Sec. II.4) for order 7; uses one evaluation."""
@@ -116,6 +127,7 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
     _F1,
     types.int64,
     types.float64,
+    types.boolean,
     _F2,
     _F1,
     _F1,
@@ -146,6 +158,7 @@ def run(
     guard,
     stall_steps,
     deadline,
+    reporting,
     A,
     B,
     C,
@@ -158,7 +171,9 @@ def run(
     writing the state at ``times`` into Y. ``first_step`` <= 0 selects it automatically; the
     run stops with ``BUDGET`` once ``max_nfev`` evaluations are used, and with ``WALL`` once
     ``time.perf_counter()`` passes ``deadline`` (s; inf: no limit), read before the first
-    step attempt and then every ``WALL_CHECK_EVALUATIONS`` evaluations.
+    step attempt and then every ``WALL_CHECK_EVALUATIONS`` evaluations. With ``reporting``
+    the time reached is reported to the progress reporter at those same reads (a long run
+    shows its progress; the integration is unchanged).
 
     The divergence guard of ``rodval.solvers.guard`` after every accepted step: ``STALLED``
     after ``stall_steps`` consecutive steps shorter than guard[0] (s); when ``guarded``,
@@ -182,6 +197,7 @@ def run(
     nsteps = 0
     n_short = 0
     timed = deadline < np.inf
+    clocked = timed or reporting
     next_clock = 0
     mech = np.zeros(2)
     w_plus = 0.0
@@ -214,9 +230,10 @@ def run(
                     return n_out, nfev, nsteps, STEP_TOO_SMALL, t
                 if nfev >= max_nfev:
                     return n_out, nfev, nsteps, BUDGET, t
-                if timed and nfev >= next_clock:
+                if clocked and nfev >= next_clock:
                     next_clock = nfev + WALL_CHECK_EVALUATIONS
-                    if _now() > deadline:
+                    now = _report_and_now(t) if reporting else _now()
+                    if now > deadline:
                         return n_out, nfev, nsteps, WALL, t
                 t_new = t + h_abs
                 if t_new > t_bound:
@@ -312,10 +329,11 @@ def integrate_compiled(
     stall_steps: int,
     Y: np.ndarray,
     deadline: float = math.inf,
+    reporting: bool = False,
 ) -> tuple[int, int, int, int, float]:
     """Run ``run`` on a CompiledForm with scipy's DOP853 coefficients (see ``run``; without
     ``form.mechanics`` or with guard[1] = inf there is no blow-up check; ``deadline``: a
-    ``time.perf_counter()`` value, s)."""
+    ``time.perf_counter()`` value, s; ``reporting``: report progress, see ``run``)."""
     guarded = form.mechanics is not None and bool(np.isfinite(guard[1]))
     mechanics = form.mechanics if form.mechanics is not None else form.rhs
     n_out, nfev, nsteps, code, t = run(
@@ -337,6 +355,7 @@ def integrate_compiled(
         np.asarray(guard, float),
         stall_steps,
         float(deadline),
+        bool(reporting),
         _A,
         _B,
         _C,

@@ -1,5 +1,6 @@
 """Progress of a single run: the driver reports the time reached after each accepted step to
-the reporter set for the current context (none by default, so library calls print nothing).
+the reporter set for the current context (none by default, so library calls print nothing);
+the compiled loop reports every ``WALL_CHECK_EVALUATIONS`` evaluations when a reporter is set.
 
 ``progress_bar`` is the CLI's reporter: a tqdm bar over [0, t_end] s on stderr that appears
 only when the run lasts more than ``delay`` seconds and only on a terminal.
@@ -15,6 +16,11 @@ Reporter = Callable[[float], None]
 _reporter: contextvars.ContextVar[Reporter | None] = contextvars.ContextVar(
     "rodval_progress", default=None
 )
+
+
+def reporting() -> bool:
+    """Whether a reporter is set for the current context (the compiled loop then reports)."""
+    return _reporter.get() is not None
 
 
 def report(t: float) -> None:
