@@ -139,3 +139,16 @@ def test_run_json_records_the_method_asked_for_whatever_it_is(tmp_path):
     requested_method then had nothing to compare with."""
     traj = rodval.simulate(SCENE, "reduced", method="RK45")
     assert traj.settings["requested_method"] == "RK45" == traj.settings["method"]
+
+
+def test_unhashable_names_in_files_are_refused_in_one_line(tmp_path):
+    """An edited run.json with a load "type": [] ended in 'unhashable type: list'."""
+    from rodval.core.scene_file import scene_from_dict
+    from rodval.study.sampling import check_distribution
+
+    with pytest.raises(ValueError, match=r"load type must be one of .*got \[\]"):
+        scene_from_dict({"n": 2, "loads": [{"type": [], "node": 1}]}, where="s")
+    with pytest.raises(ValueError, match=r"model must be one of"):
+        rodval.Study.from_dict({"models": {"a": {"model": ["full"]}}})
+    with pytest.raises(ValueError, match=r"must be a table with dist"):
+        check_distribution("k", {"dist": ["uniform"]})

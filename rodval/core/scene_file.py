@@ -86,7 +86,7 @@ def _load(spec: dict, n: int, where: str):
     if not isinstance(spec, dict) or "type" not in spec:
         raise ValueError(f"{where}: each load needs a 'type' (one of {', '.join(LOAD_FACTORIES)})")
     kind = spec["type"]
-    if kind not in LOAD_FACTORIES:
+    if not isinstance(kind, str) or kind not in LOAD_FACTORIES:
         raise ValueError(
             f"{where}: load type must be one of {', '.join(LOAD_FACTORIES)}, got {kind!r}"
         )

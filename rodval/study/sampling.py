@@ -50,7 +50,11 @@ def _real(where: str, key: str, value: Any) -> float:
 
 def check_distribution(where: str, spec: Any) -> dict[str, Any]:
     """The distribution table ``spec`` checked (ValueError naming ``where`` and the key)."""
-    if not isinstance(spec, dict) or spec.get("dist") not in DISTRIBUTIONS:
+    if (
+        not isinstance(spec, dict)
+        or not isinstance(spec.get("dist"), str)
+        or spec["dist"] not in DISTRIBUTIONS
+    ):
         raise ValueError(
             f"{where}: must be a table with dist = one of {', '.join(DISTRIBUTIONS)}, "
             f"got {spec!r:.80}"

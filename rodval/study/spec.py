@@ -340,7 +340,7 @@ def _model_specs(doc: dict, where: str) -> tuple[ModelSpec, ...]:
         if not isinstance(table, dict):
             raise _err(where, key, "must be a table")
         name = table.get("model", label)
-        if name not in REGISTRY:
+        if not isinstance(name, str) or name not in REGISTRY:
             raise _err(
                 where,
                 f"{key}.model" if "model" in table else key,
