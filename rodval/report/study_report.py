@@ -426,15 +426,15 @@ def _sample_section(out: Path, meta: dict, tables: dict[str, pd.DataFrame]) -> l
     locks = lock_statistics(tables["cases"], read_events(out), models)
     if not locks.empty:
         lines.append("### Latches\n")
-        for model, part in locks.groupby("model", sort=False):
-            lines.append(
-                f"- `{model}`: every latch locked in {part['p_all_locked'].iloc[0]:.1%} "
-                "of the samples"
-            )
-        lines += ["", to_markdown(locks, floatfmt=".4g"), ""]
+        bullets = [
+            f"- `{model}`: every latch locked by the end of the run in "
+            f"{part['p_all_locked'].iloc[0]:.1%} of the samples"
+            for model, part in locks.groupby("model", sort=False)
+        ]
+        lines += ["\n".join(bullets) + "\n", to_markdown(locks, floatfmt=".4g")]
     disc = discrepancy_percentiles(tables["discrepancies"])
     if not disc.empty:
-        lines += ["### Discrepancies\n", to_markdown(disc, floatfmt=".3g"), ""]
+        lines += ["### Discrepancies\n", to_markdown(disc, floatfmt=".3g")]
     return lines
 
 
