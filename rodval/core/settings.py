@@ -113,7 +113,7 @@ class IntegratorSettings:
             if (
                 isinstance(v, bool)
                 or not isinstance(v, numbers.Integral)
-                or not 1 <= v <= MAX_COUNT
+                or not 1 <= int(v) <= MAX_COUNT
             ):
                 raise ValueError(f"{name} must be an integer in [1, {MAX_COUNT}], got {v!r}")
 

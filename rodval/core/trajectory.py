@@ -17,7 +17,7 @@ class SolverStats:
     imports, model set-up or one-time compilation. ``status`` is always a ``Status`` (an int
     given to it is converted; ValueError for a number that is no status)."""
 
-    status: Status = STATUS_SUCCESS
+    status: int = STATUS_SUCCESS  # always a Status at run time (see __setattr__)
     message: str = ""
     t_reached: float = 0.0
     nfev: int = 0
