@@ -173,7 +173,8 @@ def test_a_sampled_deployment_reports_locking_and_repeats_exactly(tmp_path):
     assert (full["t_p5"] <= full["t_p50"]).all() and (full["t_p50"] <= full["t_p95"]).all()
     report = (a.out / "report.md").read_text()
     assert (
-        "## Sample statistics" in report and "every latch locked by the end of the run in 100.0% of the samples" in report
+        "## Sample statistics" in report
+        and "every latch locked by the end of the run in 100.0% of the samples" in report
     )
     assert "8 samples, sobol design, seed 3" in report
 
