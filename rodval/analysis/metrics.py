@@ -169,12 +169,25 @@ def scaled_errors(values: np.ndarray, reference: np.ndarray) -> dict[str, float]
     }
 
 
+def left_out_quantities(
+    model_quantities: Iterable[str], reference_quantities: Iterable[str]
+) -> list[str]:
+    """Quantities only one run of a pair outputs (e.g. the energy audit's work, dissipated
+    and energy_residual, which only audited native runs record), in order: they are left out
+    of that pair's comparison (``compare_runs``), the rest compared; reports name them."""
+    a, b = tuple(model_quantities), tuple(reference_quantities)
+    return [q for q in b if q not in a] + [q for q in a if q not in b]
+
+
 def compare_runs(
     trajectories: dict[str, Trajectory], reference: str, outputs: Iterable[str]
 ) -> list[dict]:
     """Discrepancy rows of every trajectory against the one labelled ``reference``, one row
     per quantity (``discrepancies`` plus model, reference, status). When either run failed,
-    the metrics are absent (NaN in tables) and ``status`` says which run failed."""
+    the metrics are absent (NaN in tables) and ``status`` says which run failed. A quantity
+    that only one run of a successful pair outputs is left out of that pair's comparison
+    (``left_out_quantities``; the study report names it and counts it), the others are
+    compared: a pair is never dropped for lack of a common quantity."""
     ref = trajectories[reference]
     quantities = ref.quantities if ref.success else trajectory_quantities(outputs)
     rows: list[dict] = []
@@ -188,15 +201,23 @@ def compare_runs(
             status = f"model failed ({STATUS_MESSAGES[traj.stats.status]})"
         else:
             try:
-                rows += [
-                    {**base, **r, "status": "ok"}
-                    for r in discrepancies(traj, ref, quantities).to_dict("records")
-                ]
+                rows += _pair_rows(traj, ref, quantities, base)
                 continue
             except ValueError as exc:
                 status = f"not comparable: {exc}"
         rows += [{**base, "quantity": q, "status": status} for q in quantities]
     return rows
+
+
+def _pair_rows(
+    traj: Trajectory, ref: Trajectory, quantities: Iterable[str], base: dict
+) -> list[dict]:
+    """The rows of one successful pair: the quantities both runs output, compared ("ok");
+    those only one of them outputs are left out (``left_out_quantities``). ValueError when
+    the runs cannot be compared at all."""
+    both = [q for q in quantities if q in traj.values]
+    compared = discrepancies(traj, ref, both).to_dict("records") if both else []
+    return [{**base, **r, "status": "ok"} for r in compared]
 
 
 def pareto_front(cost: np.ndarray, err: np.ndarray) -> np.ndarray:

@@ -252,8 +252,10 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     }
 
 
-#: Keys of a scene dict that label a scene without changing what is simulated.
-LABEL_KEYS = ("name",)
+#: Keys of a scene dict that label or observe a scene without changing what is simulated:
+#: runs that differ only there are runs of the same scene (compared on their common
+#: quantities and output times).
+LABEL_KEYS = ("name", "outputs")
 
 
 def scene_differences(a: dict[str, Any], b: dict[str, Any]) -> list[str]:

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from rodval.analysis.metrics import left_out_quantities
 from rodval.core.modal import Modes
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import ENERGY_RESIDUAL_BOUND, SMALL_BENDING_RAD
@@ -118,6 +119,24 @@ def _stability_map(runtime: pd.DataFrame, params: list[str]) -> list[str]:
     ]
 
 
+def left_out_table(traj: pd.DataFrame, reference: str) -> pd.DataFrame:
+    """Per case and model: the quantities left out of its comparison with the reference
+    because only one of the two runs outputs them (``left_out_quantities``), with why.
+    Columns case, model, quantity, why. O(rows of the trajectories table)."""
+    have = traj.groupby(["case", "model"], sort=False)["quantity"].unique()
+    rows = []
+    for (case, model), qs in have.items():
+        if model == reference or (case, reference) not in have.index:
+            continue
+        ref_qs = have[(case, reference)]
+        for q in left_out_quantities(qs, ref_qs):
+            lacking = model if q in ref_qs else reference
+            rows.append(
+                {"case": case, "model": model, "quantity": q, "why": f"not output by {lacking}"}
+            )
+    return pd.DataFrame(rows, columns=["case", "model", "quantity", "why"])
+
+
 def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[str]) -> list[str]:
     # a union of grids ([[grid]]) leaves some parameters unset in some cases
     disc, runtime = (
@@ -127,10 +146,25 @@ def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[st
     lines = []
     failed = runtime[runtime["status"] != "success"]
     invalid = runtime[runtime["valid"].astype(str) == "False"] if "valid" in runtime else failed[:0]
+    left = left_out_table(tables["trajectories"], ref)
+    not_made = disc[disc["status"] != "ok"]
     lines.append(
         f"## Outcome\n\n{runtime['case'].nunique()} cases, {len(runtime)} model runs, "
-        f"{len(failed)} failed, {len(invalid)} invalid.\n"
+        f"{len(failed)} failed, {len(invalid)} invalid; "
+        f"{(disc['status'] == 'ok').sum()} comparisons made (case, model, quantity), "
+        f"{len(not_made) + len(left)} could not be made.\n"
     )
+    reasons = pd.concat(
+        [not_made[["status"]], pd.DataFrame({"status": left["why"]}) if len(left) else None]
+    )
+    if len(reasons):
+        why = (
+            reasons.groupby("status", sort=False)
+            .size()
+            .reset_index(name="comparisons")
+            .rename(columns={"status": "reason"})
+        )
+        lines += ["Comparisons not made, by reason:\n", to_markdown(why)]
     if not failed.empty:
         lines += [
             "Failed runs:\n",
@@ -161,6 +195,14 @@ def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[st
         if ok.empty:
             lines.append(f"_No comparison: {part['status'].iloc[0]}._\n")
             continue
+        mine = left[left["model"] == model] if len(left) else left
+        if len(mine):
+            names = ", ".join(
+                f"`{q}` ({w})" for q, w in dict.fromkeys(zip(mine["quantity"], mine["why"]))
+            )
+            lines.append(
+                f"_Left out of this comparison: {names}; the other quantities are compared._\n"
+            )
         wide = ok.pivot_table(
             index=["case", *params], columns="quantity", values=["max_abs", "max_rel"], sort=False
         )
