@@ -75,3 +75,23 @@ def test_a_pair_without_any_common_run_failure_is_not_dropped():
     assert left_out_quantities(plain.quantities, audited.quantities) == [
         q for q in audited.quantities if q != "phi"
     ]
+
+
+def test_the_models_table_says_which_settings_apply():
+    """A study's [integrator] rtol was listed for exudyn ("auto, 1e-08, 1e-10") although exudyn
+    integrates itself: its row now shows its own options (step, elements, ...) and n/a for
+    the integrator settings, as the CLI and API refuse them for exudyn."""
+    pytest.importorskip("exudyn")
+    from rodval.report.study_report import model_row
+
+    spec = rodval.Study.from_dict(
+        {
+            "scene": {"n": 2, "t_end": 0.05},
+            "integrator": {"rtol": 1e-9},
+            "models": {"full": {}, "exudyn": {"elements": 2}},
+        }
+    )
+    rows = {m.label: model_row(m.as_dict()) for m in spec.models}
+    assert rows["full"]["rtol"] == 1e-9 and rows["full"]["method"] == "auto"
+    assert rows["exudyn"]["rtol"] == rows["exudyn"]["method"] == "n/a"
+    assert '"elements": 2' in rows["exudyn"]["options"] and '"step"' in rows["exudyn"]["options"]

@@ -21,7 +21,8 @@ from rodval.core.checks import check_keys
 from rodval.core.scene_file import read_scene_document, scene_from_dict, with_horizon
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.core.validity import describe
-from rodval.models import REGISTRY, model_class, simulate
+from rodval.models import REGISTRY, simulate
+from rodval.models.registry import uses_integrator
 from rodval.report.run_files import read_run_record, write_run
 from rodval.solvers.progress import progress_bar
 
@@ -69,7 +70,7 @@ def run(args) -> int:
         doc, model = dict(previous["scene"]), args.model or previous["model"]
         options = dict(previous["options"]) if model == previous["model"] else {}
         settings_kw = {}
-        if getattr(model_class(model), "USES_INTEGRATOR_SETTINGS", True):
+        if uses_integrator(model):
             ran = previous["settings"]
             check_keys(ran, RERUN_SETTINGS, f"{path} key 'settings'")
             settings_kw = {k: v for k, v in ran.items() if k in SETTING_NAMES}

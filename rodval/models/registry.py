@@ -35,6 +35,12 @@ def model_class(name: str) -> type[Model]:
     return getattr(mod, cls)
 
 
+def uses_integrator(name: str) -> bool:
+    """Whether model ``name`` is integrated by rodval's driver, so that IntegratorSettings
+    apply to it (False for a model that integrates itself, e.g. exudyn with its own step)."""
+    return bool(getattr(model_class(name), "USES_INTEGRATOR_SETTINGS", True))
+
+
 def get_model(name: str | Model, **options: Any) -> Model:
     """The model called ``name`` with its options (a Model instance is returned as is).
     Unknown option names are a ValueError listing the allowed ones."""
@@ -55,7 +61,7 @@ def _unknown_keyword(model: str, key: str, allowed: tuple[str, ...]) -> str:
     the integrator settings (both are keywords of ``simulate``), with the nearest name."""
     import difflib
 
-    uses = getattr(model_class(model), "USES_INTEGRATOR_SETTINGS", True)
+    uses = uses_integrator(model)
     names = (*allowed, *(SETTING_NAMES if uses else ()))
     near = difflib.get_close_matches(key, names, n=1, cutoff=0.6)
     hint = f"; did you mean {near[0]!r}?" if near else ""

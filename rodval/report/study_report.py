@@ -16,6 +16,8 @@ from rodval.analysis.metrics import left_out_quantities
 from rodval.core.modal import Modes
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import ENERGY_RESIDUAL_BOUND, SMALL_BENDING_RAD
+from rodval.models import get_model
+from rodval.models.registry import uses_integrator
 from rodval.report.figures import (
     plot_configurations,
     plot_deployment,
@@ -480,20 +482,26 @@ def _sample_section(out: Path, meta: dict, tables: dict[str, pd.DataFrame]) -> l
     return lines
 
 
+def model_row(m: dict[str, Any]) -> dict[str, Any]:
+    """A study model's row of the report's Models table: its options as the model runs them
+    (defaults included) and the integrator settings that apply to it; "n/a" for a model that
+    integrates itself (exudyn: the study's [integrator] does not apply, its own step does)."""
+    try:
+        options = get_model(m["model"], **m["options"]).options()
+        uses = uses_integrator(m["model"])
+    except ValueError:  # the model is not available here: what the study gave
+        options, uses = m["options"], True
+    settings = m["settings"]
+    return {
+        "label": m["label"],
+        "model": m["model"],
+        "options": json.dumps(options) if options else "",
+        **{k: settings[k] if uses else "n/a" for k in ("method", "rtol", "atol")},
+    }
+
+
 def _header(meta: dict, prov: dict) -> list[str]:
-    models = pd.DataFrame(
-        [
-            {
-                "label": m["label"],
-                "model": m["model"],
-                "options": json.dumps(m["options"]) if m["options"] else "",
-                "method": m["settings"]["method"],
-                "rtol": m["settings"]["rtol"],
-                "atol": m["settings"]["atol"],
-            }
-            for m in meta["models"]
-        ]
-    )
+    models = pd.DataFrame([model_row(m) for m in meta["models"]])
     mach = prov["machine"]
     pkgs = ", ".join(f"{k} {v}" for k, v in prov["packages"].items() if v)
     axes = "; ".join(f"`{p}` = {v}" for p, v in meta["axes"].items()) or "none (one case)"

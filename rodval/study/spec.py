@@ -37,7 +37,8 @@ from rodval.core.resources import (
 from rodval.core.scene import QUANTITIES, Scene, trajectory_quantities
 from rodval.core.scene_file import anchor_load_files, scene_from_dict, scene_to_dict
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
-from rodval.models import REGISTRY, get_model, model_class
+from rodval.models import REGISTRY, get_model
+from rodval.models.registry import uses_integrator
 from rodval.study.sampling import flatten_keys as _flatten_sample_keys
 from rodval.study.sampling import sample_columns
 from rodval.study.store import MAX_NAME, case_file_name
@@ -374,7 +375,7 @@ def _uses_rodval_integrator(name: str) -> bool:
     """Whether model ``name`` is integrated by rodval's driver (its IntegratorSettings apply);
     a model that cannot be imported here is taken to be (its runs fail and say why)."""
     try:
-        return bool(getattr(model_class(name), "USES_INTEGRATOR_SETTINGS", True))
+        return uses_integrator(name)
     except ValueError:
         return True
 
