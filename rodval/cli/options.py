@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
 
 from rodval.core.settings import DEFAULTS, MAX_COUNT, METHODS, MIN_RTOL, RTOL_RANGE
 
@@ -193,3 +194,25 @@ def model_options(args: argparse.Namespace) -> dict[str, object]:
             )
         options["coefficients"] = args.coefficients
     return options
+
+
+def add_junit_option(p) -> None:
+    """--junit FILE (rodval study, rodval report)."""
+    p.add_argument(
+        "--junit",
+        type=Path,
+        metavar="FILE",
+        help="write a JUnit XML report of the study's [acceptance] checks (one test case per "
+        "case, model pair and quantity) for CI systems",
+    )
+
+
+def acceptance_exit(out: Path, junit: Path | None) -> int:
+    """Print one line per breach of the study's [acceptance] in ``out`` (writing the JUnit
+    file when asked); exit code 1 when any bound broke, else 0."""
+    from rodval.report.acceptance import gate
+
+    broken = gate(out, junit)
+    for line in broken:
+        print(line)
+    return 1 if broken else 0

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rodval.cli.options import acceptance_exit, add_junit_option
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -13,6 +15,7 @@ def register(sub) -> None:
         "tables a `rodval study` run saved in DIR; nothing is recomputed.",
     )
     p.add_argument("dir", metavar="DIR", type=Path, help="output folder of `rodval study`")
+    add_junit_option(p)
     p.set_defaults(func=run)
 
 
@@ -20,4 +23,4 @@ def run(args) -> int:
     from rodval.report.study_report import build_report
 
     print(build_report(args.dir))
-    return 0
+    return acceptance_exit(args.dir, args.junit)

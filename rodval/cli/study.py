@@ -7,7 +7,7 @@ import signal
 import sys
 from pathlib import Path
 
-from rodval.cli.options import positive_float, positive_int
+from rodval.cli.options import acceptance_exit, add_junit_option, positive_float, positive_int
 from rodval.study.spec import MAX_CASES
 
 
@@ -75,6 +75,7 @@ def register(sub) -> None:
         action="store_false",
         help="no progress bar and no announcement of the number of cases",
     )
+    add_junit_option(p)
     p.set_defaults(func=run)
 
 
@@ -120,4 +121,4 @@ def run(args) -> int:
         f"{res.failed_runs} failed model runs, {res.wall_s:.1f} s -> "
         f"{res.out / 'report.md' if args.report else res.out}"
     )
-    return 0
+    return acceptance_exit(res.out, args.junit)

@@ -18,6 +18,7 @@ from rodval.core.trajectory import Trajectory
 from rodval.core.validity import ENERGY_RESIDUAL_BOUND, SMALL_BENDING_RAD
 from rodval.models import get_model
 from rodval.models.registry import uses_integrator
+from rodval.report.acceptance import acceptance_section
 from rodval.report.figures import (
     plot_configurations,
     plot_deployment,
@@ -624,6 +625,7 @@ def build_report(out: str | Path) -> Path:
     fig_dir = out / FIGURES
     fig_dir.mkdir(exist_ok=True)
     lines = _header(meta, prov)
+    lines += acceptance_section(meta, tables)
     lines += _summary_tables(meta, tables, params)
     figs = _param_figures(fig_dir, meta, tables, params)
     if figs:

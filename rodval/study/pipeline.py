@@ -44,6 +44,7 @@ def study_meta(spec: StudySpec) -> dict[str, Any]:
         "labels": spec.labels,
         "report": spec.report.as_dict(),
         **({"sample": spec.sample} if spec.sample else {}),
+        **({"acceptance": spec.acceptance} if spec.acceptance else {}),
         "cases": [
             {"id": c.id, "params": c.params, "fingerprint": c.fingerprint} for c in spec.cases
         ],

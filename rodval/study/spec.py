@@ -39,12 +39,23 @@ from rodval.core.scene_file import anchor_load_files, scene_from_dict, scene_to_
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.models import REGISTRY, get_model
 from rodval.models.registry import uses_integrator
+from rodval.study.acceptance import acceptance_spec
 from rodval.study.sampling import flatten_keys as _flatten_sample_keys
 from rodval.study.sampling import sample_columns
 from rodval.study.store import MAX_NAME, case_file_name
 from rodval.study.toml_text import toml_text
 
-TOP_KEYS = {"study", "scene", "integrator", "models", "grid", "sample", "report", "modes"}
+TOP_KEYS = {
+    "study",
+    "scene",
+    "integrator",
+    "models",
+    "grid",
+    "sample",
+    "report",
+    "modes",
+    "acceptance",
+}
 MODES_KEYS = {"count", "about", "load_at", "allow_unbalanced"}
 #: Most cases a study grid may have by default: every case is built and checked before any
 #: runs (about 1-3 ms each on the 2-core machine, so ~1 min at the limit); raise it with
@@ -193,6 +204,8 @@ class StudySpec:
     #: The [sample] table as drawn (design, count, seed, keys: path -> distribution), or
     #: None for a grid study.
     sample: dict[str, Any] | None = None
+    #: The checked [acceptance] table (``rodval.study.acceptance``), or None.
+    acceptance: dict[str, Any] | None = None
 
     @classmethod
     def from_dict(
@@ -689,6 +702,13 @@ def study_from_dict(
         cases=cases,
         report=report,
         sample=_sample_meta(doc.get("sample")),
+        acceptance=acceptance_spec(
+            doc.get("acceptance"),
+            [m.label for m in models],
+            reference,
+            {q for c in cases for q in trajectory_quantities(c.scene.outputs)},
+            where,
+        ),
     )
 
 
