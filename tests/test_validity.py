@@ -127,4 +127,4 @@ def test_study_runtime_table_and_report_count_invalid_runs(tmp_path):
     stiff = runtime[np.isclose(runtime["EI"], 1e5)]
     assert (stiff["valid"].astype(str) == "True").all()
     report = (out / "report.md").read_text()
-    assert f"{len(runtime)} model runs, 0 failed, 4 invalid." in report
+    assert f"{len(runtime)} model runs, 0 failed, 4 invalid;" in report
