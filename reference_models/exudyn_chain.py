@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 
 from rodval.core.contract import Model
-from rodval.core.scene import Scene
+from rodval.core.scene import QUANTITIES, Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import (
     STATUS_BLOWUP,
@@ -514,7 +514,7 @@ class ExudynModel(Model):
         wanted = set()
         if scene.wants("phi", "dphi", "alpha", "beta", "x", "y", "hinge_angle", "hinge_moment"):
             wanted |= {(k, 0) for k in range(chain.n)} | {(k, E) for k in range(chain.n)}
-        if scene.wants("energy") or scene.latches:
+        if scene.wants("energy", "angular_momentum") or scene.latches:
             wanted |= {(k, j) for k in range(chain.n) for j in range(E + 1)}
         ovt = exu.OutputVariableType
         node_sensors = {
@@ -1029,9 +1029,7 @@ def _observe(
         for key, (q, v, a) in records.items()
     }
     out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-    if not scene.wants(
-        "phi", "dphi", "alpha", "beta", "x", "y", "energy", "hinge_angle", "hinge_moment"
-    ):
+    if not scene.wants(*QUANTITIES):
         return out
     left = [records[(k, 0)] for k in range(n)]
     right = [records[(k, E)] for k in range(n)]
@@ -1102,7 +1100,25 @@ def _observe(
         out["kinetic"] = (kin[:, None], zero)
         out["potential"] = (pot[:, None], zero)
         out["energy"] = ((kin + pot)[:, None], zero)
+    if scene.wants("angular_momentum"):
+        out["angular_momentum"] = (_angular_momentum(scene.chain, E, at), np.arange(2))
     return out
+
+
+def _elements(chain, E: int, at: dict):
+    """Per element j of every rod k, with the Gauss points of ``_GAUSS_X`` on it: (k, weights
+    (g,) (m), shape functions S, dS, ddS (g, 4), nodal positions/slopes Q and their rates V
+    (nt, 4, 2)) from the node states ``at`` at the output times."""
+    for k in range(chain.n):
+        le = chain.l[k] / E
+        w = 0.5 * le * _GAUSS_W
+        S, dS, ddS = _hermite(0.5 * le * (_GAUSS_X + 1.0), le)
+        for j in range(E):
+            qa, va = at[(k, j)]
+            qb, vb = at[(k, j + 1)]
+            Q = np.stack([qa[:, :2], qa[:, 2:], qb[:, :2], qb[:, 2:]], 1)
+            V = np.stack([va[:, :2], va[:, 2:], vb[:, :2], vb[:, 2:]], 1)
+            yield k, w, S, dS, ddS, Q, V
 
 
 def _energies(
@@ -1114,24 +1130,16 @@ def _energies(
     chain = scene.chain
     kin = np.zeros(phi.shape[0])
     pot = np.zeros(phi.shape[0])
+    for k, w, S, dS, ddS, Q, V in _elements(chain, E, at):
+        r_t = np.einsum("gi,tic->tgc", S, V)
+        r1 = np.einsum("gi,tic->tgc", dS, Q)
+        r2 = np.einsum("gi,tic->tgc", ddS, Q)
+        norm2 = np.sum(r1**2, -1)
+        curv = (r1[..., 0] * r2[..., 1] - r1[..., 1] * r2[..., 0]) / norm2
+        strain = np.sqrt(norm2) - 1.0
+        kin += 0.5 * chain.m[k] * np.sum(w * np.sum(r_t**2, -1), -1)
+        pot += 0.5 * np.sum(w * (chain.EI[k] * curv**2 + EA * strain**2), -1)
     for k in range(chain.n):
-        le = chain.l[k] / E
-        s = 0.5 * le * (_GAUSS_X + 1.0)
-        w = 0.5 * le * _GAUSS_W
-        S, dS, ddS = _hermite(s, le)
-        for j in range(E):
-            qa, va = at[(k, j)]
-            qb, vb = at[(k, j + 1)]
-            Q = np.stack([qa[:, :2], qa[:, 2:], qb[:, :2], qb[:, 2:]], 1)  # (nt, 4, 2)
-            V = np.stack([va[:, :2], va[:, 2:], vb[:, :2], vb[:, 2:]], 1)
-            r_t = np.einsum("gi,tic->tgc", S, V)
-            r1 = np.einsum("gi,tic->tgc", dS, Q)
-            r2 = np.einsum("gi,tic->tgc", ddS, Q)
-            norm2 = np.sum(r1**2, -1)
-            curv = (r1[..., 0] * r2[..., 1] - r1[..., 1] * r2[..., 0]) / norm2
-            strain = np.sqrt(norm2) - 1.0
-            kin += 0.5 * chain.m[k] * np.sum(w * np.sum(r_t**2, -1), -1)
-            pot += 0.5 * np.sum(w * (chain.EI[k] * curv**2 + EA * strain**2), -1)
         vt = at[(k, E)][1][:, :2]
         kin += 0.5 * chain.mu[k] * np.sum(vt**2, -1)
     left = np.concatenate([np.zeros((phi.shape[0], 1)), (phi + beta)[:, :-1]], 1)
@@ -1142,6 +1150,36 @@ def _energies(
         inside = pen > 0 if stop.side == "upper" else pen < 0
         pot += np.where(inside, 0.5 * stop.stiffness * pen**2, 0.0)
     return kin, pot
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _angular_momentum(chain, E: int, at: dict) -> np.ndarray:
+    """The ``angular_momentum`` rows (nt, 2) (N m s, counter-clockwise positive) of the beam
+    field (see rodval.core.scene.QUANTITIES): k = 0 about the root node,
+    H_0 = sum int (r - r_0) x r_t dm (the rods' mass on the beam's reference arc length, the
+    node masses at the rod ends; 5 Gauss points per element integrate the degree-6 integrand
+    exactly), k = 1 about the centre of mass, H_0 - (S x P) / M."""
+    root = at[(0, 0)][0][:, None, :2]  # (nt, 1, 2)
+    H0 = np.zeros(root.shape[0])
+    P = np.zeros((root.shape[0], 2))
+    first = np.zeros((root.shape[0], 2))
+    for k, w, S, _, _, Q, V in _elements(chain, E, at):
+        r = np.einsum("gi,tic->tgc", S, Q) - root
+        v = np.einsum("gi,tic->tgc", S, V)
+        H0 += chain.m[k] * np.sum(w * _cross(r, v), -1)
+        P += chain.m[k] * np.einsum("g,tgc->tc", w, v)
+        first += chain.m[k] * np.einsum("g,tgc->tc", w, r)
+    for k in range(chain.n):
+        r = at[(k, E)][0][:, :2] - root[:, 0]
+        v = at[(k, E)][1][:, :2]
+        H0 += chain.mu[k] * _cross(r, v)
+        P += chain.mu[k] * v
+        first += chain.mu[k] * r
+    total = float(np.sum(chain.m * chain.l + chain.mu))
+    return np.stack([H0, H0 - _cross(first, P) / total], -1)
 
 
 #: Steps after the activation step at which a lock's "after" state is taken (the index-3

@@ -120,3 +120,25 @@ def hessian(f, x, h=1e-4):
                 f(x + E[i] + E[j]) - f(x + E[i] - E[j]) - f(x - E[i] + E[j]) + f(x - E[i] - E[j])
             ) / (4 * h * h)
     return H
+
+
+def momenta(q, v, l, m, mu):
+    """(H_0, H_c): angular momentum about the root (the origin) and about the centre of mass
+    (kg m^2/s) of the models' first-order velocity field: points and velocities of the chord
+    configuration q_0 = [phi; 0; 0], r_t = (dr/dq)(q_0) q' (chord velocity plus the bending
+    rate eta' n), by quadrature; H_c = sum int (r - c) x (r_t - c_t) dm with c, c_t the mass
+    averages of r and r_t."""
+    n = l.size
+    q0 = np.concatenate([np.asarray(q, float)[:n], np.zeros(2 * n)])
+    Jr, Jn = jacobians(q0, l)
+    r, w, nodes = points(q0, l)
+    rt, nt = Jr @ v, Jn @ v  # (n, 8, 2), (n, 2)
+    pts = np.concatenate([r.reshape(-1, 2), nodes])
+    vel = np.concatenate([rt.reshape(-1, 2), nt])
+    dm = np.concatenate([(m[:, None] * w).ravel(), mu])
+    c, ct = dm @ pts / dm.sum(), dm @ vel / dm.sum()
+
+    def moment(p, u):
+        return float(np.sum(dm * (p[:, 0] * u[:, 1] - p[:, 1] * u[:, 0])))
+
+    return moment(pts, vel), moment(pts - c, vel - ct)

@@ -30,8 +30,22 @@ from rodval.core.loads import NodalForce
 from rodval.core.resources import check_rods, check_run_memory
 
 #: Quantities a scene may ask for. "x"/"y" are node positions (k = 0..n); "energy" yields
-#: kinetic, potential and total energy (k = 0).
-QUANTITIES = ("phi", "dphi", "alpha", "beta", "x", "y", "energy", "hinge_angle", "hinge_moment")
+#: kinetic, potential and total energy (k = 0); "angular_momentum" (N m s, counter-clockwise
+#: positive) has k = 0: H about the root node, sum int (r - r_0) x v dm over rods and point
+#: masses, and k = 1: H about the chain's centre of mass, H_0 - (S x P) / M (S first mass
+#: moment about the root, P linear momentum, M total mass); docs/quantities.md.
+QUANTITIES = (
+    "phi",
+    "dphi",
+    "alpha",
+    "beta",
+    "x",
+    "y",
+    "energy",
+    "hinge_angle",
+    "hinge_moment",
+    "angular_momentum",
+)
 #: Units of every trajectory quantity (the energy audit adds work, dissipated, residual).
 UNITS = {
     "phi": "rad",
@@ -48,6 +62,7 @@ UNITS = {
     "energy_residual": "J",
     "hinge_angle": "rad",
     "hinge_moment": "N m",
+    "angular_momentum": "N m s",
 }
 
 

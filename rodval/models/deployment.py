@@ -34,6 +34,7 @@ from rodval.models.kernels import (
     _generator_solve,
     full_accel,
 )
+from rodval.models.paper_matrices import rod_momenta
 from rodval.models.reduced_banded import _band_size, _forces, _solve_band, _solve_sweep
 
 #: Another armed latch locks together with the one whose crossing was located when its
@@ -250,14 +251,7 @@ def reduced_hinge_gradient(chain, k: int) -> np.ndarray:
 
 def outer_momenta(chain, phi, dphi, dalpha, dbeta) -> np.ndarray:
     """Linear momentum (N s, (n, 2)) of everything beyond node k (rods k+1..n and their far
-    nodes), k = 0..n-1, with the model's velocity field: chord velocity plus the bending rate
-    eta' n (to first order, as in the models' kinetic energy; zero bending rates for the
-    reduced model). Row 0 is the whole chain's momentum."""
-    l, m, mu = chain.l, chain.m, chain.mu
-    e_n = np.stack([-np.sin(phi), np.cos(phi)], axis=-1)  # n_k
-    v_tip = np.cumsum((l * dphi)[:, None] * e_n, axis=0)  # node k+1
-    v_root = np.vstack([[0.0, 0.0], v_tip[:-1]])
-    w = m * l**2 / 12.0
-    rod = (m * l)[:, None] * v_root + (0.5 * m * l**2 * dphi + w * (dalpha - dbeta))[:, None] * e_n
-    p = rod + mu[:, None] * v_tip
+    nodes), k = 0..n-1, with the model's velocity field (``paper_matrices.rod_momenta``).
+    Row 0 is the whole chain's momentum."""
+    p = rod_momenta(chain, phi, dphi, dalpha, dbeta)[0]
     return np.cumsum(p[::-1], axis=0)[::-1]

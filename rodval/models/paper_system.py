@@ -18,6 +18,7 @@ from rodval.models.paper_matrices import (
     VARIANTS,
     ChainConstants,
     angle_differences,
+    angular_momentum,
     assemble_mass,
     chain_constants,
     damper_power,
@@ -239,7 +240,9 @@ class PaperSystem(OdeSystem):
             out["phi"] = (phi, rods)
         if scene.wants("dphi"):
             out["dphi"] = (dphi, rods)
-        if scene.wants("alpha", "beta", "energy"):
+        if scene.wants(
+            "alpha", "beta", "energy", "hinge_angle", "hinge_moment", "angular_momentum"
+        ):
             alpha, beta, dalpha, dbeta = self.bending(times, Y)
             if scene.wants("alpha"):
                 out["alpha"] = (alpha, rods)
@@ -253,8 +256,6 @@ class PaperSystem(OdeSystem):
             if scene.wants("y"):
                 out["y"] = (y, nodes)
         if scene.wants("hinge_angle", "hinge_moment"):
-            if not scene.wants("alpha", "beta", "energy"):
-                alpha, beta, dalpha, dbeta = self.bending(times, Y)
             D = hinge_angles(phi, alpha, beta)
             hinges = np.arange(n)
             if scene.wants("hinge_angle"):
@@ -267,6 +268,9 @@ class PaperSystem(OdeSystem):
             out["kinetic"] = (kin[:, None], zero)
             out["potential"] = (pot[:, None], zero)
             out["energy"] = ((kin + pot)[:, None], zero)
+        if scene.wants("angular_momentum"):
+            H = angular_momentum(self.base_chain, phi, dphi, dalpha, dbeta)
+            out["angular_momentum"] = (H, np.arange(2))
         return out
 
     def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
