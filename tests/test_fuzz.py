@@ -43,6 +43,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rodval.cli import main
+from rodval.study.toml_text import toml_text
 
 pytestmark = pytest.mark.fuzz
 
@@ -151,30 +152,8 @@ def run_cli(argv: list[str], c: Counts) -> tuple[int, str, str]:
 # ----------------------------------------------------------------------------- TOML writing
 
 
-def toml_value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "nan"
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return (
-            "{" + ", ".join(f"{json.dumps(str(k))} = {toml_value(x)}" for k, x in v.items()) + "}"
-        )
-    raise TypeError(type(v))
-
-
-def to_toml(doc: dict) -> str:
-    return "\n".join(f"{json.dumps(str(k))} = {toml_value(v)}" for k, v in doc.items()) + "\n"
+#: the library's own writer (study.toml of a Python study): one TOML writer
+to_toml = toml_text
 
 
 # ----------------------------------------------------------------------------- strategies
