@@ -12,6 +12,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from typing import Any, ClassVar
 
+from rodval.core.modal import Modes
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.trajectory import Trajectory
@@ -49,3 +50,20 @@ class Model(ABC):
     def options(self) -> dict[str, Any]:
         """Model options (recorded in ``Trajectory.options``)."""
         return {}
+
+    @classmethod
+    def modes(
+        cls,
+        scene: Scene,
+        *,
+        about: str = "initial",
+        count: int | None = None,
+        load_at: float | None = None,
+        **options: Any,
+    ) -> Modes:
+        """Linearized modes of this model about the scene's initial state (``about="initial"``)
+        or its static equilibrium (``"equilibrium"``, loads held at ``load_at`` s); ``options``:
+        the model's own options (``OPTIONS``), with the model's defaults for a modal analysis.
+        The configuration check (at rest, balanced) is the caller's
+        (``rodval.analysis.modes.model_modes``), done once for every model."""
+        raise ValueError(f"model {cls.name!r} has no modal analysis")

@@ -23,6 +23,23 @@ REGISTRY: dict[str, str] = {
 }
 
 
+#: Every model name, in registry order: the one list of model names.
+MODEL_NAMES: tuple[str, ...] = tuple(REGISTRY)
+
+
+def integrated_models() -> tuple[str, ...]:
+    """The models rodval's driver integrates (``uses_integrator``): the native ones. Resolved
+    from the registry, so a model that cannot be imported here is left out."""
+    out = []
+    for name in MODEL_NAMES:
+        try:
+            if uses_integrator(name):
+                out.append(name)
+        except ValueError:
+            continue
+    return tuple(out)
+
+
 def model_class(name: str) -> type[Model]:
     """The class registered as ``name`` (ValueError if unknown or not importable)."""
     if not isinstance(name, str) or name not in REGISTRY:
