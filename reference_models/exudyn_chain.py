@@ -53,7 +53,6 @@ from rodval.core.contract import Model
 from rodval.core.scene import QUANTITIES, Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import (
-    STATUS_BLOWUP,
     STATUS_DIVERGED,
     STATUS_ERROR,
     STATUS_FAILED,
@@ -61,6 +60,7 @@ from rodval.core.status import (
 )
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.core.validity import Check, step_resolution
+from rodval.solvers.guard import EnergyBudget, GuardSpec, diverged_message
 
 ELEMENTS = ("cable2d",)
 SOLVERS = ("generalized-alpha", "trapezoidal")
@@ -89,10 +89,6 @@ NATIVE_INTEGRATOR_FIELDS = (
     "max_evaluations",
     "max_wall_s",
 )
-
-#: Absolute slack of the blow-up budget (J), as in the native runs' check (rodval.solvers.guard):
-#: a chain at rest without loads has E(0) = W+ = 0 and may pick up rounding-level motion.
-ENERGY_FLOOR_J = 1e-6
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(5)
 
@@ -788,8 +784,8 @@ class _Guard:
 
     * non-finite coordinates or velocities: STATUS_DIVERGED;
     * kinetic energy T = v^T M v / 2 (consistent mass of the cubic elements plus the point
-      masses; the hinge data nodes carry no mass) above ``factor`` x (E(0) + W+(t) +
-      ENERGY_FLOOR_J), W+ the positive load work (trapezoid rule on the load power at the
+      masses; the hinge data nodes carry no mass) above ``factor`` x the budget of
+      ``rodval.solvers.guard`` (``GuardSpec``, ``EnergyBudget``: W+ on the load power at the
       checked states), E(0) the initial T + Pi (``_energies``): STATUS_BLOWUP;
     * max_k |dphi_k| x step above ``max_rotation``: STATUS_FAILED (under-resolved)."""
 
@@ -799,7 +795,7 @@ class _Guard:
         mbs, chain = built.mbs, scene.chain
         ref, q0, v0 = built.initial
         self.mbs, self.solver = mbs, None
-        self.factor, self.max_rotation = float(factor), float(max_rotation)
+        self.max_rotation = float(max_rotation)
         size = mbs.systemData.ODE2Size()
         ltg = [
             [np.asarray(mbs.systemData.GetNodeLTGODE2(nd), int) for nd in rod]
@@ -840,8 +836,8 @@ class _Guard:
         kin0, pot0 = _energies(
             scene, E, EA, at0, ini["phi"][None], ini["alpha"][None], ini["beta"][None]
         )
-        self.E0 = float(kin0[0] + pot0[0])
-        self.w_plus, self.t_prev, self.p_prev = 0.0, 0.0, None
+        self.spec = GuardSpec(blowup_factor=float(factor), energy0_J=float(kin0[0] + pot0[0]))
+        self.energy = EnergyBudget(self.spec)
         self.verdict: tuple | None = None
         self.min_step, self.max_rotation_seen = math.inf, 0.0
 
@@ -868,14 +864,9 @@ class _Guard:
             sd = self.mbs.systemData
             q, v = sd.GetODE2Coordinates(), sd.GetODE2Coordinates_t()
             if not math.isfinite(float(q @ q) + float(v @ v)):
-                self.verdict = (
-                    STATUS_DIVERGED,
-                    f"diverged: non-finite state at t = {t:.6g} s",
-                    t,
-                    False,
-                )
+                self.verdict = (STATUS_DIVERGED, diverged_message(t), t, False)
                 return False
-            if math.isfinite(self.factor):
+            if self.spec.checks_energy:
                 p = self._power(t, v)
                 if not math.isfinite(p):
                     self.verdict = (
@@ -885,22 +876,9 @@ class _Guard:
                         False,
                     )
                     return False
-                p = max(p, 0.0)
-                if self.p_prev is not None:
-                    self.w_plus += 0.5 * (t - self.t_prev) * (self.p_prev + p)
-                self.p_prev, self.t_prev = p, t
-                T = 0.5 * float(v @ self.M @ v)
-                budget = self.E0 + self.w_plus + ENERGY_FLOOR_J
-                if not T <= self.factor * budget:
-                    self.verdict = (
-                        STATUS_BLOWUP,
-                        (
-                            f"energy blow-up: kinetic energy {T:.4g} J > blowup_factor {self.factor:g} "
-                            f"x budget E(0) + W+ = {budget:.4g} J at t = {t:.6g} s"
-                        ),
-                        t,
-                        False,
-                    )
+                blown = self.energy.check(t, p, 0.5 * float(v @ self.M @ v))
+                if blown is not None:
+                    self.verdict = (*blown, t, False)
                     return False
             if h > 0:
                 d, dd = self.A @ q + self.d_ref, self.A @ v

@@ -8,6 +8,7 @@ from rodval import Chain, InitialState, Scene, constant, paper_scene, pulse, sim
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_STALLED
 from rodval.models import get_model
+from rodval.solvers.guard import GuardSpec
 
 
 @pytest.mark.parametrize("model", ["full", "reduced"])
@@ -44,12 +45,12 @@ def test_compiled_loop_stops_when_kinetic_energy_exceeds_its_budget():
     Y = np.empty((scene.times.size, system.y0.size))
     edges = np.array([0.0, 0.5])
     args = (form, system.y0, edges, scene.times, 1e-8, 1e-10, np.inf, None, 10**7)
-    n_out, _, _, code, t = dop853.integrate_compiled(
-        *args, np.array([0.0, 0.5, 0.0, 1e-6]), 1000, Y
+    n_out, _, _, code, t, _ = dop853.integrate_compiled(
+        *args, GuardSpec(stall_steps=1000, blowup_factor=0.5), Y
     )
     assert code == dop853.BLOWUP and 0 < t < 0.5 and n_out < scene.times.size
-    n_out, _, _, code, t = dop853.integrate_compiled(
-        *args, np.array([0.0, 1.0001, 0.0, 1e-6]), 1000, Y
+    n_out, _, _, code, t, _ = dop853.integrate_compiled(
+        *args, GuardSpec(stall_steps=1000, blowup_factor=1.0001), Y
     )
     assert code == dop853.OK and t == 0.5 and n_out == scene.times.size
 

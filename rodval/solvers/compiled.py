@@ -24,24 +24,24 @@ from rodval.core.status import (
 )
 from rodval.core.trajectory import SolverStats
 from rodval.solvers import dop853, progress
-from rodval.solvers.guard import ENERGY_FLOOR_J
+from rodval.solvers.guard import GuardSpec, blowup_message, diverged_message, stalled_message
 from rodval.solvers.system import CompiledForm
 
-_CODES = {
-    dop853.STEP_TOO_SMALL: (
-        STATUS_FAILED,
-        "Required step size is less than spacing between numbers.",
-    ),
-    dop853.NON_FINITE: (STATUS_DIVERGED, "diverged: non-finite state"),
-    dop853.BLOWUP: (
-        STATUS_BLOWUP,
-        "energy blow-up: kinetic energy > blowup_factor x budget E(0) + W+",
-    ),
-    dop853.STALLED: (
-        STATUS_STALLED,
-        "step size collapse: stall_steps consecutive steps shorter than min_step_fraction x t_end",
-    ),
-}
+
+def verdict_message(code: int, mon: np.ndarray, t: float, spec: GuardSpec) -> tuple[int, str]:
+    """Status and message of a compiled run that ended with ``code`` at t (s), from the loop's
+    monitor ``mon`` (``dop853.guard_step``): the messages of ``rodval.solvers.guard``."""
+    if code == dop853.STEP_TOO_SMALL:
+        return STATUS_FAILED, "Required step size is less than spacing between numbers."
+    if code == dop853.NON_FINITE:
+        return STATUS_DIVERGED, diverged_message(t)
+    if code == dop853.STALLED:
+        return STATUS_STALLED, stalled_message(int(mon[0]), spec.min_step_s, mon[1], t + mon[1])
+    if code == dop853.BLOWUP:
+        return STATUS_BLOWUP, blowup_message(mon[4], spec.blowup_factor, mon[5], t + mon[1])
+    raise ValueError(f"unknown return code {code} of the compiled loop")
+
+
 #: Codes of the budgets: status and the setting named in the message.
 _BUDGETS = {
     dop853.BUDGET: (STATUS_BUDGET, "max_evaluations"),
@@ -55,20 +55,17 @@ def run_compiled(
     edges: np.ndarray,
     scene: Scene,
     settings: IntegratorSettings,
-    energy0: float,
+    guard: GuardSpec,
     Y: np.ndarray,
     stats: SolverStats,
 ) -> int:
     """Integrate over [edges[0], edges[-1]] restarting at each interior edge (the scene's
     breakpoints), writing states at the output times into Y; fills ``stats`` (status,
     message, t_reached, nfev, nsteps) and returns the number of output times reached.
-    The divergence guard runs inside the loop, with the verdicts of ``rodval.solvers.guard``
-    (``energy0``: the budget's E(0), J)."""
-    guard = np.array(
-        [settings.min_step_fraction * scene.t_end, settings.blowup_factor, energy0, ENERGY_FLOOR_J]
-    )
+    The divergence guard ``guard`` runs inside the loop, with the verdicts and messages of
+    ``rodval.solvers.guard``."""
     try:
-        n_out, nfev, nsteps, code, t = dop853.integrate_compiled(
+        n_out, nfev, nsteps, code, t, mon = dop853.integrate_compiled(
             form,
             y0,
             edges,
@@ -79,7 +76,6 @@ def run_compiled(
             settings.first_step,
             settings.max_evaluations,
             guard,
-            settings.stall_steps,
             Y,
             deadline=time.perf_counter() + settings.max_wall_s,
             reporting=progress.reporting(),
@@ -98,6 +94,5 @@ def run_compiled(
         stats.status, budget = _BUDGETS[code]
         stats.message = settings.budget_message(budget, t)
     elif code != dop853.OK:
-        stats.status, message = _CODES[code]
-        stats.message = f"{message} (t = {t:.6g} s)"
+        stats.status, stats.message = verdict_message(code, mon, t, guard)
     return n_out

@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit, objmode, types
 from scipy.integrate._ivp import dop853_coefficients as dc
 
+from rodval.solvers.guard import GuardSpec
 from rodval.solvers.progress import report
 from rodval.solvers.signature import F1 as _F1
 from rodval.solvers.signature import F2 as _F2
@@ -108,10 +109,88 @@ def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, tm
     return min(100.0 * h0, h1, t_bound - t0, max_step)
 
 
+@njit(cache=True, error_model="numpy")
+def guard_step(g, mon, h, mech, guarded):
+    """The divergence guard of ``rodval.solvers.guard`` after one accepted step of h (s), as
+    the compiled loop runs it. ``g``: ``GuardSpec.as_array()``; ``mon``: the run's monitor
+    [short steps in a row, last step (s), W+ (J), last positive load power (W), T (J), budget
+    (J)], updated here (the figures of a verdict's message); ``mech``: (T, P_ext) at the step's
+    end, read only when ``guarded``. Returns ``STALLED``, ``BLOWUP`` or ``OK``. O(1)."""
+    mon[0] = mon[0] + 1.0 if h < g[0] else 0.0
+    mon[1] = h
+    if mon[0] >= g[1]:
+        return STALLED
+    if guarded:
+        p = max(mech[1], 0.0)
+        mon[2] += 0.5 * h * (mon[3] + p)
+        mon[3] = p
+        mon[4] = mech[0]
+        mon[5] = g[3] + mon[2] + g[4]
+        if not mech[0] <= g[2] * mon[5]:
+            return BLOWUP
+    return OK
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol):
+    """One DOP853 step from (t, y) to t_new (s): the stages into K, the solution into y_new;
+    returns Hairer's error norm (< 1: accepted). 12 evaluations, O(N) each combination."""
+    N = y.shape[0]
+    h = t_new - t
+    for s in range(1, N_STAGES):
+        _combine(tmp, y, K, _A[s], s, h)
+        rhs(t + _C[s] * h, tmp, P, S, M, L, K[s])
+    _combine(y_new, y, K, _B, N_STAGES, h)
+    rhs(t_new, y_new, P, S, M, L, K[N_STAGES])
+    err5 = 0.0
+    err3 = 0.0
+    for i in range(N):
+        sc = atol + max(abs(y[i]), abs(y_new[i])) * rtol
+        e5 = 0.0
+        e3 = 0.0
+        for j in range(N_STAGES + 1):
+            e5 += K[j, i] * _E5[j]
+            e3 += K[j, i] * _E3[j]
+        err5 += (e5 / sc) ** 2
+        err3 += (e3 / sc) ** 2
+    if err5 == 0.0 and err3 == 0.0:
+        return 0.0
+    return h * err5 / np.sqrt((err5 + 0.01 * err3) * N)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _dense_output(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero, times, n_out, Y):
+    """The 7th-order interpolant over the accepted step [t, t_new] (three extra stages) at
+    every output time in it, written into Y from row n_out (``zero``: N zeros); returns the
+    next row."""
+    N = y.shape[0]
+    h = t_new - t
+    nt = times.shape[0]
+    for s in range(N_STAGES + 1, 16):
+        _combine(tmp, y, K, _A[s], s, h)
+        rhs(t + _C[s] * h, tmp, P, S, M, L, K[s])
+    for i in range(N):
+        f0 = y_new[i] - y[i]
+        F[0, i] = f0
+        F[1, i] = h * K[0, i] - f0
+        F[2, i] = 2.0 * f0 - h * (K[N_STAGES, i] + K[0, i])
+    for p in range(4):
+        _combine(F[3 + p], zero, K, _D[p], 16, h)
+    while n_out < nt and times[n_out] <= t_new:
+        x = (times[n_out] - t) / h
+        for q in range(N):
+            acc = 0.0
+            for i in range(7):
+                acc += F[6 - i, q]
+                acc *= x if i % 2 == 0 else 1.0 - x
+            Y[n_out, q] = acc + y[q]
+        n_out += 1
+    return n_out
+
+
 _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64, types.float64))(
     RHS_TYPE,
     RHS_TYPE,
-    types.boolean,
     _F2,
     _F1,
     _F3,
@@ -119,70 +198,33 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
     _F1,
     _F1,
     _F1,
-    types.float64,
-    types.float64,
-    types.float64,
-    types.float64,
-    types.int64,
     _F1,
-    types.int64,
-    types.float64,
+    _F1,
     types.boolean,
     _F2,
     _F1,
-    _F1,
-    _F1,
-    _F1,
-    _F2,
-    _F2,
 )
 
 
 @njit(_RUN_SIGNATURE, cache=True, error_model="numpy")
-def run(
-    rhs,
-    mechanics,
-    guarded,
-    P,
-    S,
-    M,
-    L,
-    y0,
-    edges,
-    times,
-    rtol,
-    atol,
-    max_step,
-    first_step,
-    max_nfev,
-    guard,
-    stall_steps,
-    deadline,
-    reporting,
-    A,
-    B,
-    C,
-    E3,
-    E5,
-    D,
-    Y,
-):
+def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting, Y, mon):
     """Integrate from edges[0] to edges[-1], restarting at each interior edge (breakpoint),
-    writing the state at ``times`` into Y. ``first_step`` <= 0 selects it automatically; the
-    run stops with ``BUDGET`` once ``max_nfev`` evaluations are used, and with ``WALL`` once
-    ``time.perf_counter()`` passes ``deadline`` (s; inf: no limit), read before the first
-    step attempt and then every ``WALL_CHECK_EVALUATIONS`` evaluations. With ``reporting``
-    the time reached is reported to the progress reporter at those same reads (a long run
-    shows its progress; the integration is unchanged).
+    writing the state at ``times`` into Y.
 
-    The divergence guard of ``rodval.solvers.guard`` after every accepted step: ``STALLED``
-    after ``stall_steps`` consecutive steps shorter than guard[0] (s); when ``guarded``,
-    ``mechanics(t, y, ...)`` writes (T, P_ext) and the run stops with ``BLOWUP`` when
-    T > guard[1] (blow-up factor) x (guard[2] (E(0)) + W+ + guard[3] (floor, J)), W+ the
-    positive load work by the trapezoid rule on P_ext at step ends.
+    ``controls``: [rtol, atol, max_step (s), first_step (s; <= 0 selects it), max_nfev,
+    deadline (a ``time.perf_counter()`` value, s; inf: none)]. The run stops with ``BUDGET``
+    once max_nfev evaluations are used and with ``WALL`` once the clock passes the deadline,
+    read before the first step attempt and then every ``WALL_CHECK_EVALUATIONS`` evaluations;
+    with ``reporting`` the time reached goes to the progress reporter at those reads.
+
+    ``guard``: ``GuardSpec.as_array()``, checked by ``guard_step`` after every accepted step
+    (``mon``: its monitor, the figures of the verdict); ``mechanics(t, y, ...)`` writes
+    (T, P_ext) and runs only when guard[2] (the blow-up factor) is finite.
 
     Returns (number of output times written, nfev, accepted steps, code, t reached).
     """
+    rtol, atol, max_step, first_step = controls[0], controls[1], controls[2], controls[3]
+    max_nfev, deadline = controls[4], controls[5]
     N = y0.shape[0]
     y = y0.copy()
     K = np.empty((16, N))
@@ -195,17 +237,14 @@ def run(
     n_out = 0
     nfev = 0
     nsteps = 0
-    n_short = 0
-    timed = deadline < np.inf
-    clocked = timed or reporting
+    clocked = deadline < np.inf or reporting
     next_clock = 0
+    guarded = np.isfinite(guard[2])
     mech = np.zeros(2)
-    w_plus = 0.0
-    p_prev = 0.0
     t = edges[0]
     if guarded:
         mechanics(t, y, P, S, M, L, mech)
-        p_prev = max(mech[1], 0.0)
+        mon[3] = max(mech[1], 0.0)
     while n_out < nt and times[n_out] <= t:
         Y[n_out] = y
         n_out += 1
@@ -235,32 +274,11 @@ def run(
                     now = _report_and_now(t) if reporting else _now()
                     if now > deadline:
                         return n_out, nfev, nsteps, WALL, t
-                t_new = t + h_abs
-                if t_new > t_bound:
-                    t_new = t_bound
+                t_new = min(t + h_abs, t_bound)
                 h = t_new - t
                 h_abs = h
-                for s in range(1, N_STAGES):
-                    _combine(tmp, y, K, A[s], s, h)
-                    rhs(t + C[s] * h, tmp, P, S, M, L, K[s])
-                _combine(y_new, y, K, B, N_STAGES, h)
-                rhs(t_new, y_new, P, S, M, L, K[N_STAGES])
+                err = _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol)
                 nfev += N_STAGES
-                err5 = 0.0
-                err3 = 0.0
-                for i in range(N):
-                    sc = atol + max(abs(y[i]), abs(y_new[i])) * rtol
-                    e5 = 0.0
-                    e3 = 0.0
-                    for j in range(N_STAGES + 1):
-                        e5 += K[j, i] * E5[j]
-                        e3 += K[j, i] * E3[j]
-                    err5 += (e5 / sc) ** 2
-                    err3 += (e3 / sc) ** 2
-                if err5 == 0.0 and err3 == 0.0:
-                    err = 0.0
-                else:
-                    err = h * err5 / np.sqrt((err5 + 0.01 * err3) * N)
                 if not np.isfinite(err):
                     return n_out, nfev, nsteps, NON_FINITE, t
                 if err < 1.0:
@@ -276,38 +294,16 @@ def run(
             nsteps += 1
             if not np.all(np.isfinite(y_new)):
                 return n_out, nfev, nsteps, NON_FINITE, t
-            n_short = n_short + 1 if h < guard[0] else 0
-            if n_short >= stall_steps:
-                return n_out, nfev, nsteps, STALLED, t
             if guarded:
                 mechanics(t_new, y_new, P, S, M, L, mech)
-                p = max(mech[1], 0.0)
-                w_plus += 0.5 * h * (p_prev + p)
-                p_prev = p
-                if not mech[0] <= guard[1] * (guard[2] + w_plus + guard[3]):
-                    return n_out, nfev, nsteps, BLOWUP, t
+            code = guard_step(guard, mon, h, mech, guarded)
+            if code != OK:
+                return n_out, nfev, nsteps, code, t
             if n_out < nt and times[n_out] <= t_new:
-                # dense output: three extra stages, then the 7th-order interpolant
-                for s in range(N_STAGES + 1, 16):
-                    _combine(tmp, y, K, A[s], s, h)
-                    rhs(t + C[s] * h, tmp, P, S, M, L, K[s])
+                n_out = _dense_output(
+                    rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero, times, n_out, Y
+                )
                 nfev += 3
-                for i in range(N):
-                    f0 = y_new[i] - y[i]
-                    F[0, i] = f0
-                    F[1, i] = h * K[0, i] - f0
-                    F[2, i] = 2.0 * f0 - h * (K[N_STAGES, i] + K[0, i])
-                for p in range(4):
-                    _combine(F[3 + p], zero, K, D[p], 16, h)
-                while n_out < nt and times[n_out] <= t_new:
-                    x = (times[n_out] - t) / h
-                    for q in range(N):
-                        acc = 0.0
-                        for i in range(7):
-                            acc += F[6 - i, q]
-                            acc *= x if i % 2 == 0 else 1.0 - x
-                        Y[n_out, q] = acc + y[q]
-                    n_out += 1
             t = t_new
             for i in range(N):
                 y[i] = y_new[i]
@@ -325,21 +321,27 @@ def integrate_compiled(
     max_step: float,
     first_step: float | None,
     max_nfev: int,
-    guard: np.ndarray,
-    stall_steps: int,
+    guard: GuardSpec,
     Y: np.ndarray,
     deadline: float = math.inf,
     reporting: bool = False,
-) -> tuple[int, int, int, int, float]:
-    """Run ``run`` on a CompiledForm with scipy's DOP853 coefficients (see ``run``; without
-    ``form.mechanics`` or with guard[1] = inf there is no blow-up check; ``deadline``: a
-    ``time.perf_counter()`` value, s; ``reporting``: report progress, see ``run``)."""
-    guarded = form.mechanics is not None and bool(np.isfinite(guard[1]))
+) -> tuple[int, int, int, int, float, np.ndarray]:
+    """Run ``run`` on a CompiledForm (see ``run``; without ``form.mechanics`` there is no
+    blow-up check; ``deadline``: a ``time.perf_counter()`` value, s; ``reporting``: report
+    progress). Returns (outputs written, nfev, accepted steps, code, t reached, monitor): the
+    monitor holds the figures of a guard verdict (``guard_step``)."""
+    g = guard.as_array()
+    if form.mechanics is None:
+        g[2] = math.inf
     mechanics = form.mechanics if form.mechanics is not None else form.rhs
+    controls = np.array(
+        [rtol, atol, max_step, -1.0 if first_step is None else first_step, max_nfev, deadline],
+        float,
+    )
+    mon = np.zeros(6)
     n_out, nfev, nsteps, code, t = run(
         form.rhs,
         mechanics,
-        guarded,
         form.P,
         form.S,
         form.M,
@@ -347,21 +349,10 @@ def integrate_compiled(
         np.array(y0, float),
         np.array(edges, float),
         np.array(times, float),
-        rtol,
-        atol,
-        max_step,
-        -1.0 if first_step is None else first_step,
-        max_nfev,
-        np.asarray(guard, float),
-        stall_steps,
-        float(deadline),
+        controls,
+        g,
         bool(reporting),
-        _A,
-        _B,
-        _C,
-        _E3,
-        _E5,
-        _D,
         Y,
+        mon,
     )
-    return int(n_out), int(nfev), int(nsteps), int(code), float(t)
+    return int(n_out), int(nfev), int(nsteps), int(code), float(t), mon

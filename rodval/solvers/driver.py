@@ -357,7 +357,7 @@ def integrate(
             for _ in at_zero:
                 ledger.record()
         if form is not None:
-            out.n = run_compiled(form, y, edges, scene, settings, guard.E0, out.Y, stats)
+            out.n = run_compiled(form, y, edges, scene, settings, guard.spec, out.Y, stats)
             t_now = stats.t_reached
         else:
             scipy_run = _ScipyRun(system, scene, settings, method, stats, out, ledger, guard)
