@@ -1,9 +1,12 @@
-"""Argument checks shared by every entry point: one definition of "a table with known keys"
-and of "an argument of the right type", each raising a one-line ValueError that names the
-argument and what is allowed (rodval's rule: bad input is refused before any work)."""
+"""Argument checks shared by every entry point: one definition of "a table with known keys",
+of "an argument of the right type" and of "a number in a range", each raising a one-line
+ValueError that names the argument and what is allowed (rodval's rule: bad input is refused
+before any work)."""
 
 from __future__ import annotations
 
+import math
+import numbers
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -45,3 +48,68 @@ def check_choice(name: str, value: Any, choices: Iterable[str]) -> str:
     if not isinstance(value, str) or value not in choices:
         raise ValueError(f"{name} must be one of {choices}, got {value!r:.60}")
     return value
+
+
+def describe_range(
+    *,
+    unit: str = "",
+    low: float = -math.inf,
+    high: float = math.inf,
+    low_open: bool = False,
+    high_open: bool = False,
+    finite: bool = False,
+    integer: bool = False,
+) -> str:
+    """The range of ``check_number`` in words, e.g. "a finite real number > 0 (m)",
+    "an integer in [1, 1000]"."""
+    kind = "an integer" if integer else ("a finite real number" if finite else "a real number")
+    if math.isfinite(low) and math.isfinite(high):
+        bounds = f" in {'(' if low_open else '['}{low:g}, {high:g}{')' if high_open else ']'}"
+    elif math.isfinite(low):
+        bounds = f" {'>' if low_open else '>='} {low:g}"
+    elif math.isfinite(high):
+        bounds = f" {'<' if high_open else '<='} {high:g}"
+    else:
+        bounds = ""
+    return f"{kind}{bounds}{f' ({unit})' if unit else ''}"
+
+
+def check_number(
+    name: str,
+    value: Any,
+    *,
+    unit: str = "",
+    low: float = -math.inf,
+    high: float = math.inf,
+    low_open: bool = False,
+    high_open: bool = False,
+    finite: bool = False,
+    integer: bool = False,
+    allowed: str | None = None,
+) -> float:
+    """``value`` as a float (an int when ``integer``) when it is a real number (an integral
+    one when ``integer``; never a bool, string, complex or NaN), finite when ``finite``, and
+    within ``low``..``high`` (each end open or closed); else the one-line ValueError
+    "<name> must be <allowed>, got <value>", ``allowed`` defaulting to ``describe_range``.
+    The one number validator of rodval: types before values, the unit in the message."""
+    kind = numbers.Integral if integer else numbers.Real
+    if isinstance(value, kind) and not isinstance(value, bool):
+        v = int(value) if integer else float(value)
+        if (
+            not math.isnan(v)
+            and (math.isfinite(v) or not finite)
+            and (v > low if low_open else v >= low)
+            and (v < high if high_open else v <= high)
+        ):
+            return v
+    if allowed is None:
+        allowed = describe_range(
+            unit=unit,
+            low=low,
+            high=high,
+            low_open=low_open,
+            high_open=high_open,
+            finite=finite,
+            integer=integer,
+        )
+    raise ValueError(f"{name} must be {allowed}, got {value!r}")

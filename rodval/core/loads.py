@@ -34,6 +34,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from rodval.core.checks import check_number
+
 ForceLaw = Callable[[float], float]
 
 LOAD_COLUMNS = (
@@ -59,15 +61,10 @@ Row = tuple[int, float, float, bool, float, float, float]  # law, t0, t1, closed
 
 
 def _real(where: str, value: Any, unit: str, *, positive: bool = False) -> float:
-    """Types before values: a finite real number (not a bool, string or complex), > 0 when
-    ``positive``; the message names the parameter, its allowed range and unit."""
-    allowed = f"a finite real number{' > 0' if positive else ''} ({unit})"
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{where} must be {allowed}, got {value!r}")
-    v = float(value)
-    if not math.isfinite(v) or (positive and v <= 0):
-        raise ValueError(f"{where} must be {allowed}, got {value!r}")
-    return v
+    """A finite real number (> 0 when ``positive``) in ``unit``: ``check_number``."""
+    return check_number(
+        where, value, unit=unit, finite=True, low=0 if positive else -math.inf, low_open=True
+    )
 
 
 class Law(ABC):
@@ -236,9 +233,7 @@ class NodalForce:
 
 
 def _real_or_inf(where: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or math.isnan(value):
-        raise ValueError(f"{where} must be real numbers (s), got {value!r}")
-    return float(value)
+    return check_number(where, value, allowed="real numbers (s)")
 
 
 def pulse(node: int, Xbar: float = -150.0, Ybar: float = 1200.0, T: float = 1.0) -> NodalForce:

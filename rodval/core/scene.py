@@ -17,7 +17,6 @@ Conventions (used throughout rodval)
 
 from __future__ import annotations
 
-import math
 import numbers
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, fields, replace
@@ -25,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from rodval.core.checks import check_keys
+from rodval.core.checks import check_keys, check_number
 from rodval.core.loads import NodalForce
 from rodval.core.resources import check_rods, check_run_memory
 
@@ -257,16 +256,6 @@ def _index(name: str, value, n: int) -> int:
     return index
 
 
-def _finite(name: str, value, unit: str, *, positive: bool | None = None) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite real number ({unit}), got {value!r}")
-    if positive is True and value <= 0:
-        raise ValueError(f"{name} must be > 0 ({unit}), got {value!r}")
-    if positive is False and value < 0:
-        raise ValueError(f"{name} must be >= 0 ({unit}), got {value!r}")
-    return float(value)
-
-
 @dataclass(frozen=True)
 class Latch:
     """A latch on hinge ``hinge`` (0..n-1): the hinge locks when its angle D reaches
@@ -285,7 +274,7 @@ class Latch:
             or self.hinge < 0
         ):
             raise ValueError(f"latch hinge must be an integer >= 0, got {self.hinge!r}")
-        _finite("latch angle", self.angle, "rad")
+        check_number("latch angle", self.angle, finite=True, unit="rad")
         if self.direction is not None and (
             isinstance(self.direction, bool)
             or not isinstance(self.direction, numbers.Integral)
@@ -317,7 +306,7 @@ class Stop:
             or self.hinge < 0
         ):
             raise ValueError(f"stop hinge must be an integer >= 0, got {self.hinge!r}")
-        _finite("stop angle", self.angle, "rad")
+        check_number("stop angle", self.angle, finite=True, unit="rad")
         if self.side not in ("upper", "lower"):
             raise ValueError(f"stop side must be 'upper' or 'lower', got {self.side!r}")
         # an acting stop adds its stiffness to kappa and its damping to nu: the same bounds
@@ -410,11 +399,15 @@ class Scene:
         if not isinstance(self.chain, Chain):
             raise ValueError(f"chain must be a rodval.Chain, got {type(self.chain).__name__}")
         n = self.chain.n
-        if isinstance(self.t_end, bool) or not isinstance(self.t_end, numbers.Real):
-            raise ValueError(f"t_end (horizon) must be a real number > 0 s, got {self.t_end!r}")
-        t_end = float(self.t_end)
-        if not (math.isfinite(t_end) and t_end > 0):
-            raise ValueError(f"t_end (horizon) must be finite and > 0 s, got {self.t_end!r}")
+        check_number("t_end (horizon)", self.t_end, allowed="a real number > 0 s")
+        t_end = check_number(
+            "t_end (horizon)",
+            self.t_end,
+            low=0,
+            low_open=True,
+            finite=True,
+            allowed="finite and > 0 s",
+        )
         object.__setattr__(self, "t_end", t_end)
         if isinstance(self.loads, (str, bytes, dict)) or not isinstance(self.loads, Iterable):
             raise ValueError(

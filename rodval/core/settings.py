@@ -7,10 +7,11 @@ This module is the one source of defaults for the Python API, the CLI and study 
 from __future__ import annotations
 
 import math
-import numbers
 import sys
 from dataclasses import asdict, dataclass, fields
 from typing import Any
+
+from rodval.core.checks import check_number
 
 #: scipy.integrate.solve_ivp methods; implicit ones use the model's Jacobian where it has one.
 SCIPY_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
@@ -88,34 +89,45 @@ class IntegratorSettings:
             "blowup_factor",
             "min_step_fraction",
         ):
-            _number(name, getattr(self, name))
-        if not (MIN_RTOL <= self.rtol < 1):
-            raise ValueError(f"rtol must be {RTOL_RANGE}, got {self.rtol!r}")
-        if not (0 < self.atol < math.inf):
-            raise ValueError(f"atol must be a finite number > 0, got {self.atol!r}")
+            check_number(name, getattr(self, name))
+        check_number("rtol", self.rtol, low=MIN_RTOL, high=1, high_open=True, allowed=RTOL_RANGE)
+        check_number(
+            "atol", self.atol, low=0, low_open=True, finite=True, allowed="a finite number > 0"
+        )
         for name in ("max_step", "max_wall_s"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be > 0 (inf: no limit), got {getattr(self, name)!r}")
-        if self.first_step is not None:
-            _number("first_step", self.first_step)
-            if not (0 < self.first_step < math.inf):
-                raise ValueError(
-                    f"first_step must be a finite number > 0 or None, got {self.first_step!r}"
-                )
-        if not (self.blowup_factor > 1):
-            raise ValueError(
-                f"blowup_factor must be > 1 (inf disables), got {self.blowup_factor!r}"
+            check_number(
+                name, getattr(self, name), low=0, low_open=True, allowed="> 0 (inf: no limit)"
             )
-        if not (0 <= self.min_step_fraction < 1):
-            raise ValueError(f"min_step_fraction must be in [0, 1), got {self.min_step_fraction!r}")
+        if self.first_step is not None:
+            check_number("first_step", self.first_step)
+            check_number(
+                "first_step",
+                self.first_step,
+                low=0,
+                low_open=True,
+                finite=True,
+                allowed="a finite number > 0 or None",
+            )
+        check_number(
+            "blowup_factor", self.blowup_factor, low=1, low_open=True, allowed="> 1 (inf disables)"
+        )
+        check_number(
+            "min_step_fraction",
+            self.min_step_fraction,
+            low=0,
+            high=1,
+            high_open=True,
+            allowed="in [0, 1)",
+        )
         for name in ("stall_steps", "max_evaluations"):
-            v = getattr(self, name)
-            if (
-                isinstance(v, bool)
-                or not isinstance(v, numbers.Integral)
-                or not 1 <= int(v) <= MAX_COUNT
-            ):
-                raise ValueError(f"{name} must be an integer in [1, {MAX_COUNT}], got {v!r}")
+            check_number(
+                name,
+                getattr(self, name),
+                integer=True,
+                low=1,
+                high=MAX_COUNT,
+                allowed=f"an integer in [1, {MAX_COUNT}]",
+            )
 
     def check_horizon(self, t_end: float) -> None:
         """The settings against a scene's horizon t_end (s), before any work: a first step
@@ -149,12 +161,6 @@ class IntegratorSettings:
     def with_(self, **changes: Any) -> IntegratorSettings:
         """A copy with fields replaced (validated again)."""
         return IntegratorSettings(**{**self.as_dict(), **changes})
-
-
-def _number(name: str, value: Any) -> None:
-    """Types before values: a real number (not a bool, string or complex), not NaN."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or math.isnan(value):
-        raise ValueError(f"{name} must be a real number, got {value!r}")
 
 
 #: The defaults of every integrator setting (API keywords, CLI options, study files).
