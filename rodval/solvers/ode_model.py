@@ -5,8 +5,6 @@ from __future__ import annotations
 import time
 from abc import abstractmethod
 
-import numpy as np
-
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
@@ -41,14 +39,7 @@ class OdeModel(Model):
                 message=f"model set-up failed: {message}",
                 wall_s=time.perf_counter() - start,
             )
-            return Trajectory(
-                model=self.name,
-                scene_name=scene.name,
-                times=np.zeros(0),
-                values={},
-                k_index={},
-                stats=stats,
-                settings=settings.as_dict(),
-                options=self.options(),
+            return Trajectory.failed(
+                self.name, scene.name, stats, settings=settings.as_dict(), options=self.options()
             )
         return integrate(system, scene, settings, model=self.name, options=self.options())

@@ -16,8 +16,6 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
-import numpy as np
-
 from rodval.core.scene_file import scene_from_dict
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_ERROR
@@ -27,15 +25,12 @@ from rodval.models import get_model
 
 def failed_run(model: dict, scene_name: str, status: int, message: str) -> dict[str, Any]:
     """A run record for a model that produced nothing (error before integration, timeout...)."""
-    traj = Trajectory(
-        model=model["model"],
-        scene_name=scene_name,
-        times=np.zeros(0),
-        values={},
-        k_index={},
-        stats=SolverStats(status=status, message=message),
-        settings=dict(model["settings"]),
-        options=dict(model["options"]),
+    traj = Trajectory.failed(
+        model["model"],
+        scene_name,
+        SolverStats(status=status, message=message),
+        settings=model["settings"],
+        options=model["options"],
     )
     return {"label": model["label"], "setup_s": 0.0, "trajectory": traj.to_dict()}
 
