@@ -51,9 +51,7 @@ def test_scipy_and_compiled_guards_give_one_verdict(model):
     assert scipy_verdict[1] == compiled_verdict[1]
     # the message is the shared one, with this state's figures: T = SCALE^2 T(0)
     T0 = system.kinetic_energy(0.0, system.y0)
-    assert scipy_verdict[1] == blowup_message(
-        SCALE**2 * T0, 100.0, guard.spec.budget(0.0), T_CHECK
-    )
+    assert scipy_verdict[1] == blowup_message(SCALE**2 * T0, 100.0, guard.spec.budget(0.0), T_CHECK)
 
 
 def test_exudyn_guard_gives_the_native_verdict():

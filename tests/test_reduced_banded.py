@@ -7,6 +7,7 @@ import pytest
 
 from rodval.core.loads import constant, pulse
 from rodval.core.scene import Chain, InitialState, Scene
+from rodval.models import reduced_band_lu as lu
 from rodval.models import reduced_banded as rb
 from rodval.models.paper_matrices import (
     angle_differences,
@@ -194,13 +195,13 @@ def test_accel_wrapper_and_band_structure():
     ddphi, _ = rb.bending_at(Cst, phi, dphi, (SX, SY), True, rb.METHOD_SWEEP)
     np.testing.assert_array_equal(out, ddphi)
     assert_close(out, ref.numpy_rhs(0.3, np.concatenate([phi, dphi]))[n:])
-    scales = Cst[rb.C_RSCALE :]
+    scales = Cst[lu.C_RSCALE :]
     np.testing.assert_array_equal(np.exp2(np.round(np.log2(scales))), scales)
-    T = rb._magnitudes(Cst)  # (7n, W), row i holds columns i-KL .. i+KL+KU
-    assert not np.any(T[:, rb.KL + rb.KU + 1 :]), "the pivoting fill columns must start empty"
-    for i in range(rb.NB * n):
-        cols = i - rb.KL + np.flatnonzero(T[i])
-        assert cols.min() >= 0 and cols.max() < rb.NB * n
+    T = lu._magnitudes(Cst)  # (7n, W), row i holds columns i-KL .. i+KL+KU
+    assert not np.any(T[:, lu.KL + lu.KU + 1 :]), "the pivoting fill columns must start empty"
+    for i in range(lu.NB * n):
+        cols = i - lu.KL + np.flatnonzero(T[i])
+        assert cols.min() >= 0 and cols.max() < lu.NB * n
 
 
 @pytest.mark.parametrize("method", [rb.METHOD_AUTO, rb.METHOD_SWEEP, rb.METHOD_BAND])
@@ -259,28 +260,28 @@ def band_residual(Cst, phi, dphi, SX, SY, ddphi, gamma):
     completed by its prefix/suffix sums, in the unscaled 7n x 7n banded system (residual in
     long double)."""
     n = phi.size
-    N = rb.NB * n
+    N = lu.NB * n
     c, s = np.cos(phi), np.sin(phi)
     vec = np.empty(5 * n)
     rb._forces(Cst, phi, dphi, c, s, True, SX, SY, True, vec)
     unscaled = Cst.copy()
-    unscaled[rb.C_RSCALE :] = 1.0
-    A = np.empty((N, rb.W))
+    unscaled[lu.C_RSCALE :] = 1.0
+    A = np.empty((N, lu.W))
     for k in range(n):
-        rb._fill_rod(unscaled, k, c, s, A, -1)
-    i = rb.NB * np.arange(n)
+        lu._fill_rod(unscaled, k, c, s, A, -1)
+    i = lu.NB * np.arange(n)
     b = np.zeros(N)
-    b[i + rb.E_PHI], b[i + rb.E_AL], b[i + rb.E_BE] = vec[:n], vec[n : 2 * n], vec[2 * n : 3 * n]
+    b[i + lu.E_PHI], b[i + lu.E_AL], b[i + lu.E_BE] = vec[:n], vec[n : 2 * n], vec[2 * n : 3 * n]
     l, M = Cst[rb.V_L], Cst[rb.V_OUTER]
     u = np.zeros(N)
-    u[i + rb.U_X], u[i + rb.U_A], u[i + rb.U_B] = ddphi, gamma[:n], gamma[n:]
-    for e, u_p, u_s in ((c, rb.U_PX, rb.U_SX), (s, rb.U_PY, rb.U_SY)):
+    u[i + lu.U_X], u[i + lu.U_A], u[i + lu.U_B] = ddphi, gamma[:n], gamma[n:]
+    for e, u_p, u_s in ((c, lu.U_PX, lu.U_SX), (s, lu.U_PY, lu.U_SY)):
         u[i + u_p] = np.concatenate([[0.0], np.cumsum(l * e * ddphi)[:-1]])
         u[i + u_s] = np.cumsum((M * l * e * ddphi)[::-1])[::-1]
     r = b.astype(np.longdouble)
     size = np.abs(b)
-    for o in range(rb.W):
-        cols = np.arange(N) - rb.KL + o
+    for o in range(lu.W):
+        cols = np.arange(N) - lu.KL + o
         rows = np.flatnonzero((cols >= 0) & (cols < N))
         r[rows] -= A[rows, o].astype(np.longdouble) * u[cols[rows]].astype(np.longdouble)
         size[rows] += np.abs(A[rows, o] * u[cols[rows]])

@@ -35,7 +35,8 @@ from rodval.models.kernels import (
     full_accel,
 )
 from rodval.models.paper_matrices import rod_momenta
-from rodval.models.reduced_banded import _band_size, _forces, _solve_band, _solve_sweep
+from rodval.models.reduced_band_lu import _band_size, _solve_band
+from rodval.models.reduced_banded import _forces, _solve_sweep
 
 #: Another armed latch locks together with the one whose crossing was located when its
 #: angle is within this distance (rad) of its latch angle at that time.
