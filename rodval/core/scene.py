@@ -359,6 +359,84 @@ def _times_array(value) -> np.ndarray:
     return arr.astype(float)
 
 
+def _scene_loads(loads: Any, n: int) -> tuple[NodalForce, ...]:
+    """The scene's loads as a tuple of NodalForce on nodes 1..n (ValueError otherwise)."""
+    if isinstance(loads, (str, bytes, dict)) or not isinstance(loads, Iterable):
+        raise ValueError(
+            f"loads must be a sequence of NodalForce (e.g. () for none), got {loads!r}"
+        )
+    out = tuple(loads)
+    for f in out:
+        if not isinstance(f, NodalForce):
+            raise ValueError(f"loads must be NodalForce objects, got {type(f).__name__}")
+        if f.node > n:
+            raise ValueError(f"load node must be in 1..n = 1..{n}, got {f.node}")
+    return out
+
+
+def _scene_times(times: Any, t_end: float) -> np.ndarray:
+    """The output times (s) as a read-only array: finite, strictly increasing, in
+    [0, t_end]; None gives the default grid."""
+    arr = output_times(0.0, t_end, DEFAULT_NUM_TIMES) if times is None else _times_array(times)
+    if arr.ndim != 1 or arr.size == 0:
+        raise ValueError("times (output times) must be a non-empty 1-D sequence of seconds")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"times (output times) must be finite, got {arr.tolist()}")
+    if np.any(np.diff(arr) <= 0):
+        raise ValueError("times (output times) must be strictly increasing")
+    if arr[0] < 0 or arr[-1] > t_end * (1 + 1e-12):
+        raise ValueError(
+            f"times (output times) must lie in [0, t_end] = [0, {t_end}], got [{arr[0]}, {arr[-1]}]"
+        )
+    arr = arr.copy()
+    arr.setflags(write=False)
+    return arr
+
+
+def _scene_outputs(outputs: Any) -> tuple[str, ...]:
+    """The requested quantities as a tuple without repeats (a single name allowed)."""
+    if isinstance(outputs, Iterable) and not isinstance(outputs, str | list | tuple | dict):
+        outputs = tuple(outputs)
+    if not isinstance(outputs, str | list | tuple):
+        raise ValueError(f"outputs must be a non-empty subset of {QUANTITIES}, got {outputs!r:.60}")
+    names = (outputs,) if isinstance(outputs, str) else tuple(outputs)
+    bad = [q for q in names if q not in QUANTITIES]
+    if bad or not names:
+        raise ValueError(f"outputs must be a non-empty subset of {QUANTITIES}, got {list(names)}")
+    return tuple(dict.fromkeys(names))
+
+
+def _hinge_items(label: str, cls: type, items: Any, n: int) -> tuple:
+    """The scene's latches or stops (``label``) as a tuple of ``cls`` on hinges 0..n-1."""
+    if isinstance(items, (str, bytes, dict)) or not isinstance(items, Iterable):
+        raise ValueError(f"{label} must be a sequence of rodval.{cls.__name__}")
+    out = tuple(items)
+    for item in out:
+        if not isinstance(item, cls):
+            raise ValueError(
+                f"{label} must be rodval.{cls.__name__} objects, got {type(item).__name__}"
+            )
+        _index(f"{label[:-1] if label == 'stops' else 'latch'} hinge", item.hinge, n)
+    return out
+
+
+def _check_latches(latches: tuple[Latch, ...], D0: np.ndarray) -> None:
+    """At most one latch per hinge, each ahead of its hinge's initial angle D0 (rad) in its
+    direction."""
+    hinges = [latch.hinge for latch in latches]
+    if len(set(hinges)) != len(hinges):
+        raise ValueError(f"at most one latch per hinge, got hinges {hinges}")
+    for latch in latches:
+        d0 = D0[latch.hinge]
+        side = np.sign(latch.angle - d0)
+        if side == 0 or (latch.direction is not None and side != latch.direction):
+            raise ValueError(
+                f"latch on hinge {latch.hinge}: the hinge starts at D = {d0:.6g} rad, at or "
+                f"beyond its latch angle {latch.angle:.6g} rad"
+                + (f" in direction {latch.direction:+d}" if latch.direction else "")
+            )
+
+
 @dataclass(frozen=True, eq=False)
 class Scene:
     """A complete simulation request: the *what*, independent of any model or integrator.
@@ -409,51 +487,10 @@ class Scene:
             allowed="finite and > 0 s",
         )
         object.__setattr__(self, "t_end", t_end)
-        if isinstance(self.loads, (str, bytes, dict)) or not isinstance(self.loads, Iterable):
-            raise ValueError(
-                f"loads must be a sequence of NodalForce (e.g. () for none), got {self.loads!r}"
-            )
-        loads = tuple(self.loads)
-        for f in loads:
-            if not isinstance(f, NodalForce):
-                raise ValueError(f"loads must be NodalForce objects, got {type(f).__name__}")
-            if f.node > n:
-                raise ValueError(f"load node must be in 1..n = 1..{n}, got {f.node}")
-        object.__setattr__(self, "loads", loads)
-        times = (
-            output_times(0.0, t_end, DEFAULT_NUM_TIMES)
-            if self.times is None
-            else _times_array(self.times)
-        )
-        if times.ndim != 1 or times.size == 0:
-            raise ValueError("times (output times) must be a non-empty 1-D sequence of seconds")
-        if not np.all(np.isfinite(times)):
-            raise ValueError(f"times (output times) must be finite, got {times.tolist()}")
-        if np.any(np.diff(times) <= 0):
-            raise ValueError("times (output times) must be strictly increasing")
-        if times[0] < 0 or times[-1] > t_end * (1 + 1e-12):
-            raise ValueError(
-                f"times (output times) must lie in [0, t_end] = [0, {t_end}], "
-                f"got [{times[0]}, {times[-1]}]"
-            )
-        times = times.copy()
-        times.setflags(write=False)
+        object.__setattr__(self, "loads", _scene_loads(self.loads, n))
+        times = _scene_times(self.times, t_end)
         object.__setattr__(self, "times", times)
-        if isinstance(self.outputs, Iterable) and not isinstance(
-            self.outputs, str | list | tuple | dict
-        ):
-            object.__setattr__(self, "outputs", tuple(self.outputs))
-        if not isinstance(self.outputs, str | list | tuple):
-            raise ValueError(
-                f"outputs must be a non-empty subset of {QUANTITIES}, got {self.outputs!r:.60}"
-            )
-        outputs = (self.outputs,) if isinstance(self.outputs, str) else tuple(self.outputs)
-        bad = [q for q in outputs if q not in QUANTITIES]
-        if bad or not outputs:
-            raise ValueError(
-                f"outputs must be a non-empty subset of {QUANTITIES}, got {list(outputs)}"
-            )
-        object.__setattr__(self, "outputs", tuple(dict.fromkeys(outputs)))
+        object.__setattr__(self, "outputs", _scene_outputs(self.outputs))
         check_run_memory(
             n,
             times.size,
@@ -463,32 +500,10 @@ class Scene:
         if not isinstance(self.initial, InitialState):
             raise ValueError("initial must be a rodval.InitialState")
         init = self.initial.resolve(n)  # validate now, before any work
-        for label, cls in (("latches", Latch), ("stops", Stop)):
-            items = getattr(self, label)
-            if isinstance(items, (str, bytes, dict)) or not isinstance(items, Iterable):
-                raise ValueError(f"{label} must be a sequence of rodval.{cls.__name__}")
-            items = tuple(items)
-            for item in items:
-                if not isinstance(item, cls):
-                    raise ValueError(
-                        f"{label} must be rodval.{cls.__name__} objects, got {type(item).__name__}"
-                    )
-                _index(f"{label[:-1] if label == 'stops' else 'latch'} hinge", item.hinge, n)
-            object.__setattr__(self, label, items)
+        object.__setattr__(self, "latches", _hinge_items("latches", Latch, self.latches, n))
+        object.__setattr__(self, "stops", _hinge_items("stops", Stop, self.stops, n))
         _check_acting_stops(self.chain, self.stops)
-        hinges = [latch.hinge for latch in self.latches]
-        if len(set(hinges)) != len(hinges):
-            raise ValueError(f"at most one latch per hinge, got hinges {hinges}")
-        D0 = hinge_angles(init["phi"], init["alpha"], init["beta"])
-        for latch in self.latches:
-            d0 = D0[latch.hinge]
-            side = np.sign(latch.angle - d0)
-            if side == 0 or (latch.direction is not None and side != latch.direction):
-                raise ValueError(
-                    f"latch on hinge {latch.hinge}: the hinge starts at D = {d0:.6g} rad, at or "
-                    f"beyond its latch angle {latch.angle:.6g} rad"
-                    + (f" in direction {latch.direction:+d}" if latch.direction else "")
-                )
+        _check_latches(self.latches, hinge_angles(init["phi"], init["alpha"], init["beta"]))
 
     @property
     def n(self) -> int:

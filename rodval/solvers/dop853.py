@@ -188,6 +188,49 @@ def _dense_output(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero, times, n
     return n_out
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, reporting, cnt):
+    """Step attempts from (t, y) towards t_bound with Hairer's step-size control until one is
+    accepted (its stages in K, its solution in y_new). ``controls`` as in ``run``; ``cnt``:
+    [evaluations used, evaluation count at the next clock read], updated. Returns (code, t
+    of the accepted step's end, the next step size): ``OK``, or ``STEP_TOO_SMALL``,
+    ``BUDGET``, ``WALL`` or ``NON_FINITE`` with t unchanged."""
+    rtol, atol, max_step, max_nfev, deadline = (
+        controls[0],
+        controls[1],
+        controls[2],
+        controls[4],
+        controls[5],
+    )
+    clocked = deadline < np.inf or reporting
+    min_step = 10.0 * (np.nextafter(t, np.inf) - t)
+    h_abs = min(max(h_abs, min_step), max_step)
+    rejected = False
+    while True:
+        if h_abs < min_step:
+            return STEP_TOO_SMALL, t, h_abs
+        if cnt[0] >= max_nfev:
+            return BUDGET, t, h_abs
+        if clocked and cnt[0] >= cnt[1]:
+            cnt[1] = cnt[0] + WALL_CHECK_EVALUATIONS
+            now = _report_and_now(t) if reporting else _now()
+            if now > deadline:
+                return WALL, t, h_abs
+        t_new = min(t + h_abs, t_bound)
+        h_abs = t_new - t
+        err = _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol)
+        cnt[0] += N_STAGES
+        if not np.isfinite(err):
+            return NON_FINITE, t, h_abs
+        if err < 1.0:
+            factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
+            if rejected:
+                factor = min(1.0, factor)
+            return OK, t_new, h_abs * factor
+        h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
+        rejected = True
+
+
 _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64, types.float64))(
     RHS_TYPE,
     RHS_TYPE,
@@ -224,7 +267,6 @@ def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting
     Returns (number of output times written, nfev, accepted steps, code, t reached).
     """
     rtol, atol, max_step, first_step = controls[0], controls[1], controls[2], controls[3]
-    max_nfev, deadline = controls[4], controls[5]
     N = y0.shape[0]
     y = y0.copy()
     K = np.empty((16, N))
@@ -235,10 +277,8 @@ def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting
     zero = np.zeros(N)
     nt = times.shape[0]
     n_out = 0
-    nfev = 0
+    cnt = np.zeros(2, np.int64)  # evaluations, and the count at the next clock read
     nsteps = 0
-    clocked = deadline < np.inf or reporting
-    next_clock = 0
     guarded = np.isfinite(guard[2])
     mech = np.zeros(2)
     t = edges[0]
@@ -252,63 +292,39 @@ def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting
         t = edges[seg]
         t_bound = edges[seg + 1]
         rhs(t, y, P, S, M, L, K[0])
-        nfev += 1
+        cnt[0] += 1
         if first_step > 0:
             h_abs = min(first_step, t_bound - t)
         else:
             h_abs = _initial_step(
                 rhs, P, S, M, L, t, y, K[0], t_bound, rtol, atol, max_step, tmp, f1
             )
-            nfev += 1
+            cnt[0] += 1
         while t < t_bound:
-            min_step = 10.0 * (np.nextafter(t, np.inf) - t)
-            h_abs = min(max(h_abs, min_step), max_step)
-            rejected = False
-            while True:
-                if h_abs < min_step:
-                    return n_out, nfev, nsteps, STEP_TOO_SMALL, t
-                if nfev >= max_nfev:
-                    return n_out, nfev, nsteps, BUDGET, t
-                if clocked and nfev >= next_clock:
-                    next_clock = nfev + WALL_CHECK_EVALUATIONS
-                    now = _report_and_now(t) if reporting else _now()
-                    if now > deadline:
-                        return n_out, nfev, nsteps, WALL, t
-                t_new = min(t + h_abs, t_bound)
-                h = t_new - t
-                h_abs = h
-                err = _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol)
-                nfev += N_STAGES
-                if not np.isfinite(err):
-                    return n_out, nfev, nsteps, NON_FINITE, t
-                if err < 1.0:
-                    factor = (
-                        MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
-                    )
-                    if rejected:
-                        factor = min(1.0, factor)
-                    h_abs *= factor
-                    break
-                h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
-                rejected = True
+            code, t_new, h_abs = _step_control(
+                rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, reporting, cnt
+            )
+            if code != OK:
+                return n_out, cnt[0], nsteps, code, t
+            h = t_new - t
             nsteps += 1
             if not np.all(np.isfinite(y_new)):
-                return n_out, nfev, nsteps, NON_FINITE, t
+                return n_out, cnt[0], nsteps, NON_FINITE, t
             if guarded:
                 mechanics(t_new, y_new, P, S, M, L, mech)
             code = guard_step(guard, mon, h, mech, guarded)
             if code != OK:
-                return n_out, nfev, nsteps, code, t
+                return n_out, cnt[0], nsteps, code, t
             if n_out < nt and times[n_out] <= t_new:
                 n_out = _dense_output(
                     rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero, times, n_out, Y
                 )
-                nfev += 3
+                cnt[0] += 3
             t = t_new
             for i in range(N):
                 y[i] = y_new[i]
                 K[0, i] = K[N_STAGES, i]
-    return n_out, nfev, nsteps, OK, t
+    return n_out, cnt[0], nsteps, OK, t
 
 
 def integrate_compiled(
