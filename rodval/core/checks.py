@@ -9,7 +9,7 @@ import math
 import numbers
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 
 def check_keys(
@@ -94,7 +94,7 @@ def check_number(
     The one number validator of rodval: types before values, the unit in the message."""
     kind = numbers.Integral if integer else numbers.Real
     if isinstance(value, kind) and not isinstance(value, bool):
-        v = int(value) if integer else float(value)
+        v = int(cast(int, value)) if integer else float(value)
         if (
             not math.isnan(v)
             and (math.isfinite(v) or not finite)

@@ -406,11 +406,11 @@ def _scene_outputs(outputs: Any) -> tuple[str, ...]:
     return tuple(dict.fromkeys(names))
 
 
-def _hinge_items(label: str, cls: type, items: Any, n: int) -> tuple:
+def _hinge_items(label: str, cls: type[Latch] | type[Stop], items: Any, n: int) -> tuple[Any, ...]:
     """The scene's latches or stops (``label``) as a tuple of ``cls`` on hinges 0..n-1."""
     if isinstance(items, (str, bytes, dict)) or not isinstance(items, Iterable):
         raise ValueError(f"{label} must be a sequence of rodval.{cls.__name__}")
-    out = tuple(items)
+    out: tuple[Any, ...] = tuple(items)
     for item in out:
         if not isinstance(item, cls):
             raise ValueError(

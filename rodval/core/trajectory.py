@@ -46,30 +46,6 @@ class SolverStats:
             value = Status(value)
         object.__setattr__(self, name, value)
 
-    @classmethod
-    def failed(
-        cls,
-        model: str,
-        scene_name: str,
-        stats: SolverStats,
-        *,
-        settings: dict | None = None,
-        options: dict | None = None,
-    ) -> Trajectory:
-        """The trajectory of a run that produced no output time (a set-up error, a timeout, a
-        crashed worker): no times, no values; ``stats`` says how it ended. The one
-        constructor of a failed run, for every model and the study runner."""
-        return cls(
-            model=model,
-            scene_name=scene_name,
-            times=np.zeros(0),
-            values={},
-            k_index={},
-            stats=stats,
-            settings=dict(settings or {}),
-            options=dict(options or {}),
-        )
-
     @property
     def success(self) -> bool:
         return self.status == STATUS_SUCCESS
@@ -129,6 +105,30 @@ class Trajectory:
     #: read from files or records, whose scene is in run.json / the case record). ``compare``
     #: refuses two runs of different scenes. Not part of equality or of ``to_dict``.
     scene: Any = field(default=None, compare=False, repr=False)
+
+    @classmethod
+    def failed(
+        cls,
+        model: str,
+        scene_name: str,
+        stats: SolverStats,
+        *,
+        settings: dict | None = None,
+        options: dict | None = None,
+    ) -> Trajectory:
+        """The trajectory of a run that produced no output time (a set-up error, a timeout, a
+        crashed worker): no times, no values; ``stats`` says how it ended. The one
+        constructor of a failed run, for every model and the study runner."""
+        return cls(
+            model=model,
+            scene_name=scene_name,
+            times=np.zeros(0),
+            values={},
+            k_index={},
+            stats=stats,
+            settings=dict(settings or {}),
+            options=dict(options or {}),
+        )
 
     @property
     def success(self) -> bool:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from contextlib import contextmanager
 from functools import cached_property
 from typing import Any
@@ -394,6 +395,14 @@ class PaperSystem(OdeSystem):
         alpha, beta = self.bending(np.array([t]), Y)[:2]
         return hinge_angles(phi, alpha, beta)[0]
 
+    def _hinge_crossing(self, hinge: int, angle: float) -> Callable[[float, np.ndarray], float]:
+        """The event function g(t, y) = D_hinge - angle (rad) of a latch or stop."""
+
+        def g(t: float, y: np.ndarray) -> float:
+            return float(self.hinge_angles_at(t, y)[hinge] - angle)
+
+        return g
+
     def hinge_rates(self, y: np.ndarray) -> np.ndarray:
         """dD_k/dt as the model's dampers see it: A q' (reduced: chord rates, the bending
         rates being dropped)."""
@@ -427,7 +436,7 @@ class PaperSystem(OdeSystem):
                 continue
             specs.append(
                 EventSpec(
-                    g=lambda t, y, h=la.hinge, a=la.angle: self.hinge_angles_at(t, y)[h] - a,
+                    g=self._hinge_crossing(la.hinge, la.angle),
                     direction=self.latch_dir[j],
                     label=f"latch hinge {la.hinge}",
                 )
@@ -439,7 +448,7 @@ class PaperSystem(OdeSystem):
             entering = 1 if st.side == "upper" else -1
             specs.append(
                 EventSpec(
-                    g=lambda t, y, h=st.hinge, a=st.angle: self.hinge_angles_at(t, y)[h] - a,
+                    g=self._hinge_crossing(st.hinge, st.angle),
                     direction=-entering if self.stop_active[i] else entering,
                     label=f"stop hinge {st.hinge}",
                 )

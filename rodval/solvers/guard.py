@@ -36,7 +36,6 @@ from rodval.core.status import (
     STATUS_DIVERGED,
     STATUS_ERROR,
     STATUS_STALLED,
-    Status,
     numerical_failure,
 )
 from rodval.solvers.system import OdeSystem
@@ -46,7 +45,7 @@ from rodval.solvers.system import OdeSystem
 ENERGY_FLOOR_J = 1e-6
 
 #: A verdict: the status and its one-line message.
-Verdict = tuple[Status, str]
+Verdict = tuple[int, str]
 
 
 @dataclass(frozen=True)
