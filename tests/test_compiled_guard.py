@@ -26,7 +26,7 @@ def test_compiled_mechanics_equal_the_python_energy_and_power(model, coefficient
     scene = Scene(chain=chain, loads=(pulse(5, T=1.0), constant(2, X=3.0, Y=-4.0)), t_end=1.0)
     system = get_model(model, coefficients=coefficients).system(scene)
     form = system.compiled()
-    out = np.zeros(2)
+    out = np.zeros(3)
     for t in (0.2, 0.7):
         y = rng.normal(size=system.y0.size)
         form.mechanics(t, y, form.P, form.S, form.M, form.L, out)
@@ -45,11 +45,11 @@ def test_compiled_loop_stops_when_kinetic_energy_exceeds_its_budget():
     Y = np.empty((scene.times.size, system.y0.size))
     edges = np.array([0.0, 0.5])
     args = (form, system.y0, edges, scene.times, 1e-8, 1e-10, np.inf, None, 10**7)
-    n_out, _, _, code, t, _ = dop853.integrate_compiled(
+    n_out, _, _, code, t, *_ = dop853.integrate_compiled(
         *args, GuardSpec(stall_steps=1000, blowup_factor=0.5), Y
     )
     assert code == dop853.BLOWUP and 0 < t < 0.5 and n_out < scene.times.size
-    n_out, _, _, code, t, _ = dop853.integrate_compiled(
+    n_out, _, _, code, t, *_ = dop853.integrate_compiled(
         *args, GuardSpec(stall_steps=1000, blowup_factor=1.0001), Y
     )
     assert code == dop853.OK and t == 0.5 and n_out == scene.times.size

@@ -41,7 +41,7 @@ def test_scipy_and_compiled_guards_give_one_verdict(model):
     y = _scaled(system)
     scipy_verdict = guard.check(T_CHECK - H, T_CHECK, y)
     form = system.compiled()
-    mech = np.zeros(2)
+    mech = np.zeros(3)
     form.mechanics(T_CHECK, y, form.P, form.S, form.M, form.L, mech)
     mon = np.zeros(6)
     mon[3] = 0.0  # no loads: the positive power at the start is 0

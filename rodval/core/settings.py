@@ -19,8 +19,8 @@ SCIPY_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 #: loop, for systems that have a compiled form (native models, tabulated load laws).
 COMPILED_METHODS = ("DOP853-numba",)
 #: "auto": the compiled DOP853 when the model and scene have a compiled form and nothing the
-#: compiled loop cannot do is asked for (the energy audit), scipy's DOP853 otherwise. The
-#: Trajectory records the method that ran.
+#: compiled loop cannot do is asked for (events: stops, latches), scipy's DOP853 otherwise;
+#: the energy audit runs inside the compiled loop. The Trajectory records the method that ran.
 AUTO = "auto"
 #: Every method name accepted by IntegratorSettings (simulate, CLI, studies).
 METHODS = (AUTO,) + SCIPY_METHODS + COMPILED_METHODS

@@ -339,10 +339,28 @@ def _load_power(V, c, s, dphi, L, t):
     return p
 
 
+@njit(cache=True)
+def _damper_power(V, S, dphi, dalpha, dbeta):
+    """sum_k nu_k (dD_k/dt)^2 (W), dD_k/dt = phi'_k + alpha'_k - phi'_{k-1} - beta'_{k-1}
+    (the hinge rates, ``rodval.core.scene.hinge_angles`` of the rates); 0 unless S[0] (the
+    damped flag). O(n)."""
+    if S[0] == 0.0:
+        return 0.0
+    nu = V[V_NU]
+    p = 0.0
+    left = 0.0
+    for k in range(dphi.shape[0]):
+        rate = dphi[k] + dalpha[k] - left
+        p += nu[k] * rate * rate
+        left = dphi[k] + dbeta[k]
+    return p
+
+
 @njit(RHS_SIGNATURE, cache=True)
 def full_mechanics(t, y, P, S, M, L, out):
-    """(T, P_ext) of the full model: T = 1/2 q'^T M q' with the kinematic (printed, symmetric)
-    mass matrix, O(n)."""
+    """(T, P_ext, P_diss) of the full model into out[:3]: T = 1/2 q'^T M q' (J) with the
+    kinematic (printed, symmetric) mass matrix, the load power (W) and the damper power
+    sum_k nu_k (dD_k/dt)^2 (W; 0 unless S[0], the damped flag). O(n)."""
     n = P.shape[1]
     phi, dphi = y[:n], y[3 * n : 4 * n]
     va, vb = y[4 * n : 5 * n], y[5 * n :]
@@ -357,15 +375,19 @@ def full_mechanics(t, y, P, S, M, L, out):
         T += aa[k] * (va[k] * va[k] + vb[k] * vb[k]) + 2.0 * ab[k] * va[k] * vb[k]
     out[0] = 0.5 * T
     out[1] = _load_power(P, c, s, dphi, L, t)
+    out[2] = _damper_power(P, S, dphi, va, vb)
 
 
 @njit(RHS_SIGNATURE, cache=True)
 def reduced_mechanics(t, y, P, S, M, L, out):
-    """(T, P_ext) of the reduced model: T = 1/2 phi'^T M_pp phi' (its bending rates are
-    dropped), O(n)."""
+    """(T, P_ext, P_diss) of the reduced model into out[:3]: T = 1/2 phi'^T M_pp phi' (J; its
+    bending rates are dropped, in its dampers too: P_diss = sum_k nu_k (phi'_k -
+    phi'_{k-1})^2, W), the load power (W). O(n)."""
     n = P.shape[1]
     phi, dphi = y[:n], y[n:]
     c = np.cos(phi)
     s = np.sin(phi)
     out[0] = 0.5 * _mpp_quadratic(P, c, s, dphi)
     out[1] = _load_power(P, c, s, dphi, L, t)
+    zero = np.zeros(n)
+    out[2] = _damper_power(P, S, dphi, zero, zero)

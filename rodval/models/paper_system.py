@@ -113,7 +113,7 @@ class PaperSystem(OdeSystem):
             self.V = self.kernel_constants()
             self._no_load = np.zeros(self.n)
             self._flags = np.array([1.0 if self.damped else 0.0])
-            self._mech = np.zeros(2)
+            self._mech = np.zeros(3)
         self.rhs(0.0, self.y0)
 
     def kernel_constants(self) -> np.ndarray:

@@ -6,7 +6,8 @@ D(t) = int_0^t P_diss dt >= 0 is the energy taken out by the hinge dampers,
 P_diss = q'^T C q' (W). Both powers come from the model's ``OdeSystem.power``.
 
 The powers are integrated per accepted step of the integrator by Gauss-Legendre quadrature on
-the step's dense output (``GAUSS_NODES`` nodes, exact for polynomials of degree
+the step's dense output (here for scipy's steps; the compiled DOP853 loop does the same inside
+its loop, ``rodval.solvers.dop853._audit_step``) (``GAUSS_NODES`` nodes, exact for polynomials of degree
 2 GAUSS_NODES - 1 >= the order of every scipy dense output). The trajectory itself is
 not changed by the audit: the integrator's step selection sees the same state as without it.
 An exact balance gives R(t) = 0; what each model leaves in R is in docs/stability.md.
@@ -55,6 +56,12 @@ class PowerLedger:
         for t in out_times:
             self._records.append(self.total + step_integral(self.power, dense, t0, t))
         self.total = self.total + step_integral(self.power, dense, t0, t1)
+
+    def replace(self, rows: np.ndarray) -> None:
+        """Take the running [W_ext, D] (J) at the output times from an integrator that
+        audits inside its own loop (the compiled DOP853): ``rows`` (outputs reached, 2)."""
+        self._records = [np.array(r, float) for r in rows]
+        self.total = np.array(rows[-1], float) if len(rows) else np.zeros(2)
 
     def series(self) -> tuple[np.ndarray, np.ndarray]:
         """W_ext, D (J) at the recorded output times."""

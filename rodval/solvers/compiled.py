@@ -24,6 +24,7 @@ from rodval.core.status import (
 )
 from rodval.core.trajectory import SolverStats
 from rodval.solvers import dop853, progress
+from rodval.solvers.audit import PowerLedger
 from rodval.solvers.guard import GuardSpec, blowup_message, diverged_message, stalled_message
 from rodval.solvers.system import CompiledForm
 
@@ -58,14 +59,16 @@ def run_compiled(
     guard: GuardSpec,
     Y: np.ndarray,
     stats: SolverStats,
+    ledger: PowerLedger | None = None,
 ) -> int:
     """Integrate over [edges[0], edges[-1]] restarting at each interior edge (the scene's
     breakpoints), writing states at the output times into Y; fills ``stats`` (status,
     message, t_reached, nfev, nsteps) and returns the number of output times reached.
     The divergence guard ``guard`` runs inside the loop, with the verdicts and messages of
-    ``rodval.solvers.guard``."""
+    ``rodval.solvers.guard``; with a ``ledger`` the energy audit too (its records become the
+    loop's running W_ext, D at the output times reached)."""
     try:
-        n_out, nfev, nsteps, code, t, mon = dop853.integrate_compiled(
+        n_out, nfev, nsteps, code, t, mon, work = dop853.integrate_compiled(
             form,
             y0,
             edges,
@@ -79,6 +82,7 @@ def run_compiled(
             Y,
             deadline=time.perf_counter() + settings.max_wall_s,
             reporting=progress.reporting(),
+            audit=ledger is not None,
         )
     except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
         # raised by a model's kernel: the loop's time is lost, t_reached stays at the start
@@ -87,6 +91,8 @@ def run_compiled(
             f"{type(exc).__name__}: {exc}",
         )
         return 0
+    if ledger is not None:
+        ledger.replace(work)
     stats.nfev += nfev
     stats.nsteps += nsteps
     stats.t_reached = t

@@ -20,11 +20,13 @@ from __future__ import annotations
 
 import math
 import time
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, objmode, types
 from scipy.integrate._ivp import dop853_coefficients as dc
 
+from rodval.solvers.audit import GAUSS_NODES
 from rodval.solvers.guard import GuardSpec
 from rodval.solvers.progress import report
 from rodval.solvers.signature import F1 as _F1
@@ -39,6 +41,7 @@ _C = np.ascontiguousarray(dc.C)
 _E3 = np.ascontiguousarray(dc.E3)
 _E5 = np.ascontiguousarray(dc.E5)
 _D = np.ascontiguousarray(dc.D)
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(GAUSS_NODES)
 
 #: Return codes of ``run``.
 OK, STEP_TOO_SMALL, NON_FINITE, BUDGET, BLOWUP, STALLED, WALL = 0, 1, 2, 3, 4, 5, 6
@@ -159,13 +162,11 @@ def _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _dense_output(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero, times, n_out, Y):
-    """The 7th-order interpolant over the accepted step [t, t_new] (three extra stages) at
-    every output time in it, written into Y from row n_out (``zero``: N zeros); returns the
-    next row."""
+def _dense_coefficients(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero):
+    """The 7th-order interpolant's coefficients F over the accepted step [t, t_new]: three
+    extra stages (3 evaluations), O(N) each combination (``zero``: N zeros)."""
     N = y.shape[0]
     h = t_new - t
-    nt = times.shape[0]
     for s in range(N_STAGES + 1, 16):
         _combine(tmp, y, K, _A[s], s, h)
         rhs(t + _C[s] * h, tmp, P, S, M, L, K[s])
@@ -176,16 +177,66 @@ def _dense_output(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero, times, n
         F[2, i] = 2.0 * f0 - h * (K[N_STAGES, i] + K[0, i])
     for p in range(4):
         _combine(F[3 + p], zero, K, _D[p], 16, h)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _interpolate(F, y, x, out):
+    """The state at the fraction x of the step (the interpolant with coefficients F) into
+    out. O(N)."""
+    for q in range(y.shape[0]):
+        acc = 0.0
+        for i in range(7):
+            acc += F[6 - i, q]
+            acc *= x if i % 2 == 0 else 1.0 - x
+        out[q] = acc + y[q]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _write_outputs(F, y, t, t_new, times, n_out, Y):
+    """The interpolated states at every output time in (t, t_new] into Y from row n_out;
+    returns the next row."""
+    nt = times.shape[0]
+    h = t_new - t
     while n_out < nt and times[n_out] <= t_new:
-        x = (times[n_out] - t) / h
-        for q in range(N):
-            acc = 0.0
-            for i in range(7):
-                acc += F[6 - i, q]
-                acc *= x if i % 2 == 0 else 1.0 - x
-            Y[n_out, q] = acc + y[q]
+        _interpolate(F, y, (times[n_out] - t) / h, Y[n_out])
         n_out += 1
     return n_out
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _power_integral(mechanics, P, S, M, L, F, y, t, h, span, tmp, mech, acc):
+    """[int P_ext, int P_diss] (J) over [t, t + span] inside the step [t, t + h] into acc[:2]:
+    Gauss-Legendre with ``rodval.solvers.audit.GAUSS_NODES`` nodes on the dense output (the
+    scipy path's ``step_integral``). GAUSS_NODES evaluations of ``mechanics``, O(N) each."""
+    acc[0] = 0.0
+    acc[1] = 0.0
+    if span <= 0.0:
+        return
+    for i in range(_GAUSS_X.shape[0]):
+        ts = t + 0.5 * span * (_GAUSS_X[i] + 1.0)
+        _interpolate(F, y, (ts - t) / h, tmp)
+        mechanics(ts, tmp, P, S, M, L, mech)
+        acc[0] += _GAUSS_W[i] * mech[1]
+        acc[1] += _GAUSS_W[i] * mech[2]
+    acc[0] *= 0.5 * span
+    acc[1] *= 0.5 * span
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _audit_step(mechanics, P, S, M, L, F, y, t, t_new, times, n_out, tmp, mech, total, W):
+    """The energy audit over the accepted step [t, t_new]: the running [W_ext, D] (J) at each
+    output time in it into W's rows from n_out, then ``total`` advanced to t_new."""
+    h = t_new - t
+    part = np.empty(2)
+    j = n_out
+    while j < times.shape[0] and times[j] <= t_new:
+        _power_integral(mechanics, P, S, M, L, F, y, t, h, times[j] - t, tmp, mech, part)
+        W[j, 0] = total[0] + part[0]
+        W[j, 1] = total[1] + part[1]
+        j += 1
+    _power_integral(mechanics, P, S, M, L, F, y, t, h, h, tmp, mech, part)
+    total[0] += part[0]
+    total[1] += part[1]
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -245,12 +296,13 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
     _F1,
     types.boolean,
     _F2,
+    _F2,
     _F1,
 )
 
 
 @njit(_RUN_SIGNATURE, cache=True, error_model="numpy")
-def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting, Y, mon):
+def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting, Y, W, mon):
     """Integrate from edges[0] to edges[-1], restarting at each interior edge (breakpoint),
     writing the state at ``times`` into Y.
 
@@ -262,7 +314,13 @@ def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting
 
     ``guard``: ``GuardSpec.as_array()``, checked by ``guard_step`` after every accepted step
     (``mon``: its monitor, the figures of the verdict); ``mechanics(t, y, ...)`` writes
-    (T, P_ext) and runs only when guard[2] (the blow-up factor) is finite.
+    (T, P_ext, P_diss) and runs for the guard only when guard[2] (the blow-up factor) is
+    finite.
+
+    ``W`` (nt, 2), or (0, 2) for no audit: the energy audit's running [W_ext, D] (J) at the
+    output times, the powers integrated on every accepted step as the scipy path does
+    (``_audit_step``; costs 3 evaluations for the dense output on steps without an output
+    time, and GAUSS_NODES (+ GAUSS_NODES per output time) evaluations of ``mechanics``).
 
     Returns (number of output times written, nfev, accepted steps, code, t reached).
     """
@@ -280,7 +338,9 @@ def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting
     cnt = np.zeros(2, np.int64)  # evaluations, and the count at the next clock read
     nsteps = 0
     guarded = np.isfinite(guard[2])
-    mech = np.zeros(2)
+    audited = W.shape[0] > 0
+    total = np.zeros(2)
+    mech = np.zeros(3)
     t = edges[0]
     if guarded:
         mechanics(t, y, P, S, M, L, mech)
@@ -315,16 +375,33 @@ def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting
             code = guard_step(guard, mon, h, mech, guarded)
             if code != OK:
                 return n_out, cnt[0], nsteps, code, t
-            if n_out < nt and times[n_out] <= t_new:
-                n_out = _dense_output(
-                    rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero, times, n_out, Y
-                )
+            outputs = n_out < nt and times[n_out] <= t_new
+            if outputs or audited:
+                _dense_coefficients(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero)
                 cnt[0] += 3
+            if audited:
+                _audit_step(
+                    mechanics, P, S, M, L, F, y, t, t_new, times, n_out, tmp, mech, total, W
+                )
+            if outputs:
+                n_out = _write_outputs(F, y, t, t_new, times, n_out, Y)
             t = t_new
             for i in range(N):
                 y[i] = y_new[i]
                 K[0, i] = K[N_STAGES, i]
     return n_out, cnt[0], nsteps, OK, t
+
+
+class CompiledRun(NamedTuple):
+    """What ``integrate_compiled`` returns."""
+
+    n_out: int  #: output times written
+    nfev: int  #: right-hand-side evaluations
+    nsteps: int  #: accepted steps
+    code: int  #: how the loop ended (OK, STEP_TOO_SMALL, ...)
+    t: float  #: time reached (s)
+    monitor: np.ndarray  #: the guard's figures (``guard_step``)
+    work: np.ndarray  #: the audit's [W_ext, D] (J) at the output times written, (n_out, 2)
 
 
 def integrate_compiled(
@@ -341,20 +418,23 @@ def integrate_compiled(
     Y: np.ndarray,
     deadline: float = math.inf,
     reporting: bool = False,
-) -> tuple[int, int, int, int, float, np.ndarray]:
+    audit: bool = False,
+) -> CompiledRun:
     """Run ``run`` on a CompiledForm (see ``run``; without ``form.mechanics`` there is no
-    blow-up check; ``deadline``: a ``time.perf_counter()`` value, s; ``reporting``: report
-    progress). Returns (outputs written, nfev, accepted steps, code, t reached, monitor): the
-    monitor holds the figures of a guard verdict (``guard_step``)."""
+    blow-up check and no audit; ``deadline``: a ``time.perf_counter()`` value, s;
+    ``reporting``: report progress; ``audit``: integrate the load and damper powers)."""
     g = guard.as_array()
     if form.mechanics is None:
         g[2] = math.inf
+        if audit:
+            raise ValueError("an energy audit needs the compiled form's mechanics")
     mechanics = form.mechanics if form.mechanics is not None else form.rhs
     controls = np.array(
         [rtol, atol, max_step, -1.0 if first_step is None else first_step, max_nfev, deadline],
         float,
     )
     mon = np.zeros(6)
+    W = np.zeros((len(times) if audit else 0, 2))
     n_out, nfev, nsteps, code, t = run(
         form.rhs,
         mechanics,
@@ -369,6 +449,7 @@ def integrate_compiled(
         g,
         bool(reporting),
         Y,
+        W,
         mon,
     )
-    return int(n_out), int(nfev), int(nsteps), int(code), float(t), mon
+    return CompiledRun(int(n_out), int(nfev), int(nsteps), int(code), float(t), mon, W[:n_out])

@@ -68,22 +68,23 @@ def choose_method(system: OdeSystem, scene: Scene, settings: IntegratorSettings)
     for what it cannot do."""
     audit = scene.wants("energy") and system.has_energy
     events = bool(system.event_functions())
+    form = system.compiled()
     if settings.method == AUTO:
-        if not audit and not events and system.compiled() is not None:
+        if not events and form is not None and (form.mechanics is not None or not audit):
             return "DOP853-numba"
         return "DOP853"
     if settings.compiled:
-        if system.compiled() is None:
+        if form is None:
             raise ValueError(
                 f"method {settings.method!r} needs a system with a compiled form "
                 "(native models with kernel='numba' and loads built from rodval's "
                 "load laws: pulse/constant/ramp/harmonic/tabulated, not plain "
                 "callables); use a scipy method or 'auto'"
             )
-        if audit:
+        if audit and form.mechanics is None:
             raise ValueError(
-                f"method {settings.method!r} runs in one compiled loop and cannot "
-                "audit energy; use a scipy method or 'auto' for 'energy' outputs"
+                f"method {settings.method!r} cannot audit energy for this system (its "
+                "compiled form has no mechanics); use a scipy method or 'auto'"
             )
         if events:
             raise ValueError(
@@ -357,7 +358,7 @@ def integrate(
             for _ in at_zero:
                 ledger.record()
         if form is not None:
-            out.n = run_compiled(form, y, edges, scene, settings, guard.spec, out.Y, stats)
+            out.n = run_compiled(form, y, edges, scene, settings, guard.spec, out.Y, stats, ledger)
             t_now = stats.t_reached
         else:
             scipy_run = _ScipyRun(system, scene, settings, method, stats, out, ledger, guard)

@@ -40,9 +40,10 @@ class CompiledForm:
     may be empty), ``L`` (the load
     table, ``rodval.core.loads.load_table``). The integrator passes them through untouched.
 
-    ``mechanics`` (optional, same type): writes (T, P_ext) — kinetic energy (J) and power of
-    the loads (W) — into a length-2 ``out``, for the divergence guard inside the loop; None
-    disables the energy blow-up check.
+    ``mechanics`` (optional, same type): writes (T, P_ext, P_diss) — kinetic energy (J), power
+    of the loads (W) and power taken out by the dampers (W, ``OdeSystem.power``) — into a
+    length-3 ``out``, for the divergence guard and the energy audit inside the loop; None
+    disables both (the energy blow-up check, and "auto" then runs an audit on scipy).
     """
 
     rhs: Any
