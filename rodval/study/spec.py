@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from rodval.core.checks import as_path
+from rodval.core.checks import as_path, check_keys
 from rodval.core.resources import (
     STATE_PER_ROD,
     check_run_memory,
@@ -135,7 +135,7 @@ def _modes_spec(table: Any, where: str) -> dict[str, Any] | None:
     ``allow_unbalanced`` as in ``rodval.modes``; None without the table."""
     if table is None:
         return None
-    _check_keys(table, MODES_KEYS, where, "modes")
+    check_keys(table, MODES_KEYS, f"{where}:", path="modes")
     count = table.get("count", 10)
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_MODES:
         raise _err(where, "modes.count", f"must be an integer in 1..{MAX_MODES}, got {count!r}")
@@ -228,15 +228,6 @@ class StudySpec:
 
 def _err(where: str, key: str, msg: str) -> ValueError:
     return ValueError(f"{where}: key '{key}': {msg}")
-
-
-def _check_keys(d: Any, allowed: set[str], where: str, table: str) -> None:
-    if not isinstance(d, dict):
-        raise ValueError(f"{where}: '{table}' must be a table, got {type(d).__name__}")
-    unknown = sorted(set(d) - allowed)
-    if unknown:
-        key = f"{table}.{unknown[0]}" if table else unknown[0]
-        raise _err(where, key, f"unknown key (allowed: {', '.join(sorted(allowed))})")
 
 
 def _flatten(d: dict, prefix: str = "") -> dict[str, Any]:
@@ -340,7 +331,7 @@ def _axis_labels(paths: list[str]) -> dict[str, str]:
 
 def _model_specs(doc: dict, where: str) -> tuple[ModelSpec, ...]:
     integ = doc.get("integrator", {})
-    _check_keys(integ, INTEGRATOR_KEYS, where, "integrator")
+    check_keys(integ, INTEGRATOR_KEYS, f"{where}:", path="integrator")
     models = doc.get("models")
     if not isinstance(models, dict) or not models:
         raise _err(
@@ -412,7 +403,7 @@ def _report_spec(table: Any, cases: tuple[Case, ...], where: str) -> ReportSpec:
     number within every report case's chain, every quantity among every report case's outputs,
     every time within every report case's horizon (s)."""
     table = {} if table is None else table
-    _check_keys(table, REPORT_KEYS, where, "report")
+    check_keys(table, REPORT_KEYS, f"{where}:", path="report")
     by_id = {c.id: c for c in cases}
     demanding = max(cases, key=lambda c: c.scene.n * c.scene.t_end).id
     ids = table.get("cases", list(dict.fromkeys([demanding, cases[0].id])))
@@ -660,9 +651,9 @@ def study_from_dict(
     """
     doc = _plain_document(doc, where)
     max_cases = _check_max_cases(max_cases)
-    _check_keys(doc, TOP_KEYS, where, "")
+    check_keys(doc, TOP_KEYS, f"{where}:", path="")
     study = doc.setdefault("study", {})
-    _check_keys(study, STUDY_KEYS, where, "study")
+    check_keys(study, STUDY_KEYS, f"{where}:", path="study")
     models = _model_specs(doc, where)
     labels_m = [m.label for m in models]
     reference = study.get("reference", labels_m[0])
