@@ -24,9 +24,10 @@ from rodval.core.provenance import provenance
 from rodval.core.scene_file import scene_to_dict
 from rodval.core.status import STATUS_CRASHED, STATUS_DIVERGED, STATUS_TIMEOUT
 from rodval.core.trajectory import Trajectory
+from rodval.study.case import Case
 from rodval.study.records import CaseRecord, DamagedRecord, RunRecord, read_case
 from rodval.study.schedule import BACKENDS, default_workers, run_dask, run_processes
-from rodval.study.spec import Case, StudySpec, load_study
+from rodval.study.spec import StudySpec, load_study
 from rodval.study.store import StudyStore, write_json_atomic, write_text_atomic
 
 RETRIED = (STATUS_TIMEOUT, STATUS_CRASHED)
