@@ -138,26 +138,13 @@ def run_study(
     Every argument is checked before any work; a second run on the same folder at the same
     time is refused (``FolderBusy``).
     """
-    if isinstance(spec, str | Path):
-        spec = load_study(spec)
-    elif isinstance(spec, dict):
-        spec = StudySpec.from_dict(spec)
-    check_type("spec", spec, StudySpec, "a study (rodval.load_study) or a study file's path")
+    spec = _as_study(spec)
     out = as_path("out", out)
     check_choice("backend", backend, BACKENDS)
     if backend == "dask" and not scheduler:
         raise ValueError("backend 'dask' needs --scheduler ADDRESS of a running dask scheduler")
-    workers = default_workers() if workers is None else workers
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
-    if case_timeout is not None and (
-        isinstance(case_timeout, bool)
-        or not isinstance(case_timeout, int | float)
-        or not 0 < case_timeout < math.inf
-    ):
-        raise ValueError(
-            f"case_timeout must be a finite number > 0 s or None (no limit), got {case_timeout!r:.60}"
-        )
+    workers = _check_workers(default_workers() if workers is None else workers)
+    _check_case_timeout(case_timeout)
     if out.exists() and not out.is_dir():
         raise ValueError(f"out must be a folder, got the file {str(out)!r}")
     start = time.perf_counter()
@@ -174,35 +161,17 @@ def run_study(
         todo = sorted(
             (c for c in spec.cases if c.id not in reused), key=lambda c: -c.scene.n * c.scene.t_end
         )
-        by_id = {c.id: c for c in todo}
-        failed = 0
-        bar = tqdm(total=len(todo), desc=spec.name, unit="case", disable=not progress or not todo)
-
-        def done(payload: dict[str, Any], runs: list[dict[str, Any]]) -> None:
-            nonlocal failed
-            case = by_id[payload["case"]]
-            record = case_record(case, runs)
-            write_text_atomic(store.case_path(case.id), record.to_json())
-            failed += sum(r.status != 0 for r in record.runs)
-            bar.update(1)
-            bar.set_postfix(failed_runs=failed)
-
-        payloads = [c.payload() for c in todo]
-        try:
-            if backend == "processes":
-                run_processes(payloads, done, workers, case_timeout)
-            else:
-                assert scheduler is not None
-                run_dask(payloads, done, scheduler, case_timeout)
-        finally:
-            bar.close()
-        from rodval.study.tables import write_tables
-
-        write_tables(store.out, spec)
-        if report:
-            from rodval.report.study_report import build_report
-
-            build_report(store.out)
+        failed = _run_cases(
+            store,
+            spec.name,
+            todo,
+            backend=backend,
+            workers=workers,
+            scheduler=scheduler,
+            case_timeout=case_timeout,
+            progress=progress,
+        )
+        _write_results(store.out, spec, report)
     return StudyRun(
         out=store.out,
         ran=[c.id for c in todo],
@@ -211,3 +180,81 @@ def run_study(
         wall_s=time.perf_counter() - start,
         warnings=warnings,
     )
+
+
+def _as_study(spec: Any) -> StudySpec:
+    """``run_study``'s ``spec`` as a study: read from a path, built from a dict, or checked."""
+    if isinstance(spec, str | Path):
+        spec = load_study(spec)
+    elif isinstance(spec, dict):
+        spec = StudySpec.from_dict(spec)
+    check_type("spec", spec, StudySpec, "a study (rodval.load_study) or a study file's path")
+    return spec
+
+
+def _check_workers(workers: Any) -> int:
+    """``workers`` when it is an integer >= 1, else ValueError."""
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    return workers
+
+
+def _check_case_timeout(case_timeout: Any) -> None:
+    """ValueError unless ``case_timeout`` is None (no limit) or a finite number > 0 (s)."""
+    if case_timeout is not None and (
+        isinstance(case_timeout, bool)
+        or not isinstance(case_timeout, int | float)
+        or not 0 < case_timeout < math.inf
+    ):
+        raise ValueError(
+            f"case_timeout must be a finite number > 0 s or None (no limit), got {case_timeout!r:.60}"
+        )
+
+
+def _run_cases(
+    store: StudyStore,
+    name: str,
+    todo: list[Case],
+    *,
+    backend: str,
+    workers: int,
+    scheduler: str | None,
+    case_timeout: float | None,
+    progress: bool,
+) -> int:
+    """Run the cases ``todo`` on the backend, writing each one's record to ``store`` as it
+    finishes (with a progress bar named ``name``); returns the number of failed model runs."""
+    by_id = {c.id: c for c in todo}
+    failed = 0
+    bar = tqdm(total=len(todo), desc=name, unit="case", disable=not progress or not todo)
+
+    def done(payload: dict[str, Any], runs: list[dict[str, Any]]) -> None:
+        nonlocal failed
+        case = by_id[payload["case"]]
+        record = case_record(case, runs)
+        write_text_atomic(store.case_path(case.id), record.to_json())
+        failed += sum(r.status != 0 for r in record.runs)
+        bar.update(1)
+        bar.set_postfix(failed_runs=failed)
+
+    payloads = [c.payload() for c in todo]
+    try:
+        if backend == "processes":
+            run_processes(payloads, done, workers, case_timeout)
+        else:
+            assert scheduler is not None
+            run_dask(payloads, done, scheduler, case_timeout)
+    finally:
+        bar.close()
+    return failed
+
+
+def _write_results(out: Path, spec: StudySpec, report: bool) -> None:
+    """The study's tables in ``out`` from its case records, then its report (when ``report``)."""
+    from rodval.study.tables import write_tables
+
+    write_tables(out, spec)
+    if report:
+        from rodval.report.study_report import build_report
+
+        build_report(out)
