@@ -73,7 +73,7 @@ def acceptance_spec(
         if not limits:
             raise err(key, f"needs at least one of {', '.join(BOUND_METRICS)}")
         for m, v in limits.items():
-            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not 0 < v < math.inf:
+            if isinstance(v, bool) or not isinstance(v, numbers.Real) or v <= 0 or not v < math.inf:
                 raise err(f"{key}.{m}", f"must be a finite number > 0, got {v!r}")
         bounds.append({"model": b["model"], "quantity": b["quantity"], **limits})
     return {"valid": valid, "bounds": bounds}
