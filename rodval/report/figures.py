@@ -23,6 +23,7 @@ from rodval.analysis.metrics import pareto_front
 from rodval.core.modal import Modes
 from rodval.core.scene import UNITS
 from rodval.core.trajectory import Trajectory
+from rodval.models.registry import integrated_models
 
 
 def _figure(nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
@@ -329,11 +330,11 @@ def plot_work_precision(
     """One figure per model and x axis (wall, nfev): error against cost per quantity, one
     line per method/kernel, and the monotone front over all of them. Returns the paths."""
     paths = []
+    integrated = integrated_models()  # their cost counts RHS evaluations, others' Newton steps
     for model, part in frame.groupby("model"):
-        native = model in ("full", "reduced")
         for xcol, xlabel in (
             ("wall_s", "wall time (s)"),
-            ("nfev", "RHS evaluations" if native else "Newton iterations"),
+            ("nfev", "RHS evaluations" if model in integrated else "Newton iterations"),
         ):
             qs = [q for q in quantities if f"max_{q}" in part and part[f"max_{q}"].notna().any()]
             fig, axes = _figure(1, len(qs), figsize=(4.2 * len(qs), 3.8), squeeze=False)

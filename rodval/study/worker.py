@@ -23,6 +23,7 @@ from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_ERROR
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.models import get_model
+from rodval.models.registry import integrated_models
 
 
 def failed_run(model: dict, scene_name: str, status: int, message: str) -> dict[str, Any]:
@@ -72,7 +73,7 @@ def case_modes(scene, model: dict, spec: dict[str, Any]) -> dict[str, Any]:
     from rodval.analysis.modes import model_modes
 
     options = dict(model["options"])
-    if model["model"] != "exudyn":  # the native models' modal option is their variant
+    if model["model"] in integrated_models():  # a native model's modal option: its variant
         options = {"coefficients": options.get("coefficients", "printed")}
     try:
         m = model_modes(
