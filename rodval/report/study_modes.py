@@ -35,6 +35,7 @@ def modes_from_tables(freq: pd.DataFrame, shapes: pd.DataFrame, case: str, model
     sh = shapes[(shapes["case"] == case) & (shapes["model"] == model)]
 
     def arr(kind: str, mode: int) -> np.ndarray:
+        """The values of ``kind`` (a mode_shapes kind) of ``mode``, by node or hinge k."""
         part = sh[(sh["kind"] == kind) & (sh["mode"] == mode)].sort_values("k")
         return part["value"].to_numpy(float)
 

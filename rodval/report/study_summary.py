@@ -158,6 +158,7 @@ def _stability_map(runtime: pd.DataFrame, params: list[str]) -> list[str]:
     """Case x model: how each run ended, its cost and (when audited) its energy residual."""
 
     def cell(row: pd.Series) -> str:
+        """One run's cell: status, wall time (s), time reached (s), energy residual."""
         text = f"{row['status']}, {row['wall_s']:.3g} s"
         if row["status"] != "success":
             text += f", t = {row['t_reached']:.3g} s"

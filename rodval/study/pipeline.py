@@ -86,6 +86,8 @@ def _no_silent_nonfinite(traj: Trajectory) -> None:
 
 
 def _reusable(store: StudyStore, case: Case, warnings: list[str]) -> bool:
+    """Whether ``case``'s record in ``store`` verifies, is of this case (fingerprint) and has
+    no run to retry; a damaged record adds a warning to ``warnings``."""
     path = store.case_path(case.id)
     if not path.exists():
         return False
@@ -229,6 +231,7 @@ def _run_cases(
     bar = tqdm(total=len(todo), desc=name, unit="case", disable=not progress or not todo)
 
     def done(payload: dict[str, Any], runs: list[dict[str, Any]]) -> None:
+        """Record a finished case (its payload and run records) and advance the bar."""
         nonlocal failed
         case = by_id[payload["case"]]
         record = case_record(case, runs)

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from rodval.core.scene import Scene
 from rodval.core.scene_file import scene_from_dict
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_ERROR
@@ -72,7 +73,7 @@ def iter_case(payload: dict[str, Any]) -> Iterator[dict[str, Any]]:
         yield run
 
 
-def case_modes(scene, model: dict, spec: dict[str, Any]) -> dict[str, Any]:
+def case_modes(scene: Scene, model: dict[str, Any], spec: dict[str, Any]) -> dict[str, Any]:
     """``{"modes": ...}`` (``Modes.to_dict``) of one model about the study's configuration,
     or ``{"modes_error": message}``: a failed modal analysis never fails the run."""
     from rodval.analysis.modes import model_modes
