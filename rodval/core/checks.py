@@ -13,18 +13,33 @@ from typing import Any, cast
 
 
 def check_keys(
-    d: Any, allowed: Iterable[str], where: str, *, noun: str = "key", table: str = "a table"
+    d: Any,
+    allowed: Iterable[str],
+    where: str,
+    *,
+    noun: str = "key",
+    table: str = "a table",
+    path: str | None = None,
 ) -> None:
     """ValueError naming ``where`` unless ``d`` is a dict whose keys are all in ``allowed``;
-    the message names the first unknown ``noun`` and lists the allowed ones."""
+    the message names the first unknown ``noun`` and lists the allowed ones.
+
+    ``path``: the table's dotted path in a document ("" for the document itself, as in study
+    files); the messages then name the key by its full path after ``where``:
+    ``<where> key 'report.foo': unknown key (allowed: ...)`` and
+    ``<where> 'report' must be a table, got list``."""
     allowed = set(allowed)
     if not isinstance(d, dict):
+        if path is not None:
+            raise ValueError(f"{where} '{path}' must be a table, got {type(d).__name__}")
         raise ValueError(f"{where}: expected {table}, got {type(d).__name__}")
     unknown = sorted(set(d) - allowed)
     if unknown:
-        raise ValueError(
-            f"{where}: unknown {noun} {unknown[0]!r} (allowed: {', '.join(sorted(allowed))})"
-        )
+        listed = ", ".join(sorted(allowed))
+        if path is not None:
+            key = f"{path}.{unknown[0]}" if path else unknown[0]
+            raise ValueError(f"{where} key '{key}': unknown key (allowed: {listed})")
+        raise ValueError(f"{where}: unknown {noun} {unknown[0]!r} (allowed: {listed})")
 
 
 def check_type(name: str, value: Any, kind: type | tuple[type, ...], expected: str) -> None:

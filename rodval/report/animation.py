@@ -13,10 +13,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from matplotlib import animation, colormaps
+from matplotlib import animation
 from matplotlib.figure import Figure
 
 from rodval.core.trajectory import Trajectory
+from rodval.report.figures import MODEL_COLOURS
 
 #: Output formats and their writers.
 FORMATS = (".gif", ".mp4")
@@ -112,7 +113,6 @@ def animate_runs(
     nodes = {k: node_history(t, np.asarray(lengths[k], float)) for k, t in runs.items()}
     index = {k: np.searchsorted(t.times, times - 1e-12) for k, t in runs.items()}
     marks = {k: _event_marks(t) for k, t in runs.items()}
-    colours = colormaps["tab10"].colors
     fig = Figure(figsize=(6.4, 5.2))
     ax = fig.add_subplot()
     allx = np.concatenate([x.ravel() for x, _ in nodes.values()])
@@ -126,7 +126,9 @@ def animate_runs(
     ax.grid(alpha=0.3)
     ax.plot([0], [0], "k^", ms=9)
     lines = {
-        k: ax.plot([], [], "-o", color=colours[i % len(colours)], ms=3, lw=1.6, label=k)[0]
+        k: ax.plot(
+            [], [], "-o", color=MODEL_COLOURS[i % len(MODEL_COLOURS)], ms=3, lw=1.6, label=k
+        )[0]
         for i, k in enumerate(runs)
     }
     locks = {k: ax.plot([], [], "s", color="red", ms=8, mfc="none", mew=2)[0] for k in runs}

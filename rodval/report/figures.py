@@ -10,17 +10,20 @@ from __future__ import annotations
 import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
 from matplotlib import colormaps, ticker
+from matplotlib.colors import TABLEAU_COLORS
 from matplotlib.figure import Figure
+from matplotlib.typing import ColorType
 
 from rodval.analysis.metrics import pareto_front
 from rodval.core.modal import Modes
 from rodval.core.scene import UNITS
 from rodval.core.trajectory import Trajectory
+from rodval.models.registry import integrated_models
 
 
 def _figure(nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
@@ -31,6 +34,8 @@ def _figure(nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:
 
 
 LINESTYLES = ("-", "--", ":", "-.")
+#: One colour per model, in order, in every figure and animation (matplotlib's tab10 palette).
+MODEL_COLOURS: tuple[ColorType, ...] = tuple(TABLEAU_COLORS.values())
 #: Widest average glyph width of the default font, in units of the font size (DejaVu Sans:
 #: ~0.55 for lower case, ~0.64 for digits and capitals), and the part of the figure's width a
 #: title may take.
@@ -47,7 +52,8 @@ def fit_title(text: str, width_in: float, fontsize: float) -> str:
     return "\n".join(textwrap.wrap(text, per_line, break_long_words=True)) if text else text
 
 
-def _title_size(which: str = "figure.titlesize") -> float:
+def _title_size(which: Literal["figure.titlesize", "axes.titlesize"] = "figure.titlesize") -> float:
+    """The font size (points) of the figure's or an axes' title in the current rcParams."""
     from matplotlib import rcParams
     from matplotlib.font_manager import FontProperties
 
@@ -129,9 +135,11 @@ def plot_configurations(
 
 def model_styles(labels: Sequence[str]) -> dict[str, dict]:
     """One colour and line style per model label, the same in every figure of a report."""
-    colours = colormaps["tab10"].colors
     return {
-        lab: {"color": colours[i % len(colours)], "ls": LINESTYLES[i % len(LINESTYLES)]}
+        lab: {
+            "color": MODEL_COLOURS[i % len(MODEL_COLOURS)],
+            "ls": LINESTYLES[i % len(LINESTYLES)],
+        }
         for i, lab in enumerate(labels)
     }
 
@@ -322,11 +330,11 @@ def plot_work_precision(
     """One figure per model and x axis (wall, nfev): error against cost per quantity, one
     line per method/kernel, and the monotone front over all of them. Returns the paths."""
     paths = []
+    integrated = integrated_models()  # their cost counts RHS evaluations, others' Newton steps
     for model, part in frame.groupby("model"):
-        native = model in ("full", "reduced")
         for xcol, xlabel in (
             ("wall_s", "wall time (s)"),
-            ("nfev", "RHS evaluations" if native else "Newton iterations"),
+            ("nfev", "RHS evaluations" if model in integrated else "Newton iterations"),
         ):
             qs = [q for q in quantities if f"max_{q}" in part and part[f"max_{q}"].notna().any()]
             fig, axes = _figure(1, len(qs), figsize=(4.2 * len(qs), 3.8), squeeze=False)
@@ -438,7 +446,8 @@ def plot_deployment(
 def plot_scale(frame: pd.DataFrame, speedup: pd.DataFrame | None, path: Path) -> Path:
     """Wall time over 0..2 s, RHS cost and (if given) the equal-accuracy speed-up against n,
     log-log (``rodval bench scale``)."""
-    panels = 3 if speedup is not None and len(speedup) else 2
+    speedup = speedup if speedup is not None and len(speedup) else None
+    panels = 3 if speedup is not None else 2
     fig = Figure(figsize=(4.4 * panels, 3.8))
     axes = fig.subplots(1, panels)
     for model, part in frame.groupby("model", sort=False):
@@ -447,7 +456,7 @@ def plot_scale(frame: pd.DataFrame, speedup: pd.DataFrame | None, path: Path) ->
         axes[1].loglog(part.n, part.rhs_run_s, "x--", ms=4, label=f"{model}, state at t = 0.5 s")
     axes[0].set_ylabel("wall time over 0..2 s (s)")
     axes[1].set_ylabel("compiled RHS, s per evaluation")
-    if panels == 3:
+    if speedup is not None:
         axes[2].semilogx(speedup.n, speedup["full/reduced"], "o-", ms=3)
         axes[2].axhline(1.0, color="k", lw=0.8)
         axes[2].set_ylabel("full / reduced wall time, phi error <= 1e-6")

@@ -5,7 +5,8 @@ each model's results over the samples, as engineers read a deployment's reliabil
   samples whose run recorded a lock of each latch of its scene) and, per hinge, the fraction
   that locked and the percentiles of its lock time (s);
 * ``discrepancy_percentiles``: per model pair and quantity, percentiles of max_abs and rms
-  over the samples (the comparisons that were made).
+  over the samples (the comparisons that were made);
+* ``sample_section``: both as the study report's Sample statistics section.
 
 Percentiles are numpy's linear interpolation (``numpy.percentile``) at ``PERCENTILES``.
 """
@@ -13,9 +14,12 @@ Percentiles are numpy's linear interpolation (``numpy.percentile``) at ``PERCENT
 from __future__ import annotations
 
 import re
+from typing import Any
 
 import numpy as np
 import pandas as pd
+
+from rodval.report.markdown import to_markdown
 
 PERCENTILES = (5, 50, 95)
 
@@ -77,3 +81,34 @@ def discrepancy_percentiles(disc: pd.DataFrame) -> pd.DataFrame:
                 row[f"{metric}_p{p}"] = float(np.percentile(vals, p))
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def sample_section(
+    meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
+) -> list[str]:
+    """The report's Sample statistics of a ``[sample]`` study (none for a grid study): latch
+    locking and lock times when the scenes have latches (``events``: the events table), and
+    the discrepancies (markdown lines)."""
+    sample = meta.get("sample")
+    if not sample:
+        return []
+    keys = ", ".join(f"`{k}` ({v['dist']})" for k, v in sample["keys"].items())
+    lines = [
+        "## Sample statistics\n",
+        f"{sample['count']} samples, {sample['design']} design, seed {sample['seed']}, of "
+        f"{keys}; percentiles {', '.join(str(p) for p in PERCENTILES)} over the samples.\n",
+    ]
+    models = [m["label"] for m in meta["models"]]
+    locks = lock_statistics(tables["cases"], events, models)
+    if not locks.empty:
+        lines.append("### Latches\n")
+        bullets = [
+            f"- `{model}`: every latch locked by the end of the run in "
+            f"{part['p_all_locked'].iloc[0]:.1%} of the samples"
+            for model, part in locks.groupby("model", sort=False)
+        ]
+        lines += ["\n".join(bullets) + "\n", to_markdown(locks, floatfmt=".4g")]
+    disc = discrepancy_percentiles(tables["discrepancies"])
+    if not disc.empty:
+        lines += ["### Discrepancies\n", to_markdown(disc, floatfmt=".3g")]
+    return lines

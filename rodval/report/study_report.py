@@ -1,7 +1,14 @@
 """The study report: ``OUT/report.md`` and ``OUT/figures/*.png`` rebuilt from the saved tables
 (``cases.csv``, ``trajectories.csv``, ``discrepancies.csv``, ``runtime.csv``, and
 ``events.csv`` when some run recorded events: the deployment section) and the study's
-``study.json`` / ``provenance.json``; nothing is recomputed."""
+``study.json`` / ``provenance.json``; nothing is recomputed.
+
+``build_report`` puts the sections in order: the header (study, models, machine), Acceptance
+(``rodval.report.acceptance``), Outcome, Discrepancies, Run time and Stability map
+(``study_summary``), the figures against the grid parameters (``study_figures``), Sample
+statistics (``sample_stats``), the Deployment section (here, with the events tables), Modes
+(``study_modes``) and the report cases' time histories and configurations (``study_figures``).
+"""
 
 from __future__ import annotations
 
@@ -9,266 +16,17 @@ import json
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
-from rodval.analysis.metrics import left_out_quantities
-from rodval.core.modal import Modes
-from rodval.core.trajectory import Trajectory
-from rodval.core.validity import ENERGY_RESIDUAL_BOUND, SMALL_BENDING_RAD
 from rodval.models import get_model
 from rodval.models.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
-from rodval.report.figures import (
-    plot_configurations,
-    plot_deployment,
-    plot_discrepancy_vs,
-    plot_modes,
-    plot_runtime_vs,
-    plot_speedup_vs,
-    plot_time_histories,
-    speedups,
-)
 from rodval.report.markdown import to_markdown
-from rodval.report.sample_stats import (
-    PERCENTILES,
-    discrepancy_percentiles,
-    lock_statistics,
-)
-from rodval.report.tables import FIGURES, axis_columns, read_tables, trajectory_samples
-
-
-def varying_params(cases: pd.DataFrame, params: list[str]) -> list[str]:
-    """Case parameters with more than one value, all numeric and finite: the x axes of the
-    figures (an axis such as max_step = [inf, 1e-7] has no place on a plot axis)."""
-    return [
-        p
-        for p in params
-        if pd.api.types.is_numeric_dtype(cases[p])
-        and cases[p].nunique() > 1
-        and np.isfinite(cases[p].to_numpy(float)).all()
-    ]
-
-
-def _case_figures(
-    out: Path, fig_dir: Path, meta: dict, tables: dict[str, pd.DataFrame]
-) -> list[str]:
-    rep, lines = meta["report"], []
-    traj, cases = tables["trajectories"], tables["cases"]
-    labels = [m["label"] for m in meta["models"]]
-    for cid in rep["cases"]:
-        sub = traj[traj["case"] == cid]
-        row = cases[cases["case"] == cid].iloc[0]
-        n, horizon, l = int(row["n"]), float(row["horizon"]), np.asarray(json.loads(row["l"]))
-        trajs = {
-            lab: Trajectory.from_frame(sub[sub["model"] == lab], lab, cid)
-            for lab in labels
-            if (sub["model"] == lab).any()
-        }
-        lines.append(f"### Case `{cid}` (n = {n}, horizon = {horizon:g} s)\n")
-        if not trajs:
-            lines.append("_No model produced output for this case._\n")
-            continue
-        rods = sorted(
-            {n if r == "last" else int(r) for r in rep["rods"] if r == "last" or int(r) <= n}
-        )
-        qs = [q for q in rep["quantities"] if (sub["quantity"] == q).any()]
-        slug = cid.replace(",", "_").replace("=", "")
-        hist = plot_time_histories(
-            trajs, qs, rods, fig_dir / f"history_{slug}.png", title=f"case {cid}: all models"
-        )
-        lines.append(f"![time histories, case {cid}](figures/{hist.name})\n")
-        if "phi" in qs or (sub["quantity"] == "phi").any():
-            out_t = np.unique(sub["t"].to_numpy())
-            want = rep["times"] or [horizon * f for f in (0.25, 0.5, 0.75, 1.0)]
-            snapped = sorted(
-                {float(out_t[np.abs(out_t - t).argmin()]) for t in want if t <= horizon}
-            )
-            conf = plot_configurations(
-                trajs,
-                snapped,
-                l,
-                fig_dir / f"configurations_{slug}.png",
-                title=f"case {cid}: chain at t = " + ", ".join(f"{t:.4g}" for t in snapped) + " s",
-            )
-            lines.append(f"![configurations, case {cid}](figures/{conf.name})\n")
-    samples = trajectory_samples(traj, meta, cases)
-    if not samples.empty:
-        lines += ["Values at the report times (rad, rad/s):\n", to_markdown(samples, ".6g")]
-    return lines
-
-
-def _stability_map(runtime: pd.DataFrame, params: list[str]) -> list[str]:
-    """Case x model: how each run ended, its cost and (when audited) its energy residual."""
-
-    def cell(row) -> str:
-        text = f"{row['status']}, {row['wall_s']:.3g} s"
-        if row["status"] != "success":
-            text += f", t = {row['t_reached']:.3g} s"
-        res = row.get("energy_residual")
-        if res is not None and pd.notna(res):
-            text += f", R = {res:.2g}"
-        return text
-
-    grid = runtime.assign(cell=runtime.apply(cell, axis=1)).pivot_table(
-        index=["case", *params], columns="model", values="cell", aggfunc="first", sort=False
-    )
-    return [
-        "## Stability map\n",
-        "Each run: status, integration wall time, the time reached if it did not finish, "
-        "and R = max |E - E(0) - W_ext + D| / max(E, |W_ext|), the energy balance "
-        "residual (see docs/stability.md), when the scene asks for energy.\n",
-        to_markdown(grid.reset_index()),
-    ]
-
-
-def left_out_table(traj: pd.DataFrame, reference: str) -> pd.DataFrame:
-    """Per case and model: the quantities left out of its comparison with the reference
-    because only one of the two runs outputs them (``left_out_quantities``), with why.
-    Columns case, model, quantity, why. O(rows of the trajectories table)."""
-    have = traj.groupby(["case", "model"], sort=False)["quantity"].unique()
-    rows = []
-    for (case, model), qs in have.items():
-        if model == reference or (case, reference) not in have.index:
-            continue
-        ref_qs = have[(case, reference)]
-        for q in left_out_quantities(qs, ref_qs):
-            lacking = model if q in ref_qs else reference
-            rows.append(
-                {"case": case, "model": model, "quantity": q, "why": f"not output by {lacking}"}
-            )
-    return pd.DataFrame(rows, columns=["case", "model", "quantity", "why"])
-
-
-def _summary_tables(meta: dict, tables: dict[str, pd.DataFrame], params: list[str]) -> list[str]:
-    # a union of grids ([[grid]]) leaves some parameters unset in some cases
-    disc, runtime = (
-        tables[k].fillna({p: "-" for p in params}) for k in ("discrepancies", "runtime")
-    )
-    ref = meta["reference"]
-    lines = []
-    failed = runtime[runtime["status"] != "success"]
-    invalid = runtime[runtime["valid"].astype(str) == "False"] if "valid" in runtime else failed[:0]
-    left = left_out_table(tables["trajectories"], ref)
-    not_made = disc[disc["status"] != "ok"]
-    lines.append(
-        f"## Outcome\n\n{runtime['case'].nunique()} cases, {len(runtime)} model runs, "
-        f"{len(failed)} failed, {len(invalid)} invalid; "
-        f"{(disc['status'] == 'ok').sum()} comparisons made (case, model, quantity), "
-        f"{len(not_made) + len(left)} could not be made.\n"
-    )
-    reasons = pd.concat(
-        [not_made[["status"]], pd.DataFrame({"status": left["why"]}) if len(left) else None]
-    )
-    if len(reasons):
-        why = (
-            reasons.groupby("status", sort=False)
-            .size()
-            .reset_index(name="comparisons")
-            .rename(columns={"status": "reason"})
-        )
-        lines += ["Comparisons not made, by reason:\n", to_markdown(why)]
-    if not failed.empty:
-        lines += [
-            "Failed runs:\n",
-            to_markdown(failed[["case", "model", "status", "t_reached", "message"]]),
-        ]
-    lines.append(
-        "Validity: a run is invalid when it broke an assumption of its model (small bending, "
-        f"largest |alpha|, |beta| <= {SMALL_BENDING_RAD:g} rad, in the paper models; an "
-        f"energy-audit residual <= {ENERGY_RESIDUAL_BOUND:g} where audited; see "
-        "docs/stability.md), whether or not it reached its end; its results are not those of "
-        "the model's premise." + (" Invalid runs:\n" if len(invalid) else "\n")
-    )
-    if len(invalid):
-        lines.append(to_markdown(invalid[["case", "model", "status", "invalid_because"]]))
-    lines.append(f"## Discrepancies against `{ref}`\n")
-    if len(meta["models"]) == 1:
-        lines.append(f"The study has one model (`{ref}`): nothing to compare.\n")
-    else:
-        lines.append(
-            "Largest absolute difference over all output times and rods (`max_abs`; rad, "
-            "rad/s) and the same relative to each reference rod's largest value "
-            "(`max_rel`); see `discrepancies.csv` for rms, final value and where the "
-            "maximum occurs.\n"
-        )
-    for model, part in disc.groupby("model", sort=False):
-        ok = part[part["status"] == "ok"]
-        lines.append(f"### `{model}` against `{ref}`\n")
-        if ok.empty:
-            lines.append(f"_No comparison: {part['status'].iloc[0]}._\n")
-            continue
-        mine = left[left["model"] == model] if len(left) else left
-        if len(mine):
-            names = ", ".join(
-                f"`{q}` ({w})" for q, w in dict.fromkeys(zip(mine["quantity"], mine["why"]))
-            )
-            lines.append(
-                f"_Left out of this comparison: {names}; the other quantities are compared._\n"
-            )
-        wide = ok.pivot_table(
-            index=["case", *params], columns="quantity", values=["max_abs", "max_rel"], sort=False
-        )
-        wide.columns = [f"{q} {m}" for m, q in wide.columns]
-        order = [f"{q} {m}" for q in dict.fromkeys(ok["quantity"]) for m in ("max_abs", "max_rel")]
-        lines.append(to_markdown(wide[order].reset_index()))
-    lines.append("## Run time\n")
-    lines.append(
-        "Integration wall time in s (without model set-up); speed-up = wall time of "
-        f"`{ref}` / wall time of the model.\n"
-    )
-    ok = runtime[runtime["status"] == "success"]
-    wall = ok.pivot_table(index=["case", *params], columns="model", values="wall_s", sort=False)
-    speed = speedups(runtime, ref, params)
-    if not speed.empty:
-        sp = speed.pivot_table(
-            index=["case", *params], columns="model", values="speedup", sort=False
-        )
-        wall = wall.join(sp.add_prefix("speed-up "))
-    lines.append("Failed runs are left out.\n")
-    lines.append(to_markdown(wall.reset_index()))
-    if not failed.empty or (
-        "energy_residual" in runtime and runtime["energy_residual"].notna().any()
-    ):
-        lines += _stability_map(runtime, params)
-    return lines
-
-
-def _param_figures(
-    fig_dir: Path, meta: dict, tables: dict[str, pd.DataFrame], params: list[str]
-) -> list[str]:
-    labels = [m["label"] for m in meta["models"]]
-    ref, lines = meta["reference"], []
-    speed = speedups(tables["runtime"], ref, params)
-    for x in varying_params(tables["cases"], params):
-        others = [p for p in varying_params(tables["cases"], params) if p != x]
-        logx = (
-            x != "horizon"
-            and tables["cases"][x].min() > 0
-            and tables["cases"][x].max() / tables["cases"][x].min() >= 8
-        )
-        lines.append(f"### Against {x}\n")
-        if not tables["discrepancies"].empty:
-            d = plot_discrepancy_vs(
-                tables["discrepancies"],
-                x,
-                others,
-                labels,
-                fig_dir / f"discrepancy_vs_{x}.png",
-                logx=logx,
-            )
-            lines.append(f"![discrepancy against {x}](figures/{d.name})\n")
-        r = plot_runtime_vs(
-            tables["runtime"], x, others, labels, fig_dir / f"runtime_vs_{x}.png", logx=logx
-        )
-        lines.append(f"![run time against {x}](figures/{r.name})\n")
-        if not speed.empty:
-            s = plot_speedup_vs(
-                speed, x, others, labels, ref, fig_dir / f"speedup_vs_{x}.png", logx=logx
-            )
-            lines.append(f"![speed-up against {x}](figures/{s.name})\n")
-    return lines
-
+from rodval.report.sample_stats import sample_section
+from rodval.report.study_figures import case_figures, deployment_figures, param_figures
+from rodval.report.study_modes import modes_section
+from rodval.report.study_summary import summary_sections
+from rodval.report.tables import FIGURES, axis_columns, read_tables
 
 #: Columns of the events table shown in the report, when present.
 EVENT_REPORT_COLUMNS = (
@@ -387,9 +145,11 @@ def peak_hinge_moments(traj: pd.DataFrame, events: pd.DataFrame) -> pd.DataFrame
 
 
 def _deployment_section(
-    out: Path, fig_dir: Path, meta: dict, tables: dict[str, pd.DataFrame]
+    fig_dir: Path, meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
 ) -> list[str]:
-    events = read_events(out)
+    """The Deployment section when runs recorded events (``events``): the events, the lock
+    discrepancies against the reference, peak hinge moments, residual vibration after the
+    last lock, and the report cases' deployment figures (markdown lines)."""
     if events.empty:
         return []
     ref, labels = meta["reference"], [m["label"] for m in meta["models"]]
@@ -426,61 +186,7 @@ def _deployment_section(
             "|alpha|, |beta| in rad, spread of the chord angles at the end in rad):\n",
             to_markdown(resid, ".4g"),
         ]
-    traj, cases = tables["trajectories"], tables["cases"]
-    for cid in meta["report"]["cases"]:
-        sub = traj[traj["case"] == cid]
-        if sub.empty or not (sub["quantity"] == "phi").any():
-            continue
-        row = cases[cases["case"] == cid].iloc[0]
-        l = np.asarray(json.loads(row["l"]))
-        trajs = {
-            lab: Trajectory.from_frame(sub[sub["model"] == lab], lab, cid)
-            for lab in labels
-            if (sub["model"] == lab).any()
-        }
-        out_t = np.unique(sub["t"].to_numpy())
-        horizon = float(row["horizon"])
-        want = meta["report"]["times"] or [horizon * f for f in (0.0, 0.25, 0.5, 0.75, 1.0)]
-        snapped = sorted({float(out_t[np.abs(out_t - t).argmin()]) for t in want if t <= horizon})
-        slug = cid.replace(",", "_").replace("=", "")
-        fig = plot_deployment(
-            trajs,
-            events[events["case"] == cid],
-            snapped,
-            l,
-            fig_dir / f"deployment_{slug}.png",
-            title=f"case {cid}: deployment sequence and tip y (dotted: lock times)",
-        )
-        lines.append(f"![deployment, case {cid}](figures/{fig.name})\n")
-    return lines
-
-
-def _sample_section(out: Path, meta: dict, tables: dict[str, pd.DataFrame]) -> list[str]:
-    """Percentiles over the samples of a ``[sample]`` study (``rodval.report.sample_stats``):
-    latch locking and lock times when the scenes have latches, and the discrepancies."""
-    sample = meta.get("sample")
-    if not sample:
-        return []
-    keys = ", ".join(f"`{k}` ({v['dist']})" for k, v in sample["keys"].items())
-    lines = [
-        "## Sample statistics\n",
-        f"{sample['count']} samples, {sample['design']} design, seed {sample['seed']}, of "
-        f"{keys}; percentiles {', '.join(str(p) for p in PERCENTILES)} over the samples.\n",
-    ]
-    models = [m["label"] for m in meta["models"]]
-    locks = lock_statistics(tables["cases"], read_events(out), models)
-    if not locks.empty:
-        lines.append("### Latches\n")
-        bullets = [
-            f"- `{model}`: every latch locked by the end of the run in "
-            f"{part['p_all_locked'].iloc[0]:.1%} of the samples"
-            for model, part in locks.groupby("model", sort=False)
-        ]
-        lines += ["\n".join(bullets) + "\n", to_markdown(locks, floatfmt=".4g")]
-    disc = discrepancy_percentiles(tables["discrepancies"])
-    if not disc.empty:
-        lines += ["### Discrepancies\n", to_markdown(disc, floatfmt=".3g")]
-    return lines
+    return [*lines, *deployment_figures(fig_dir, meta, tables, events)]
 
 
 def model_row(m: dict[str, Any]) -> dict[str, Any]:
@@ -501,7 +207,9 @@ def model_row(m: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def _header(meta: dict, prov: dict) -> list[str]:
+def _header(meta: dict[str, Any], prov: dict[str, Any]) -> list[str]:
+    """The report's title, description, study file, grid, reference, Models table and the
+    machine and packages it ran on (``prov``: provenance.json)."""
     models = pd.DataFrame([model_row(m) for m in meta["models"]])
     mach = prov["machine"]
     pkgs = ", ".join(f"{k} {v}" for k, v in prov["packages"].items() if v)
@@ -532,87 +240,6 @@ def _read_json(path: Path, keys: tuple[str, ...]) -> dict[str, Any]:
     return doc
 
 
-def modes_from_tables(freq: pd.DataFrame, shapes: pd.DataFrame, case: str, model: str) -> Modes:
-    """One model's modes of one case rebuilt from the modes and mode_shapes tables."""
-    f = freq[(freq["case"] == case) & (freq["model"] == model)].sort_values("mode")
-    sh = shapes[(shapes["case"] == case) & (shapes["model"] == model)]
-
-    def arr(kind: str, mode: int) -> np.ndarray:
-        part = sh[(sh["kind"] == kind) & (sh["mode"] == mode)].sort_values("k")
-        return part["value"].to_numpy(float)
-
-    x0, y0 = arr("node_x0", 0), arr("node_y0", 0)
-    modes = [int(m) for m in f["mode"]]
-    return Modes(
-        model=model,
-        about="",
-        omega=f["omega_rad_s"].to_numpy(float),
-        damping=f["damping_ratio"].to_numpy(float),
-        dx=np.array([arr("node_dx", m) for m in modes]),
-        dy=np.array([arr("node_dy", m) for m in modes]),
-        hinge=np.array([arr("hinge", m) for m in modes]),
-        phi0=np.arctan2(np.diff(y0), np.diff(x0)),
-        l=np.hypot(np.diff(x0), np.diff(y0)),
-    )
-
-
-def _modes_section(out: Path, fig_dir: Path, meta: dict) -> list[str]:
-    """Frequencies of every model, the MAC pairing against the reference and mode-shape
-    figures of the report cases, when the study asked for modes ([modes])."""
-    if not (out / "modes.csv").is_file():
-        return []
-    freq = pd.read_csv(out / "modes.csv")
-    lines = [
-        "## Modes\n",
-        "Linearized natural frequencies (rad/s) of every model "
-        "(`modes.csv`; damping ratios there), and each model's modes paired by shape with "
-        f"`{meta['reference']}`'s (modal assurance criterion, `mac.csv`).\n",
-    ]
-    if "omega_rad_s" in freq:
-        ok = freq[freq["omega_rad_s"].notna()]
-        wide = ok.pivot_table(
-            index=["case", "mode"], columns="model", values="omega_rad_s", sort=False
-        )
-        lines.append(to_markdown(wide.reset_index(), ".6g"))
-    if "error" in freq and freq["error"].notna().any():
-        failed = freq[freq["error"].notna()][["case", "model", "error"]]
-        lines += ["Modal analyses that failed:\n", to_markdown(failed)]
-    mac_path = out / "mac.csv"
-    if mac_path.is_file() and mac_path.stat().st_size > 1:
-        mac = pd.read_csv(mac_path)
-        cols = [
-            c
-            for c in (
-                "case",
-                "model",
-                "reference",
-                "mode_a",
-                "mode_b",
-                "omega_a",
-                "omega_b",
-                "rel_gap",
-                "mac",
-            )
-            if c in mac
-        ]
-        lines.append(to_markdown(mac[cols], ".4g"))
-    shapes_path = out / "mode_shapes.csv"
-    if shapes_path.is_file() and "omega_rad_s" in freq:
-        shapes = pd.read_csv(shapes_path)
-        for cid in meta["report"]["cases"]:
-            have = set(freq[(freq["case"] == cid) & freq["omega_rad_s"].notna()]["model"])
-            model = meta["reference"] if meta["reference"] in have else next(iter(have), None)
-            if model is None:
-                continue
-            m = modes_from_tables(freq, shapes, cid, model)
-            slug = cid.replace(",", "_").replace("=", "")
-            fig = plot_modes(
-                m, fig_dir / f"modes_{slug}.png", title=f"case {cid}: {model}, first modes"
-            )
-            lines.append(f"![mode shapes, case {cid}](figures/{fig.name})\n")
-    return lines
-
-
 def build_report(out: str | Path) -> Path:
     """Write ``out/report.md`` and ``out/figures/`` from the saved tables; returns the path."""
     out = Path(out)
@@ -626,14 +253,15 @@ def build_report(out: str | Path) -> Path:
     fig_dir.mkdir(exist_ok=True)
     lines = _header(meta, prov)
     lines += acceptance_section(meta, tables)
-    lines += _summary_tables(meta, tables, params)
-    figs = _param_figures(fig_dir, meta, tables, params)
+    lines += summary_sections(meta, tables, params)
+    figs = param_figures(fig_dir, meta, tables, params)
     if figs:
         lines += ["## Discrepancy, run time and speed-up against the grid parameters\n", *figs]
-    lines += _sample_section(out, meta, tables)
-    lines += _deployment_section(out, fig_dir, meta, tables)
-    lines += _modes_section(out, fig_dir, meta)
-    lines += ["## Time histories and configurations\n", *_case_figures(out, fig_dir, meta, tables)]
+    events = read_events(out)
+    lines += sample_section(meta, tables, events)
+    lines += _deployment_section(fig_dir, meta, tables, events)
+    lines += modes_section(out, fig_dir, meta)
+    lines += ["## Time histories and configurations\n", *case_figures(fig_dir, meta, tables)]
     path = out / "report.md"
     path.write_text("\n".join(x for x in lines if x))
     return path

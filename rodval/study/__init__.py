@@ -5,8 +5,10 @@ verified file per finished case, in a store) -> tables (pandas, CSV and markdown
 (``rodval.report``); ``pipeline.run_study`` runs them in that order.
 """
 
+from rodval.study.case import Case
+from rodval.study.model_specs import ModelSpec
 from rodval.study.pipeline import StudyRun, run_study
-from rodval.study.spec import Case, ModelSpec, StudySpec, load_study, study_from_dict
+from rodval.study.spec import StudySpec, load_study, study_from_dict
 from rodval.study.tables import build_tables, write_tables
 
 __all__ = [

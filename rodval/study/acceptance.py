@@ -22,6 +22,7 @@ import math
 import numbers
 from typing import Any
 
+from rodval.core.checks import check_keys
 from rodval.report.acceptance import BOUND_METRICS
 
 ACCEPTANCE_KEYS = {"valid", "bound"}
@@ -42,9 +43,7 @@ def acceptance_spec(
 
     if not isinstance(table, dict):
         raise err("", "must be a table")
-    unknown = sorted(set(table) - ACCEPTANCE_KEYS)
-    if unknown:
-        raise err(f".{unknown[0]}", f"unknown key (allowed: {', '.join(sorted(ACCEPTANCE_KEYS))})")
+    check_keys(table, ACCEPTANCE_KEYS, where, path="acceptance")
     valid = table.get("valid", False)
     if not isinstance(valid, bool):
         raise err(".valid", f"must be true or false, got {valid!r}")
@@ -57,11 +56,7 @@ def acceptance_spec(
     bounds = []
     for i, b in enumerate(raw):
         key = f".bound[{i}]"
-        unknown = sorted(set(b) - BOUND_KEYS)
-        if unknown:
-            raise err(
-                f"{key}.{unknown[0]}", f"unknown key (allowed: {', '.join(sorted(BOUND_KEYS))})"
-            )
+        check_keys(b, BOUND_KEYS, where, path=f"acceptance{key}")
         if b.get("model") not in others:
             raise err(
                 f"{key}.model",
@@ -78,7 +73,7 @@ def acceptance_spec(
         if not limits:
             raise err(key, f"needs at least one of {', '.join(BOUND_METRICS)}")
         for m, v in limits.items():
-            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not 0 < v < math.inf:
+            if isinstance(v, bool) or not isinstance(v, numbers.Real) or v <= 0 or not v < math.inf:
                 raise err(f"{key}.{m}", f"must be a finite number > 0, got {v!r}")
         bounds.append({"model": b["model"], "quantity": b["quantity"], **limits})
     return {"valid": valid, "bounds": bounds}

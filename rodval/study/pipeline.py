@@ -24,9 +24,10 @@ from rodval.core.provenance import provenance
 from rodval.core.scene_file import scene_to_dict
 from rodval.core.status import STATUS_CRASHED, STATUS_DIVERGED, STATUS_TIMEOUT
 from rodval.core.trajectory import Trajectory
+from rodval.study.case import Case
 from rodval.study.records import CaseRecord, DamagedRecord, RunRecord, read_case
 from rodval.study.schedule import BACKENDS, default_workers, run_dask, run_processes
-from rodval.study.spec import Case, StudySpec, load_study
+from rodval.study.spec import StudySpec, load_study
 from rodval.study.store import StudyStore, write_json_atomic, write_text_atomic
 
 RETRIED = (STATUS_TIMEOUT, STATUS_CRASHED)
@@ -85,6 +86,8 @@ def _no_silent_nonfinite(traj: Trajectory) -> None:
 
 
 def _reusable(store: StudyStore, case: Case, warnings: list[str]) -> bool:
+    """Whether ``case``'s record in ``store`` verifies, is of this case (fingerprint) and has
+    no run to retry; a damaged record adds a warning to ``warnings``."""
     path = store.case_path(case.id)
     if not path.exists():
         return False
@@ -137,26 +140,13 @@ def run_study(
     Every argument is checked before any work; a second run on the same folder at the same
     time is refused (``FolderBusy``).
     """
-    if isinstance(spec, str | Path):
-        spec = load_study(spec)
-    elif isinstance(spec, dict):
-        spec = StudySpec.from_dict(spec)
-    check_type("spec", spec, StudySpec, "a study (rodval.load_study) or a study file's path")
+    spec = _as_study(spec)
     out = as_path("out", out)
     check_choice("backend", backend, BACKENDS)
     if backend == "dask" and not scheduler:
         raise ValueError("backend 'dask' needs --scheduler ADDRESS of a running dask scheduler")
-    workers = default_workers() if workers is None else workers
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
-    if case_timeout is not None and (
-        isinstance(case_timeout, bool)
-        or not isinstance(case_timeout, int | float)
-        or not 0 < case_timeout < math.inf
-    ):
-        raise ValueError(
-            f"case_timeout must be a finite number > 0 s or None (no limit), got {case_timeout!r:.60}"
-        )
+    workers = _check_workers(default_workers() if workers is None else workers)
+    _check_case_timeout(case_timeout)
     if out.exists() and not out.is_dir():
         raise ValueError(f"out must be a folder, got the file {str(out)!r}")
     start = time.perf_counter()
@@ -173,35 +163,17 @@ def run_study(
         todo = sorted(
             (c for c in spec.cases if c.id not in reused), key=lambda c: -c.scene.n * c.scene.t_end
         )
-        by_id = {c.id: c for c in todo}
-        failed = 0
-        bar = tqdm(total=len(todo), desc=spec.name, unit="case", disable=not progress or not todo)
-
-        def done(payload: dict[str, Any], runs: list[dict[str, Any]]) -> None:
-            nonlocal failed
-            case = by_id[payload["case"]]
-            record = case_record(case, runs)
-            write_text_atomic(store.case_path(case.id), record.to_json())
-            failed += sum(r.status != 0 for r in record.runs)
-            bar.update(1)
-            bar.set_postfix(failed_runs=failed)
-
-        payloads = [c.payload() for c in todo]
-        try:
-            if backend == "processes":
-                run_processes(payloads, done, workers, case_timeout)
-            else:
-                assert scheduler is not None
-                run_dask(payloads, done, scheduler, case_timeout)
-        finally:
-            bar.close()
-        from rodval.study.tables import write_tables
-
-        write_tables(store.out, spec)
-        if report:
-            from rodval.report.study_report import build_report
-
-            build_report(store.out)
+        failed = _run_cases(
+            store,
+            spec.name,
+            todo,
+            backend=backend,
+            workers=workers,
+            scheduler=scheduler,
+            case_timeout=case_timeout,
+            progress=progress,
+        )
+        _write_results(store.out, spec, report)
     return StudyRun(
         out=store.out,
         ran=[c.id for c in todo],
@@ -210,3 +182,82 @@ def run_study(
         wall_s=time.perf_counter() - start,
         warnings=warnings,
     )
+
+
+def _as_study(spec: Any) -> StudySpec:
+    """``run_study``'s ``spec`` as a study: read from a path, built from a dict, or checked."""
+    if isinstance(spec, str | Path):
+        spec = load_study(spec)
+    elif isinstance(spec, dict):
+        spec = StudySpec.from_dict(spec)
+    check_type("spec", spec, StudySpec, "a study (rodval.load_study) or a study file's path")
+    return spec
+
+
+def _check_workers(workers: Any) -> int:
+    """``workers`` when it is an integer >= 1, else ValueError."""
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    return workers
+
+
+def _check_case_timeout(case_timeout: Any) -> None:
+    """ValueError unless ``case_timeout`` is None (no limit) or a finite number > 0 (s)."""
+    if case_timeout is not None and (
+        isinstance(case_timeout, bool)
+        or not isinstance(case_timeout, int | float)
+        or not 0 < case_timeout < math.inf
+    ):
+        raise ValueError(
+            f"case_timeout must be a finite number > 0 s or None (no limit), got {case_timeout!r:.60}"
+        )
+
+
+def _run_cases(
+    store: StudyStore,
+    name: str,
+    todo: list[Case],
+    *,
+    backend: str,
+    workers: int,
+    scheduler: str | None,
+    case_timeout: float | None,
+    progress: bool,
+) -> int:
+    """Run the cases ``todo`` on the backend, writing each one's record to ``store`` as it
+    finishes (with a progress bar named ``name``); returns the number of failed model runs."""
+    by_id = {c.id: c for c in todo}
+    failed = 0
+    bar = tqdm(total=len(todo), desc=name, unit="case", disable=not progress or not todo)
+
+    def done(payload: dict[str, Any], runs: list[dict[str, Any]]) -> None:
+        """Record a finished case (its payload and run records) and advance the bar."""
+        nonlocal failed
+        case = by_id[payload["case"]]
+        record = case_record(case, runs)
+        write_text_atomic(store.case_path(case.id), record.to_json())
+        failed += sum(r.status != 0 for r in record.runs)
+        bar.update(1)
+        bar.set_postfix(failed_runs=failed)
+
+    payloads = [c.payload() for c in todo]
+    try:
+        if backend == "processes":
+            run_processes(payloads, done, workers, case_timeout)
+        else:
+            assert scheduler is not None
+            run_dask(payloads, done, scheduler, case_timeout)
+    finally:
+        bar.close()
+    return failed
+
+
+def _write_results(out: Path, spec: StudySpec, report: bool) -> None:
+    """The study's tables in ``out`` from its case records, then its report (when ``report``)."""
+    from rodval.study.tables import write_tables
+
+    write_tables(out, spec)
+    if report:
+        from rodval.report.study_report import build_report
+
+        build_report(out)

@@ -30,6 +30,8 @@ from typing import Any
 
 import numpy as np
 
+from rodval.core.checks import check_keys
+
 DESIGNS = ("sobol", "lhs", "random")
 SAMPLE_KEYS = {"design", "count", "seed", "keys"}
 #: Most samples a study may draw (each is a case).
@@ -131,12 +133,7 @@ def sample_columns(table: Any, where: str) -> dict[str, list[float]]:
     order. ValueError naming ``sample.<key>`` for anything wrong, before any case exists."""
     if not isinstance(table, dict):
         raise ValueError(f"{where} key 'sample': must be a table")
-    unknown = sorted(set(table) - SAMPLE_KEYS)
-    if unknown:
-        raise ValueError(
-            f"{where} key 'sample.{unknown[0]}': unknown key (allowed: "
-            f"{', '.join(sorted(SAMPLE_KEYS))})"
-        )
+    check_keys(table, SAMPLE_KEYS, where, path="sample")
     design = table.get("design", "sobol")
     if design not in DESIGNS:
         raise ValueError(f"{where} key 'sample.design': must be one of {DESIGNS}, got {design!r}")

@@ -16,11 +16,12 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
+from rodval.core.scene import Scene
 from rodval.core.scene_file import scene_from_dict
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_ERROR
 from rodval.core.trajectory import SolverStats, Trajectory
-from rodval.models import get_model
+from rodval.models.registry import integrated_models, simulate
 
 
 def failed_run(model: dict, scene_name: str, status: int, message: str) -> dict[str, Any]:
@@ -38,15 +39,21 @@ def failed_run(model: dict, scene_name: str, status: int, message: str) -> dict[
 def iter_case(payload: dict[str, Any]) -> Iterator[dict[str, Any]]:
     """Run every model of a case in turn, yielding one run record per model.
 
-    A model that raises (including "not available") yields a failed run with status
-    ``model error``; the next model still runs.
+    Each run goes through ``rodval.models.registry.simulate``, the entry point of
+    ``rodval simulate`` (the model's options and memory checked before it runs). A model that
+    raises (including "not available") yields a failed run with status ``model error``; the
+    next model still runs.
     """
     scene = scene_from_dict(payload["scene"], where=payload["where"])
     for model in payload["models"]:
         start = time.perf_counter()
         try:
-            m = get_model(model["model"], **model["options"])
-            traj = m.simulate(scene, IntegratorSettings(**model["settings"]))
+            traj = simulate(
+                scene,
+                model["model"],
+                settings=IntegratorSettings(**model["settings"]),
+                **model["options"],
+            )
         except Exception as exc:  # noqa: BLE001 - a failure is data
             yield failed_run(model, scene.name, STATUS_ERROR, f"{type(exc).__name__}: {exc}")
             continue
@@ -61,13 +68,13 @@ def iter_case(payload: dict[str, Any]) -> Iterator[dict[str, Any]]:
         yield run
 
 
-def case_modes(scene, model: dict, spec: dict[str, Any]) -> dict[str, Any]:
+def case_modes(scene: Scene, model: dict[str, Any], spec: dict[str, Any]) -> dict[str, Any]:
     """``{"modes": ...}`` (``Modes.to_dict``) of one model about the study's configuration,
     or ``{"modes_error": message}``: a failed modal analysis never fails the run."""
     from rodval.analysis.modes import model_modes
 
     options = dict(model["options"])
-    if model["model"] != "exudyn":  # the native models' modal option is their variant
+    if model["model"] in integrated_models():  # a native model's modal option: its variant
         options = {"coefficients": options.get("coefficients", "printed")}
     try:
         m = model_modes(

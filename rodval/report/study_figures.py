@@ -1,0 +1,179 @@
+"""The study report's figures: discrepancy, run time and speed-up against each grid parameter,
+and for each report case its time histories, configurations and deployment sequence, drawn
+from the saved tables (``rodval.report.figures`` draws them; this module chooses what)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from rodval.core.trajectory import Trajectory
+from rodval.report.figures import (
+    plot_configurations,
+    plot_deployment,
+    plot_discrepancy_vs,
+    plot_runtime_vs,
+    plot_speedup_vs,
+    plot_time_histories,
+    speedups,
+)
+from rodval.report.markdown import to_markdown
+from rodval.report.tables import trajectory_samples
+
+
+def varying_params(cases: pd.DataFrame, params: list[str]) -> list[str]:
+    """Case parameters with more than one value, all numeric and finite: the x axes of the
+    figures (an axis such as max_step = [inf, 1e-7] has no place on a plot axis)."""
+    return [
+        p
+        for p in params
+        if pd.api.types.is_numeric_dtype(cases[p])
+        and cases[p].nunique() > 1
+        and np.isfinite(cases[p].to_numpy(float)).all()
+    ]
+
+
+def figure_slug(cid: str) -> str:
+    """A case id as part of a figure's file name: ``n=8,t_end=2`` -> ``n8_t_end2``."""
+    return cid.replace(",", "_").replace("=", "")
+
+
+def param_figures(
+    fig_dir: Path, meta: dict[str, Any], tables: dict[str, pd.DataFrame], params: list[str]
+) -> list[str]:
+    """Per varying parameter (``varying_params``): the discrepancy, run time and speed-up
+    figures against it, each line one value of the other parameters (markdown lines)."""
+    labels = [m["label"] for m in meta["models"]]
+    ref, lines = meta["reference"], []
+    speed = speedups(tables["runtime"], ref, params)
+    varying = varying_params(tables["cases"], params)
+    for x in varying:
+        others = [p for p in varying if p != x]
+        logx = (
+            x != "horizon"
+            and tables["cases"][x].min() > 0
+            and tables["cases"][x].max() / tables["cases"][x].min() >= 8
+        )
+        lines.append(f"### Against {x}\n")
+        if not tables["discrepancies"].empty:
+            d = plot_discrepancy_vs(
+                tables["discrepancies"],
+                x,
+                others,
+                labels,
+                fig_dir / f"discrepancy_vs_{x}.png",
+                logx=logx,
+            )
+            lines.append(f"![discrepancy against {x}](figures/{d.name})\n")
+        r = plot_runtime_vs(
+            tables["runtime"], x, others, labels, fig_dir / f"runtime_vs_{x}.png", logx=logx
+        )
+        lines.append(f"![run time against {x}](figures/{r.name})\n")
+        if not speed.empty:
+            s = plot_speedup_vs(
+                speed, x, others, labels, ref, fig_dir / f"speedup_vs_{x}.png", logx=logx
+            )
+            lines.append(f"![speed-up against {x}](figures/{s.name})\n")
+    return lines
+
+
+def _case_runs(sub: pd.DataFrame, labels: list[str], cid: str) -> dict[str, Trajectory]:
+    """The runs of case ``cid`` that produced output, by model label, from its rows ``sub`` of
+    the trajectories table."""
+    return {
+        lab: Trajectory.from_frame(sub[sub["model"] == lab], lab, cid)
+        for lab in labels
+        if (sub["model"] == lab).any()
+    }
+
+
+def _snapped_times(
+    sub: pd.DataFrame, times: list[float] | None, horizon: float, fractions: Sequence[float]
+) -> list[float]:
+    """The output times of ``sub`` nearest to the report's ``times`` (s; default: the
+    ``fractions`` of the ``horizon``), those within the horizon, sorted and distinct."""
+    out_t = np.unique(sub["t"].to_numpy())
+    want = times or [horizon * f for f in fractions]
+    return sorted({float(out_t[np.abs(out_t - t).argmin()]) for t in want if t <= horizon})
+
+
+def case_figures(fig_dir: Path, meta: dict[str, Any], tables: dict[str, pd.DataFrame]) -> list[str]:
+    """Per report case: every model's time histories of the report's rods and quantities and
+    the chain's configurations at the report times; then the values at the report times
+    (markdown lines)."""
+    traj, cases = tables["trajectories"], tables["cases"]
+    lines = []
+    for cid in meta["report"]["cases"]:
+        row = cases[cases["case"] == cid].iloc[0]
+        lines += _one_case_figures(fig_dir, meta, traj[traj["case"] == cid], row, cid)
+    samples = trajectory_samples(traj, meta, cases)
+    if not samples.empty:
+        lines += ["Values at the report times (rad, rad/s):\n", to_markdown(samples, ".6g")]
+    return lines
+
+
+def _one_case_figures(
+    fig_dir: Path, meta: dict[str, Any], sub: pd.DataFrame, row: pd.Series, cid: str
+) -> list[str]:
+    """``case_figures`` of the case ``cid`` (``sub``: its trajectories, ``row``: its cases
+    row)."""
+    rep = meta["report"]
+    n, horizon, l = int(row["n"]), float(row["horizon"]), np.asarray(json.loads(row["l"]))
+    trajs = _case_runs(sub, [m["label"] for m in meta["models"]], cid)
+    lines = [f"### Case `{cid}` (n = {n}, horizon = {horizon:g} s)\n"]
+    if not trajs:
+        return [*lines, "_No model produced output for this case._\n"]
+    rods = sorted({n if r == "last" else int(r) for r in rep["rods"] if r == "last" or int(r) <= n})
+    qs = [q for q in rep["quantities"] if (sub["quantity"] == q).any()]
+    slug = figure_slug(cid)
+    hist = plot_time_histories(
+        trajs, qs, rods, fig_dir / f"history_{slug}.png", title=f"case {cid}: all models"
+    )
+    lines.append(f"![time histories, case {cid}](figures/{hist.name})\n")
+    if "phi" in qs or (sub["quantity"] == "phi").any():
+        snapped = _snapped_times(sub, rep["times"], horizon, (0.25, 0.5, 0.75, 1.0))
+        conf = plot_configurations(
+            trajs,
+            snapped,
+            l,
+            fig_dir / f"configurations_{slug}.png",
+            title=f"case {cid}: chain at t = " + ", ".join(f"{t:.4g}" for t in snapped) + " s",
+        )
+        lines.append(f"![configurations, case {cid}](figures/{conf.name})\n")
+    return lines
+
+
+def deployment_figures(
+    fig_dir: Path, meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
+) -> list[str]:
+    """Per report case with chord angles: each model's deployment sequence (the chain at the
+    report times, default 0, 1/4 ... of the horizon) and the tip's y with the lock times of
+    ``events`` (markdown lines)."""
+    traj, cases = tables["trajectories"], tables["cases"]
+    labels = [m["label"] for m in meta["models"]]
+    lines = []
+    for cid in meta["report"]["cases"]:
+        sub = traj[traj["case"] == cid]
+        if sub.empty or not (sub["quantity"] == "phi").any():
+            continue
+        row = cases[cases["case"] == cid].iloc[0]
+        l = np.asarray(json.loads(row["l"]))
+        trajs = _case_runs(sub, labels, cid)
+        snapped = _snapped_times(
+            sub, meta["report"]["times"], float(row["horizon"]), (0.0, 0.25, 0.5, 0.75, 1.0)
+        )
+        fig = plot_deployment(
+            trajs,
+            events[events["case"] == cid],
+            snapped,
+            l,
+            fig_dir / f"deployment_{figure_slug(cid)}.png",
+            title=f"case {cid}: deployment sequence and tip y (dotted: lock times)",
+        )
+        lines.append(f"![deployment, case {cid}](figures/{fig.name})\n")
+    return lines

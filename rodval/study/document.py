@@ -1,0 +1,75 @@
+"""A study document: the study file's tables as plain dicts (``rodval.study.spec`` reads it).
+
+One form for the errors of a study file, a ValueError naming the file and the dotted key
+(``key_error``), and dotted paths into the document: a grid's or a sample's keys, set in each
+case's copy of it (``set_path``; in a list, ``*`` is every element and an integer one).
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+from rodval.core.scene import Scene
+from rodval.core.scene_file import scene_to_dict
+
+
+def key_error(where: str, key: str, msg: str) -> ValueError:
+    """The error of the study file ``where`` at its dotted ``key``: "where: key 'key': msg"."""
+    return ValueError(f"{where}: key '{key}': {msg}")
+
+
+def plain_document(doc: Any, where: str) -> dict[str, Any]:
+    """A deep copy of a study document (never changing the caller's dict), with a
+    ``rodval.Scene`` given as [scene] turned into its scene-file table (``scene_to_dict``)."""
+    if not isinstance(doc, dict):
+        raise ValueError(f"{where}: a study document must be a dict, got {type(doc).__name__}")
+    doc = copy.deepcopy(doc)
+    if isinstance(doc.get("scene"), Scene):
+        doc["scene"] = scene_to_dict(doc["scene"])
+    return doc
+
+
+def flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """The leaves of nested tables by their dotted paths: {"scene": {"n": v}} -> {"scene.n": v}."""
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        path = f"{prefix}.{k}" if prefix else str(k)
+        if isinstance(v, dict):
+            out.update(flatten(v, path))
+        else:
+            out[path] = v
+    return out
+
+
+def set_path(doc: dict[str, Any], path: str, value: Any) -> None:
+    """Set ``value`` at the dotted ``path`` of ``doc``, creating tables on the way; in a list
+    a segment is an index or ``*`` (every element: every latch). ValueError when the path
+    runs into a value that is neither a table nor a list."""
+    _set_parts(doc, path.split("."), value, path)
+
+
+def _set_parts(node: Any, parts: list[str], value: Any, path: str) -> None:
+    """``set_path`` from ``node`` down the remaining segments ``parts`` of ``path``."""
+    head, rest = parts[0], parts[1:]
+    if isinstance(node, list):
+        if head == "*":
+            index = range(len(node))
+        elif head.isdigit() and int(head) < len(node):
+            index = range(int(head), int(head) + 1)
+        else:
+            raise ValueError(f"{path}: {head!r} is not '*' or an index of a list of {len(node)}")
+        for i in index:
+            if rest:
+                _set_parts(node[i], rest, value, path)
+            else:
+                node[i] = value
+        return
+    if not isinstance(node, dict):
+        raise ValueError(f"{path}: {head!r} goes into {node!r:.40}, which is not a table or list")
+    if not rest:
+        node[head] = value
+        return
+    if node.get(head) is None:
+        node[head] = {}
+    _set_parts(node[head], rest, value, path)
