@@ -282,6 +282,26 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
         rejected = True
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _record_step(rhs, mechanics, model, t, t_new, buffers, times, n_out, Y, W, cnt):
+    """After the accepted step [t, t_new]: the dense output when an output time falls in it or
+    the audit runs (W with rows: ``_audit_step``), the outputs written; returns the next
+    output row. ``model``: (P, S, M, L); ``buffers``: the loop's (y, y_new, K, F, tmp, zero,
+    mech, total); ``cnt[0]``: evaluations, updated."""
+    P, S, M, L = model
+    y, y_new, K, F, tmp, zero, mech, total = buffers
+    outputs = n_out < times.shape[0] and times[n_out] <= t_new
+    audited = W.shape[0] > 0
+    if outputs or audited:
+        _dense_coefficients(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero)
+        cnt[0] += 3
+    if audited:
+        _audit_step(mechanics, P, S, M, L, F, y, t, t_new, times, n_out, tmp, mech, total, W)
+    if outputs:
+        n_out = _write_outputs(F, y, t, t_new, times, n_out, Y)
+    return n_out
+
+
 _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64, types.float64))(
     RHS_TYPE,
     RHS_TYPE,
@@ -338,9 +358,9 @@ def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting
     cnt = np.zeros(2, np.int64)  # evaluations, and the count at the next clock read
     nsteps = 0
     guarded = np.isfinite(guard[2])
-    audited = W.shape[0] > 0
     total = np.zeros(2)
     mech = np.zeros(3)
+    buffers = (y, y_new, K, F, tmp, zero, mech, total)
     t = edges[0]
     if guarded:
         mechanics(t, y, P, S, M, L, mech)
@@ -375,16 +395,9 @@ def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting
             code = guard_step(guard, mon, h, mech, guarded)
             if code != OK:
                 return n_out, cnt[0], nsteps, code, t
-            outputs = n_out < nt and times[n_out] <= t_new
-            if outputs or audited:
-                _dense_coefficients(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero)
-                cnt[0] += 3
-            if audited:
-                _audit_step(
-                    mechanics, P, S, M, L, F, y, t, t_new, times, n_out, tmp, mech, total, W
-                )
-            if outputs:
-                n_out = _write_outputs(F, y, t, t_new, times, n_out, Y)
+            n_out = _record_step(
+                rhs, mechanics, (P, S, M, L), t, t_new, buffers, times, n_out, Y, W, cnt
+            )
             t = t_new
             for i in range(N):
                 y[i] = y_new[i]
