@@ -33,6 +33,8 @@ largest beam-node displacement.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import scipy.linalg
 
@@ -123,7 +125,7 @@ def exudyn_modes(
     load_at: float | None = None,
     load_steps: int = 20,
     axial_tol: float = AXIAL_TOL,
-    **options,
+    **options: Any,
 ) -> Modes:
     """Modes of the exudyn beam model about the scene's initial state or its static
     equilibrium under the static loads (``rodval.core.modal.static_loads`` at ``load_at``,
@@ -137,113 +139,38 @@ def exudyn_modes(
     model = ExudynModel(**{**MODES_DEFAULTS, **options})
     n = scene.n
     loads = static_loads(scene, load_at) if about == "equilibrium" else None
-    held = (
-        ()
-        if loads is None
-        else tuple(
-            constant(k + 1, X=float(loads.X[k]), Y=float(loads.Y[k]))
-            for k in np.flatnonzero((loads.X != 0) | (loads.Y != 0))
-        )
-    )
-    built_scene = scene.with_(loads=held)
+    held = _held_forces(loads)
     prestressed = bool(np.any(scene.chain.kappa * scene.chain.rest_angle != 0))
-    _, mbs, nodes = model.assembled(built_scene)
+    _, mbs, nodes = model.assembled(scene.with_(loads=held))
     for row in nodes:
         for nd in row:
             if mbs.GetNode(nd)["nodeType"] != "Point2DSlope1":
                 raise RuntimeError("unexpected exudyn node numbering")
     console = exu.config.printToConsole
     exu.config.printToConsole = False
-    eq = None
-    residual = float("nan")
+    solved = about == "equilibrium" and (bool(held) or prestressed)
     try:
-        solved = about == "equilibrium" and (bool(held) or prestressed)
-        if solved:
-            sim = exu.SimulationSettings()
-            st = sim.staticSolver
-            st.numberOfLoadSteps = int(load_steps)
-            st.useLoadFactor = True
-            st.verboseMode = 0
-            st.newton.relativeTolerance = 1e-10
-            st.newton.absoluteTolerance = model.newton_atol_per_EA * model.EA
-            st.newton.maxIterations = 50
-            sim.solution.file.write = False
-            sim.show.computationTime = False
-            ok = exu.solver.SolveStatic(mbs, sim, updateInitialValues=True)
-            solver = mbs.sys.get("staticSolver")
-            iters = int(solver.it.newtonStepsCount) if solver is not None else -1
-            # exudyn's last Newton residual (its own norm, N, relative to its tolerances)
-            residual = float(solver.conv.residual) if solver is not None else float("nan")
-            if not ok:
-                raise ValueError("exudyn static solve failed")
+        iters, residual = _static_solve(exu, mbs, model, load_steps) if solved else (0, 0.0)
         matrices = _linear_matrices(exu, mbs)
     finally:
         exu.config.printToConsole = console
     lam, V, s_damped, basis = _eigen(*matrices, damped=bool(np.any(scene.chain.nu > 0)))
-    cfg = exu.ConfigurationType.Initial
-    q_all = np.asarray(mbs.systemData.GetODE2Coordinates(configuration=cfg))
-
-    def node_state(nd):
-        i = mbs.GetNodeODE2Index(nd)
-        ref = np.asarray(mbs.GetNodeParameter(nd, "referenceCoordinates"), float)
-        return i, ref + q_all[i : i + 4]
-
-    idx, state = zip(*(node_state(nd) for row in nodes for nd in row))
-    idx = np.array(idx).reshape(n, -1)  # (n, E+1) first ODE2 index
-    state = np.array(state).reshape(n, idx.shape[1], 4)  # position and slope at q0
-    # per mode: beam-node displacements (n, E+1, 2) and slope changes
-    U = np.stack([V[idx + c] for c in range(4)], axis=-1)  # (n, E+1, modes, 4)
-    U = np.moveaxis(U, 2, 0)  # (modes, n, E+1, 4)
-    disp = U[..., :2]
-    # axial test: element elongation along the current tangent
-    chord = state[:, 1:, :2] - state[:, :-1, :2]
-    t_hat = chord / np.linalg.norm(chord, axis=-1, keepdims=True)
-    elong = np.abs(np.sum((disp[:, :, 1:] - disp[:, :, :-1]) * t_hat, -1))
-    dmax = np.max(np.linalg.norm(disp, axis=-1), axis=(1, 2))
-    axial = np.max(elong, axis=(1, 2)) > axial_tol * np.maximum(dmax, 1e-300)
-    keep = ~axial
-    lam, U = lam[keep], U[keep]
-    order = np.argsort(lam)
-    lam, U = lam[order], U[order]
-    if count is not None:
-        lam, U = lam[: int(count)], U[: int(count)]
-    # node displacements: node 0 = rod 1's root (pinned), node k = rod k's end
-    dx = np.concatenate([U[:, :1, 0, 0], U[:, :, -1, 0]], axis=1)
-    dy = np.concatenate([U[:, :1, 0, 1], U[:, :, -1, 1]], axis=1)
-
-    def dtheta(s, ds):
-        return (s[..., 0] * ds[..., 1] - s[..., 1] * ds[..., 0]) / np.sum(s * s, -1)
-
-    root = dtheta(state[None, :, 0, 2:], U[:, :, 0, 2:])  # (modes, n) rod k root tangent
-    end = dtheta(state[None, :, -1, 2:], U[:, :, -1, 2:])  # rod k end tangent
-    hinge = root.copy()
-    hinge[:, 1:] -= end[:, :-1]
-    dx, dy, hinge = normalize_shapes(dx, dy, hinge)
+    idx, state = _node_states(exu, mbs, nodes, n)
+    lam, U, axial = _bending_modes(lam, V, idx, state, axial_tol, count)
+    dx, dy, hinge = _node_shapes(U, state)
     omega = angular_frequencies(lam)
-    zeta = np.full(omega.size, np.nan)
-    if s_damped is None:
-        zeta[omega > 0] = 0.0
-    else:
-        # pair each undamped mode with the damped eigenvalue (Im > 0) of nearest |s|
-        from scipy.optimize import linear_sum_assignment
-
-        s_up = np.asarray(s_damped)[np.asarray(s_damped).imag > 0]
-        pos = np.flatnonzero(omega > 0)
-        if pos.size and s_up.size:
-            cost = np.abs(np.abs(s_up)[None, :] - omega[pos, None]) / omega[pos, None]
-            r, c = linear_sum_assignment(cost)
-            zeta[pos[r]] = -s_up[c].real / np.abs(s_up[c])
     ends = np.concatenate([state[:1, 0, :2], state[:, -1, :2]])
     d = np.diff(ends, axis=0)
     phi0 = np.arctan2(d[:, 1], d[:, 0])
+    eq = None
     if about == "equilibrium":
         ini = scene.initial.resolve(n)
         phi0 = ini["phi"] + (phi0 - ini["phi"] + np.pi) % (2 * np.pi) - np.pi
         eq = Equilibrium(
             q=np.concatenate([phi0, np.zeros(2 * n)]),
-            iterations=iters if solved else 0,
+            iterations=iters,
             load_steps=int(load_steps),
-            residual=residual if solved else 0.0,
+            residual=residual,
             converged=True,
             loads=loads,
         )
@@ -251,7 +178,7 @@ def exudyn_modes(
         model="exudyn",
         about=about,
         omega=omega,
-        damping=zeta,
+        damping=_damping_ratios(omega, s_damped),
         dx=dx,
         dy=dy,
         hinge=hinge,
@@ -265,3 +192,108 @@ def exudyn_modes(
             "options": model.options(),
         },
     )
+
+
+def _held_forces(loads) -> tuple:
+    """The static loads (``static_loads``; None: none) as constant nodal forces (N)."""
+    if loads is None:
+        return ()
+    return tuple(
+        constant(k + 1, X=float(loads.X[k]), Y=float(loads.Y[k]))
+        for k in np.flatnonzero((loads.X != 0) | (loads.Y != 0))
+    )
+
+
+def _static_solve(exu, mbs, model: ExudynModel, load_steps: int) -> tuple[int, float]:
+    """exudyn's static solve in ``load_steps`` load steps (the state becomes the
+    configuration the modes are about): (Newton iterations, exudyn's last Newton residual in
+    its own norm, N). ValueError if it fails."""
+    sim = exu.SimulationSettings()
+    st = sim.staticSolver
+    st.numberOfLoadSteps = int(load_steps)
+    st.useLoadFactor = True
+    st.verboseMode = 0
+    st.newton.relativeTolerance = 1e-10
+    st.newton.absoluteTolerance = model.newton_atol_per_EA * model.EA
+    st.newton.maxIterations = 50
+    sim.solution.file.write = False
+    sim.show.computationTime = False
+    ok = exu.solver.SolveStatic(mbs, sim, updateInitialValues=True)
+    solver = mbs.sys.get("staticSolver")
+    iters = int(solver.it.newtonStepsCount) if solver is not None else -1
+    residual = float(solver.conv.residual) if solver is not None else float("nan")
+    if not ok:
+        raise ValueError("exudyn static solve failed")
+    return iters, residual
+
+
+def _node_states(exu, mbs, nodes, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each beam node's first ODE2 index (n, E+1) and its position and slope at the
+    configuration (n, E+1, 4)."""
+    q_all = np.asarray(
+        mbs.systemData.GetODE2Coordinates(configuration=exu.ConfigurationType.Initial)
+    )
+
+    def node_state(nd):
+        i = mbs.GetNodeODE2Index(nd)
+        ref = np.asarray(mbs.GetNodeParameter(nd, "referenceCoordinates"), float)
+        return i, ref + q_all[i : i + 4]
+
+    idx, state = zip(*(node_state(nd) for row in nodes for nd in row), strict=True)
+    first = np.array(idx).reshape(n, -1)
+    return first, np.array(state).reshape(n, first.shape[1], 4)
+
+
+def _bending_modes(lam, V, idx, state, axial_tol: float, count: int | None):
+    """The modes without axial content (element elongation along the tangent below
+    ``axial_tol`` x the largest node displacement), ascending, the first ``count``:
+    (eigenvalues, beam-node shapes (modes, n, E+1, 4), which modes were axial)."""
+    U = np.stack([V[idx + c] for c in range(4)], axis=-1)  # (n, E+1, modes, 4)
+    U = np.moveaxis(U, 2, 0)  # (modes, n, E+1, 4)
+    disp = U[..., :2]
+    chord = state[:, 1:, :2] - state[:, :-1, :2]
+    t_hat = chord / np.linalg.norm(chord, axis=-1, keepdims=True)
+    elong = np.abs(np.sum((disp[:, :, 1:] - disp[:, :, :-1]) * t_hat, -1))
+    dmax = np.max(np.linalg.norm(disp, axis=-1), axis=(1, 2))
+    axial = np.max(elong, axis=(1, 2)) > axial_tol * np.maximum(dmax, 1e-300)
+    keep = ~axial
+    lam, U = lam[keep], U[keep]
+    order = np.argsort(lam)
+    lam, U = lam[order], U[order]
+    if count is not None:
+        lam, U = lam[: int(count)], U[: int(count)]
+    return lam, U, axial
+
+
+def _node_shapes(U, state) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Normalized node displacements dx, dy (node 0 = rod 1's root, node k = rod k's end) and
+    hinge-angle changes of each mode."""
+    dx = np.concatenate([U[:, :1, 0, 0], U[:, :, -1, 0]], axis=1)
+    dy = np.concatenate([U[:, :1, 0, 1], U[:, :, -1, 1]], axis=1)
+
+    def dtheta(s, ds):
+        return (s[..., 0] * ds[..., 1] - s[..., 1] * ds[..., 0]) / np.sum(s * s, -1)
+
+    root = dtheta(state[None, :, 0, 2:], U[:, :, 0, 2:])  # (modes, n) rod k root tangent
+    end = dtheta(state[None, :, -1, 2:], U[:, :, -1, 2:])  # rod k end tangent
+    hinge = root.copy()
+    hinge[:, 1:] -= end[:, :-1]
+    return normalize_shapes(dx, dy, hinge)
+
+
+def _damping_ratios(omega: np.ndarray, s_damped) -> np.ndarray:
+    """Each undamped mode's damping ratio from the damped eigenvalue (Im > 0) of nearest |s|
+    (Hungarian pairing); 0 without dampers, NaN where undefined."""
+    zeta = np.full(omega.size, np.nan)
+    if s_damped is None:
+        zeta[omega > 0] = 0.0
+        return zeta
+    from scipy.optimize import linear_sum_assignment
+
+    s_up = np.asarray(s_damped)[np.asarray(s_damped).imag > 0]
+    pos = np.flatnonzero(omega > 0)
+    if pos.size and s_up.size:
+        cost = np.abs(np.abs(s_up)[None, :] - omega[pos, None]) / omega[pos, None]
+        r, c = linear_sum_assignment(cost)
+        zeta[pos[r]] = -s_up[c].real / np.abs(s_up[c])
+    return zeta

@@ -15,7 +15,8 @@ from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_BLOWUP, STATUS_FAILED
 
 exu = pytest.importorskip("exudyn")
-from reference_models.exudyn_chain import DEFAULTS, ExudynModel, _bent_rod  # noqa: E402
+from reference_models.exudyn_beam import _bent_rod  # noqa: E402
+from reference_models.exudyn_chain import DEFAULTS, ExudynModel  # noqa: E402
 
 pytestmark = pytest.mark.exudyn
 
@@ -230,7 +231,7 @@ def test_guard_verdicts_on_a_set_state():
     """The per-step check on states set by hand: a NaN velocity is STATUS_DIVERGED (exudyn's
     Newton usually gives up before a state turns non-finite, so no run reaches this), a huge
     one STATUS_BLOWUP, and its kinetic energy agrees with the measured one."""
-    from reference_models.exudyn_chain import _Guard
+    from reference_models.exudyn_guard import _Guard
     from rodval.core.status import STATUS_DIVERGED
 
     scene = Scene(

@@ -56,7 +56,8 @@ def test_scipy_and_compiled_guards_give_one_verdict(model):
 
 def test_exudyn_guard_gives_the_native_verdict():
     pytest.importorskip("exudyn")
-    from reference_models.exudyn_chain import ExudynModel, _Guard
+    from reference_models.exudyn_chain import ExudynModel
+    from reference_models.exudyn_guard import _Guard
 
     built = ExudynModel()._build(SCENE)
     guard = _Guard(built, SCENE, 2, 1e10, IntegratorSettings().blowup_factor, 0.1)

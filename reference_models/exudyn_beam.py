@@ -1,0 +1,318 @@
+"""The exudyn beam model's kinematics, shared by its build, guard, latches and observation:
+the cubic Hermite shape functions, the initial bent-rod node states, the stop and load laws
+as exudyn user functions, and the beam-field quadratures of energy and angular momentum
+(see ``reference_models.exudyn_chain``'s module docstring for the model)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rodval.core.scene import Scene
+
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(5)
+
+
+def _positive(name: str, value, *, upper: float = math.inf, integer: bool = False):
+    ok_type = (
+        isinstance(value, (int, np.integer))
+        if integer
+        else isinstance(value, (int, float, np.number))
+    )
+    if (
+        isinstance(value, bool)
+        or not ok_type
+        or not (0 < value <= upper)
+        or not math.isfinite(value)
+    ):
+        kind = "an integer >= 1" if integer else f"a number in (0, {upper:g}]"
+        raise ValueError(f"{name} must be {kind}, got {value!r}")
+    return int(value) if integer else float(value)
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    """Angle(s) wrapped to (-pi, pi]."""
+    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+
+
+def _hermite(s: np.ndarray, le: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cubic Hermite shape functions of an element of length le at local s (m):
+    values, first and second s-derivatives, each (len(s), 4) for [r0, r0', r1, r1']."""
+    x = s / le
+    S = np.stack(
+        [
+            1 - 3 * x**2 + 2 * x**3,
+            le * (x - 2 * x**2 + x**3),
+            3 * x**2 - 2 * x**3,
+            le * (-(x**2) + x**3),
+        ],
+        axis=-1,
+    )
+    dS = np.stack(
+        [
+            (-6 * x + 6 * x**2) / le,
+            1 - 4 * x + 3 * x**2,
+            (6 * x - 6 * x**2) / le,
+            -2 * x + 3 * x**2,
+        ],
+        axis=-1,
+    )
+    ddS = np.stack(
+        [(-6 + 12 * x) / le**2, (-4 + 6 * x) / le, (6 - 12 * x) / le**2, (-2 + 6 * x) / le], axis=-1
+    )
+    return S, dS, ddS
+
+
+#: Composite Gauss-Legendre rule on [0, 1] for the arc-length integrals of the initial shape.
+_ARC_PANELS = 8
+_ARC_X, _ARC_W = np.polynomial.legendre.leggauss(16)
+
+
+def _arc_rule(upper: float) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes and weights integrating over [0, upper] (composite Gauss, exact to round-off for
+    the smooth integrands of ``_bent_rod``)."""
+    edges = np.linspace(0.0, upper, _ARC_PANELS + 1)
+    half = 0.5 * np.diff(edges)[:, None]
+    x = (edges[:-1, None] + half * (_ARC_X + 1.0)).ravel()
+    return x, (half * _ARC_W).ravel()
+
+
+def _bent_rod(alpha: float, beta: float, l: float, elements: int):
+    """One rod bent into the assumed shape with end tangent angles alpha, beta (rad) to its
+    chord and arc length exactly l, in its chord frame (x along the chord from the root).
+
+    The curve is y = eta(x) = X (ta sig(xi) + tb tau(xi)), xi = x / X, sig = xi (1 - xi)^2,
+    tau = -xi^2 (1 - xi), ta = tan(alpha), tb = tan(beta): the paper's shape functions on a
+    chord of length X, with end slopes whose angles are alpha and beta exactly. X = l / c with
+    c = int_0^1 sqrt(1 + g^2) dxi, g = eta'(x) (g depends on xi only), so the arc length is l.
+    Beam node j (of elements + 1) sits at arc length j l / elements.
+
+    Returns positions p (E+1, 2), unit tangents t (E+1, 2), and their derivatives with
+    respect to alpha and beta: dp (2, E+1, 2), dt (2, E+1, 2)."""
+    if not (abs(alpha) < 0.5 * math.pi and abs(beta) < 0.5 * math.pi):
+        raise ValueError(
+            f"initial alpha and beta must lie in (-pi/2, pi/2), got {alpha!r}, {beta!r}"
+        )
+    ta, tb = math.tan(alpha), math.tan(beta)
+
+    def g(xi):
+        return ta * (1 - xi) * (1 - 3 * xi) - tb * xi * (2 - 3 * xi)
+
+    def gp(xi):  # dg/dta, dg/dtb
+        return np.stack([(1 - xi) * (1 - 3 * xi), -xi * (2 - 3 * xi)])
+
+    def w(xi):
+        return np.sqrt(1.0 + g(xi) ** 2)
+
+    x1, w1 = _arc_rule(1.0)
+    c = float(np.sum(w1 * w(x1)))
+    dc = np.sum(w1 * g(x1) * gp(x1) / w(x1), axis=-1)  # (2,)
+    X = l / c
+    dX = -l / c**2 * dc
+    # arc-length positions of the beam nodes: int_0^xi w = (j / E) c, by Newton
+    frac = np.arange(elements + 1) / elements
+    xi = frac.copy()
+    for _ in range(50):
+        A = np.array([np.sum(wq * w(xq)) for xq, wq in map(_arc_rule, xi)])
+        step = (A - frac * c) / w(xi)
+        xi = np.clip(xi - step, 0.0, 1.0)
+        if np.max(np.abs(step)) < 1e-15:
+            break
+    xi[0], xi[-1] = 0.0, 1.0
+    dA = np.stack(
+        [np.sum(wq * g(xq) * gp(xq) / w(xq), axis=-1) for xq, wq in map(_arc_rule, xi)], -1
+    )
+    dxi = (frac * dc[:, None] - dA) / w(xi)  # (2, E+1)
+    dxi[:, 0] = dxi[:, -1] = 0.0
+    sig, tau = xi * (1 - xi) ** 2, -(xi**2) * (1 - xi)
+    eta_hat = ta * sig + tb * tau
+    gj, wj = g(xi), w(xi)
+    dg_dxi = ta * (-4 + 6 * xi) + tb * (-2 + 6 * xi)
+    p = np.stack([X * xi, X * eta_hat], -1)
+    t = np.stack([1.0 / wj, gj / wj], -1)
+    dp = np.empty((2, elements + 1, 2))
+    dt = np.empty((2, elements + 1, 2))
+    for i, (shape, dtan) in enumerate(((sig, 1.0 + ta**2), (tau, 1.0 + tb**2))):
+        dp_i = dX[i] * np.stack([xi, eta_hat], -1) + X * np.stack(
+            [dxi[i], gj * dxi[i] + shape], -1
+        )  # per unit d(tan)
+        dgj = gp(xi)[i] + dg_dxi * dxi[i]
+        dt_i = np.stack([-gj / wj**3, 1.0 / wj**3], -1) * dgj[:, None]
+        dp[i], dt[i] = dp_i * dtan, dt_i * dtan  # per unit angle
+    return p, t, dp, dt
+
+
+def _initial_node_states(scene: Scene, elements: int):
+    """Reference coordinates (straight rods along the initial chords) and initial coordinate
+    offsets and velocities of every beam node, per rod: arrays (n, elements+1, 4) with
+    [x, y, slope_x, slope_y] (m, m, -, -) and their rates.
+
+    Each rod starts on the bent curve of ``_bent_rod``: arc length exactly l, nodes at equal
+    arc-length spacing and slopes equal to the unit tangents, so the axial strain is zero at
+    the nodes (the Hermite interpolation between them departs from it at the order of the
+    fourth power of curvature x element length); the chord points along phi_k, the end
+    tangents at phi_k + alpha_k and phi_k + beta_k. The velocities are those of the same
+    curve moving with dphi (rigid rotation about the rod's root), dalpha and dbeta (shape
+    rates, with the chord length following the constant arc length)."""
+    chain, ini = scene.chain, scene.initial.resolve(scene.n)
+    n, l = chain.n, chain.l
+    phi, dphi = ini["phi"], ini["dphi"]
+    J = np.array([[0.0, -1.0], [1.0, 0.0]])
+    root, root_vel = np.zeros(2), np.zeros(2)
+    s = np.linspace(0.0, 1.0, elements + 1)
+    ref = np.empty((n, elements + 1, 4))
+    cur = np.empty((n, elements + 1, 4))
+    vel = np.empty((n, elements + 1, 4))
+    for k in range(n):
+        p, t, dp, dt = _bent_rod(
+            float(ini["alpha"][k]), float(ini["beta"][k]), float(l[k]), elements
+        )
+        c, sn = math.cos(phi[k]), math.sin(phi[k])
+        R = np.array([[c, -sn], [sn, c]])
+        e = R[:, 0]
+        ref[k, :, :2] = root + s[:, None] * l[k] * e
+        ref[k, :, 2:] = e
+        cur[k, :, :2] = root + p @ R.T
+        cur[k, :, 2:] = t @ R.T
+        dp_rate = ini["dalpha"][k] * dp[0] + ini["dbeta"][k] * dp[1]
+        dt_rate = ini["dalpha"][k] * dt[0] + ini["dbeta"][k] * dt[1]
+        vel[k, :, :2] = root_vel + dphi[k] * p @ (R @ J).T + dp_rate @ R.T
+        vel[k, :, 2:] = dphi[k] * t @ (R @ J).T + dt_rate @ R.T
+        root, root_vel = cur[k, -1, :2].copy(), vel[k, -1, :2].copy()
+    return ref, cur - ref, vel
+
+
+def _revolutions(angle: float) -> float:
+    """Initial value of a torsional spring's revolution counter for a relative angle (rad)."""
+    return float(round(angle / (2.0 * math.pi)))
+
+
+def _stop_law(side: str):
+    """springTorqueUserFunction of a one-sided limit stop (exudyn's sign: the returned torque
+    is the spring's restoring torque, k (rotation - offset) for a plain spring): stiffness x
+    penetration + damping x rate beyond the stop angle (``offset``), zero on the free side."""
+    upper = side == "upper"
+
+    def law(mbs, t, item, rotation, omega, stiffness, damping, offset):
+        pen = rotation - offset
+        if (pen > 0.0) if upper else (pen < 0.0):
+            return stiffness * pen + damping * omega
+        return 0.0
+
+    return law
+
+
+def stop_moment(stop, D, dD):
+    """The moment (N m, same sign as a hinge spring's kappa (D - rest)) of a limit stop at
+    hinge angle(s) D (rad) and rate(s) dD (rad/s): zero on the free side."""
+    pen = np.asarray(D, float) - stop.angle
+    inside = pen > 0 if stop.side == "upper" else pen < 0
+    return np.where(inside, stop.stiffness * pen + stop.damping * np.asarray(dD, float), 0.0)
+
+
+def _load_function(f, errors: list):
+    """exudyn load user function of a NodalForce: [X, Y, 0] (N) inside its support, zero
+    (and not evaluated) outside; exceptions are recorded and re-raised."""
+    fx, fy = f.fx, f.fy
+
+    def user_function(mbs, t, load):
+        if not f.active(t):
+            return [0.0, 0.0, 0.0]
+        try:
+            return [fx(t) if fx is not None else 0.0, fy(t) if fy is not None else 0.0, 0.0]
+        except Exception as exc:
+            errors.append(exc)
+            raise
+
+    return user_function
+
+
+def _interpolate(times: np.ndarray, t_rec: np.ndarray, y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """Cubic Hermite interpolation of records y (nt, m) with derivatives dy at ``times``;
+    exact at recorded times."""
+    i = np.clip(np.searchsorted(t_rec, times, side="right") - 1, 0, max(t_rec.size - 2, 0))
+    if t_rec.size < 2:
+        return np.repeat(y[:1], times.size, axis=0)
+    h = (t_rec[i + 1] - t_rec[i])[:, None]
+    th = ((times - t_rec[i])[:, None] / h).clip(0.0, 1.0)
+    h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
+    h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
+    return h00 * y[i] + h10 * h * dy[i] + h01 * y[i + 1] + h11 * h * dy[i + 1]
+
+
+def _elements(chain, E: int, at: dict):
+    """Per element j of every rod k, with the Gauss points of ``_GAUSS_X`` on it: (k, weights
+    (g,) (m), shape functions S, dS, ddS (g, 4), nodal positions/slopes Q and their rates V
+    (nt, 4, 2)) from the node states ``at`` at the output times."""
+    for k in range(chain.n):
+        le = chain.l[k] / E
+        w = 0.5 * le * _GAUSS_W
+        S, dS, ddS = _hermite(0.5 * le * (_GAUSS_X + 1.0), le)
+        for j in range(E):
+            qa, va = at[(k, j)]
+            qb, vb = at[(k, j + 1)]
+            Q = np.stack([qa[:, :2], qa[:, 2:], qb[:, :2], qb[:, 2:]], 1)
+            V = np.stack([va[:, :2], va[:, 2:], vb[:, :2], vb[:, 2:]], 1)
+            yield k, w, S, dS, ddS, Q, V
+
+
+def _energies(
+    scene: Scene, E: int, EA: float, at: dict, phi, alpha, beta
+) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and potential energy (J) per output time: beam kinetic, bending (EI kappa^2/2),
+    axial (EA eps^2/2, EA of the run), point masses and hinge springs (kappa D^2/2 with the
+    continuous tangent angles phi + alpha, phi + beta)."""
+    chain = scene.chain
+    kin = np.zeros(phi.shape[0])
+    pot = np.zeros(phi.shape[0])
+    for k, w, S, dS, ddS, Q, V in _elements(chain, E, at):
+        r_t = np.einsum("gi,tic->tgc", S, V)
+        r1 = np.einsum("gi,tic->tgc", dS, Q)
+        r2 = np.einsum("gi,tic->tgc", ddS, Q)
+        norm2 = np.sum(r1**2, -1)
+        curv = (r1[..., 0] * r2[..., 1] - r1[..., 1] * r2[..., 0]) / norm2
+        strain = np.sqrt(norm2) - 1.0
+        kin += 0.5 * chain.m[k] * np.sum(w * np.sum(r_t**2, -1), -1)
+        pot += 0.5 * np.sum(w * (chain.EI[k] * curv**2 + EA * strain**2), -1)
+    for k in range(chain.n):
+        vt = at[(k, E)][1][:, :2]
+        kin += 0.5 * chain.mu[k] * np.sum(vt**2, -1)
+    left = np.concatenate([np.zeros((phi.shape[0], 1)), (phi + beta)[:, :-1]], 1)
+    D = (phi + alpha) - left
+    pot += 0.5 * np.sum(chain.kappa * (D - chain.rest_angle) ** 2, -1)
+    for stop in scene.stops:
+        pen = D[:, stop.hinge] - stop.angle
+        inside = pen > 0 if stop.side == "upper" else pen < 0
+        pot += np.where(inside, 0.5 * stop.stiffness * pen**2, 0.0)
+    return kin, pot
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _angular_momentum(chain, E: int, at: dict) -> np.ndarray:
+    """The ``angular_momentum`` rows (nt, 2) (N m s, counter-clockwise positive) of the beam
+    field (see rodval.core.scene.QUANTITIES): k = 0 about the root node,
+    H_0 = sum int (r - r_0) x r_t dm (the rods' mass on the beam's reference arc length, the
+    node masses at the rod ends; 5 Gauss points per element integrate the degree-6 integrand
+    exactly), k = 1 about the centre of mass, H_0 - (S x P) / M."""
+    root = at[(0, 0)][0][:, None, :2]  # (nt, 1, 2)
+    H0 = np.zeros(root.shape[0])
+    P = np.zeros((root.shape[0], 2))
+    first = np.zeros((root.shape[0], 2))
+    for k, w, S, _, _, Q, V in _elements(chain, E, at):
+        r = np.einsum("gi,tic->tgc", S, Q) - root
+        v = np.einsum("gi,tic->tgc", S, V)
+        H0 += chain.m[k] * np.sum(w * _cross(r, v), -1)
+        P += chain.m[k] * np.einsum("g,tgc->tc", w, v)
+        first += chain.m[k] * np.einsum("g,tgc->tc", w, r)
+    for k in range(chain.n):
+        r = at[(k, E)][0][:, :2] - root[:, 0]
+        v = at[(k, E)][1][:, :2]
+        H0 += chain.mu[k] * _cross(r, v)
+        P += chain.mu[k] * v
+        first += chain.mu[k] * r
+    total = float(np.sum(chain.m * chain.l + chain.mu))
+    return np.stack([H0, H0 - _cross(first, P) / total], -1)

@@ -1,0 +1,212 @@
+"""Building the exudyn beam model of a scene: nodes, ANCF cable elements, hinges (joints,
+spring-dampers, stops, latch joints), point masses, loads and sensors (``build``)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from reference_models.exudyn_beam import (
+    _initial_node_states,
+    _load_function,
+    _revolutions,
+    _stop_law,
+)
+from rodval.core.scene import Scene
+
+
+@dataclass
+class _Built:
+    """An assembled exudyn system and the sensor ids needed for the scene's outputs."""
+
+    SC: Any
+    mbs: Any
+    node_sensors: dict[tuple[int, int], tuple[int, int, int]]  # (rod, local node) -> (q, v, a)
+    load_errors: list
+    nodes: list | None = None  # beam node numbers per rod
+    initial: tuple | None = None  # _initial_node_states: ref, offsets, velocities
+    latch_joints: dict | None = None  # hinge -> exudyn object number of its locking joint
+
+
+def _items():
+    """exudyn's item classes (exudyn is optional: imported on first use)."""
+    from exudyn import itemInterface
+
+    return itemInterface
+
+
+def build(scene: Scene, E: int, EA: float) -> _Built:
+    """The exudyn beam model of ``scene``, each rod meshed into E ANCF cable elements of axial
+    stiffness EA (N), assembled: O(n E) items. Hinges are a position joint plus a torsional
+    spring-damper on the end tangents (relaxed at the rest angle: exudyn's ``offset``); limit
+    stops a second spring-damper with a one-sided user law; latches a rotation-locking
+    ObjectJointGeneric, inactive until the pre-step function (``_Latches``) switches it on."""
+    import exudyn as exu
+
+    chain = scene.chain
+    SC = exu.SystemContainer()
+    mbs = SC.AddSystem()
+    ground = mbs.AddObject(_items().ObjectGround())
+    ref, q0, v0 = _initial_node_states(scene, E)
+    nodes, elems = _add_rods(mbs, scene, E, EA, (ref, q0, v0))
+    latch_joints = _add_hinges(mbs, scene, E, ground, nodes, elems)
+    it = _items()
+    for k in range(chain.n):
+        if chain.mu[k] > 0:
+            mbs.AddObject(it.ObjectMassPoint2D(nodeNumber=nodes[k][-1], mass=float(chain.mu[k])))
+    load_errors: list = []
+    for f in scene.loads:
+        marker = mbs.AddMarker(it.MarkerNodePosition(nodeNumber=nodes[f.node - 1][-1]))
+        mbs.AddLoad(
+            it.LoadForceVector(
+                markerNumber=marker,
+                loadVector=[0, 0, 0],
+                loadVectorUserFunction=_load_function(f, load_errors),
+            )
+        )
+    node_sensors = _add_sensors(mbs, scene, E, nodes)
+    mbs.Assemble()
+    return _Built(SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints)
+
+
+def _add_rods(mbs, scene: Scene, E: int, EA: float, initial) -> tuple[list, list]:
+    """Each rod's E + 1 slope nodes at their initial states and its E cable elements."""
+    it = _items()
+    chain = scene.chain
+    ref, q0, v0 = initial
+    nodes: list[list[int]] = []
+    elems: list[list[int]] = []
+    for k in range(chain.n):
+        nodes.append(
+            [
+                mbs.AddNode(
+                    it.NodePoint2DSlope1(
+                        referenceCoordinates=ref[k, j].tolist(),
+                        initialCoordinates=q0[k, j].tolist(),
+                        initialVelocities=v0[k, j].tolist(),
+                    )
+                )
+                for j in range(E + 1)
+            ]
+        )
+        le = float(chain.l[k]) / E
+        elems.append(
+            [
+                mbs.AddObject(
+                    it.ObjectANCFCable2D(
+                        nodeNumbers=[nodes[k][j], nodes[k][j + 1]],
+                        length=le,
+                        massPerLength=float(chain.m[k]),
+                        bendingStiffness=float(chain.EI[k]),
+                        axialStiffness=EA,
+                    )
+                )
+                for j in range(E)
+            ]
+        )
+    return nodes, elems
+
+
+def _add_hinges(mbs, scene: Scene, E: int, ground: int, nodes, elems) -> dict[int, int]:
+    """Hinge k's joint, spring-damper, stops and latch joint; returns hinge -> latch joint."""
+    it = _items()
+    chain = scene.chain
+    ini = scene.initial.resolve(chain.n)
+    tangent_left = ini["phi"] + ini["alpha"]
+    tangent_right = ini["phi"] + ini["beta"]
+    latch_of = {latch.hinge: latch for latch in scene.latches}
+    stops_of: dict[int, list] = {}
+    for stop in scene.stops:
+        stops_of.setdefault(stop.hinge, []).append(stop)
+    latch_joints: dict[int, int] = {}
+    for k in range(chain.n):
+        if k == 0:
+            pos0 = mbs.AddMarker(it.MarkerBodyPosition(bodyNumber=ground))
+            rot0 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=ground))
+            angle0 = tangent_left[0]
+        else:
+            pos0 = mbs.AddMarker(it.MarkerNodePosition(nodeNumber=nodes[k - 1][-1]))
+            rot0 = mbs.AddMarker(
+                it.MarkerBodyRigid(
+                    bodyNumber=elems[k - 1][-1], localPosition=[chain.l[k - 1] / E, 0, 0]
+                )
+            )
+            angle0 = tangent_left[k] - tangent_right[k - 1]
+        pos1 = mbs.AddMarker(it.MarkerNodePosition(nodeNumber=nodes[k][0]))
+        mbs.AddObject(it.ObjectJointRevolute2D(markerNumbers=[pos0, pos1]))
+        rot1 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=elems[k][0], localPosition=[0, 0, 0]))
+        springs = [(float(chain.kappa[k]), float(chain.nu[k]), float(chain.rest_angle[k]), 0)]
+        springs += [
+            (stop.stiffness, stop.damping, stop.angle, _stop_law(stop.side))
+            for stop in stops_of.get(k, [])
+        ]
+        _add_springs(mbs, (rot0, rot1), angle0, springs)
+        if k in latch_of:
+            latch_joints[k] = _add_latch_joint(mbs, (rot0, rot1), float(latch_of[k].angle))
+    return latch_joints
+
+
+def _add_springs(mbs, markers: tuple[int, int], angle0: float, springs: list) -> None:
+    """Torsional spring-dampers (stiffness N m/rad, damping N m s/rad, offset rad, user law)
+    between the two rotation markers, each with its revolution counter from angle0 (rad)."""
+    it = _items()
+    for stiffness, damping, offset, law in springs:
+        if stiffness == 0 and damping == 0:
+            continue
+        turns = mbs.AddNode(
+            it.NodeGenericData(numberOfDataCoordinates=1, initialCoordinates=[_revolutions(angle0)])
+        )
+        mbs.AddObject(
+            it.ObjectConnectorTorsionalSpringDamper(
+                markerNumbers=list(markers),
+                nodeNumber=turns,
+                stiffness=stiffness,
+                damping=damping,
+                offset=offset,
+                springTorqueUserFunction=law,
+            )
+        )
+
+
+def _add_latch_joint(mbs, markers: tuple[int, int], angle: float) -> int:
+    """The inactive rotation lock of a latch at ``angle`` (rad): joint frame 1 = marker 1
+    turned back by the latch angle, so the locked relative rotation is D_k = angle (locally
+    unique)."""
+    c, sn = math.cos(-angle), math.sin(-angle)
+    return mbs.AddObject(
+        _items().ObjectJointGeneric(
+            markerNumbers=list(markers),
+            constrainedAxes=[0, 0, 0, 0, 0, 1],
+            rotationMarker1=[[c, -sn, 0.0], [sn, c, 0.0], [0.0, 0.0, 1.0]],
+            activeConnector=False,
+        )
+    )
+
+
+def _add_sensors(mbs, scene: Scene, E: int, nodes) -> dict:
+    """Sensors (coordinates, velocities, accelerations, stored internally) on the beam nodes
+    the outputs need: (rod, node) -> three sensor numbers."""
+    import exudyn as exu
+
+    n = scene.n
+    wanted = set()
+    if scene.wants("phi", "dphi", "alpha", "beta", "x", "y", "hinge_angle", "hinge_moment"):
+        wanted |= {(k, 0) for k in range(n)} | {(k, E) for k in range(n)}
+    if scene.wants("energy", "angular_momentum") or scene.latches:
+        wanted |= {(k, j) for k in range(n) for j in range(E + 1)}
+    ovt = exu.OutputVariableType
+    return {
+        key: tuple(
+            mbs.AddSensor(
+                _items().SensorNode(
+                    nodeNumber=nodes[key[0]][key[1]],
+                    storeInternal=True,
+                    writeToFile=False,
+                    outputVariableType=v,
+                )
+            )
+            for v in (ovt.CoordinatesTotal, ovt.Coordinates_t, ovt.Coordinates_tt)
+        )
+        for key in sorted(wanted)
+    }

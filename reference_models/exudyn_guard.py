@@ -1,0 +1,153 @@
+"""The exudyn model's per-step divergence and resolution check (``_Guard``), on the guard
+spec, energy budget and messages of ``rodval.solvers.guard``."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, _energies, _hermite
+from reference_models.exudyn_build import _Built
+from rodval.core.scene import Scene
+from rodval.core.status import (
+    STATUS_DIVERGED,
+    STATUS_ERROR,
+    STATUS_FAILED,
+    numerical_failure,
+)
+from rodval.solvers.guard import EnergyBudget, GuardSpec, diverged_message
+
+
+class _Guard:
+    """Divergence and resolution checks of one run, on every accepted step (exudyn's
+    PreStepUserFunction: called before each step with t = the end of the coming step, on the
+    state of the last accepted step, at t - step). A verdict stops the solver after the coming
+    step; ``verdict`` is then (status, message, time of the checked state, whether output times
+    at that time are kept).
+
+    * non-finite coordinates or velocities: STATUS_DIVERGED;
+    * kinetic energy T = v^T M v / 2 (consistent mass of the cubic elements plus the point
+      masses; the hinge data nodes carry no mass) above ``factor`` x the budget of
+      ``rodval.solvers.guard`` (``GuardSpec``, ``EnergyBudget``: W+ on the load power at the
+      checked states), E(0) the initial T + Pi (``_energies``): STATUS_BLOWUP;
+    * max_k |dphi_k| x step above ``max_rotation``: STATUS_FAILED (under-resolved)."""
+
+    def __init__(
+        self, built: _Built, scene: Scene, E: int, EA: float, factor: float, max_rotation: float
+    ):
+        mbs, chain = built.mbs, scene.chain
+        ref, q0, v0 = built.initial
+        self.mbs, self.solver = mbs, None
+        self.max_rotation = float(max_rotation)
+        size = mbs.systemData.ODE2Size()
+        ltg = [
+            [np.asarray(mbs.systemData.GetNodeLTGODE2(nd), int) for nd in rod]
+            for rod in built.nodes
+        ]
+        self.ref = np.zeros(size)
+        for k, rod in enumerate(ltg):
+            for j, idx in enumerate(rod):
+                self.ref[idx] = ref[k, j]
+        self.M = np.zeros((size, size))  # dense: a 4 us product at n = 8, 2 elements/rod
+        for k in range(chain.n):
+            le = chain.l[k] / E
+            s = 0.5 * le * (_GAUSS_X + 1.0)
+            S = _hermite(s, le)[0]
+            Me = chain.m[k] * np.einsum("g,gi,gj->ij", 0.5 * le * _GAUSS_W, S, S)  # (4, 4)
+            for j in range(E):
+                a, b = ltg[k][j], ltg[k][j + 1]
+                dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
+                for c in range(2):
+                    self.M[np.ix_(dofs[:, c], dofs[:, c])] += Me
+            if chain.mu[k] > 0:
+                tip = ltg[k][E][:2]
+                self.M[tip, tip] += chain.mu[k]
+        # chord vectors d = A q + d_ref (rows: x, y of rod 1, 2, ...)
+        self.A = np.zeros((2 * chain.n, size))
+        for k in range(chain.n):
+            for c in range(2):
+                self.A[2 * k + c, ltg[k][E][c]] += 1.0
+                self.A[2 * k + c, ltg[k][0][c]] -= 1.0
+        self.d_ref = self.A @ self.ref
+        self.loads = [(f, ltg[f.node - 1][E][:2]) for f in scene.loads]
+        ini = scene.initial.resolve(chain.n)
+        at0 = {
+            (k, j): ((ref + q0)[k, j][None], v0[k, j][None])
+            for k in range(chain.n)
+            for j in range(E + 1)
+        }
+        kin0, pot0 = _energies(
+            scene, E, EA, at0, ini["phi"][None], ini["alpha"][None], ini["beta"][None]
+        )
+        self.spec = GuardSpec(blowup_factor=float(factor), energy0_J=float(kin0[0] + pot0[0]))
+        self.energy = EnergyBudget(self.spec)
+        self.verdict: tuple | None = None
+        self.min_step, self.max_rotation_seen = math.inf, 0.0
+
+    def _power(self, t: float, v: np.ndarray) -> float:
+        p = 0.0
+        for f, idx in self.loads:
+            if f.active(t):
+                fx = f.fx(t) if f.fx is not None else 0.0
+                fy = f.fy(t) if f.fy is not None else 0.0
+                p += fx * v[idx[0]] + fy * v[idx[1]]
+        return p
+
+    def pre_step(self, mbs, t: float) -> bool:
+        h = float(self.solver.it.currentStepSize) if self.solver is not None else 0.0
+        if h > 0:
+            self.min_step = min(self.min_step, h)
+        return self.check(t - h, h)
+
+    def check(self, t: float, h: float = 0.0) -> bool:
+        """Check the current state, at time t (s), before a step h (s); False stops the run."""
+        if self.verdict is not None:
+            return False
+        try:
+            sd = self.mbs.systemData
+            q, v = sd.GetODE2Coordinates(), sd.GetODE2Coordinates_t()
+            if not math.isfinite(float(q @ q) + float(v @ v)):
+                self.verdict = (STATUS_DIVERGED, diverged_message(t), t, False)
+                return False
+            if self.spec.checks_energy:
+                p = self._power(t, v)
+                if not math.isfinite(p):
+                    self.verdict = (
+                        STATUS_ERROR,
+                        (f"a load is not finite at t = {t:.6g} s (load power {p!r} W)"),
+                        t,
+                        False,
+                    )
+                    return False
+                blown = self.energy.check(t, p, 0.5 * float(v @ self.M @ v))
+                if blown is not None:
+                    self.verdict = (*blown, t, False)
+                    return False
+            if h > 0:
+                d, dd = self.A @ q + self.d_ref, self.A @ v
+                dx, dy, ddx, ddy = d[0::2], d[1::2], dd[0::2], dd[1::2]
+                rate = np.abs(dx * ddy - dy * ddx) / (dx * dx + dy * dy)
+                rot = float(rate.max()) * h
+                self.max_rotation_seen = max(self.max_rotation_seen, rot)
+                if rot > self.max_rotation:
+                    k = int(rate.argmax()) + 1
+                    self.verdict = (
+                        STATUS_FAILED,
+                        (
+                            f"under-resolved: rod {k} turns by {rot:.3g} rad in one step of {h:.3g} s "
+                            f"(|dphi| = {rate.max():.4g} rad/s) at t = {t:.6g} s, above "
+                            f"max_rotation_per_step = {self.max_rotation:g} rad; reduce step"
+                        ),
+                        t,
+                        True,
+                    )
+                    return False
+        except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
+            status, message = numerical_failure(exc, t) or (
+                STATUS_ERROR,
+                f"divergence check failed at t = {t:.6g} s: {type(exc).__name__}: {exc}",
+            )
+            self.verdict = (status, message, t, True)
+            return False
+        return True

@@ -1,0 +1,355 @@
+"""Latches in the exudyn model: the rotation-locking joints switched on in the pre-step
+function when a hinge angle crosses its latch angle, and the lock records (``_Latches``)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, _hermite, _wrap, stop_moment
+from reference_models.exudyn_build import _Built
+from reference_models.exudyn_guard import _Guard
+from rodval.core.scene import Scene
+
+#: Steps after the activation step at which a lock's "after" state is taken (the index-3
+#: constraint brings the relative rate to zero within the activation step; the extra steps let
+#: the generalized-alpha velocity transient settle; see docs/deployment.md).
+LOCK_SETTLE_STEPS = 2
+
+
+class _Latches:
+    """The latches of one run, driven from exudyn's PreStepUserFunction (state of the last
+    accepted step, at t - h, before the step to t).
+
+    Each latch's hinge angle D = (tangent angle of rod k+1's root) - (tangent angle of rod k's
+    end) is measured on the beam nodes' slopes, continuous in time from the scene's initial D,
+    with its rate and acceleration. The latch's ObjectJointGeneric (relative rotation locked
+    at the latch angle) is switched on before the step in which D reaches the angle: when D
+    is already past it, or its second-order Taylor extrapolation D + dD h + ddD h^2 / 2 passes
+    it within the coming step. The lock time is where D crosses the angle: the root of that
+    extrapolation within the coming step, or of the cubic Hermite interpolant between the last
+    two states when D is already past (bracketed between steps either way).
+
+    Measures of each lock, on the beam solution: the kinetic energy v^T M v / 2 of the whole
+    chain (consistent mass), the angular momentum about the root (node 0) and the angular
+    momentum H_k of the outboard part (rods k+1..n and their node masses) about the hinge node
+    k, just before the activation step and ``LOCK_SETTLE_STEPS`` steps after it. The angular
+    impulse of the latch on the outboard part is
+    S = H_k(after) - H_k(before) - int M_k dt, with M_k the finite moments on the outboard part
+    about the moving hinge node (hinge k's spring, damper and stops, the outboard loads, and
+    -v_P x p of the moving reference point), integrated by the trapezoid rule: the jump of the
+    relative angular momentum (N m s, counter-clockwise positive on rod k+1)."""
+
+    def __init__(self, built: _Built, guard: _Guard, scene: Scene, E: int):
+        self.mbs, self.guard, self.scene, self.E = built.mbs, guard, scene, E
+        chain, n = scene.chain, scene.n
+        sd = built.mbs.systemData
+        ltg = [[np.asarray(sd.GetNodeLTGODE2(nd), int) for nd in rod] for rod in built.nodes]
+        self.ltg = ltg
+        size = guard.ref.size
+        D0 = scene.initial_hinge_angles()
+        self.items = []
+        for latch in scene.latches:
+            k = latch.hinge
+            direction = latch.direction or int(np.sign(latch.angle - D0[k]))
+            self.items.append(
+                {
+                    "latch": latch,
+                    "k": k,
+                    "dir": direction,
+                    "joint": built.latch_joints[latch.hinge],
+                    "left": None if k == 0 else ltg[k - 1][E][2:],
+                    "right": ltg[k][0][2:],
+                    "D": float(D0[k]),
+                    "state": "armed",
+                }
+            )
+        # quadrature points of every rod (5 Gauss points per element) and the node masses:
+        # position rows Gx, Gy (points x size), weights (kg), rod of each point
+        rows_x, rows_y, wts, rod_of = [], [], [], []
+        for k in range(n):
+            le = chain.l[k] / E
+            sg = 0.5 * le * (_GAUSS_X + 1.0)
+            S = _hermite(sg, le)[0]
+            for j in range(E):
+                a, b = ltg[k][j], ltg[k][j + 1]
+                dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
+                for g in range(sg.size):
+                    for rows, c in ((rows_x, 0), (rows_y, 1)):
+                        r = np.zeros(size)
+                        r[dofs[:, c]] = S[g]
+                        rows.append(r)
+                    wts.append(chain.m[k] * 0.5 * le * _GAUSS_W[g])
+                    rod_of.append(k)
+            if chain.mu[k] > 0:
+                for rows, c in ((rows_x, 0), (rows_y, 1)):
+                    r = np.zeros(size)
+                    r[ltg[k][E][c]] = 1.0
+                    rows.append(r)
+                wts.append(chain.mu[k])
+                rod_of.append(k)
+        self.Gx, self.Gy = np.array(rows_x), np.array(rows_y)
+        self.w, self.rod_of = np.array(wts), np.array(rod_of)
+        self.loads = [(f, ltg[f.node - 1][E][:2], f.node) for f in scene.loads]
+        self.stops = {}
+        for stop in scene.stops:
+            self.stops.setdefault(stop.hinge, []).append(stop)
+        self.root = {"left": None, "right": ltg[0][0][2:], "D": float(D0[0])}
+        self.prev: dict | None = None
+        self.pending: list[dict] = []
+        self.events: list[dict] = []
+        self.lock_times: dict[int, float] = {}
+        self.step_count = 0
+        self._cfg = None  # exudyn's configuration of the last accepted state (StartOfStep)
+
+    # -- measures --------------------------------------------------------------------------
+    def _state(self):
+        import exudyn as exu
+
+        sd, cfg = self.mbs.systemData, self._cfg
+        if cfg is None:
+            cfg = exu.ConfigurationType.StartOfStep
+        q = np.asarray(sd.GetODE2Coordinates(cfg)) + self.guard.ref
+        return (
+            q,
+            np.asarray(sd.GetODE2Coordinates_t(cfg)),
+            np.asarray(sd.GetODE2Coordinates_tt(cfg)),
+        )
+
+    @staticmethod
+    def _angle(q, v, a, idx):
+        """Tangent angle (wrapped), its rate and acceleration of slope dofs ``idx`` (None: the
+        x axis)."""
+        if idx is None:
+            return 0.0, 0.0, 0.0
+        sx, sy = q[idx]
+        vx, vy = v[idx]
+        ax, ay = a[idx]
+        r2 = sx * sx + sy * sy
+        cross = sx * vy - sy * vx
+        rate = cross / r2
+        acc = (sx * ay - sy * ax) / r2 - 2.0 * (sx * vx + sy * vy) * cross / r2**2
+        return math.atan2(sy, sx), rate, acc
+
+    def _hinge(self, item, q, v, a):
+        tl, rl, al = self._angle(q, v, a, item["left"])
+        tr, rr, ar = self._angle(q, v, a, item["right"])
+        D = item["D"] + float(_wrap(np.array((tr - tl) - item["D"])))
+        return D, rr - rl, ar - al
+
+    def _momenta(self, q, v):
+        """Per rod: linear momentum (n, 2) and angular momentum about the origin (n,)."""
+        x, y, vx, vy = self.Gx @ q, self.Gy @ q, self.Gx @ v, self.Gy @ v
+        n = self.scene.n
+        px = np.bincount(self.rod_of, self.w * vx, n)
+        py = np.bincount(self.rod_of, self.w * vy, n)
+        h = np.bincount(self.rod_of, self.w * (x * vy - y * vx), n)
+        return np.stack([px, py], -1), h
+
+    def _chord_rate(self, j: int, q, v) -> float:
+        """d(phi)/dt of rod j (0-based): (d x d') / |d|^2, d the chord vector."""
+        a, b = self.ltg[j][0][:2], self.ltg[j][self.E][:2]
+        d, dd = q[b] - q[a], v[b] - v[a]
+        return float((d[0] * dd[1] - d[1] * dd[0]) / (d @ d))
+
+    def _root_moment(self, j: int, q) -> float:
+        """EI kappa_b (N m) at the root of rod j (0-based): the moment the hinge there
+        transmits, in the sense of its spring's kappa (D - rest)."""
+        E, le = self.E, self.scene.chain.l[j] / self.E
+        _, dS, ddS = _hermite(np.zeros(1), le)
+        a, b = self.ltg[j][0], self.ltg[j][1 if E >= 1 else 0]
+        Q = np.stack([q[a[:2]], q[a[2:]], q[b[:2]], q[b[2:]]])  # (4, 2)
+        r1, r2 = dS[0] @ Q, ddS[0] @ Q
+        return float(self.scene.chain.EI[j] * (r1[0] * r2[1] - r1[1] * r2[0]) / (r1 @ r1))
+
+    def _measures(self, t: float, item, q, v, a) -> dict:
+        k, chain = item["k"], self.scene.chain
+        p, h = self._momenta(q, v)
+        P = q[self.ltg[k][0][:2]]
+        vP = v[self.ltg[k][0][:2]]
+        p_out = p[k:].sum(0)
+        H_out = float(h[k:].sum() - (P[0] * p_out[1] - P[1] * p_out[0]))
+        D, dD, _ = self._hinge(item, q, v, a)
+        moment = chain.kappa[k] * (D - chain.rest_angle[k]) + chain.nu[k] * dD
+        moment += sum(float(stop_moment(st, D, dD)) for st in self.stops.get(k, []))
+        finite = -moment - (vP[0] * p_out[1] - vP[1] * p_out[0])
+        for f, idx, node in self.loads:
+            if node > k and f.active(t):
+                fx = f.fx(t) if f.fx is not None else 0.0
+                fy = f.fy(t) if f.fy is not None else 0.0
+                r = q[idx] - P
+                finite += r[0] * fy - r[1] * fx
+        # about the origin: hinge 0's spring, damper and stops on rod 1, and all loads
+        D0, dD0, _ = self._hinge(self.root, q, v, a)
+        root_moment = -(chain.kappa[0] * (D0 - chain.rest_angle[0]) + chain.nu[0] * dD0)
+        root_moment -= sum(float(stop_moment(st, D0, dD0)) for st in self.stops.get(0, []))
+        for f, idx, _ in self.loads:
+            if f.active(t):
+                fx = f.fx(t) if f.fx is not None else 0.0
+                fy = f.fy(t) if f.fy is not None else 0.0
+                root_moment += q[idx][0] * fy - q[idx][1] * fx
+        rel = self._chord_rate(k, q, v) - (self._chord_rate(k - 1, q, v) if k > 0 else 0.0)
+        return {
+            "t": t,
+            "rel": rel,
+            "M_beam": self._root_moment(k, q),
+            "H_out": H_out,
+            "finite": finite,
+            "H_root": float(h.sum()),
+            "root_moment": root_moment,
+            "T": 0.5 * float(v @ self.guard.M @ v),
+            "D": D,
+            "dD": dD,
+        }
+
+    # -- per step --------------------------------------------------------------------------
+    def pre_step(self, t: float, h: float) -> None:
+        """Called before the step to t, on the state at t - h (the last accepted step)."""
+        if h <= 0:
+            return
+        t0 = t - h
+        q, v, a = self._state()
+        self.root["D"] = self._hinge(self.root, q, v, a)[0]
+        now = {}
+        for item in self.items:
+            if item["state"] != "armed":
+                continue
+            D, dD, ddD = self._hinge(item, q, v, a)
+            item["D"] = D
+            now[item["k"]] = (D, dD, ddD)
+        for ev in list(self.pending):
+            ev["steps"] += 1
+            now_m = self._measures(t0, ev["item"], q, v, a)
+            last = ev["last"]
+            ev["integral"] += 0.5 * (now_m["t"] - last["t"]) * (last["finite"] + now_m["finite"])
+            ev["root_integral"] += (
+                0.5 * (now_m["t"] - last["t"]) * (last["root_moment"] + now_m["root_moment"])
+            )
+            ev["peak"] = max(ev["peak"], abs(now_m["M_beam"]))
+            s0 = np.sign(ev["before"]["rel"])
+            if ev["steps"] > LOCK_SETTLE_STEPS and np.sign(now_m["rel"]) != s0:
+                self._finish(ev, last, now_m)
+            else:
+                ev["last"] = now_m
+        for item in self.items:
+            if item["state"] != "armed":
+                continue
+            D, dD, ddD = now[item["k"]]
+            angle, s = item["latch"].angle, item["dir"]
+            t_lock = None
+            if s * (D - angle) >= 0:  # already at or past: Hermite root in the last step
+                if self.prev is not None and item["k"] in self.prev["D"]:
+                    Dp, dDp, _ = self.prev["D"][item["k"]]
+                    t_lock = _hermite_root(self.prev["t"], t0, Dp - angle, dDp, D - angle, dD)
+                else:
+                    t_lock = t0
+            else:
+                tau = _taylor_root(D - angle, dD, ddD, h)
+                if tau is not None:
+                    t_lock = t0 + tau
+            if t_lock is None:
+                continue
+            self.mbs.SetObjectParameter(item["joint"], "activeConnector", True)
+            item["state"] = "locking"
+            self.lock_times[item["k"]] = t0
+            before = self._measures(t0, item, q, v, a)
+            self.pending.append(
+                {
+                    "item": item,
+                    "t_lock": t_lock,
+                    "steps": 0,
+                    "before": before,
+                    "last": before,
+                    "integral": 0.0,
+                    "root_integral": 0.0,
+                    "peak": abs(before["M_beam"]),
+                    "step": h,
+                }
+            )
+        self.prev = {"t": t0, "D": now}
+
+    def close(self) -> None:
+        """At the end of the run: locks whose window has not closed are recorded with the
+        last state (``window_closed`` False)."""
+        for ev in list(self.pending):
+            self._finish(ev, ev["last"], None)
+
+    def _finish(self, ev: dict, last: dict, now: dict | None) -> None:
+        """Record a lock. The lock window ends where the relative chord rate of the two rods
+        (d phi_{k+1}/dt - d phi_k/dt) first reaches zero after the activation (linear
+        interpolation between ``last`` and ``now``; the last state if it never does)."""
+        item, before = ev["item"], ev["before"]
+        if now is None:
+            after, frac, closed = last, 0.0, False
+        else:
+            frac = last["rel"] / (last["rel"] - now["rel"]) if last["rel"] != now["rel"] else 1.0
+            frac = min(max(frac, 0.0), 1.0)
+            after = {key: last[key] + frac * (now[key] - last[key]) for key in last}
+            closed = True
+            # the integral holds the whole last step: take back the part beyond the crossing
+            h = now["t"] - last["t"]
+            ev["integral"] -= 0.5 * (1 - frac) * h * (after["finite"] + now["finite"])
+            ev["root_integral"] -= (
+                0.5 * (1 - frac) * h * (after["root_moment"] + now["root_moment"])
+            )
+        impulse = after["H_out"] - before["H_out"] - ev["integral"]
+        root_jump = after["H_root"] - before["H_root"] - ev["root_integral"]
+        latch = item["latch"]
+        self.events.append(
+            {
+                "t": float(ev["t_lock"]),
+                "label": f"latch hinge {latch.hinge}",
+                "hinge": int(latch.hinge),
+                "angle": float(latch.angle),
+                "angular_impulse": float(impulse),
+                "kinetic_before": float(before["T"]),
+                "kinetic_after": float(after["T"]),
+                "rate_before": float(before["dD"]),
+                "chord_rate_before": float(before["rel"]),
+                "angular_momentum_root_before": float(before["H_root"]),
+                "angular_momentum_root_after": float(after["H_root"]),
+                "angular_momentum_root_jump": float(root_jump),
+                "peak_moment": float(ev["peak"]),
+                "t_activated": float(before["t"]),
+                "lock_duration": float(after["t"] - before["t"]),
+                "window_closed": closed,
+                "step": float(ev["step"]),
+            }
+        )
+        item["state"] = "locked"
+        self.pending.remove(ev)
+
+
+def _taylor_root(g: float, dg: float, ddg: float, h: float) -> float | None:
+    """Smallest tau in (0, h] where g + dg tau + ddg tau^2 / 2 changes sign from that of g
+    (None if it does not within the step)."""
+    tau = np.array([h])
+    coeffs = [0.5 * ddg, dg, g]
+    roots = np.roots(coeffs) if abs(ddg) > 0 or abs(dg) > 0 else np.array([])
+    real = sorted(
+        float(r.real) for r in np.atleast_1d(roots) if abs(r.imag) < 1e-12 and 0 < r.real <= tau[0]
+    )
+    return real[0] if real else None
+
+
+def _hermite_root(t0: float, t1: float, g0: float, dg0: float, g1: float, dg1: float) -> float:
+    """Where the cubic Hermite interpolant of g between (t0, g0, dg0) and (t1, g1, dg1) crosses
+    zero (g0 and g1 of opposite sign or g1 = 0), by bisection; t1 when not bracketed."""
+    h = t1 - t0
+    if h <= 0 or g0 * g1 > 0:
+        return t1
+
+    def g(th):
+        h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
+        h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
+        return h00 * g0 + h10 * h * dg0 + h01 * g1 + h11 * h * dg1
+
+    lo, hi = 0.0, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if (g(mid) > 0) == (g0 > 0) and g(mid) != 0:
+            lo = mid
+        else:
+            hi = mid
+    return t0 + hi * h

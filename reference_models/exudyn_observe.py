@@ -1,0 +1,130 @@
+"""The exudyn model's outputs: the scene's quantities at the output times from the recorded
+beam-node states (``observe``; definitions in docs/quantities.md)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reference_models.exudyn_beam import (
+    _angular_momentum,
+    _energies,
+    _hermite,
+    _interpolate,
+    _wrap,
+    stop_moment,
+)
+from rodval.core.scene import QUANTITIES, Scene
+
+
+def _observe(
+    scene: Scene,
+    E: int,
+    EA: float,
+    times: np.ndarray,
+    t_rec: np.ndarray,
+    records: dict,
+    lock_steps: dict | None = None,
+):
+    """The scene's quantities at ``times`` from recorded node states (see module docstring).
+
+    "hinge_angle": D_k (k = 0..n-1) from the continuous tangent angles; "hinge_moment" (N m):
+    the moment of hinge k, in the sense of its spring's kappa (D - rest): the spring, damper
+    and stop laws at the measured D and dD while the hinge is free, and from the state
+    where its latch was switched on (``lock_steps``: hinge -> time, s) the beam's own bending
+    moment EI kappa_b at the root of rod k+1 (the hinge has no inertia: it transmits that
+    moment), kappa_b the curvature of the cable's field there."""
+    n = scene.n
+    rods = np.arange(1, n + 1)
+    at = {
+        key: (_interpolate(times, t_rec, q, v), _interpolate(times, t_rec, v, a))
+        for key, (q, v, a) in records.items()
+    }
+    out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    if not scene.wants(*QUANTITIES):
+        return out
+    left = [records[(k, 0)] for k in range(n)]
+    right = [records[(k, E)] for k in range(n)]
+    # chord angles on every recorded step, unwrapped in time from the initial phi
+    chord_rec = np.stack([r[0][:, :2] - lft[0][:, :2] for lft, r in zip(left, right)], 1)
+    raw_rec = np.arctan2(chord_rec[..., 1], chord_rec[..., 0])
+    phi_rec = np.unwrap(raw_rec, axis=0)
+    phi0 = scene.initial.resolve(n)["phi"]
+    phi_rec += 2 * np.pi * np.round((phi0 - phi_rec[0]) / (2 * np.pi))
+    i = np.clip(np.searchsorted(t_rec, times, side="right") - 1, 0, t_rec.size - 1)
+    qL = np.stack([at[(k, 0)][0] for k in range(n)], 1)  # (nt, n, 4)
+    qR = np.stack([at[(k, E)][0] for k in range(n)], 1)
+    vL = np.stack([at[(k, 0)][1] for k in range(n)], 1)
+    vR = np.stack([at[(k, E)][1] for k in range(n)], 1)
+    d, dd = qR[..., :2] - qL[..., :2], vR[..., :2] - vL[..., :2]
+    phi = phi_rec[i] + _wrap(np.arctan2(d[..., 1], d[..., 0]) - phi_rec[i])
+    dphi = (d[..., 0] * dd[..., 1] - d[..., 1] * dd[..., 0]) / np.sum(d**2, -1)
+    alpha = _wrap(np.arctan2(qL[..., 3], qL[..., 2]) - phi)
+    beta = _wrap(np.arctan2(qR[..., 3], qR[..., 2]) - phi)
+    for name, val in (("phi", phi), ("dphi", dphi), ("alpha", alpha), ("beta", beta)):
+        if scene.wants(name):
+            out[name] = (val, rods)
+    if scene.wants("x", "y"):
+        nodes = np.arange(0, n + 1)
+        x = np.concatenate([qL[:, :1, 0], qR[..., 0]], 1)
+        y = np.concatenate([qL[:, :1, 1], qR[..., 1]], 1)
+        if scene.wants("x"):
+            out["x"] = (x, nodes)
+        if scene.wants("y"):
+            out["y"] = (y, nodes)
+    if scene.wants("hinge_angle", "hinge_moment"):
+        _hinge_quantities(
+            scene, E, times, at, (phi, alpha, beta), (qL, vL, qR, vR), lock_steps, out
+        )
+    if scene.wants("energy"):
+        kin, pot = _energies(scene, E, EA, at, phi, alpha, beta)
+        zero = np.zeros(1, dtype=int)
+        out["kinetic"] = (kin[:, None], zero)
+        out["potential"] = (pot[:, None], zero)
+        out["energy"] = ((kin + pot)[:, None], zero)
+    if scene.wants("angular_momentum"):
+        out["angular_momentum"] = (_angular_momentum(scene.chain, E, at), np.arange(2))
+    return out
+
+
+def _hinge_quantities(scene: Scene, E: int, times, at: dict, angles, ends, lock_steps, out):
+    """ "hinge_angle" D_k (rad) and "hinge_moment" (N m) into ``out`` (see ``_observe``):
+    ``angles`` = (phi, alpha, beta) (nt, n); ``ends`` = the rods' left and right node states
+    and rates (qL, vL, qR, vR), (nt, n, 4)."""
+    phi, alpha, beta = angles
+    qL, vL, qR, vR = ends
+    hinges = np.arange(scene.n)
+    left = np.concatenate([np.zeros((phi.shape[0], 1)), (phi + beta)[:, :-1]], 1)
+    D = (phi + alpha) - left
+
+    def rate(q, v):
+        return (q[..., 2] * v[..., 3] - q[..., 3] * v[..., 2]) / (q[..., 2] ** 2 + q[..., 3] ** 2)
+
+    rate_left = rate(qL, vL)
+    rate_right = np.concatenate([np.zeros((phi.shape[0], 1)), rate(qR, vR)[:, :-1]], 1)
+    dD = rate_left - rate_right
+    if scene.wants("hinge_angle"):
+        out["hinge_angle"] = (D, hinges)
+    if scene.wants("hinge_moment"):
+        chain = scene.chain
+        M = chain.kappa * (D - chain.rest_angle) + chain.nu * dD
+        for stop in scene.stops:
+            M[:, stop.hinge] += stop_moment(stop, D[:, stop.hinge], dD[:, stop.hinge])
+        for k, t_on in (lock_steps or {}).items():
+            after = times >= t_on - 1e-12
+            if after.any():
+                M[after, k] = _root_bending_moment(chain, E, at, k)[after]
+        out["hinge_moment"] = (M, hinges)
+
+
+def _root_bending_moment(chain, E: int, at: dict, k: int) -> np.ndarray:
+    """The beam's bending moment EI kappa_b (N m) at the root of rod k+1 at every output time,
+    kappa_b the curvature of its first cable element's field at s = 0."""
+    le = chain.l[k] / E
+    ddS = _hermite(np.zeros(1), le)[2][0]  # (4,) at s = 0
+    dS = _hermite(np.zeros(1), le)[1][0]
+    qa, qb = at[(k, 0)][0], at[(k, 1)][0]
+    Q = np.stack([qa[:, :2], qa[:, 2:], qb[:, :2], qb[:, 2:]], 1)  # (nt, 4, 2)
+    r1 = np.einsum("i,tic->tc", dS, Q)
+    r2 = np.einsum("i,tic->tc", ddS, Q)
+    curv = (r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]) / np.sum(r1**2, -1)
+    return chain.EI[k] * curv
