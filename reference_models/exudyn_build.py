@@ -24,9 +24,9 @@ class _Built:
     mbs: Any
     node_sensors: dict[tuple[int, int], tuple[int, int, int]]  # (rod, local node) -> (q, v, a)
     load_errors: list
-    nodes: list | None = None  # beam node numbers per rod
-    initial: tuple | None = None  # _initial_node_states: ref, offsets, velocities
-    latch_joints: dict | None = None  # hinge -> exudyn object number of its locking joint
+    nodes: list  # beam node numbers per rod
+    initial: tuple  # _initial_node_states: ref, offsets, velocities
+    latch_joints: dict  # hinge -> exudyn object number of its locking joint
 
 
 def _items():

@@ -343,7 +343,7 @@ class ExudynModel(Model):
         function; the outcome and counters into ``stats`` (the guard keeps its verdict)."""
         import exudyn as exu
 
-        solver = exu.MainSolverImplicitSecondOrder()
+        solver: Any = exu.MainSolverImplicitSecondOrder()
         guard.solver = solver
 
         def pre_step(mbs, t):

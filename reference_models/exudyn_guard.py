@@ -4,6 +4,7 @@ spec, energy budget and messages of ``rodval.solvers.guard``."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -38,7 +39,8 @@ class _Guard:
     ):
         mbs, chain = built.mbs, scene.chain
         ref, q0, v0 = built.initial
-        self.mbs, self.solver = mbs, None
+        self.mbs = mbs
+        self.solver: Any = None  # exudyn's solver, set by the run
         self.max_rotation = float(max_rotation)
         size = mbs.systemData.ODE2Size()
         ltg = [

@@ -67,7 +67,10 @@ class _Latches:
             )
         # quadrature points of every rod (5 Gauss points per element) and the node masses:
         # position rows Gx, Gy (points x size), weights (kg), rod of each point
-        rows_x, rows_y, wts, rod_of = [], [], [], []
+        rows_x: list[np.ndarray] = []
+        rows_y: list[np.ndarray] = []
+        wts: list[float] = []
+        rod_of: list[int] = []
         for k in range(n):
             le = chain.l[k] / E
             sg = 0.5 * le * (_GAUSS_X + 1.0)
@@ -92,7 +95,7 @@ class _Latches:
         self.Gx, self.Gy = np.array(rows_x), np.array(rows_y)
         self.w, self.rod_of = np.array(wts), np.array(rod_of)
         self.loads = [(f, ltg[f.node - 1][E][:2], f.node) for f in scene.loads]
-        self.stops = {}
+        self.stops: dict[int, list] = {}
         for stop in scene.stops:
             self.stops.setdefault(stop.hinge, []).append(stop)
         self.root = {"left": None, "right": ltg[0][0][2:], "D": float(D0[0])}

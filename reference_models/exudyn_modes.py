@@ -199,7 +199,7 @@ def _held_forces(loads) -> tuple:
     if loads is None:
         return ()
     return tuple(
-        constant(k + 1, X=float(loads.X[k]), Y=float(loads.Y[k]))
+        constant(int(k) + 1, X=float(loads.X[k]), Y=float(loads.Y[k]))
         for k in np.flatnonzero((loads.X != 0) | (loads.Y != 0))
     )
 
