@@ -54,7 +54,6 @@ from reference_models.exudyn_guard import _Guard
 from reference_models.exudyn_latches import _Latches
 from reference_models.exudyn_observe import _observe
 from rodval.core.contract import Model
-from rodval.core.modal import Modes
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import (
@@ -132,6 +131,9 @@ class ExudynModel(Model):
 
     name = "exudyn"
     OPTIONS = tuple(DEFAULTS)
+    MODAL_ANALYSIS = "reference_models.exudyn_modes:exudyn_modes"
+    #: a modal analysis takes the model's options and its own (``exudyn_modes``)
+    MODES_OPTIONS = (*OPTIONS, "load_steps", "axial_tol")
     #: exudyn integrates with its own options: rodval's integrator settings do not apply.
     USES_INTEGRATOR_SETTINGS = False
 
@@ -197,23 +199,6 @@ class ExudynModel(Model):
         return built.SC, built.mbs, nodes
 
     # -- system ------------------------------------------------------------------------------
-    @classmethod
-    def modes(
-        cls,
-        scene: Scene,
-        *,
-        about: str = "initial",
-        count: int | None = None,
-        load_at: float | None = None,
-        **options: Any,
-    ) -> Modes:
-        """Modes of the beam model (``reference_models.exudyn_modes.exudyn_modes``;
-        ``options``: this model's options and the modal ones (``load_steps``,
-        ``axial_tol``), with ``MODES_DEFAULTS`` for a modal analysis)."""
-        from reference_models.exudyn_modes import exudyn_modes
-
-        return exudyn_modes(scene, about=about, count=count, load_at=load_at, **options)
-
     def _build(self, scene: Scene) -> _Built:
         """The beam model of ``scene`` with this model's discretization (``build``)."""
         return build(scene, self.elements, self.EA)

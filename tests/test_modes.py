@@ -10,12 +10,11 @@ import numpy as np
 import pytest
 
 from rodval import Chain, Scene, constant, paper_scene
-from rodval.analysis.modes import (
-    compare_modes,
+from rodval.analysis.modes import compare_modes, pair_modes
+from rodval.models.linear_modes import (
     mac,
     modes,
     natural_frequencies,
-    pair_modes,
     static_equilibrium,
     static_residual,
 )
@@ -103,7 +102,7 @@ def test_static_equilibrium_residual_and_rest_angle_argument():
 def test_damping_ratios_match_modal_approximation():
     """Paper chain n = 8 (nu = 0.01): damping ratios from the quadratic eigenproblem agree with
     the light-damping estimate x^T C x / (2 omega x^T M x) to 1e-3 (relative)."""
-    from rodval.analysis.modes import eigen, linear_system
+    from rodval.models.linear_modes import eigen, linear_system
 
     chain = Chain.uniform(8)
     M, C, K = linear_system(chain, "full")
@@ -332,7 +331,7 @@ def _mp_frequencies(M, K, dps=40):
 def test_published_spectrum_against_mpmath_n10():
     """n = 10 (30 x 30): every frequency of the published full model agrees with mpmath's
     (40 digits) to 1e-7 relative."""
-    from rodval.analysis.modes import linear_matrices
+    from rodval.models.linear_modes import linear_matrices
 
     chain = Chain.uniform(10)
     M, K = linear_matrices(chain, "full", coefficients="published")
@@ -350,7 +349,7 @@ def test_published_spectrum_n64_is_real_and_matches_mpmath():
     agree with the reduced model's to 1e-3 (measured 9e-5, the model difference)."""
     import scipy.linalg
 
-    from rodval.analysis.modes import linear_matrices
+    from rodval.models.linear_modes import linear_matrices
 
     chain = Chain.uniform(64)
     M, K = linear_matrices(chain, "full", coefficients="published")
@@ -369,7 +368,7 @@ def test_published_spectrum_n64_is_real_and_matches_mpmath():
 @pytest.mark.slow
 def test_published_spectrum_against_mpmath_n32_all():
     """n = 32 (96 x 96, ~75 s in mpmath): all 96 frequencies to 1e-7."""
-    from rodval.analysis.modes import linear_matrices
+    from rodval.models.linear_modes import linear_matrices
 
     chain = Chain.uniform(32)
     M, K = linear_matrices(chain, "full", coefficients="published")

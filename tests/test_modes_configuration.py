@@ -12,10 +12,10 @@ import pytest
 from test_cli_errors import assert_refused, run_main
 
 from rodval import Chain, InitialState, Scene, constant, paper_scene
-from rodval.analysis.modes import AT_REST_RTOL, modes, static_residual
 from rodval.cli import main
 from rodval.core.loads import harmonic, pulse
 from rodval.core.modal import static_loads
+from rodval.models.linear_modes import AT_REST_RTOL, modes, static_residual
 from rodval.models.paper_matrices import hinge_matrix
 
 CHAIN = Chain.uniform(3, nu=0.0)

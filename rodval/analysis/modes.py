@@ -1,73 +1,7 @@
-"""Linearized free vibration (modal analysis) of the paper's full and reduced models.
-
-About a configuration at rest, q0 = [phi0; alpha0; beta0], the convective terms (quadratic in
-the rates) and dM/dphi q'' (q'' = 0 at an equilibrium) drop out of the linearization, so both
-models become
-
-    M(phi0) dq'' + C dq' + (K + K_L(phi0)) dq = 0
-
-with the load stiffness K_L = -dQ/dphi of the constant loads on the phi rows,
-
-    Q_k = l_k (cos phi_k SY_k - sin phi_k SX_k)  ->  (K_L)_kk = l_k (sin phi_k SY_k + cos phi_k SX_k)
-
-(diagonal; SX_k = sum_{j>=k} X_j). Full model: q = [phi; alpha; beta] (3n); reduced model:
-q = phi (n) with M_r(phi0), C_r, K_r + K_L (the bending rows condensed quasi-statically).
-
-Configurations (``about``)
---------------------------
-``initial``: the scene's initial state (loads left out: free vibration about that shape). It
-must be at rest in equilibrium without loads (``check_at_rest``: zero rates, static residual
-of the hinge springs about their rest angles and the bending below ``AT_REST_RTOL``); a
-pre-stressed fold is refused unless ``allow_unbalanced=True`` (the residual is then
-recorded). A chain held by loads is linearized about its equilibrium (``equilibrium``).
-``equilibrium``: the static equilibrium under the scene's static loads
-(``rodval.core.modal.static_loads``: the loads that act for ever at their final value,
-windowed ones left out and named; or, with ``load_at``, every load at that instant) and the
-hinge rest angles, found by Newton's method on the static residual
-
-    R(q) = K q - A^T (kappa * rest) - [Q(phi); 0; 0]
-
-(``static_residual``; ``rest``: the chain's hinge rest angles) with its exact Jacobian
-K + K_L, and load stepping when the full step fails. The reduced model's equilibrium is the
-same phi (its bending rows are the full model's, condensed).
-
-Frequencies and damping
------------------------
-Undamped: the generalized eigenproblem (K + K_L) x = omega^2 M x. For the full model with the
-kinematic ("printed") coefficients M is symmetric positive definite:
-``rodval.core.eigen.symmetric_pencil`` (direct and inverted pencil, each eigenvalue from the
-one that carries it: the same digits on every BLAS kernel).
-The reduced model's M_r = M_pp - K_pg B^-1 M_gp is not symmetric (a quasi-static
-condensation, not a Galerkin projection: asymmetry ~1e-5 of its largest entry at n = 3..8),
-and neither is the full M with the ``published`` erratum; both take the general path below.
-For the published M the generalized eigenproblem is extremely ill-conditioned for long
-uniform chains: right eigenvectors of the bending cluster localize at the tip, left ones at
-the root (a "skin effect" of the non-symmetric rod-to-rod coupling), so the eigenvalue
-condition numbers grow exponentially with n (94 at n = 8, 2e5 at n = 16, 3e12 at n = 32, 2e14
-at n = 64) and double-precision QZ on (K, M) returns complex pairs from n ~ 32 although the
-spectrum is real. ``_general_eig`` removes that: it rewrites the pencil in node transverse
-displacements (phi_k = (y_k - y_{k-1}) / l_k, exact; the pencil is then block-banded, one rod
-coupling only its neighbours, in the straight configuration) ordered rod by rod, applies the
-exact diagonal similarity diag(rho^k) per rod for a few rho (undoing the geometric
-localization without mixing the band), runs QZ for each, and takes every eigenvalue from the
-run whose first-order error estimate (left/right eigenvectors) for it is smallest, matching
-the runs' spectra one-to-one. n = 10 and 32 (all eigenvalues) and 64 (all 192) agree with
-mpmath at 40 digits (tests/test_modes.py, docs/modes.md).
-
-Damped (nu > 0): the quadratic eigenproblem (s^2 M + s C + K + K_L) x = 0 as a first-order
-state-space problem (``rodval.core.eigen.quadratic_eigenvalues``, inverted); each undamped
-mode is paired (Hungarian, on the MAC of the displacement parts) with an eigenvalue s of
-positive imaginary part, and the damping ratio is zeta = -Re(s) / |s|. Modes with omega = 0
-(free rigid rotation) have no damping ratio (NaN).
-
-Mode shapes
------------
-From the linearized kinematics: node displacements dx_k = -sum_{j<=k} l_j sin(phi0_j) dphi_j,
-dy_k = sum_{j<=k} l_j cos(phi0_j) dphi_j (nodes k = 0..n, node 0 fixed) and hinge angles
-D = A [dphi; dalpha; dbeta] (hinges 0..n-1). The reduced model's bending coordinates follow
-from its bending rows at the mode's frequency: gamma = -B^-1 (K_gp - omega^2 M_gp) dphi.
-Normalization: the largest node displacement magnitude is 1 (the hinge angles scaled with it),
-and the largest node-displacement component is positive.
+"""Modes of every model side by side: ``model_modes`` checks once what the modes are about
+(``rodval.models.linear_modes.check_configuration``) and asks the model for them
+(``Model.modes``: the paper models' linearization in ``rodval.models.linear_modes``, exudyn's
+in ``reference_models.exudyn_modes``).
 
 Comparison
 ----------
@@ -79,475 +13,16 @@ on 1 - MAC), not by index; ``compare_modes`` tabulates several models against a 
 
 from __future__ import annotations
 
-import numbers
+from typing import Any
 
 import numpy as np
 import pandas as pd
-import scipy.linalg
 from scipy.optimize import linear_sum_assignment
 
-from rodval.core.checks import check_choice, check_type
-from rodval.core.eigen import angular_frequencies, quadratic_eigenvalues, symmetric_pencil
-from rodval.core.modal import (
-    ABOUT,
-    Equilibrium,
-    Modes,
-    normalize_shapes,
-    static_loads,
-)
-from rodval.core.scene import Chain, InitialState, Scene
-from rodval.models.paper_matrices import (
-    chain_constants,
-    damping_matrix,
-    hinge_matrix,
-    mass_matrix,
-    stiffness_matrix,
-)
-from rodval.models.reduced import ReducedSystem
-
-MODELS = ("full", "reduced")
-#: Diagonal-similarity ratios tried (in order) for non-symmetric mass matrices, see
-#: ``_general_eig``. Powers of two scale exactly.
-RHO = (1.0, 2.0, 4.0, 0.5, 3.0, 8.0)
-#: Relative size of an imaginary part (to the largest |eigenvalue|) still taken as round-off.
-IMAG_TOL = 1e-9
-#: Relative size (to the largest |eigenvalue|) below which a QZ eigenvalue is a zero mode.
-ZERO_TOL = 1e-13
-
-
-# -- loads and statics ------------------------------------------------------------------------
-def load_stiffness(l: np.ndarray, phi: np.ndarray, SX: np.ndarray, SY: np.ndarray) -> np.ndarray:
-    """K_L = -dQ/dphi (n, n), diagonal: l_k (sin phi_k SY_k + cos phi_k SX_k) (N m/rad)."""
-    return np.diag(l * (np.sin(phi) * SY + np.cos(phi) * SX))
-
-
-def static_residual(
-    chain: Chain, q: np.ndarray, SX=None, SY=None, rest=None, K: np.ndarray | None = None
-) -> np.ndarray:
-    """R(q) = K q - A^T (kappa * rest) - [Q(phi); 0; 0] (3n): the gradient of
-    Pi(q) - work of the constant loads. ``rest``: hinge rest angles (rad, n; None = 0), the
-    spring moments being kappa_k (D_k - rest_k)."""
-    n = chain.n
-    K = stiffness_matrix(chain) if K is None else K
-    R = K @ q
-    if rest is not None:
-        R -= hinge_matrix(n).T @ (chain.kappa * np.broadcast_to(np.asarray(rest, float), (n,)))
-    if SX is not None:
-        phi = q[:n]
-        R[:n] -= chain.l * (np.cos(phi) * SY - np.sin(phi) * SX)
-    return R
-
-
-def static_equilibrium(
-    chain: Chain,
-    SX=None,
-    SY=None,
-    q0=None,
-    rest=None,
-    *,
-    rtol: float = 1e-12,
-    max_iter: int = 30,
-    max_steps: int = 256,
-) -> Equilibrium:
-    """Static equilibrium R(q) = 0 (``static_residual``) by Newton's method with the exact
-    Jacobian K + K_L, starting from q0 (default straight). If a Newton solve fails, the load
-    (and rest angles) are applied in more equal steps (1, 2, 4, ... up to ``max_steps``).
-    Converged when max |R| <= rtol * (max |K q| + max |Q| + 1 N m)."""
-    n = chain.n
-    K = stiffness_matrix(chain)
-    SX = np.zeros(n) if SX is None else np.asarray(SX, float)
-    SY = np.zeros(n) if SY is None else np.asarray(SY, float)
-    rest = None if rest is None else np.broadcast_to(np.asarray(rest, float), (n,))
-    start = np.zeros(3 * n) if q0 is None else np.asarray(q0, float).copy()
-    total = 0
-    steps = 1
-    while steps <= max_steps:
-        q = start.copy()
-        ok = True
-        for i in range(1, steps + 1):
-            f = i / steps
-            args = (f * SX, f * SY, None if rest is None else f * rest)
-            for _ in range(max_iter):
-                R = static_residual(chain, q, *args, K=K)
-                Q = chain.l * (np.cos(q[:n]) * args[1] - np.sin(q[:n]) * args[0])
-                scale = np.max(np.abs(K @ q)) + np.max(np.abs(Q)) + 1.0
-                if np.max(np.abs(R)) <= rtol * scale:
-                    break
-                J = K.copy()
-                J[:n, :n] += load_stiffness(chain.l, q[:n], args[0], args[1])
-                try:
-                    q = q - np.linalg.solve(J, R)
-                except np.linalg.LinAlgError:  # singular: no Newton step; try more load steps
-                    q = np.full_like(q, np.nan)
-                total += 1
-                if not np.all(np.isfinite(q)):
-                    break
-            else:
-                R = static_residual(chain, q, *args, K=K)
-            if not (np.all(np.isfinite(q)) and np.max(np.abs(R)) <= rtol * scale):
-                ok = False
-                break
-        if ok:
-            return Equilibrium(q, total, steps, float(np.max(np.abs(R))), True)
-        steps *= 2
-    R = static_residual(chain, q, SX, SY, rest, K=K)
-    return Equilibrium(q, total, steps // 2, float(np.max(np.abs(R))), False)
-
-
-def no_equilibrium(chain: Chain, eq: Equilibrium) -> str:
-    """Why ``static_equilibrium`` found none, in one line: hinges without stiffness
-    (kappa = 0) that the loads do not hold leave the chain free to turn there (a singular
-    stiffness, no unique equilibrium); otherwise Newton's method did not converge."""
-    free = [int(k) for k in np.flatnonzero(chain.kappa == 0)]
-    if free:
-        return (
-            f"static equilibrium not found: hinge(s) {free} have no stiffness (kappa = 0), so "
-            "where the loads do not hold them the chain turns freely and its stiffness is "
-            "singular (no unique equilibrium, or none Newton's method reaches from the initial "
-            "state); give those hinges kappa > 0, start nearer an equilibrium ([initial] phi), "
-            "or linearize about the initial state (about='initial', --about initial)"
-        )
-    return (
-        f"static equilibrium not found (max |R| = {eq.residual:.3g} N m after "
-        f"{eq.iterations} Newton iterations and {eq.load_steps} load steps)"
-    )
-
-
-#: Largest static residual of an initial state still taken as an equilibrium, relative to
-#: max |K q0| + max |A^T kappa rest| + max |Q| + 1 N m: a state written with 9 significant
-#: digits from an equilibrium (static_equilibrium converges to 1e-12 of the same scale)
-#: passes; a pre-stressed fold (residuals of order kappa x angle) does not.
-AT_REST_RTOL = 1e-8
-
-
-def check_at_rest(scene: Scene) -> float:
-    """The initial state's static residual max |R(q0)| (N m, ``static_residual`` with the
-    hinge rest angles and without loads, which the linearization about the initial state
-    leaves out), or ValueError when the state is not at rest in equilibrium (rates not zero,
-    or max |R| above ``AT_REST_RTOL`` of its scale): a linearization about a state the chain
-    immediately leaves describes no motion of the scene. A scene-level check, made before any
-    model's modal analysis. O(n^2) (the dense K of the paper's matrices)."""
-    chain, n = scene.chain, scene.n
-    ini = scene.initial.resolve(n)
-    moving = [k for k in ("dphi", "dalpha", "dbeta") if np.any(ini[k] != 0)]
-    if moving:
-        raise ValueError(
-            f"the initial state is not at rest ({', '.join(moving)} not zero), so there is no "
-            "configuration to vibrate about; linearize about the static equilibrium "
-            "(about='equilibrium', --about equilibrium) or pass allow_unbalanced=True "
-            "(--allow-unbalanced) to linearize about the initial positions anyway"
-        )
-    q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
-    K = stiffness_matrix(chain)
-    R = static_residual(chain, q0, rest=chain.rest_angle, K=K)
-    spring = hinge_matrix(n).T @ (chain.kappa * chain.rest_angle)
-    scale = np.max(np.abs(K @ q0)) + np.max(np.abs(spring)) + 1.0
-    worst = int(np.argmax(np.abs(R)))
-    residual = float(abs(R[worst]))
-    if residual > AT_REST_RTOL * scale:
-        row = ("phi", "alpha", "beta")[worst // n] + f"[{worst % n}]"
-        raise ValueError(
-            f"the initial state is not an equilibrium: static residual {residual:.3g} N m on "
-            f"{row} (hinge springs about their rest angles and bending; loads are left out "
-            "about the initial state), so the chain does not stay there; linearize about the "
-            "static equilibrium (about='equilibrium', --about equilibrium, which holds the "
-            "loads) or pass allow_unbalanced=True (--allow-unbalanced) to linearize about it "
-            "anyway"
-        )
-    return residual
-
-
-def check_arguments(scene: Scene, count: int | None) -> None:
-    """Types before any work: a Scene, and ``count`` an integer >= 1 or None (ValueError)."""
-    check_type("scene", scene, Scene, "a rodval.Scene (e.g. rodval.paper_scene())")
-    if count is not None and (
-        isinstance(count, bool) or not isinstance(count, numbers.Integral) or count < 1
-    ):
-        raise ValueError(f"count (number of modes) must be an integer >= 1 or None, got {count!r}")
-
-
-# -- linear matrices ---------------------------------------------------------------------------
-def linear_system(
-    chain: Chain, model: str = "full", q0=None, coefficients: str = "printed", SX=None, SY=None
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(M, C, K + K_L) of the model linearized about q0 at rest (q0: phi (n) or
-    [phi; alpha; beta] (3n); default straight). The bending coordinates of q0 do not enter
-    (the first-order model's M depends on phi only and K is constant)."""
-    check_choice("model", model, MODELS)
-    n = chain.n
-    phi0 = np.zeros(n) if q0 is None else np.asarray(q0, float)[:n]
-    if phi0.shape != (n,):
-        raise ValueError(f"phi0 must have length n = {n}, got shape {phi0.shape}")
-    if model == "full":
-        M = mass_matrix(chain_constants(chain, coefficients), phi0)
-        K = stiffness_matrix(chain)
-        C = damping_matrix(chain)
-        if SX is not None:
-            K[:n, :n] += load_stiffness(chain.l, phi0, SX, SY)
-        return M, C, K
-    system = ReducedSystem(
-        Scene(chain=chain, t_end=1.0, initial=InitialState(phi=phi0)), coefficients, kernel="numpy"
-    )
-    M = system.reduced_matrices(phi0)[0]
-    K = system.K_r.copy()
-    if SX is not None:
-        K += load_stiffness(chain.l, phi0, SX, SY)
-    return M, system.C_r.copy(), K
-
-
-def linear_matrices(
-    chain: Chain, model: str = "full", phi0=None, coefficients: str = "printed"
-) -> tuple[np.ndarray, np.ndarray]:
-    """(M, K) of the unloaded linearized model about phi0 (default straight along x)."""
-    M, _, K = linear_system(chain, model, phi0, coefficients)
-    return M, K
-
-
-def _node_transform(chain: Chain, model: str) -> tuple[np.ndarray, np.ndarray]:
-    """T with q = T z, z = per rod [y_k, (alpha_k, beta_k)] (rod-major), phi_k = (y_k -
-    y_{k-1}) / l_k; and the rod index of each z coordinate."""
-    n = chain.n
-    per = 3 if model == "full" else 1
-    Tp = (np.eye(n) - np.eye(n, k=-1)) / chain.l[:, None]
-    T = np.eye(per * n)
-    T[:n, :n] = Tp
-    perm = np.arange(per * n).reshape(per, n).T.ravel()  # rod-major ordering of z
-    return T[:, perm], np.repeat(np.arange(n), per)
-
-
-def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors: bool = True):
-    """Eigenvalues (and right eigenvectors in q) of K x = lam M x for a non-symmetric M, by QZ
-    on the equivalent pencil in rod-major node displacements with the exact similarity
-    diag(rho^k) per rod, for each rho of ``RHO`` (see the module docstring).
-
-    Each run gives first-order error estimates err = eps (|K| + |lam| |M|) kappa_lam from its
-    left and right eigenvectors (kappa_lam = |y| |x| / |y^H M x|). The spectrum starts from the
-    run with the fewest complex eigenvalues (then the smallest median relative estimate), its
-    complex ones unresolved; then, run by run, its eigenvalues are matched one-to-one
-    (Hungarian, on the distance) with the run's, and each is replaced by its match when that
-    one is real, has a smaller estimate and lies within the two estimates (an unresolved one:
-    by any real match). The geometric scaling that conditions the tip-localized bending
-    cluster de-conditions the extended low modes, which the unscaled run gets right. Returns (lam,
-    X, info); lam is complex when no rho gave a
-    real spectrum (the caller decides)."""
-    T, rod = _node_transform(chain, model)
-    Kz, Mz = T.T @ K @ T, T.T @ M @ T
-    eps = np.finfo(float).eps
-    runs = []
-    for rho in RHO:
-        # D^-1 X D with D = diag(rho^rod): entry (i, j) times rho^(rod_j - rod_i); entries far
-        # from the band are (near) zero in the straight configuration; the exponent is clipped
-        # so that a bent configuration cannot overflow.
-        S = np.float64(rho) ** np.clip(rod[None, :] - rod[:, None], -60, 60)
-        Ks, Ms = Kz * S, Mz * S
-        lam, VL, VR = scipy.linalg.eig(Ks, Ms, left=True, right=True)
-        kappa = (
-            np.linalg.norm(VL, axis=0)
-            * np.linalg.norm(VR, axis=0)
-            / np.maximum(np.abs(np.sum(VL.conj() * (Ms @ VR), axis=0)), 1e-300)
-        )
-        err = eps * (np.linalg.norm(Ks, 2) + np.abs(lam) * np.linalg.norm(Ms, 2)) * kappa
-        real = np.abs(lam.imag) <= IMAG_TOL * np.max(np.abs(lam))
-        runs.append({"rho": rho, "lam": lam, "VR": VR, "err": err, "real": real})
-
-    def rel(r):
-        return np.median(r["err"] / np.maximum(np.abs(r["lam"]), 1e-300))
-
-    base = min(runs, key=lambda r: (int(np.sum(~r["real"])), rel(r)))
-    lam = base["lam"].copy()
-    err = np.where(base["real"], base["err"], np.inf)  # complex entries: unresolved
-    src = [(base, i) for i in range(lam.size)]
-    for r in sorted((r for r in runs if r is not base), key=rel):
-        # one-to-one matching of the current spectrum with this run's eigenvalues
-        rows, cols = linear_sum_assignment(np.abs(lam[:, None] - r["lam"][None, :]))
-        for i, j in zip(rows, cols):
-            mu, e = r["lam"][j], r["err"][j]
-            if r["real"][j] and e < err[i] and (np.isinf(err[i]) or abs(mu - lam[i]) <= err[i] + e):
-                lam[i], err[i], src[i] = mu.real, e, (r, j)
-    if np.all(np.isfinite(err)):
-        lam = lam.real
-    X = None
-    if vectors:
-        X = np.column_stack([T @ ((np.float64(r["rho"]) ** rod) * r["VR"][:, j]) for r, j in src])
-        if np.isrealobj(lam):
-            X = X.real
-    order = np.argsort(lam.real)
-    return (
-        lam[order],
-        None if X is None else X[:, order],
-        {"rho": [src[i][0]["rho"] for i in order], "error_estimate": err[order]},
-    )
-
-
-def eigen(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors: bool = True):
-    """omega^2 (real, ascending) and the eigenvectors (columns) of K x = omega^2 M x."""
-    if np.allclose(M, M.T, rtol=0, atol=1e-13 * np.max(np.abs(M))):
-        return symmetric_pencil(K, M, vectors=vectors)
-    lam, X, _ = _general_eig(K, M, chain, model, vectors)
-    if np.max(np.abs(lam.imag)) > IMAG_TOL * np.max(np.abs(lam)):
-        raise ValueError("linearized system has complex eigenvalues (non-oscillatory modes)")
-    order = np.argsort(lam.real)
-    # QZ's absolute round-off is ~eps |lam|_max: below 1e-13 of it an eigenvalue is a zero mode
-    lam = lam.real[order]
-    lam = np.where(np.abs(lam) <= ZERO_TOL * np.max(np.abs(lam)), 0.0, lam)
-    return lam, (None if X is None else np.real_if_close(X[:, order], tol=1e8).real)
-
-
-def natural_frequencies(
-    chain: Chain, model: str = "full", phi0=None, coefficients: str = "printed"
-) -> np.ndarray:
-    """Natural angular frequencies (rad/s) of the unloaded model about phi0, ascending."""
-    M, K = linear_matrices(chain, model, phi0, coefficients)
-    lam, _ = eigen(K, M, chain, model, vectors=False)
-    return np.sort(np.sqrt(np.clip(lam, 0.0, None)))
-
-
-# -- modes --------------------------------------------------------------------------------------
-def _shapes(
-    chain: Chain,
-    model: str,
-    phi0: np.ndarray,
-    X: np.ndarray,
-    lam: np.ndarray,
-    M: np.ndarray | None = None,
-    coefficients: str = "printed",
-):
-    """Node displacements and hinge angles of eigenvectors X (columns)."""
-    n, l = chain.n, chain.l
-    if model == "full":
-        Q = X.T  # (count, 3n)
-    else:
-        K = stiffness_matrix(chain)
-        Mfull = mass_matrix(chain_constants(chain, coefficients), phi0)
-        g, p = slice(n, 3 * n), slice(0, n)
-        B = K[g, g]
-        Q = np.zeros((X.shape[1], 3 * n))
-        for i in range(X.shape[1]):
-            dphi = X[:, i]
-            Q[i, :n] = dphi
-            Q[i, n:] = -np.linalg.solve(B, (K[g, p] - lam[i] * Mfull[g, p]) @ dphi)
-    dphi = Q[:, :n]
-    dx = np.hstack([np.zeros((Q.shape[0], 1)), np.cumsum(-l * np.sin(phi0) * dphi, axis=1)])
-    dy = np.hstack([np.zeros((Q.shape[0], 1)), np.cumsum(l * np.cos(phi0) * dphi, axis=1)])
-    hinge = Q @ hinge_matrix(n).T
-    return normalize_shapes(dx, dy, hinge)
-
-
-def mac(a: np.ndarray, b: np.ndarray) -> float:
-    """Modal assurance criterion |a.b|^2 / ((a.a)(b.b)) of two real shape vectors."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    den = float(a @ a) * float(b @ b)
-    return float((a @ b) ** 2 / den) if den > 0 else 0.0
-
-
-def mac_matrix(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """MAC of every row of A against every row of B."""
-    A, B = np.asarray(A), np.asarray(B)
-    num = np.abs(A.conj() @ B.T) ** 2
-    den = np.outer(np.sum(np.abs(A) ** 2, 1), np.sum(np.abs(B) ** 2, 1))
-    return np.divide(num, den, out=np.zeros_like(num, dtype=float), where=den > 0)
-
-
-def _damping_ratios(M, C, K, X, omega) -> np.ndarray:
-    """zeta_i of the quadratic eigenproblem, paired with the undamped modes X (columns)."""
-    zeta = np.full(omega.size, np.nan)
-    if not np.any(C):
-        zeta[omega > 0] = 0.0
-        return zeta
-    s, V = quadratic_eigenvalues(M, C, K)
-    up = s.imag > 0
-    s, Z = s[up], V[:, up]
-    keep = omega > 0
-    if not np.any(keep) or s.size == 0:
-        return zeta
-    cost = 1.0 - mac_matrix(X[:, keep].T, Z.T)
-    rows, cols = linear_sum_assignment(cost)
-    idx = np.flatnonzero(keep)
-    zeta[idx[rows]] = -s[cols].real / np.abs(s[cols])
-    return zeta
-
-
-def modes(
-    scene: Scene,
-    model: str = "full",
-    *,
-    about: str = "initial",
-    count: int | None = None,
-    coefficients: str = "printed",
-    load_at: float | None = None,
-    allow_unbalanced: bool = False,
-) -> Modes:
-    """Linearized modes of the native ``model`` ("full" or "reduced") about the scene's
-    initial state at rest (``check_at_rest`` unless ``allow_unbalanced``) or its static
-    equilibrium under its static loads (``rodval.core.modal.static_loads``: the loads acting
-    for ever, or every load at ``load_at`` s) and hinge rest angles (see module docstring).
-    ``count``: the lowest ``count`` modes (default all)."""
-    check_arguments(scene, count)
-    check_choice("model", model, MODELS)
-    balance = check_configuration(scene, about, load_at, allow_unbalanced)
-    chain, n = scene.chain, scene.n
-    ini = scene.initial.resolve(n)
-    q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
-    eq, SX, SY = None, None, None
-    if about == "equilibrium":
-        loads = static_loads(scene, load_at)
-        SX, SY = loads.SX, loads.SY
-        eq = static_equilibrium(chain, SX, SY, q0=q0, rest=chain.rest_angle)
-        eq.loads = loads
-        if not eq.converged:
-            raise ValueError(no_equilibrium(chain, eq))
-        q0 = eq.q
-    M, C, K = linear_system(chain, model, q0, coefficients, SX, SY)
-    lam, X = eigen(K, M, chain, model)
-    N = lam.size
-    count = N if count is None else min(count, N)
-    lam, X = lam[:count], X[:, :count]
-    omega = angular_frequencies(lam)
-    zeta = _damping_ratios(M, C, K, X, omega)
-    dx, dy, hinge = _shapes(chain, model, q0[:n], X, lam, coefficients=coefficients)
-    return Modes(
-        model=model,
-        about=about,
-        omega=omega,
-        damping=zeta,
-        dx=dx,
-        dy=dy,
-        hinge=hinge,
-        phi0=q0[:n].copy(),
-        l=chain.l.copy(),
-        equilibrium=eq,
-        info={"coefficients": coefficients, "q0": q0, **balance},
-    )
-
-
-def check_configuration(
-    scene: Scene, about: str, load_at: float | None, allow_unbalanced: bool
-) -> dict[str, float]:
-    """The checks of what every model's modes are about, before any work: ``about`` among
-    ``ABOUT``; ``load_at`` (equilibrium only) a time >= 0 or None, and the scene's loads with a
-    static value (``static_loads``); for ``about="initial"`` the state at rest in equilibrium
-    (``check_at_rest``) unless ``allow_unbalanced``, whose residual is then returned as
-    ``{"unbalanced_residual_Nm": r}`` for the record."""
-    check_choice("about", about, ABOUT)
-    if not isinstance(allow_unbalanced, bool):
-        raise ValueError(f"allow_unbalanced must be True or False, got {allow_unbalanced!r}")
-    if about == "equilibrium":
-        if allow_unbalanced:
-            raise ValueError("allow_unbalanced applies to about='initial' only")
-        static_loads(scene, load_at)
-        return {}
-    if load_at is not None:
-        raise ValueError(
-            "load_at applies to about='equilibrium' only (loads are left out about the "
-            "initial state)"
-        )
-    if not allow_unbalanced:
-        check_at_rest(scene)
-        return {}
-    ini = scene.initial.resolve(scene.n)
-    q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
-    R = static_residual(scene.chain, q0, rest=scene.chain.rest_angle)
-    return {"unbalanced_residual_Nm": float(np.max(np.abs(R)))}
+from rodval.core.modal import Modes
+from rodval.core.scene import Scene
+from rodval.models.linear_modes import check_arguments, check_configuration, mac_matrix
+from rodval.models.registry import MODEL_NAMES, modal_options, model_class
 
 
 def model_modes(
@@ -556,41 +31,20 @@ def model_modes(
     *,
     about: str = "initial",
     count: int | None = None,
-    coefficients: str = "printed",
     load_at: float | None = None,
     allow_unbalanced: bool = False,
-    **options,
+    **options: Any,
 ) -> Modes:
-    """``modes`` for "full"/"reduced", ``reference_models.exudyn_modes.exudyn_modes`` for
-    "exudyn" (``options``: ExudynModel options); every model about the same configuration,
-    checked here once (``check_configuration``)."""
+    """The modes of ``model`` (a registered name) about the scene's initial state or its
+    static equilibrium, every model about the same configuration, checked here once
+    (``check_configuration``); ``options``: the model's own (``Model.modes``; e.g. the paper
+    models' ``coefficients``, exudyn's discretization)."""
     check_arguments(scene, count)
-    check_choice("model", model, (*MODELS, "exudyn"))
-    if model == "exudyn":
-        balance = check_configuration(scene, about, load_at, allow_unbalanced)
-        try:
-            from reference_models.exudyn_modes import exudyn_modes
-        except ImportError as exc:
-            raise ValueError(f"model 'exudyn' is not available: {exc}") from exc
-        try:
-            m = exudyn_modes(scene, about=about, count=count, load_at=load_at, **options)
-        except TypeError as exc:  # an unknown option name
-            raise ValueError(
-                f"model 'exudyn' does not accept options {sorted(options)}: {exc}"
-            ) from None
-        m.info.update(balance)
-        return m
-    if options:
-        raise ValueError(f"model {model!r} takes no options, got {sorted(options)}")
-    return modes(
-        scene,
-        model,
-        about=about,
-        count=count,
-        coefficients=coefficients,
-        load_at=load_at,
-        allow_unbalanced=allow_unbalanced,
-    )
+    cls = model_class(model)
+    balance = check_configuration(scene, about, load_at, allow_unbalanced)
+    m = cls.modes(scene, about=about, count=count, load_at=load_at, **options)
+    m.info.update(balance)
+    return m
 
 
 # -- pairing -----------------------------------------------------------------------------------
@@ -624,7 +78,7 @@ def pair_modes(a: Modes, b: Modes) -> pd.DataFrame:
 
 def compare_modes(
     scene: Scene,
-    models=("full", "reduced", "exudyn"),
+    models: tuple[str, ...] = MODEL_NAMES,
     *,
     about: str = "initial",
     count: int = 10,
@@ -632,13 +86,14 @@ def compare_modes(
     computed: dict[str, Modes] | None = None,
     load_at: float | None = None,
     allow_unbalanced: bool = False,
-    **exudyn_options,
+    **options: Any,
 ) -> pd.DataFrame:
     """Side-by-side table of the lowest ``count`` modes of ``reference`` (default: the last of
     ``models``, e.g. exudyn) with the paired modes of the other models: columns mode,
     omega_<ref>, and per other model omega_<m>, gap_<m> (relative to the reference) and
     mac_<m>. ``computed`` may pass Modes already computed (name -> Modes); ``about``,
-    ``load_at``, ``allow_unbalanced``: see ``model_modes``."""
+    ``load_at``, ``allow_unbalanced``: see ``model_modes``; ``options``: each model takes the
+    ones its modal analysis accepts (``modal_options``)."""
     models = tuple(models)
     reference = models[-1] if reference is None else reference
     got = dict(computed or {})
@@ -650,7 +105,7 @@ def compare_modes(
                 about=about,
                 load_at=load_at,
                 allow_unbalanced=allow_unbalanced,
-                **(exudyn_options if m == "exudyn" else {}),
+                **modal_options(m, options),
             )
     ref = got[reference]
     table = pd.DataFrame({"mode": np.arange(1, min(count, ref.count) + 1)})

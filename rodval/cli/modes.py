@@ -10,11 +10,9 @@ import numpy as np
 from rodval.cli.options import add_model_options, positive_int, set_options
 from rodval.core.scene import Scene
 from rodval.core.scene_file import load_scene, scene_from_dict
+from rodval.models.registry import MODEL_NAMES, model_class
 from rodval.report.figures import plot_modes
 from rodval.report.run_files import read_run_record
-
-MODEL_CHOICES = ("full", "reduced", "exudyn")
-#: Mode shapes drawn in modes.png.
 
 
 def register(sub) -> None:
@@ -32,7 +30,7 @@ def register(sub) -> None:
     )
     p.add_argument("scene", metavar="SCENE", help="'paper', a TOML scene file or a run.json")
     p.add_argument(
-        "--model", choices=MODEL_CHOICES, help="model (default full; a run.json's own model)"
+        "--model", choices=MODEL_NAMES, help="model (default full; a run.json's own model)"
     )
     p.add_argument("--out", required=True, type=Path, help="output folder")
     p.add_argument(
@@ -75,38 +73,63 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from rodval.analysis.modes import compare_modes, model_modes
+    from rodval.analysis.modes import model_modes
 
-    compare = ()
-    if args.compare:
-        compare = tuple(x.strip() for x in args.compare.split(",") if x.strip())
-        bad = [x for x in compare if x not in MODEL_CHOICES]
-        if bad or not compare:
-            raise ValueError(f"--compare models must be from {MODEL_CHOICES}, got {args.compare!r}")
+    compare = _compare_list(args.compare)
     scene, model = _scene_and_model(args)
     args.model = model
-    options = set_options(args.options)
-    if options and args.model != "exudyn" and not args.compare:
-        raise ValueError(f"--set applies to the exudyn model only, got {sorted(options)}")
+    given = set_options(args.options)
+    unknown = sorted(set(given) - set(model_class(model).MODES_OPTIONS))
+    if unknown and not compare:
+        raise ValueError(
+            f"--set {', '.join(unknown)} does not apply to the {model} model's modes "
+            f"(its options: {', '.join(model_class(model).MODES_OPTIONS) or 'none'})"
+        )
+    pool = {"coefficients": args.coefficients, **given}
     m = model_modes(
         scene,
-        args.model,
+        model,
         about=args.about,
         count=args.count,
-        coefficients=args.coefficients,
         load_at=args.load_at,
         allow_unbalanced=args.allow_unbalanced,
-        **(options if args.model == "exudyn" else {}),
+        **_options_for(model, pool),
     )
     args.out.mkdir(parents=True, exist_ok=True)
     m.frequencies_frame().to_csv(args.out / "frequencies.csv", index=False)
     m.modes_frame().to_csv(args.out / "modes.csv", index=False)
     plot_modes(m, args.out / "modes.png", title=f"{scene.name}: {m.model} about {m.about}")
+    lines = _summary(scene, m, args)
+    if compare:
+        lines += _comparison(scene, m, compare, pool, args)
+    (args.out / "modes.json").write_text(json.dumps(_record(scene, m, args), indent=2, default=str))
+    print("\n".join(lines))
+    return 0
+
+
+def _compare_list(text: str | None) -> tuple[str, ...]:
+    """--compare MODELS as a tuple of registered model names (ValueError otherwise)."""
+    if not text:
+        return ()
+    compare = tuple(x.strip() for x in text.split(",") if x.strip())
+    if not compare or any(x not in MODEL_NAMES for x in compare):
+        raise ValueError(f"--compare models must be from {MODEL_NAMES}, got {text!r}")
+    return compare
+
+
+def _options_for(model: str, pool: dict) -> dict:
+    """The options of ``pool`` (the command line's) that ``model``'s modes take."""
+    accepted = model_class(model).MODES_OPTIONS
+    return {k: v for k, v in pool.items() if k in accepted}
+
+
+def _record(scene: Scene, m, args) -> dict:
+    """modes.json: what the modes are of and about, and the equilibrium found."""
     record = {
         "scene": scene.name,
         "model": m.model,
         "about": m.about,
-        "coefficients": args.coefficients if m.model != "exudyn" else None,
+        "coefficients": m.info.get("coefficients"),
         "options": m.info.get("options", {}),
         "count": m.count,
         "load_at": args.load_at,
@@ -121,54 +144,58 @@ def run(args) -> int:
             "phi": eq.phi.tolist(),
             "left_out_loads": list(eq.loads.ignored) if eq.loads else [],
         }
+    return record
+
+
+def _summary(scene: Scene, m, args) -> list[str]:
+    """The printed lines: what was linearized about what, the equilibrium, the modes."""
     lines = [f"{m.model} modes of {scene.name} about the {m.about} state -> {args.out}"]
     if "unbalanced_residual_Nm" in m.info:
         lines.append(
             "the initial state is NOT an equilibrium (static residual "
             f"{m.info['unbalanced_residual_Nm']:.3g} N m): linearized there as asked"
         )
+    eq = m.equilibrium
     if eq is not None:
         ign = (
             f"; loads left out: {', '.join(eq.loads.ignored)}"
             if eq.loads and eq.loads.ignored
             else ""
         )
-        unit = "(exudyn's Newton residual norm)" if m.model == "exudyn" else "N m"
+        unit = "N m" if "coefficients" in m.info else "(exudyn's Newton residual norm)"
         res = f", residual {eq.residual:.2g} {unit}" if np.isfinite(eq.residual) else ""
         lines.append(f"static equilibrium: {eq.iterations} Newton iterations{res}{ign}")
     lines.append(" mode   omega (rad/s)        f (Hz)   damping ratio")
     for i in range(m.count):
         z = "" if not np.isfinite(m.damping[i]) else f"{m.damping[i]:.3e}"
         lines.append(f"{i + 1:5d} {m.omega[i]:15.6g} {m.f_hz[i]:13.6g}   {z}")
-    if compare:
-        models = compare
-        computed = {args.model: m}
-        for other in models:
-            if other not in computed:
-                computed[other] = model_modes(
-                    scene,
-                    other,
-                    about=args.about,
-                    coefficients=args.coefficients,
-                    load_at=args.load_at,
-                    allow_unbalanced=args.allow_unbalanced,
-                    **(options if other == "exudyn" else {}),
-                )
-        order = tuple(x for x in models if x != args.model) + (args.model,)
-        table = compare_modes(
-            scene,
-            order,
-            about=args.about,
-            count=args.count,
-            reference=args.model,
-            computed=computed,
-        )
-        table.to_csv(args.out / "compare.csv", index=False)
-        lines.append("paired by MAC (gap relative to " + args.model + "):")
-        lines.append(table.to_string(index=False, float_format=lambda v: f"{v:.6g}"))
-    (args.out / "modes.json").write_text(json.dumps(record, indent=2, default=str))
-    print("\n".join(lines))
-    return 0
+    return lines
+
+
+def _comparison(scene: Scene, m, models: tuple[str, ...], pool: dict, args) -> list[str]:
+    """The other models' modes paired by MAC with ``m`` (written to DIR/compare.csv)."""
+    from rodval.analysis.modes import compare_modes, model_modes
+
+    computed = {args.model: m}
+    for other in models:
+        if other not in computed:
+            computed[other] = model_modes(
+                scene,
+                other,
+                about=args.about,
+                load_at=args.load_at,
+                allow_unbalanced=args.allow_unbalanced,
+                **_options_for(other, pool),
+            )
+    order = tuple(x for x in models if x != args.model) + (args.model,)
+    table = compare_modes(
+        scene, order, about=args.about, count=args.count, reference=args.model, computed=computed
+    )
+    table.to_csv(args.out / "compare.csv", index=False)
+    return [
+        "paired by MAC (gap relative to " + args.model + "):",
+        table.to_string(index=False, float_format=lambda v: f"{v:.6g}"),
+    ]
 
 
 def _scene_and_model(args) -> tuple[Scene, str]:
@@ -178,5 +205,5 @@ def _scene_and_model(args) -> tuple[Scene, str]:
     if path.suffix != ".json":
         return load_scene(args.scene), args.model or "full"
     record = read_run_record(path)
-    ran = record["model"] if record["model"] in MODEL_CHOICES else "full"
+    ran = record["model"] if record["model"] in MODEL_NAMES else "full"
     return scene_from_dict(record["scene"], where=str(path)), args.model or ran

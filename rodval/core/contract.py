@@ -9,9 +9,11 @@ its own validity (``validity_checks``, ``rodval.core.validity``): ``stats.valid`
 
 from __future__ import annotations
 
+import importlib
 from abc import ABC, abstractmethod
 from typing import Any, ClassVar
 
+from rodval.core.checks import check_keys
 from rodval.core.modal import Modes
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
@@ -24,6 +26,11 @@ class Model(ABC):
     ``simulate`` (the run, then the model's verdict on its assumptions)."""
 
     name: ClassVar[str]
+    #: "module:function" of this model's modal analysis, loaded when asked for (as the
+    #: registry loads models): f(scene, *, about, count, load_at, **options) -> Modes.
+    MODAL_ANALYSIS: ClassVar[str | None] = None
+    #: The option names its modal analysis takes.
+    MODES_OPTIONS: ClassVar[tuple[str, ...]] = ()
     #: Largest energy-audit residual of a valid run of this model (``rodval.core.validity``).
     energy_residual_bound: ClassVar[float] = ENERGY_RESIDUAL_BOUND
 
@@ -62,8 +69,18 @@ class Model(ABC):
         **options: Any,
     ) -> Modes:
         """Linearized modes of this model about the scene's initial state (``about="initial"``)
-        or its static equilibrium (``"equilibrium"``, loads held at ``load_at`` s); ``options``:
-        the model's own options (``OPTIONS``), with the model's defaults for a modal analysis.
-        The configuration check (at rest, balanced) is the caller's
-        (``rodval.analysis.modes.model_modes``), done once for every model."""
-        raise ValueError(f"model {cls.name!r} has no modal analysis")
+        or its static equilibrium (``"equilibrium"``, loads held at ``load_at`` s) by its
+        modal analysis (``MODAL_ANALYSIS``); ``options``: among ``MODES_OPTIONS``, with the
+        model's defaults for a modal analysis. The configuration check (at rest, balanced) is
+        the caller's (``rodval.analysis.modes.model_modes``), done once for every model."""
+        check_keys(
+            options,
+            cls.MODES_OPTIONS,
+            f"{cls.name} modes",
+            noun="option",
+        )
+        if cls.MODAL_ANALYSIS is None:
+            raise ValueError(f"model {cls.name!r} has no modal analysis")
+        module, function = cls.MODAL_ANALYSIS.split(":")
+        analysis = getattr(importlib.import_module(module), function)
+        return analysis(scene, about=about, count=count, load_at=load_at, **options)

@@ -1,5 +1,5 @@
 """Results of a modal analysis, shared by the native models' analysis
-(``rodval.analysis.modes``) and the reference model's (``reference_models.exudyn_modes``):
+(``rodval.models.linear_modes``) and the reference model's (``reference_models.exudyn_modes``):
 the configuration a model is linearised about, its constant loads, and the modes.
 
 Units: frequencies in rad/s (``omega``) and Hz (``f_hz``); mode shapes as node displacements
@@ -16,7 +16,7 @@ import pandas as pd
 from rodval.core.scene import Scene
 
 #: What a model is linearised about: its initial state at rest (free vibration, loads
-#: ignored; it must be an equilibrium, see ``rodval.analysis.modes.check_at_rest``) or the
+#: ignored; it must be an equilibrium, see ``rodval.models.linear_modes.check_at_rest``) or the
 #: static equilibrium under the scene's static loads (``static_loads``) and hinge rest angles.
 ABOUT = ("initial", "equilibrium")
 

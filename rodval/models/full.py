@@ -12,6 +12,7 @@ import numpy as np
 from rodval.core.scene import Scene
 from rodval.models import deployment, kernels
 from rodval.models.paper_matrices import (
+    DEFAULT_VARIANT,
     angle_differences,
     angle_jacobian,
     assemble_mass,
@@ -27,7 +28,7 @@ class FullSystem(PaperSystem):
     compiled_rhs = staticmethod(kernels.full_rhs)
     compiled_mechanics = staticmethod(kernels.full_mechanics)
 
-    def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
+    def __init__(self, scene: Scene, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
         super().__init__(scene, coefficients, kernel)
         i = self.initial
         self.y0 = np.concatenate(
@@ -183,3 +184,4 @@ class FullModel(PaperModel):
 
     name = "full"
     system_class = FullSystem
+    MODAL_ANALYSIS = "rodval.models.linear_modes:full_modes"

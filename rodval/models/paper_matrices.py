@@ -42,6 +42,8 @@ from scipy.linalg import solveh_banded
 from rodval.core.scene import Chain, hinge_angles
 
 VARIANTS = ("printed", "published")
+#: The coefficient variant every model and analysis uses unless told otherwise.
+DEFAULT_VARIANT = VARIANTS[0]
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,7 +76,7 @@ class ChainConstants:
         return np.triu(np.outer(self.l, self.w), k=1)
 
 
-def chain_constants(chain: Chain, variant: str = "printed") -> ChainConstants:
+def chain_constants(chain: Chain, variant: str = DEFAULT_VARIANT) -> ChainConstants:
     """Precompute everything in M and G that does not depend on the angles (O(n))."""
     if variant not in VARIANTS:
         raise ValueError(f"coefficients must be one of {VARIANTS}, got {variant!r}")

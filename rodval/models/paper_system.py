@@ -16,6 +16,7 @@ from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
 from rodval.models import deployment
 from rodval.models.paper_matrices import (
+    DEFAULT_VARIANT,
     VARIANTS,
     ChainConstants,
     angle_differences,
@@ -52,7 +53,7 @@ class PaperSystem(OdeSystem):
     compiled_rhs: Any
     compiled_mechanics: Any
 
-    def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
+    def __init__(self, scene: Scene, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
         self.kernel = check_choice("kernel", kernel, KERNELS)
         self.coefficients = coefficients
         chain = scene.chain
@@ -554,8 +555,9 @@ class PaperModel(OdeModel):
 
     system_class: type[PaperSystem]
     OPTIONS = ("coefficients", "kernel")
+    MODES_OPTIONS = ("coefficients",)
 
-    def __init__(self, coefficients: str = "printed", kernel: str = "numba"):
+    def __init__(self, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
         self.coefficients = check_choice("coefficients", coefficients, VARIANTS)
         self.kernel = check_choice("kernel", kernel, KERNELS)
 

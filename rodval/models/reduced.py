@@ -22,6 +22,7 @@ import numpy as np
 from rodval.core.scene import Scene
 from rodval.models import deployment, kernels, reduced_banded
 from rodval.models.paper_matrices import (
+    DEFAULT_VARIANT,
     angle_differences,
     angle_jacobian,
     assemble_mass,
@@ -38,7 +39,7 @@ class ReducedSystem(PaperSystem):
     compiled_rhs = staticmethod(reduced_banded.reduced_rhs)
     compiled_mechanics = staticmethod(kernels.reduced_mechanics)
 
-    def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
+    def __init__(self, scene: Scene, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
         super().__init__(scene, coefficients, kernel)
         i = self.initial
         self.y0 = np.concatenate([i["phi"], i["dphi"]])
@@ -313,3 +314,4 @@ class ReducedModel(PaperModel):
 
     name = "reduced"
     system_class = ReducedSystem
+    MODAL_ANALYSIS = "rodval.models.linear_modes:reduced_modes"

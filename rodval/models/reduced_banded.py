@@ -73,7 +73,7 @@ from rodval.models.kernels import (
     _rows,
     _upper_t_times,
 )
-from rodval.models.paper_matrices import chain_constants
+from rodval.models.paper_matrices import DEFAULT_VARIANT, chain_constants
 from rodval.models.reduced_band_lu import (
     _BASE,
     C_AP,
@@ -351,7 +351,7 @@ def reduced_accel_banded(Cst, phi, dphi, has_load, SX, SY, damped, out):
     reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, out, gamma)
 
 
-def banded_constants(cc, chain, variant: str = "printed") -> np.ndarray:
+def banded_constants(cc, chain, variant: str = DEFAULT_VARIANT) -> np.ndarray:
     """Every angle-independent per-rod constant of ``reduced_solve`` as a float64 array
     (N_CST, n); ``cc = paper_matrices.chain_constants(chain, variant)``, or None to compute
     the per-rod constants here for ``variant`` (O(n) memory; chain_constants is O(n^2)). O(n).

@@ -58,6 +58,13 @@ def uses_integrator(name: str) -> bool:
     return bool(getattr(model_class(name), "USES_INTEGRATOR_SETTINGS", True))
 
 
+def modal_options(name: str, options: dict[str, Any]) -> dict[str, Any]:
+    """The ones of ``options`` that model ``name``'s modal analysis takes
+    (``Model.MODES_OPTIONS``), for callers that hold options for several models."""
+    accepted = model_class(name).MODES_OPTIONS
+    return {k: v for k, v in options.items() if k in accepted}
+
+
 def get_model(name: str | Model, **options: Any) -> Model:
     """The model called ``name`` with its options (a Model instance is returned as is).
     Unknown option names are a ValueError listing the allowed ones."""

@@ -21,7 +21,7 @@ from rodval.core.scene_file import scene_from_dict
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_ERROR
 from rodval.core.trajectory import SolverStats, Trajectory
-from rodval.models.registry import integrated_models, simulate
+from rodval.models.registry import modal_options, simulate
 
 
 def failed_run(model: dict, scene_name: str, status: int, message: str) -> dict[str, Any]:
@@ -73,10 +73,8 @@ def case_modes(scene: Scene, model: dict[str, Any], spec: dict[str, Any]) -> dic
     or ``{"modes_error": message}``: a failed modal analysis never fails the run."""
     from rodval.analysis.modes import model_modes
 
-    options = dict(model["options"])
-    if model["model"] in integrated_models():  # a native model's modal option: its variant
-        options = {"coefficients": options.get("coefficients", "printed")}
     try:
+        options = modal_options(model["model"], model["options"])
         m = model_modes(
             scene,
             model["model"],

@@ -1,0 +1,83 @@
+"""The shape of the code (issue "one run contract"): small functions and modules, one list of
+model names. Each check counts with ``ast`` and names every offender, so it fails on the first
+function or module that grows past its bound."""
+
+import ast
+from pathlib import Path
+
+import pytest
+
+from rodval.models.registry import MODEL_NAMES
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("rodval", "reference_models")
+MAX_FUNCTION_LINES = 80
+MAX_MODULE_LINES = 600
+
+
+def _modules() -> list[Path]:
+    return sorted(p for pkg in PACKAGES for p in (ROOT / pkg).rglob("*.py"))
+
+
+def _trees() -> list[tuple[Path, ast.Module]]:
+    return [(p, ast.parse(p.read_text(), filename=str(p))) for p in _modules()]
+
+
+def test_the_packages_are_found():
+    assert len(_modules()) > 50
+
+
+def test_no_module_longer_than_600_lines():
+    long = {
+        str(p.relative_to(ROOT)): n
+        for p in _modules()
+        if (n := len(p.read_text().splitlines())) > MAX_MODULE_LINES
+    }
+    assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
+
+
+def test_no_function_longer_than_80_lines():
+    long = {
+        f"{p.relative_to(ROOT)}::{node.name}": node.end_lineno - node.lineno + 1
+        for p, tree in _trees()
+        for node in ast.walk(tree)
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+        and node.end_lineno - node.lineno + 1 > MAX_FUNCTION_LINES
+    }
+    assert not long, f"functions over {MAX_FUNCTION_LINES} lines: {long}"
+
+
+def _name_lists(tree: ast.Module) -> list[tuple[int, list[str]]]:
+    """Tuple, list and set literals of two or more model names (line, names)."""
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Tuple | ast.List | ast.Set):
+            names = [
+                e.value for e in node.elts if isinstance(e, ast.Constant) and e.value in MODEL_NAMES
+            ]
+            if len(names) >= 2 and len(names) == len(node.elts):
+                out.append((node.lineno, names))
+    return out
+
+
+def test_the_registry_is_the_only_list_of_model_names():
+    registry = ROOT / "rodval" / "models" / "registry.py"
+    found = {
+        f"{p.relative_to(ROOT)}:{line}": names
+        for p, tree in _trees()
+        if p != registry
+        for line, names in _name_lists(tree)
+    }
+    assert not found, f"model names listed outside the registry: {found}"
+
+
+@pytest.mark.parametrize(
+    "source, count",
+    [
+        ("x = ('full', 'reduced')", 1),
+        ("x = ['reduced', 'exudyn', 'full']", 1),
+        ("x = ('full',)", 0),
+    ],
+)
+def test_the_name_list_check_finds_literals(source, count):
+    assert len(_name_lists(ast.parse(source))) == count
