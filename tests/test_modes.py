@@ -11,13 +11,8 @@ import pytest
 
 from rodval import Chain, Scene, constant, paper_scene
 from rodval.analysis.modes import compare_modes, pair_modes
-from rodval.models.linear_modes import (
-    mac,
-    modes,
-    natural_frequencies,
-    static_equilibrium,
-    static_residual,
-)
+from rodval.models.linear_modes import mac, modes, natural_frequencies
+from rodval.models.statics import static_equilibrium, static_residual
 
 L, M_LEN, EI = 2.0, 3.0, 1e5
 EB_SCALE = math.sqrt(EI / (M_LEN * L**4))

@@ -16,7 +16,7 @@ import pandas as pd
 from rodval.core.scene import Scene
 
 #: What a model is linearised about: its initial state at rest (free vibration, loads
-#: ignored; it must be an equilibrium, see ``rodval.models.linear_modes.check_at_rest``) or the
+#: ignored; it must be an equilibrium, see ``rodval.models.statics.check_at_rest``) or the
 #: static equilibrium under the scene's static loads (``static_loads``) and hinge rest angles.
 ABOUT = ("initial", "equilibrium")
 

@@ -86,7 +86,6 @@ from rodval.core.checks import check_choice, check_type
 from rodval.core.eigen import angular_frequencies, quadratic_eigenvalues, symmetric_pencil
 from rodval.core.modal import (
     ABOUT,
-    Equilibrium,
     Modes,
     normalize_shapes,
     static_loads,
@@ -102,6 +101,13 @@ from rodval.models.paper_matrices import (
     stiffness_matrix,
 )
 from rodval.models.reduced import ReducedModel, ReducedSystem
+from rodval.models.statics import (
+    check_at_rest,
+    load_stiffness,
+    no_equilibrium,
+    static_equilibrium,
+    static_residual,
+)
 
 #: The models linearized here: the paper's two.
 PAPER_MODELS = (FullModel.name, ReducedModel.name)
@@ -118,148 +124,6 @@ IMAG_TOL = 1e-9
 
 #: Relative size (to the largest |eigenvalue|) below which a QZ eigenvalue is a zero mode.
 ZERO_TOL = 1e-13
-
-
-# -- loads and statics ------------------------------------------------------------------------
-def load_stiffness(l: np.ndarray, phi: np.ndarray, SX: np.ndarray, SY: np.ndarray) -> np.ndarray:
-    """K_L = -dQ/dphi (n, n), diagonal: l_k (sin phi_k SY_k + cos phi_k SX_k) (N m/rad)."""
-    return np.diag(l * (np.sin(phi) * SY + np.cos(phi) * SX))
-
-
-def static_residual(
-    chain: Chain, q: np.ndarray, SX=None, SY=None, rest=None, K: np.ndarray | None = None
-) -> np.ndarray:
-    """R(q) = K q - A^T (kappa * rest) - [Q(phi); 0; 0] (3n): the gradient of
-    Pi(q) - work of the constant loads. ``rest``: hinge rest angles (rad, n; None = 0), the
-    spring moments being kappa_k (D_k - rest_k)."""
-    n = chain.n
-    K = stiffness_matrix(chain) if K is None else K
-    R = K @ q
-    if rest is not None:
-        R -= hinge_matrix(n).T @ (chain.kappa * np.broadcast_to(np.asarray(rest, float), (n,)))
-    if SX is not None:
-        phi = q[:n]
-        R[:n] -= chain.l * (np.cos(phi) * SY - np.sin(phi) * SX)
-    return R
-
-
-def static_equilibrium(
-    chain: Chain,
-    SX=None,
-    SY=None,
-    q0=None,
-    rest=None,
-    *,
-    rtol: float = 1e-12,
-    max_iter: int = 30,
-    max_steps: int = 256,
-) -> Equilibrium:
-    """Static equilibrium R(q) = 0 (``static_residual``) by Newton's method with the exact
-    Jacobian K + K_L, starting from q0 (default straight). If a Newton solve fails, the load
-    (and rest angles) are applied in more equal steps (1, 2, 4, ... up to ``max_steps``).
-    Converged when max |R| <= rtol * (max |K q| + max |Q| + 1 N m)."""
-    n = chain.n
-    K = stiffness_matrix(chain)
-    SX = np.zeros(n) if SX is None else np.asarray(SX, float)
-    SY = np.zeros(n) if SY is None else np.asarray(SY, float)
-    rest = None if rest is None else np.broadcast_to(np.asarray(rest, float), (n,))
-    start = np.zeros(3 * n) if q0 is None else np.asarray(q0, float).copy()
-    total = 0
-    steps = 1
-    while steps <= max_steps:
-        q = start.copy()
-        ok = True
-        for i in range(1, steps + 1):
-            f = i / steps
-            args = (f * SX, f * SY, None if rest is None else f * rest)
-            for _ in range(max_iter):
-                R = static_residual(chain, q, *args, K=K)
-                Q = chain.l * (np.cos(q[:n]) * args[1] - np.sin(q[:n]) * args[0])
-                scale = np.max(np.abs(K @ q)) + np.max(np.abs(Q)) + 1.0
-                if np.max(np.abs(R)) <= rtol * scale:
-                    break
-                J = K.copy()
-                J[:n, :n] += load_stiffness(chain.l, q[:n], args[0], args[1])
-                try:
-                    q = q - np.linalg.solve(J, R)
-                except np.linalg.LinAlgError:  # singular: no Newton step; try more load steps
-                    q = np.full_like(q, np.nan)
-                total += 1
-                if not np.all(np.isfinite(q)):
-                    break
-            else:
-                R = static_residual(chain, q, *args, K=K)
-            if not (np.all(np.isfinite(q)) and np.max(np.abs(R)) <= rtol * scale):
-                ok = False
-                break
-        if ok:
-            return Equilibrium(q, total, steps, float(np.max(np.abs(R))), True)
-        steps *= 2
-    R = static_residual(chain, q, SX, SY, rest, K=K)
-    return Equilibrium(q, total, steps // 2, float(np.max(np.abs(R))), False)
-
-
-def no_equilibrium(chain: Chain, eq: Equilibrium) -> str:
-    """Why ``static_equilibrium`` found none, in one line: hinges without stiffness
-    (kappa = 0) that the loads do not hold leave the chain free to turn there (a singular
-    stiffness, no unique equilibrium); otherwise Newton's method did not converge."""
-    free = [int(k) for k in np.flatnonzero(chain.kappa == 0)]
-    if free:
-        return (
-            f"static equilibrium not found: hinge(s) {free} have no stiffness (kappa = 0), so "
-            "where the loads do not hold them the chain turns freely and its stiffness is "
-            "singular (no unique equilibrium, or none Newton's method reaches from the initial "
-            "state); give those hinges kappa > 0, start nearer an equilibrium ([initial] phi), "
-            "or linearize about the initial state (about='initial', --about initial)"
-        )
-    return (
-        f"static equilibrium not found (max |R| = {eq.residual:.3g} N m after "
-        f"{eq.iterations} Newton iterations and {eq.load_steps} load steps)"
-    )
-
-
-#: Largest static residual of an initial state still taken as an equilibrium, relative to
-#: max |K q0| + max |A^T kappa rest| + max |Q| + 1 N m: a state written with 9 significant
-#: digits from an equilibrium (static_equilibrium converges to 1e-12 of the same scale)
-#: passes; a pre-stressed fold (residuals of order kappa x angle) does not.
-AT_REST_RTOL = 1e-8
-
-
-def check_at_rest(scene: Scene) -> float:
-    """The initial state's static residual max |R(q0)| (N m, ``static_residual`` with the
-    hinge rest angles and without loads, which the linearization about the initial state
-    leaves out), or ValueError when the state is not at rest in equilibrium (rates not zero,
-    or max |R| above ``AT_REST_RTOL`` of its scale): a linearization about a state the chain
-    immediately leaves describes no motion of the scene. A scene-level check, made before any
-    model's modal analysis. O(n^2) (the dense K of the paper's matrices)."""
-    chain, n = scene.chain, scene.n
-    ini = scene.initial.resolve(n)
-    moving = [k for k in ("dphi", "dalpha", "dbeta") if np.any(ini[k] != 0)]
-    if moving:
-        raise ValueError(
-            f"the initial state is not at rest ({', '.join(moving)} not zero), so there is no "
-            "configuration to vibrate about; linearize about the static equilibrium "
-            "(about='equilibrium', --about equilibrium) or pass allow_unbalanced=True "
-            "(--allow-unbalanced) to linearize about the initial positions anyway"
-        )
-    q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
-    K = stiffness_matrix(chain)
-    R = static_residual(chain, q0, rest=chain.rest_angle, K=K)
-    spring = hinge_matrix(n).T @ (chain.kappa * chain.rest_angle)
-    scale = np.max(np.abs(K @ q0)) + np.max(np.abs(spring)) + 1.0
-    worst = int(np.argmax(np.abs(R)))
-    residual = float(abs(R[worst]))
-    if residual > AT_REST_RTOL * scale:
-        row = ("phi", "alpha", "beta")[worst // n] + f"[{worst % n}]"
-        raise ValueError(
-            f"the initial state is not an equilibrium: static residual {residual:.3g} N m on "
-            f"{row} (hinge springs about their rest angles and bending; loads are left out "
-            "about the initial state), so the chain does not stay there; linearize about the "
-            "static equilibrium (about='equilibrium', --about equilibrium, which holds the "
-            "loads) or pass allow_unbalanced=True (--allow-unbalanced) to linearize about it "
-            "anyway"
-        )
-    return residual
 
 
 def check_arguments(scene: Scene, count: int | None) -> None:
