@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from rodval import Chain, Scene, constant, paper_scene
-from rodval.bench import errors, references, timed
+from rodval.bench.precision import errors, references, timed
 from rodval.core.settings import IntegratorSettings
 from rodval.report.markdown import to_markdown
 

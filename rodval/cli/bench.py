@@ -18,6 +18,7 @@ from rodval.cli.options import positive_float
 from rodval.core.provenance import provenance
 from rodval.core.scene import paper_scene
 from rodval.core.settings import METHODS
+from rodval.models.registry import MODEL_NAMES, integrated_models, uses_integrator
 from rodval.report.figures import plot_scale, plot_work_precision
 from rodval.report.markdown import to_markdown
 
@@ -89,8 +90,8 @@ def register(sub) -> None:
     wp.add_argument("--n", type=int, default=8, help="number of rods (default 8)")
     wp.add_argument(
         "--models",
-        type=_choice_list("--models", ("full", "reduced", "exudyn")),
-        default=["reduced", "full", "exudyn"],
+        type=_choice_list("--models", MODEL_NAMES),
+        default=list(MODEL_NAMES),
     )
     wp.add_argument(
         "--methods", type=_choice_list("--methods", METHODS), default=list(DEFAULT_METHODS)
@@ -126,8 +127,10 @@ def register(sub) -> None:
     sc.add_argument("--n-values", type=_int_list, default=list(bench.SCALE_N))
     sc.add_argument(
         "--models",
-        type=_choice_list("--models", ("reduced", "full")),
-        default=["reduced", "full"],
+        type=_choice_list("--models", MODEL_NAMES),
+        default=None,
+        help="models (default: the native ones; the scale benchmark times rodval's own "
+        "integration)",
     )
     sc.add_argument(
         "--budget",
@@ -241,7 +244,7 @@ def run_work_precision(args) -> int:
 
 
 def run_cost_n(args) -> int:
-    frame = bench.per_eval_cost(args.n_values, models=("full", "reduced"), repeats=args.repeats)
+    frame = bench.per_eval_cost(args.n_values, models=integrated_models(), repeats=args.repeats)
     fits = []
     for (model, kernel), part in frame.groupby(["model", "kernel"]):
         n, c = part.n.to_numpy(), part.s_per_eval.to_numpy()
@@ -317,6 +320,12 @@ def _load() -> str:
 
 
 def run_scale(args) -> int:
+    foreign = [m for m in args.models or () if not uses_integrator(m)]
+    if foreign:
+        raise ValueError(
+            f"--models: the scale benchmark runs the models rodval integrates "
+            f"({', '.join(integrated_models())}), got {', '.join(foreign)}"
+        )
     load_before = _load()
     frame, notes = bench.scale_rows(
         args.n_values, args.models, repeats=args.repeats, budget_s=args.budget

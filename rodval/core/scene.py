@@ -18,7 +18,7 @@ Conventions (used throughout rodval)
 from __future__ import annotations
 
 import numbers
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
@@ -536,7 +536,7 @@ def paper_scene(
     times: Iterable[float] | None = None,
     outputs: Iterable[str] = ("phi", "dphi", "alpha", "beta"),
     load_node: int | None = None,
-    **chain_overrides: Mapping,
+    **chain_overrides: Any,
 ) -> Scene:
     """The example of the paper (section 3): n uniform rods, the pulse at the last node.
 

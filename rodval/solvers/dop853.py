@@ -324,10 +324,9 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
 @njit(_RUN_SIGNATURE, cache=True, error_model="numpy")
 def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting, Y, W, mon):
     """Integrate from edges[0] to edges[-1], restarting at each interior edge (breakpoint),
-    writing the state at ``times`` into Y.
-
-    ``controls``: [rtol, atol, max_step (s), first_step (s; <= 0 selects it), max_nfev,
-    deadline (a ``time.perf_counter()`` value, s; inf: none)]. The run stops with ``BUDGET``
+    writing the state at ``times`` into Y. ``controls``: [rtol, atol, max_step (s),
+    first_step (s; <= 0 selects it), max_nfev, deadline (a ``time.perf_counter()`` value, s;
+    inf: none)]. The run stops with ``BUDGET``
     once max_nfev evaluations are used and with ``WALL`` once the clock passes the deadline,
     read before the first step attempt and then every ``WALL_CHECK_EVALUATIONS`` evaluations;
     with ``reporting`` the time reached goes to the progress reporter at those reads.

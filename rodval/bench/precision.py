@@ -1,0 +1,259 @@
+"""Work-precision: errors against a reference computed with a different method, runs timed
+side by side, the cheapest settings per accuracy and the baseline ratios (conventions in
+``rodval.bench``)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import pandas as pd
+
+from rodval.analysis.metrics import scaled_errors
+from rodval.core.provenance import machine, package_versions
+from rodval.core.scene import Scene
+from rodval.core.settings import IntegratorSettings
+from rodval.core.trajectory import Trajectory
+from rodval.models import get_model
+from rodval.models.paper_system import PaperSystem
+from rodval.models.registry import integrated_models, simulate, uses_integrator
+from rodval.solvers.ode_model import OdeModel
+
+QUANTITIES = ("phi", "dphi", "alpha", "beta")
+
+
+DOP853_FAMILY = ("DOP853", "DOP853-numba")
+
+
+#: The two references: (method, rtol, atol).
+REFERENCE_DOP = ("LSODA", 1e-12, 1e-14)
+
+
+REFERENCE_OTHER = ("DOP853-numba", 1e-13, 1e-15)
+
+
+#: Reference models (exudyn) integrate with a fixed step: their precision ladder is the step
+#: (s), and their reference is a run with a *different* solver at a much finer step.
+REFERENCE_MODEL_STEPS = (1e-3, 5e-4, 2e-4, 1e-4, 5e-5)
+
+
+REFERENCE_MODEL_REF: dict[str, Any] = {"solver": "trapezoidal", "step": 2e-5}
+
+
+def paper_system_of(model: str, scene: Scene, **options: Any) -> PaperSystem:
+    """The ODE system of ``scene`` in paper model ``model`` (its options given), what the
+    cost benchmarks time; ValueError for any other model."""
+    m = get_model(model, **options)
+    system = m.system(scene) if isinstance(m, OdeModel) else None
+    if not isinstance(system, PaperSystem):
+        raise ValueError(f"model {model!r} is not one of the paper's models")
+    return system
+
+
+def ladder(model: str, method: str, rtols) -> list[tuple[float, IntegratorSettings, dict]]:
+    """(precision knob, settings, model options), loosest first: the tolerance ladder
+    (atol = rtol / 100) for native models, the step ladder for fixed-step reference models."""
+    if uses_integrator(model):
+        return [
+            (r, IntegratorSettings(method=method, rtol=r, atol=r * 1e-2), {})
+            for r in sorted(rtols, reverse=True)
+        ]
+    return [(h, IntegratorSettings(), {"step": h}) for h in REFERENCE_MODEL_STEPS]
+
+
+def reference_model_reference(scene: Scene, model: str) -> Trajectory:
+    """A fixed-step reference model's reference: another solver at a much finer step."""
+    run = simulate(scene, model, **REFERENCE_MODEL_REF)
+    if not run.success:
+        raise RuntimeError(f"reference run of {model} failed: {run.stats.message}")
+    return run
+
+
+#: Runs whose warm-up takes longer than this (s) are timed once (their noise is relatively small).
+SLOW_RUN_S = 2.0
+
+
+def timed(
+    scene: Scene, model: str, settings: IntegratorSettings, repeats: int = 3, **options
+) -> tuple[Trajectory, float]:
+    """(trajectory, min wall time over ``repeats`` runs after a warm-up run) in s."""
+    warm = simulate(scene, model, settings=settings, **options)
+    count = 1 if warm.stats.wall_s > SLOW_RUN_S else repeats
+    runs = [simulate(scene, model, settings=settings, **options) for _ in range(count)]
+    return runs[-1], min(r.stats.wall_s for r in runs)
+
+
+def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str, float]:
+    """Relative errors of ``traj`` against ``ref`` (``rodval.analysis.metrics.scaled_errors``
+    per quantity as ``final_q``, ``rms_q``, ``max_q``, and ``scd``; see module docstring); NaN
+    for a run that did not reach every output time."""
+    out: dict[str, float] = {}
+    worst = 0.0
+    for q in quantities:
+        if q not in ref.values:
+            continue
+        if q not in traj.values or len(traj.times) != len(ref.times):
+            out.update({f"final_{q}": math.nan, f"rms_{q}": math.nan, f"max_{q}": math.nan})
+            worst = math.inf
+            continue
+        out.update({f"{k}_{q}": v for k, v in scaled_errors(traj[q], ref[q]).items()})
+        worst = max(worst, out[f"max_{q}"])
+    out["scd"] = (
+        -math.log10(worst) if 0 < worst < math.inf else (math.inf if worst == 0 else math.nan)
+    )
+    return out
+
+
+@dataclass
+class References:
+    """The two references of one (scene, model) and their mutual difference."""
+
+    dop: Trajectory  # for the DOP853 family
+    other: Trajectory  # for every other method
+    uncertainty: float  # max relative difference over phi, dphi
+
+    def for_method(self, method: str) -> Trajectory:
+        return self.dop if method in DOP853_FAMILY else self.other
+
+
+def references(scene: Scene, model: str, **options) -> References:
+    runs = [
+        simulate(scene, model, method=m, rtol=r, atol=a, **options)
+        for m, r, a in (REFERENCE_DOP, REFERENCE_OTHER)
+    ]
+    for run in runs:
+        if not run.success:
+            raise RuntimeError(f"reference run of {model} failed: {run.stats.message}")
+    e = errors(runs[0], runs[1], ("phi", "dphi"))
+    return References(runs[0], runs[1], max(e["max_phi"], e["max_dphi"]))
+
+
+def work_precision(
+    scene: Scene,
+    models: list[str],
+    methods: list[str],
+    rtols: list[float],
+    *,
+    repeats: int = 3,
+    budget_s: float = 20.0,
+    baseline: bool = True,
+    progress=print,
+) -> tuple[pd.DataFrame, dict[str, float], list[str]]:
+    """One row per (model, method, kernel, rtol): cost and errors. For each model and method
+    the ladder (loosest first) stops after a run slower than ``budget_s``. ``baseline`` adds
+    scipy DOP853 with the numpy right-hand side (``kernel="numpy"``) for native models.
+
+    Returns (rows, reference uncertainty per model, notes)."""
+    rows, uncertainty, notes = [], {}, []
+    for model in models:
+        try:
+            get_model(model)
+        except ValueError as exc:
+            notes.append(f"model {model} skipped: {exc}")
+            continue
+        native = uses_integrator(model)
+        if native:
+            refs = references(scene, model)
+            uncertainty[model] = refs.uncertainty
+            variants = [(m, "numba") for m in methods] + ([("DOP853", "numpy")] if baseline else [])
+        else:
+            ref_model = reference_model_reference(scene, model)
+            notes.append(
+                f"model {model}: step ladder {REFERENCE_MODEL_STEPS} s (its default "
+                f"solver); reference = {REFERENCE_MODEL_REF}"
+            )
+            variants = [("default", "")]
+        for method, kernel in variants:
+            for knob, settings, opts in ladder(model, method, rtols):
+                if native:
+                    opts = {"kernel": kernel}
+                traj, wall = timed(scene, model, settings, repeats, **opts)
+                ref = refs.for_method(method) if native else ref_model
+                row = {
+                    "model": model,
+                    "method": method if native else traj.options["solver"],
+                    "kernel": kernel,
+                    "rtol": knob if native else math.nan,
+                    "atol": settings.atol if native else math.nan,
+                    "step": math.nan if native else knob,
+                    **traj.stats.as_dict(),
+                    "reference": (
+                        f"{ref.settings['method']} rtol {ref.settings['rtol']:g}"
+                        if native
+                        else f"{model} {REFERENCE_MODEL_REF}"
+                    ),
+                }
+                row["wall_s"] = wall  # the minimum, not the last run's
+                row.update(errors(traj, ref))
+                rows.append(row)
+                progress(
+                    f"{model:8s} {row['method']:13s} {kernel:6s} "
+                    f"{'rtol' if native else 'step'} {knob:7.0e}  wall {wall * 1e3:9.2f} ms  "
+                    f"nfev {traj.stats.nfev:7d}  phi err {row.get('max_phi', math.nan):.2e}"
+                )
+                if wall > budget_s:
+                    notes.append(
+                        f"{model} {method} {kernel}: ladder stopped after {knob:g} "
+                        f"({wall:.1f} s > budget {budget_s:g} s)"
+                    )
+                    break
+    frame = pd.DataFrame(rows)
+    return with_provenance(frame), uncertainty, notes
+
+
+def with_provenance(frame: pd.DataFrame) -> pd.DataFrame:
+    """Machine and package versions as constant columns (so a CSV carries its own context)."""
+    info = {
+        **{k: str(v) for k, v in machine().items()},
+        **{f"version_{k}": str(v) for k, v in package_versions().items()},
+    }
+    return frame.assign(**info)
+
+
+def cheapest(frame: pd.DataFrame, quantity: str = "phi", tol: float = 1e-6) -> pd.DataFrame:
+    """Per (model, method, kernel): the fastest run whose ``max_<quantity>`` <= tol."""
+    ok = frame[frame[f"max_{quantity}"] <= tol]
+    idx = ok.groupby(["model", "method", "kernel"])["wall_s"].idxmin()
+    return ok.loc[idx].sort_values(["model", "wall_s"])
+
+
+def baseline_ratios(
+    scene: Scene,
+    tol: float = 1e-6,
+    rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
+    repeats: int = 3,
+    progress=print,
+) -> pd.DataFrame:
+    """Per native model: the loosest rtol at which the compiled DOP853 reaches phi error <= tol,
+    then, side by side at that same tolerance, scipy DOP853 with the numba kernel and with
+    the straightforward numpy kernel; speed-up = baseline wall / compiled wall."""
+    rows = []
+    for model in integrated_models():
+        refs = references(scene, model)
+        for rtol in sorted(rtols, reverse=True):
+            settings = IntegratorSettings("DOP853-numba", rtol=rtol, atol=rtol * 1e-2)
+            fast, wall = timed(scene, model, settings, repeats)
+            err = errors(fast, refs.dop)["max_phi"]
+            if err <= tol:
+                break
+        runs = {"DOP853-numba/numba": (fast, wall)}
+        for kernel in ("numba", "numpy"):
+            s = IntegratorSettings("DOP853", rtol=rtol, atol=rtol * 1e-2)
+            runs[f"DOP853/{kernel}"] = timed(scene, model, s, repeats, kernel=kernel)
+        for name, (traj, w) in runs.items():
+            method, kernel = name.split("/")
+            rows.append(
+                {
+                    "model": model,
+                    "method": method,
+                    "kernel": kernel,
+                    "rtol": rtol,
+                    "wall_s": w,
+                    "nfev": traj.stats.nfev,
+                    "max_phi": errors(traj, refs.dop)["max_phi"],
+                    "speedup_vs_numpy_DOP853": runs["DOP853/numpy"][1] / w,
+                }
+            )
+            progress(f"{model:8s} {name:20s} rtol {rtol:g}: {w * 1e3:9.2f} ms")
+    return with_provenance(pd.DataFrame(rows))
