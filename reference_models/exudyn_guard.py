@@ -17,7 +17,7 @@ from rodval.core.status import (
     STATUS_FAILED,
     numerical_failure,
 )
-from rodval.solvers.guard import EnergyBudget, GuardSpec, diverged_message
+from rodval.solvers.guard import GuardSpec, Monitor, diverged_message
 
 
 class _Guard:
@@ -30,7 +30,7 @@ class _Guard:
     * non-finite coordinates or velocities: STATUS_DIVERGED;
     * kinetic energy T = v^T M v / 2 (consistent mass of the cubic elements plus the point
       masses; the hinge data nodes carry no mass) above ``factor`` x the budget of
-      ``rodval.solvers.guard`` (``GuardSpec``, ``EnergyBudget``: W+ on the load power at the
+      ``rodval.solvers.guard`` (``GuardSpec``, ``Monitor``: W+ on the load power at the
       checked states), E(0) the initial T + Pi (``_energies``): STATUS_BLOWUP;
     * max_k |dphi_k| x step above ``max_rotation``: STATUS_FAILED (under-resolved)."""
 
@@ -83,7 +83,7 @@ class _Guard:
             scene, E, EA, at0, ini["phi"][None], ini["alpha"][None], ini["beta"][None]
         )
         self.spec = GuardSpec(blowup_factor=float(factor), energy0_J=float(kin0[0] + pot0[0]))
-        self.energy = EnergyBudget(self.spec)
+        self.energy = Monitor(self.spec)
         self.verdict: tuple | None = None
         self.min_step, self.max_rotation_seen = math.inf, 0.0
 

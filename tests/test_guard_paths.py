@@ -14,9 +14,8 @@ import pytest
 from rodval import Chain, InitialState, IntegratorSettings, Scene
 from rodval.core.status import STATUS_BLOWUP
 from rodval.models import get_model
-from rodval.solvers import dop853
 from rodval.solvers.compiled import verdict_message
-from rodval.solvers.guard import DivergenceGuard, blowup_message
+from rodval.solvers.guard import DivergenceGuard, blowup_message, guard_step
 
 SCENE = Scene(
     chain=Chain.uniform(2),
@@ -45,7 +44,7 @@ def test_scipy_and_compiled_guards_give_one_verdict(model):
     form.mechanics(T_CHECK, y, form.P, form.S, form.M, form.L, mech)
     mon = np.zeros(6)
     mon[3] = 0.0  # no loads: the positive power at the start is 0
-    code = dop853.guard_step(guard.spec.as_array(), mon, H, mech, True)
+    code = guard_step(guard.spec.as_array(), mon, H, mech, True)
     compiled_verdict = verdict_message(code, mon, T_CHECK - H, guard.spec)
     assert scipy_verdict[0] == compiled_verdict[0] == STATUS_BLOWUP
     assert scipy_verdict[1] == compiled_verdict[1]

@@ -13,34 +13,31 @@ import numpy as np
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import (
-    STATUS_BLOWUP,
     STATUS_BUDGET,
     STATUS_DIVERGED,
     STATUS_ERROR,
     STATUS_FAILED,
-    STATUS_STALLED,
     STATUS_WALL,
     numerical_failure,
 )
 from rodval.core.trajectory import SolverStats
 from rodval.solvers import dop853, progress
 from rodval.solvers.audit import PowerLedger
-from rodval.solvers.guard import GuardSpec, blowup_message, diverged_message, stalled_message
+from rodval.solvers.guard import GuardSpec, diverged_message, verdict
 from rodval.solvers.system import CompiledForm
 
 
 def verdict_message(code: int, mon: np.ndarray, t: float, spec: GuardSpec) -> tuple[int, str]:
-    """Status and message of a compiled run that ended with ``code`` at t (s), from the loop's
-    monitor ``mon`` (``dop853.guard_step``): the messages of ``rodval.solvers.guard``."""
+    """Status and message of a compiled run that ended with ``code`` at t (s), the start of
+    the last step; the guard's verdicts (``rodval.solvers.guard.verdict``) at its end."""
     if code == dop853.STEP_TOO_SMALL:
         return STATUS_FAILED, "Required step size is less than spacing between numbers."
     if code == dop853.NON_FINITE:
         return STATUS_DIVERGED, diverged_message(t)
-    if code == dop853.STALLED:
-        return STATUS_STALLED, stalled_message(int(mon[0]), spec.min_step_s, mon[1], t + mon[1])
-    if code == dop853.BLOWUP:
-        return STATUS_BLOWUP, blowup_message(mon[4], spec.blowup_factor, mon[5], t + mon[1])
-    raise ValueError(f"unknown return code {code} of the compiled loop")
+    judged = verdict(code, mon, t + mon[1], spec)
+    if judged is None:
+        raise ValueError(f"unknown return code {code} of the compiled loop")
+    return judged
 
 
 #: Codes of the budgets: status and the setting named in the message.

@@ -26,8 +26,9 @@ import numpy as np
 from numba import njit, objmode, types
 from scipy.integrate._ivp import dop853_coefficients as dc
 
+from rodval.solvers import guard as _guard
 from rodval.solvers.audit import GAUSS_NODES
-from rodval.solvers.guard import GuardSpec
+from rodval.solvers.guard import GuardSpec, guard_step
 from rodval.solvers.progress import report
 from rodval.solvers.signature import F1 as _F1
 from rodval.solvers.signature import F2 as _F2
@@ -43,8 +44,9 @@ _E5 = np.ascontiguousarray(dc.E5)
 _D = np.ascontiguousarray(dc.D)
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(GAUSS_NODES)
 
-#: Return codes of ``run``.
-OK, STEP_TOO_SMALL, NON_FINITE, BUDGET, BLOWUP, STALLED, WALL = 0, 1, 2, 3, 4, 5, 6
+#: Return codes of ``run``: the guard's (``rodval.solvers.guard.guard_step``) and the loop's own.
+OK, BLOWUP, STALLED = _guard.OK, _guard.BLOWUP, _guard.STALLED
+STEP_TOO_SMALL, NON_FINITE, BUDGET, WALL = 1, 2, 3, 6
 
 #: Evaluations between two reads of the clock for the wall-clock budget: the read costs about
 #: one evaluation of the smallest system, so this keeps it below 1 % of a run, and the run
@@ -110,28 +112,6 @@ def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, tm
     else:
         h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
     return min(100.0 * h0, h1, t_bound - t0, max_step)
-
-
-@njit(cache=True, error_model="numpy")
-def guard_step(g, mon, h, mech, guarded):
-    """The divergence guard of ``rodval.solvers.guard`` after one accepted step of h (s), as
-    the compiled loop runs it. ``g``: ``GuardSpec.as_array()``; ``mon``: the run's monitor
-    [short steps in a row, last step (s), W+ (J), last positive load power (W), T (J), budget
-    (J)], updated here (the figures of a verdict's message); ``mech``: (T, P_ext) at the step's
-    end, read only when ``guarded``. Returns ``STALLED``, ``BLOWUP`` or ``OK``. O(1)."""
-    mon[0] = mon[0] + 1.0 if h < g[0] else 0.0
-    mon[1] = h
-    if mon[0] >= g[1]:
-        return STALLED
-    if guarded:
-        p = max(mech[1], 0.0)
-        mon[2] += 0.5 * h * (mon[3] + p)
-        mon[3] = p
-        mon[4] = mech[0]
-        mon[5] = g[3] + mon[2] + g[4]
-        if not mech[0] <= g[2] * mon[5]:
-            return BLOWUP
-    return OK
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -12,11 +12,11 @@ Three verdicts, each with its own status (``rodval.core.status``):
 * ``STATUS_STALLED``: ``stall_steps`` consecutive accepted steps shorter than
   ``min_step_fraction * t_end``.
 
-What is checked is a ``GuardSpec``; the verdict's text comes from the message functions here.
-Three paths use them: ``DivergenceGuard`` (the scipy loop), the compiled DOP853 loop
-(``rodval.solvers.dop853.guard_step`` on ``GuardSpec.as_array``, its figures formatted by
-``rodval.solvers.compiled``) and the exudyn model's per-step check (``EnergyBudget``), so the
-same blow-up reads the same on each.
+What is checked is a ``GuardSpec``; the check itself is one compiled function, ``guard_step``
+(stall count, W+, the budget), and the verdict's text comes from ``verdict``. Three paths use
+them: ``DivergenceGuard`` (the scipy loop), the compiled DOP853 loop (which calls
+``guard_step`` inside its loop) and the exudyn model's per-step check (``Monitor``), so the
+same blow-up is judged by the same arithmetic and reads the same on each.
 
 The energy check needs the system's energy capability (``OdeSystem.has_energy``); it
 costs one kinetic-energy evaluation per step: a mass-matrix product, no linear solve, and no
@@ -29,6 +29,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import (
@@ -85,7 +86,7 @@ class GuardSpec:
 
     def as_array(self) -> np.ndarray:
         """[min_step_s, stall_steps, blowup_factor, energy0_J, ENERGY_FLOOR_J], the form the
-        compiled loop reads (``rodval.solvers.dop853.guard_step``)."""
+        compiled check reads (``guard_step``)."""
         return np.array(
             [
                 self.min_step_s,
@@ -95,6 +96,49 @@ class GuardSpec:
                 ENERGY_FLOOR_J,
             ]
         )
+
+
+#: Codes of ``guard_step`` (and of the compiled loop, ``rodval.solvers.dop853``).
+OK, BLOWUP, STALLED = 0, 4, 5
+
+
+@njit(cache=True, error_model="numpy")
+def guard_step(g, mon, h, mech, guarded):
+    """The guard after one accepted step of h (s): the one arithmetic of every path.
+    ``g``: ``GuardSpec.as_array()``; ``mon``: the run's monitor [short steps in a row, last
+    step (s), W+ (J), last positive load power (W), T (J), budget (J)], updated here (the
+    figures of a verdict's message); ``mech``: (T, P_ext) at the step's end, read only when
+    ``guarded``. Returns ``STALLED``, ``BLOWUP`` or ``OK``. O(1)."""
+    mon[0] = mon[0] + 1.0 if h < g[0] else 0.0
+    mon[1] = h
+    if mon[0] >= g[1]:
+        return STALLED
+    if guarded:
+        p = max(mech[1], 0.0)
+        mon[2] += 0.5 * h * (mon[3] + p)
+        mon[3] = p
+        mon[4] = mech[0]
+        mon[5] = g[3] + mon[2] + g[4]
+        if not mech[0] <= g[2] * mon[5]:
+            return BLOWUP
+    return OK
+
+
+def new_monitor(power0: float = 0.0) -> np.ndarray:
+    """A run's monitor for ``guard_step``, the load power at the start ``power0`` (W) in it."""
+    mon = np.zeros(6)
+    mon[3] = max(power0, 0.0)
+    return mon
+
+
+def verdict(code: int, mon: np.ndarray, t: float, spec: GuardSpec) -> Verdict | None:
+    """The status and message of ``guard_step``'s ``code`` on the step that ended at t (s),
+    with the monitor's figures; None for OK."""
+    if code == STALLED:
+        return STATUS_STALLED, stalled_message(int(mon[0]), spec.min_step_s, mon[1], t)
+    if code == BLOWUP:
+        return STATUS_BLOWUP, blowup_message(mon[4], spec.blowup_factor, mon[5], t)
+    return None
 
 
 def diverged_message(t: float) -> str:
@@ -121,31 +165,27 @@ def blowup_message(kinetic: float, factor: float, budget: float, t: float) -> st
     )
 
 
-class EnergyBudget:
-    """The blow-up check of one run: W+ by the trapezoid rule on the positive load power
-    at the checked states, and the verdict on T against ``spec``'s budget. O(1) per check."""
+class Monitor:
+    """The blow-up check of a run checked at states it is handed (the exudyn model's):
+    ``guard_step`` with W+ by the trapezoid rule between the checked states."""
 
     def __init__(self, spec: GuardSpec):
         self.spec = spec
-        self.w_plus = 0.0
-        self._last: tuple[float, float] | None = None  # (t, positive power) of the last state
-
-    def start(self, t: float, power: float) -> None:
-        """Start W+ at t (s) with load power ``power`` (W), without a verdict."""
-        self._last = (t, max(power, 0.0))
+        self.g = spec.as_array()
+        self.mon = new_monitor()
+        self._t: float | None = None  # time of the last checked state (s)
 
     def check(self, t: float, power: float, kinetic: float) -> Verdict | None:
         """Verdict on the state at t (s) with load power ``power`` (W) and kinetic energy
-        ``kinetic`` (J); without ``start`` the first call starts W+ at t."""
-        p = max(power, 0.0)
-        if self._last is not None:
-            t0, p0 = self._last
-            self.w_plus += 0.5 * (t - t0) * (p0 + p)
-        self._last = (t, p)
-        budget = self.spec.budget(self.w_plus)
-        if not kinetic <= self.spec.blowup_factor * budget:
-            return STATUS_BLOWUP, blowup_message(kinetic, self.spec.blowup_factor, budget, t)
-        return None
+        ``kinetic`` (J); the first call starts W+ at t."""
+        if self._t is None:
+            self.mon[3] = max(power, 0.0)
+            h = 0.0
+        else:
+            h = t - self._t
+        self._t = t
+        code = guard_step(self.g, self.mon, h, np.array([kinetic, power]), True)
+        return verdict(code, self.mon, t, self.spec)
 
 
 class DivergenceGuard:
@@ -159,28 +199,23 @@ class DivergenceGuard:
         checked = system.has_energy and math.isfinite(settings.blowup_factor)
         energy0 = system.energy_budget(0.0, y0) if checked else 0.0
         self.spec = GuardSpec.from_settings(settings, t_end, energy0)
-        self.n_short = 0
+        self.g = self.spec.as_array()
         self.system = system if checked else None
-        self.energy: EnergyBudget | None = None
-        if self.system is not None:
-            self.energy = EnergyBudget(self.spec)
-            self.energy.start(0.0, self.system.power(0.0, y0)[0])
+        self.mon = new_monitor(system.power(0.0, y0)[0] if checked else 0.0)
 
     def check(self, t0: float, t1: float, y: np.ndarray) -> Verdict | None:
         """Verdict after the accepted step [t0, t1] that ended in state y."""
         if not np.all(np.isfinite(y)):
             return STATUS_DIVERGED, diverged_message(t1)
-        self.n_short = self.n_short + 1 if t1 - t0 < self.spec.min_step_s else 0
-        if self.n_short >= self.spec.stall_steps:
-            return STATUS_STALLED, stalled_message(self.n_short, self.spec.min_step_s, t1 - t0, t1)
-        if self.system is None or self.energy is None:
-            return None
-        try:
-            p = self.system.power(t1, y)[0]
-            kinetic = self.system.kinetic_energy(t1, y)
-        except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
-            return numerical_failure(exc, t1) or (
-                STATUS_ERROR,
-                f"energy check failed at t = {t1:.6g} s: {type(exc).__name__}: {exc}",
-            )
-        return self.energy.check(t1, p, kinetic)
+        mech = np.zeros(2)
+        if self.system is not None:
+            try:
+                mech[1] = self.system.power(t1, y)[0]
+                mech[0] = self.system.kinetic_energy(t1, y)
+            except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
+                return numerical_failure(exc, t1) or (
+                    STATUS_ERROR,
+                    f"energy check failed at t = {t1:.6g} s: {type(exc).__name__}: {exc}",
+                )
+        code = guard_step(self.g, self.mon, t1 - t0, mech, self.system is not None)
+        return verdict(code, self.mon, t1, self.spec)
