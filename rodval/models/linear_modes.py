@@ -443,34 +443,25 @@ def check_configuration(
     return {"unbalanced_residual_Nm": float(np.max(np.abs(R)))}
 
 
-def full_modes(
-    scene: Scene,
-    *,
-    about: str,
-    count: int | None,
-    load_at: float | None,
-    coefficients: str = DEFAULT_VARIANT,
-) -> Modes:
-    """The full model's modal analysis (``FullModel.MODAL_ANALYSIS``): ``modes_about``."""
-    return modes_about(
-        scene, FullModel.name, about=about, count=count, coefficients=coefficients, load_at=load_at
-    )
+def _paper_modes(model: str):
+    """The modal analysis of paper model ``model`` in the form ``Model.MODAL_ANALYSIS``
+    names: f(scene, *, about, count, load_at, coefficients) -> Modes (``modes_about``)."""
+
+    def analysis(
+        scene: Scene,
+        *,
+        about: str,
+        count: int | None,
+        load_at: float | None,
+        coefficients: str = DEFAULT_VARIANT,
+    ) -> Modes:
+        return modes_about(
+            scene, model, about=about, count=count, coefficients=coefficients, load_at=load_at
+        )
+
+    return analysis
 
 
-def reduced_modes(
-    scene: Scene,
-    *,
-    about: str,
-    count: int | None,
-    load_at: float | None,
-    coefficients: str = DEFAULT_VARIANT,
-) -> Modes:
-    """The reduced model's modal analysis (``ReducedModel.MODAL_ANALYSIS``): ``modes_about``."""
-    return modes_about(
-        scene,
-        ReducedModel.name,
-        about=about,
-        count=count,
-        coefficients=coefficients,
-        load_at=load_at,
-    )
+#: ``FullModel.MODAL_ANALYSIS`` and ``ReducedModel.MODAL_ANALYSIS``
+full_modes = _paper_modes(FullModel.name)
+reduced_modes = _paper_modes(ReducedModel.name)
