@@ -16,6 +16,12 @@ Conventions
 
 from rodval.analysis.metrics import pareto_front
 from rodval.bench.cost import fitted_exponent, per_eval_cost, skip_rows, speedup_vs_n
+from rodval.bench.fast_path import (
+    eight_rod_wing,
+    fast_path_rows,
+    feature_costs,
+    four_panel_wing,
+)
 from rodval.bench.precision import (
     baseline_ratios,
     cheapest,
@@ -35,6 +41,10 @@ from rodval.bench.scale import (
 )
 
 __all__ = [
+    "eight_rod_wing",
+    "fast_path_rows",
+    "feature_costs",
+    "four_panel_wing",
     "SCALE_N",
     "SCALE_REFERENCE_RTOL",
     "baseline_ratios",

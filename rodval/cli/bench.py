@@ -1,4 +1,4 @@
-"""rodval bench {work-precision, cost-n, skips, speedup, scale} --out DIR: performance measurements
+"""rodval bench {work-precision, cost-n, skips, speedup, scale, fast-path} --out DIR: performance measurements
 (see ``rodval.bench``). Each writes a CSV (with machine and package versions), a markdown
 summary and, where it applies, plots into DIR."""
 
@@ -148,7 +148,12 @@ def register(sub) -> None:
         "--no-speedup", dest="speedup", action="store_false", help="skip the speed-up part"
     )
     sc.set_defaults(func=run_scale)
-    for q in (wp, cn, sk, sp, sc):
+    fp = bsub.add_parser(
+        "fast-path",
+        help="the default method against scipy's DOP853 with and without events and energy",
+    )
+    fp.set_defaults(func=run_fast_path)
+    for q in (wp, cn, sk, sp, sc, fp):
         q.add_argument(
             "--repeats", type=_repeats, default=3, help="timed runs after a warm-up (min is kept)"
         )
@@ -279,6 +284,45 @@ def run_skips(args) -> int:
     frame = bench.skip_rows(repeats=args.repeats)
     body = [_table(frame, ["skip", "model", "with_skip_s", "without_skip_s", "saving", "note"])]
     _write(args.out, "skips", frame, "What a scene does not need: cost with and without", body)
+    return 0
+
+
+def run_fast_path(args) -> int:
+    frame = bench.fast_path_rows(repeats=args.repeats)
+    costs = bench.feature_costs(frame)
+    body = [
+        "Wall s (`stats.wall_s`, best of the repeats after a warm-up) of the default method "
+        "(`auto`) and of scipy's DOP853, one after the other in one process; "
+        "`max_event_dt_s`, `max_impulse_rel`: the largest lock-time and impulse differences "
+        "between the two.",
+        "",
+        _table(
+            frame,
+            [
+                "scene",
+                "feature",
+                "with_feature",
+                "model",
+                "auto_method",
+                "auto_wall_s",
+                "auto_nfev",
+                "scipy_wall_s",
+                "speedup",
+                "events",
+                "max_event_dt_s",
+                "max_impulse_rel",
+                "auto_residual",
+                "scipy_residual",
+            ],
+        ),
+        "",
+        "The default method with the feature over without it (wall time and cost per evaluation):",
+        "",
+        _table(costs, list(costs.columns)),
+    ]
+    _write(
+        args.out, "fast_path", frame, "The fast path: events and energy on the default method", body
+    )
     return 0
 
 

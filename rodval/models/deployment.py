@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 from scipy.linalg import solveh_banded
 
+from rodval.core.loads import load_sums
 from rodval.models.kernels import (
     V_L,
     V_OUTER,
@@ -36,7 +37,8 @@ from rodval.models.kernels import (
 )
 from rodval.models.paper_matrices import rod_momenta
 from rodval.models.reduced_band_lu import _band_size, _solve_band
-from rodval.models.reduced_banded import _forces, _solve_sweep
+from rodval.models.reduced_banded import _forces, _solve_sweep, reduced_rhs, track_bending
+from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE
 
 #: Another armed latch locks together with the one whose crossing was located when its
 #: angle is within this distance (rad) of its latch angle at that time.
@@ -256,3 +258,98 @@ def outer_momenta(chain, phi, dphi, dalpha, dbeta) -> np.ndarray:
     Row 0 is the whole chain's momentum."""
     p = rod_momenta(chain, phi, dphi, dalpha, dbeta)[0]
     return np.cumsum(p[::-1], axis=0)[::-1]
+
+
+# ------------------------------------------------------------------ compiled event forms
+# A mode with locked hinges runs on the compiled integrators with S = [damped, m, hinges (m),
+# angles (m, rad)] (``lock_scalars``); the event table E has one row [hinge, angle (rad)] per
+# armed latch or switching stop, g = D_hinge - angle (``PaperSystem.event_rows``).
+
+
+def lock_scalars(damped: float, hinges: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """S of a compiled form with the hinges ``hinges`` held at ``angles`` (rad)."""
+    m = len(hinges)
+    return np.concatenate([[damped, float(m)], np.asarray(hinges, float), angles]).astype(float)
+
+
+@njit(cache=True)
+def _locks(S):
+    """(hinges, angles) held, from a compiled form's S (``lock_scalars``)."""
+    m = int(S[1])
+    locks = np.empty(m, np.int64)
+    for j in range(m):
+        locks[j] = int(S[2 + j])
+    return locks, S[2 + m : 2 + 2 * m]
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def full_rhs_locked(t, y, P, S, M, L, out):
+    """y' of the full model with the hinges of S held (``full_accel_locked``); O(n m)."""
+    half = y.shape[0] // 2
+    out[:half] = y[half:]
+    n = P.shape[1]
+    SX = np.empty(n)
+    SY = np.empty(n)
+    has_load = load_sums(L, t, SX, SY)
+    locks, _ = _locks(S)
+    lam = np.empty(locks.shape[0])
+    full_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[half:], lam)
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def reduced_rhs_locked(t, y, P, S, M, L, out):
+    """y' of the reduced model with the hinges of S held at their angles
+    (``reduced_solve_locked``); gamma and the largest |gamma| kept in the work space M[0, 0]
+    as ``reduced_banded.reduced_rhs`` does; a singular solve gives NaN (the run ends as
+    diverged). O(n m)."""
+    half = y.shape[0] // 2
+    out[:half] = y[half:]
+    work = M[0, 0]
+    SX = work[:half]
+    SY = work[half : 2 * half]
+    gamma = work[2 * half : 4 * half]
+    has_load = load_sums(L, t, SX, SY)
+    locks, angles = _locks(S)
+    lam = np.empty(locks.shape[0])
+    ddphi = np.empty(half)
+    ok = reduced_solve_locked(
+        P, y[:half], y[half:], has_load, SX, SY, S[0] != 0.0, locks, angles, ddphi, gamma, lam
+    )
+    if not ok:
+        ddphi[:] = np.nan
+    out[half:] = ddphi
+    work[-1] = track_bending(gamma, work[-1])
+
+
+@njit(cache=True)
+def _hinge_events(phi, alpha, beta, E, out):
+    """out[i] = D_k - angle for the rows [k, angle] of E, D_k = phi_k + alpha_k - phi_{k-1} -
+    beta_{k-1} (rad); O(rows)."""
+    for i in range(E.shape[0]):
+        k = int(E[i, 0])
+        D = phi[k] + alpha[k]
+        if k > 0:
+            D -= phi[k - 1] + beta[k - 1]
+        out[i] = D - E[i, 1]
+
+
+@njit(EVENTS_SIGNATURE, cache=True)
+def full_hinge_events(t, y, P, S, M, L, E, out):
+    """The full model's latch and stop events: g = D_k - angle from the state's q; O(rows)."""
+    n = P.shape[1]
+    _hinge_events(y[:n], y[n : 2 * n], y[2 * n : 3 * n], E, out)
+
+
+@njit(EVENTS_SIGNATURE, cache=True)
+def reduced_hinge_events(t, y, P, S, M, L, E, out):
+    """The reduced model's latch and stop events: g = D_k - angle with the quasi-static
+    bending gamma of the current mode (one solve of the mode's right-hand side, which leaves
+    gamma in M[0, 0]); O(n) (O(n m) with m hinges held)."""
+    n = P.shape[1]
+    rates = np.empty(y.shape[0])
+    if S.shape[0] > 1:
+        reduced_rhs_locked(t, y, P, S, M, L, rates)
+    else:
+        reduced_rhs(t, y, P, S, M, L, rates)
+    gamma = M[0, 0][2 * n : 4 * n]
+    _hinge_events(y[:n], gamma[:n], gamma[n:], E, out)

@@ -27,6 +27,8 @@ class FullSystem(PaperSystem):
     accel_kernel = staticmethod(kernels.full_accel)
     compiled_rhs = staticmethod(kernels.full_rhs)
     compiled_mechanics = staticmethod(kernels.full_mechanics)
+    compiled_rhs_locked = staticmethod(deployment.full_rhs_locked)
+    compiled_events = staticmethod(deployment.full_hinge_events)
 
     def __init__(self, scene: Scene, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
         super().__init__(scene, coefficients, kernel)

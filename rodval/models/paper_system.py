@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from contextlib import contextmanager
 from functools import cached_property
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -39,6 +39,17 @@ from rodval.solvers.system import CompiledForm, EventRecord, EventSpec, OdeSyste
 KERNELS = ("numba", "numpy")
 
 
+class EventRow(NamedTuple):
+    """One event of the current mode: a latch or stop (``kind``; ``item``: its index among the
+    scene's latches or stops), on ``hinge``, g = D_hinge - ``angle`` (rad) crossing in ``direction``."""
+
+    kind: str
+    item: int
+    hinge: int
+    angle: float
+    direction: int
+
+
 class PaperSystem(OdeSystem):
     """Base of the paper's ODE systems. Subclasses provide ``numpy_rhs``, the compiled
     kernels (``accel_kernel``, ``compiled_rhs``) and their constants (``kernel_constants``),
@@ -48,10 +59,13 @@ class PaperSystem(OdeSystem):
     has_energy = True
     #: True for the full model (state [q; q'], 6n), False for the reduced one ([phi; phi']).
     full: bool
-    #: accel(V, y, has_load, SX, SY, damped, out) and the RHS_TYPE functions (rhs, mechanics).
+    #: accel(V, y, has_load, SX, SY, damped, out) and the RHS_TYPE functions (rhs, mechanics;
+    #: rhs with locked hinges, ``deployment.lock_scalars``) and the EVENTS_TYPE one.
     accel_kernel: Any
     compiled_rhs: Any
     compiled_mechanics: Any
+    compiled_rhs_locked: Any
+    compiled_events: Any
 
     def __init__(self, scene: Scene, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
         self.kernel = check_choice("kernel", kernel, KERNELS)
@@ -142,21 +156,29 @@ class PaperSystem(OdeSystem):
         return out
 
     def compiled(self) -> CompiledForm | None:
-        """The compiled form, or None with the numpy kernel or a load that is a plain
-        Python callable (no load-table form)."""
+        """The compiled form of the current mode (locked hinges in S, the armed latches and
+        switching stops as event rows; active stops are in V), or None with the numpy kernel
+        or a load that is a plain Python callable (no load-table form)."""
         if self.kernel != "numba":
             return None
         table = self._load_table
         if table is None:
             return None
+        rows = self.event_rows()
+        locked = bool(self.locked)
         return CompiledForm(
-            self.compiled_rhs,
+            self.compiled_rhs_locked if locked else self.compiled_rhs,
             self.V,
-            self._flags,
+            deployment.lock_scalars(self._flags[0], self._lock_h, self._lock_a)
+            if locked
+            else self._flags,
             self.compiled_scratch(),
             table,
             mechanics=self.compiled_mechanics,
             name=type(self).__name__,
+            events=self.compiled_events,
+            E=np.array([[r.hinge, r.angle] for r in rows], float).reshape(-1, 2),
+            directions=np.array([r.direction for r in rows], float),
         )
 
     @cached_property
@@ -424,43 +446,42 @@ class PaperSystem(OdeSystem):
                 M[i, self._lock_h] -= lam
         return M
 
-    def event_functions(self) -> tuple[EventSpec, ...]:
-        """Latches not yet locked (g = D_k - angle in the latch's direction) and limit stops
-        on hinges not locked (g = D_k - angle in the direction that switches the stop: into
-        its side while it is off, out of it while it acts; a root found again just after the
-        switch, where g may sit a rounding error on the old side, then cannot fire twice)."""
-        specs = []
-        self._spec_map: list[tuple[str, int]] = []
+    def event_rows(self) -> tuple[EventRow, ...]:
+        """The current mode's events, in one order for the Python event functions and the
+        compiled event table: latches not yet locked (g = D_k - angle in the latch's
+        direction) and limit stops on hinges not locked (g = D_k - angle in the direction
+        that switches the stop: into its side while it is off, out of it while it acts; a
+        root found again just after the switch, where g may sit a rounding error on the old
+        side, then cannot fire twice)."""
+        rows = []
         held = {self.latches[j].hinge for j in self.locked}
         for j, la in enumerate(self.latches):
-            if j in self.locked:
-                continue
-            specs.append(
-                EventSpec(
-                    g=self._hinge_crossing(la.hinge, la.angle),
-                    direction=self.latch_dir[j],
-                    label=f"latch hinge {la.hinge}",
-                )
-            )
-            self._spec_map.append(("latch", j))
+            if j not in self.locked:
+                rows.append(EventRow("latch", j, la.hinge, la.angle, self.latch_dir[j]))
         for i, st in enumerate(self.stops):
             if st.hinge in held:
                 continue
             entering = 1 if st.side == "upper" else -1
-            specs.append(
-                EventSpec(
-                    g=self._hinge_crossing(st.hinge, st.angle),
-                    direction=-entering if self.stop_active[i] else entering,
-                    label=f"stop hinge {st.hinge}",
-                )
+            direction = -entering if self.stop_active[i] else entering
+            rows.append(EventRow("stop", i, st.hinge, st.angle, direction))
+        return tuple(rows)
+
+    def event_functions(self) -> tuple[EventSpec, ...]:
+        """The current mode's events (``event_rows``) as g(t, y) = D_k - angle."""
+        return tuple(
+            EventSpec(
+                g=self._hinge_crossing(r.hinge, r.angle),
+                direction=r.direction,
+                label=f"{r.kind} hinge {r.hinge}",
             )
-            self._spec_map.append(("stop", i))
-        return tuple(specs)
+            for r in self.event_rows()
+        )
 
     def apply_event(self, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:
         """A stop switching (no jump: the integrator restarts at the kink) or a latch locking
         (a plastic impact, then the hinge is held); see docs/deployment_native.md."""
-        kind, j = self._spec_map[index]
+        row = self.event_rows()[index]
+        kind, j = row.kind, row.item
         if kind == "stop":
             st = self.stops[j]
             on = not self.stop_active[j]  # the event looks for the crossing that switches

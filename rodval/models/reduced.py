@@ -38,6 +38,8 @@ class ReducedSystem(PaperSystem):
     accel_kernel = staticmethod(reduced_banded.reduced_accel)
     compiled_rhs = staticmethod(reduced_banded.reduced_rhs)
     compiled_mechanics = staticmethod(kernels.reduced_mechanics)
+    compiled_rhs_locked = staticmethod(deployment.reduced_rhs_locked)
+    compiled_events = staticmethod(deployment.reduced_hinge_events)
 
     def __init__(self, scene: Scene, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
         super().__init__(scene, coefficients, kernel)

@@ -7,6 +7,7 @@ no model. ``run_compiled`` is called by the driver (``rodval.solvers.driver``).
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import numpy as np
 
@@ -23,8 +24,9 @@ from rodval.core.status import (
 from rodval.core.trajectory import SolverStats
 from rodval.solvers import dop853, progress
 from rodval.solvers.audit import PowerLedger
+from rodval.solvers.events import apply_hit
 from rodval.solvers.guard import GuardSpec, diverged_message, verdict
-from rodval.solvers.system import CompiledForm
+from rodval.solvers.system import OdeSystem
 
 
 def verdict_message(code: int, mon: np.ndarray, t: float, spec: GuardSpec) -> tuple[int, str]:
@@ -48,7 +50,7 @@ _BUDGETS = {
 
 
 def run_compiled(
-    form: CompiledForm,
+    system: OdeSystem,
     y0: np.ndarray,
     edges: np.ndarray,
     scene: Scene,
@@ -57,45 +59,76 @@ def run_compiled(
     Y: np.ndarray,
     stats: SolverStats,
     ledger: PowerLedger | None = None,
+    events: list[dict[str, Any]] | None = None,
 ) -> int:
-    """Integrate over [edges[0], edges[-1]] restarting at each interior edge (the scene's
-    breakpoints), writing states at the output times into Y; fills ``stats`` (status,
-    message, t_reached, nfev, nsteps) and returns the number of output times reached.
-    The divergence guard ``guard`` runs inside the loop, with the verdicts and messages of
-    ``rodval.solvers.guard``; with a ``ledger`` the energy audit too (its records become the
-    loop's running W_ext, D at the output times reached)."""
-    try:
-        n_out, nfev, nsteps, code, t, mon, work = dop853.integrate_compiled(
-            form,
-            y0,
-            edges,
-            np.asarray(scene.times, float),
-            settings.rtol,
-            settings.atol,
-            settings.max_step,
-            settings.first_step,
-            settings.max_evaluations,
-            guard,
-            Y,
-            deadline=time.perf_counter() + settings.max_wall_s,
-            reporting=progress.reporting(),
-            audit=ledger is not None,
-        )
-    except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
-        # raised by a model's kernel: the loop's time is lost, t_reached stays at the start
-        stats.status, stats.message = numerical_failure(exc, float(edges[0])) or (
-            STATUS_ERROR,
-            f"{type(exc).__name__}: {exc}",
-        )
-        return 0
+    """Integrate ``system`` (its ``compiled()`` form) over [edges[0], edges[-1]] restarting at
+    each interior edge (the scene's breakpoints) and after each event, writing states at the
+    output times into Y; fills ``stats`` (status, message, t_reached, nfev, nsteps) and
+    returns the number of output times reached. The divergence guard ``guard`` runs inside
+    the loop, with the verdicts and messages of ``rodval.solvers.guard``; with a ``ledger``
+    the energy audit too (its records become the loop's running W_ext, D at the output times
+    reached). Events are located inside the loop; each one's jump is the system's
+    (``rodval.solvers.events.apply_hit``, as on the scipy path), its record appended to
+    ``events``, and the loop continues from there in the system's new mode."""
+    times = np.asarray(scene.times, float)
+    W = np.zeros((times.size, 2))
+    total = np.zeros(2)
+    deadline = time.perf_counter() + settings.max_wall_s
+    t, y, n_out = float(edges[0]), np.array(y0, float), 0
+    monitor = None
+    while True:
+        form = system.compiled()
+        assert form is not None  # choose_method took the compiled path for this system
+        try:
+            res = dop853.integrate_compiled(
+                form,
+                y,
+                np.concatenate([[t], edges[edges > t]]),
+                times[n_out:],
+                settings.rtol,
+                settings.atol,
+                settings.max_step,
+                settings.first_step,
+                settings.max_evaluations - stats.nfev,
+                guard,
+                Y[n_out:],
+                deadline=deadline,
+                reporting=progress.reporting(),
+                audit=ledger is not None,
+                monitor=monitor,
+                total=total,
+            )
+        except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
+            # raised by a model's kernel: the loop's time is lost, t_reached stays at its start
+            stats.status, stats.message = numerical_failure(exc, t) or (
+                STATUS_ERROR,
+                f"{type(exc).__name__}: {exc}",
+            )
+            stats.t_reached = t
+            break
+        if ledger is not None:
+            W[n_out : n_out + res.n_out] = res.work
+        n_out += res.n_out
+        monitor = res.monitor
+        stats.nfev += res.nfev
+        stats.nsteps += res.nsteps
+        stats.t_reached = t = res.t
+        if res.code != dop853.EVENT:
+            _ending(res, settings, guard, stats)
+            break
+        y, record, lost = apply_hit(system, res.event, res.t, res.y)
+        total[1] += lost  # an impact's kinetic energy loss is dissipated energy of the audit
+        if events is not None:
+            events.append(record)
     if ledger is not None:
-        ledger.replace(work)
-    stats.nfev += nfev
-    stats.nsteps += nsteps
-    stats.t_reached = t
-    if code in _BUDGETS:
-        stats.status, budget = _BUDGETS[code]
-        stats.message = settings.budget_message(budget, t)
-    elif code != dop853.OK:
-        stats.status, stats.message = verdict_message(code, mon, t, guard)
+        ledger.replace(W[:n_out])
     return n_out
+
+
+def _ending(res: dop853.CompiledRun, settings: IntegratorSettings, guard, stats) -> None:
+    """Status and message of a compiled run that ended with ``res.code`` (not an event)."""
+    if res.code in _BUDGETS:
+        stats.status, budget = _BUDGETS[res.code]
+        stats.message = settings.budget_message(budget, res.t)
+    elif res.code != dop853.OK:
+        stats.status, stats.message = verdict_message(res.code, res.monitor, res.t, guard)

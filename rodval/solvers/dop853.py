@@ -28,12 +28,13 @@ from scipy.integrate._ivp import dop853_coefficients as dc
 
 from rodval.solvers import guard as _guard
 from rodval.solvers.audit import GAUSS_NODES
-from rodval.solvers.guard import GuardSpec, guard_step
+from rodval.solvers.dop853_events import any_crossing, interpolate, locate, no_events
+from rodval.solvers.guard import GuardSpec, guard_step, new_monitor
 from rodval.solvers.progress import report
+from rodval.solvers.signature import EVENTS_TYPE, RHS_TYPE
 from rodval.solvers.signature import F1 as _F1
 from rodval.solvers.signature import F2 as _F2
 from rodval.solvers.signature import F3 as _F3
-from rodval.solvers.signature import RHS_TYPE
 
 N_STAGES = dc.N_STAGES
 _A = np.ascontiguousarray(dc.A)
@@ -46,7 +47,8 @@ _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(GAUSS_NODES)
 
 #: Return codes of ``run``: the guard's (``rodval.solvers.guard.guard_step``) and the loop's own.
 OK, BLOWUP, STALLED = _guard.OK, _guard.BLOWUP, _guard.STALLED
-STEP_TOO_SMALL, NON_FINITE, BUDGET, WALL = 1, 2, 3, 6
+STEP_TOO_SMALL, NON_FINITE, BUDGET, WALL, EVENT = 1, 2, 3, 6, 7
+
 
 #: Evaluations between two reads of the clock for the wall-clock budget: the read costs about
 #: one evaluation of the smallest system, so this keeps it below 1 % of a run, and the run
@@ -160,25 +162,13 @@ def _dense_coefficients(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _interpolate(F, y, x, out):
-    """The state at the fraction x of the step (the interpolant with coefficients F) into
-    out. O(N)."""
-    for q in range(y.shape[0]):
-        acc = 0.0
-        for i in range(7):
-            acc += F[6 - i, q]
-            acc *= x if i % 2 == 0 else 1.0 - x
-        out[q] = acc + y[q]
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _write_outputs(F, y, t, t_new, times, n_out, Y):
-    """The interpolated states at every output time in (t, t_new] into Y from row n_out;
-    returns the next row."""
+def _write_outputs(F, y, t, t_new, t_cut, times, n_out, Y):
+    """The interpolated states at every output time in (t, t_cut] (t_cut <= t_new, the
+    step's end) into Y from row n_out; returns the next row."""
     nt = times.shape[0]
     h = t_new - t
-    while n_out < nt and times[n_out] <= t_new:
-        _interpolate(F, y, (times[n_out] - t) / h, Y[n_out])
+    while n_out < nt and times[n_out] <= t_cut:
+        interpolate(F, y, (times[n_out] - t) / h, Y[n_out])
         n_out += 1
     return n_out
 
@@ -194,7 +184,7 @@ def _power_integral(mechanics, P, S, M, L, F, y, t, h, span, tmp, mech, acc):
         return
     for i in range(_GAUSS_X.shape[0]):
         ts = t + 0.5 * span * (_GAUSS_X[i] + 1.0)
-        _interpolate(F, y, (ts - t) / h, tmp)
+        interpolate(F, y, (ts - t) / h, tmp)
         mechanics(ts, tmp, P, S, M, L, mech)
         acc[0] += _GAUSS_W[i] * mech[1]
         acc[1] += _GAUSS_W[i] * mech[2]
@@ -203,18 +193,19 @@ def _power_integral(mechanics, P, S, M, L, F, y, t, h, span, tmp, mech, acc):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _audit_step(mechanics, P, S, M, L, F, y, t, t_new, times, n_out, tmp, mech, total, W):
-    """The energy audit over the accepted step [t, t_new]: the running [W_ext, D] (J) at each
-    output time in it into W's rows from n_out, then ``total`` advanced to t_new."""
+def _audit_step(mechanics, P, S, M, L, F, y, t, t_new, t_cut, times, n_out, tmp, mech, total, W):
+    """The energy audit over [t, t_cut] of the accepted step [t, t_new] (t_cut < t_new at an
+    event): the running [W_ext, D] (J) at each output time in it into W's rows from n_out,
+    then ``total`` advanced to t_cut."""
     h = t_new - t
     part = np.empty(2)
     j = n_out
-    while j < times.shape[0] and times[j] <= t_new:
+    while j < times.shape[0] and times[j] <= t_cut:
         _power_integral(mechanics, P, S, M, L, F, y, t, h, times[j] - t, tmp, mech, part)
         W[j, 0] = total[0] + part[0]
         W[j, 1] = total[1] + part[1]
         j += 1
-    _power_integral(mechanics, P, S, M, L, F, y, t, h, h, tmp, mech, part)
+    _power_integral(mechanics, P, S, M, L, F, y, t, h, t_cut - t, tmp, mech, part)
     total[0] += part[0]
     total[1] += part[1]
 
@@ -263,32 +254,82 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _record_step(rhs, mechanics, model, t, t_new, buffers, times, n_out, Y, W, cnt):
-    """After the accepted step [t, t_new]: the dense output when an output time falls in it or
-    the audit runs (W with rows: ``_audit_step``), the outputs written; returns the next
-    output row. ``model``: (P, S, M, L); ``buffers``: the loop's (y, y_new, K, F, tmp, zero,
-    mech, total); ``cnt[0]``: evaluations, updated."""
-    P, S, M, L = model
-    y, y_new, K, F, tmp, zero, mech, total = buffers
+def _record_step(rhs, mechanics, events, arrays, t, t_new, buffers, times, n_out, Y, W, cnt):
+    """After the accepted step [t, t_new]: the events at its end (g_new, against g_old at
+    its start); the dense output when an output time falls in it, the audit runs (W with
+    rows: ``_audit_step``) or an event crosses; the crossing located
+    (``dop853_events.locate``), then the outputs written and the audit advanced up to it.
+    Returns (next output row, event index or -1, the time the step is cut at: the event's
+    or t_new). ``arrays``: the form's (P, S, M, L, E, directions); ``buffers``: the loop's
+    (see ``run``); ``cnt[0]``: evaluations, updated."""
+    P, S, M, L, E, directions = arrays
+    y, y_new, K, F, tmp, zero, mech, total, g, g_old, g_new = buffers
+    crossing = False
+    if E.shape[0] > 0:
+        events(t_new, y_new, P, S, M, L, E, g_new)
+        crossing = any_crossing(g_old, g_new, directions)
     outputs = n_out < times.shape[0] and times[n_out] <= t_new
     audited = W.shape[0] > 0
-    if outputs or audited:
+    if outputs or audited or crossing:
         _dense_coefficients(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero)
         cnt[0] += 3
+    index, t_cut = -1, t_new
+    if crossing:
+        index, t_cut = locate(
+            events, P, S, M, L, E, directions, F, y, t, t_new, g_old, g_new, tmp, g
+        )
     if audited:
-        _audit_step(mechanics, P, S, M, L, F, y, t, t_new, times, n_out, tmp, mech, total, W)
+        _audit_step(mechanics, P, S, M, L, F, y, t, t_new, t_cut, times, n_out, tmp, mech, total, W)
     if outputs:
-        n_out = _write_outputs(F, y, t, t_new, times, n_out, Y)
-    return n_out
+        n_out = _write_outputs(F, y, t, t_new, t_cut, times, n_out, Y)
+    return n_out, index, t_cut
 
+
+@njit(cache=True, inline="always")
+def _buffers(y0, total, n_events):
+    """The loop's buffers: state, trial state, stages, interpolant, scratch, zeros, mechanics,
+    the audit's totals, event values (scratch, at the step's start, at its end). O(N)."""
+    N = y0.shape[0]
+    e = n_events
+    return (
+        y0.copy(),
+        np.empty(N),
+        np.empty((16, N)),
+        np.empty((7, N)),
+        np.empty(N),
+        np.zeros(N),
+        np.zeros(3),
+        total,
+        np.empty(e),
+        np.empty(e),
+        np.empty(e),
+    )
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _segment_start(rhs, P, S, M, L, t, t_bound, y, K, tmp, controls, cnt):
+    """The derivative at a segment's start into K[0] and the first step size (s): the given
+    one (controls[3] > 0) or ``_initial_step``'s; 1 or 2 evaluations, counted in cnt[0]."""
+    rhs(t, y, P, S, M, L, K[0])
+    cnt[0] += 1
+    if controls[3] > 0:
+        return min(controls[3], t_bound - t)
+    cnt[0] += 1
+    rtol, atol, max_step = controls[0], controls[1], controls[2]
+    return _initial_step(
+        rhs, P, S, M, L, t, y, K[0], t_bound, rtol, atol, max_step, tmp, np.empty(y.shape[0])
+    )
+
+
+#: A compiled form's arrays as the loop takes them: (P, S, M, L, E, directions) (its functions
+#: are separate arguments: numba warns of tuples of first-class functions as experimental).
+_ARRAYS = types.Tuple((_F2, _F1, _F3, _F2, _F2, _F1))
 
 _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64, types.float64))(
     RHS_TYPE,
     RHS_TYPE,
-    _F2,
-    _F1,
-    _F3,
-    _F2,
+    EVENTS_TYPE,
+    _ARRAYS,
     _F1,
     _F1,
     _F1,
@@ -297,68 +338,52 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
     types.boolean,
     _F2,
     _F2,
-    _F1,
+    types.Tuple((_F1, _F1, _F1)),
 )
 
 
 @njit(_RUN_SIGNATURE, cache=True, error_model="numpy")
-def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting, Y, W, mon):
+def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, reporting, Y, W, carry):
     """Integrate from edges[0] to edges[-1], restarting at each interior edge (breakpoint),
-    writing the state at ``times`` into Y. ``controls``: [rtol, atol, max_step (s),
+    writing the state at ``times`` into Y, until the end or the first event. ``rhs``,
+    ``mechanics``, ``events`` and ``arrays`` (P, S, M, L, E, directions): a
+    ``CompiledForm``'s functions and arrays. ``controls``: [rtol, atol, max_step (s),
     first_step (s; <= 0 selects it), max_nfev, deadline (a ``time.perf_counter()`` value, s;
-    inf: none)]. The run stops with ``BUDGET``
-    once max_nfev evaluations are used and with ``WALL`` once the clock passes the deadline,
-    read before the first step attempt and then every ``WALL_CHECK_EVALUATIONS`` evaluations;
-    with ``reporting`` the time reached goes to the progress reporter at those reads.
+    inf: none)]: ``BUDGET`` once max_nfev evaluations are used, ``WALL`` once the clock
+    passes the deadline (read before the first attempt, then every
+    ``WALL_CHECK_EVALUATIONS`` evaluations, when the time reached goes to the progress
+    reporter if ``reporting``).
 
-    ``guard``: ``GuardSpec.as_array()``, checked by ``guard_step`` after every accepted step
-    (``mon``: its monitor, the figures of the verdict); ``mechanics(t, y, ...)`` writes
-    (T, P_ext, P_diss) and runs for the guard only when guard[2] (the blow-up factor) is
-    finite.
-
-    ``W`` (nt, 2), or (0, 2) for no audit: the energy audit's running [W_ext, D] (J) at the
-    output times, the powers integrated on every accepted step as the scipy path does
-    (``_audit_step``; costs 3 evaluations for the dense output on steps without an output
-    time, and GAUSS_NODES (+ GAUSS_NODES per output time) evaluations of ``mechanics``).
+    ``carry``: (mon, total, hit), carried over restarts. ``guard``: ``GuardSpec.as_array()``,
+    checked by ``guard_step`` after every accepted step (``mon``: its monitor);
+    ``mechanics(t, y, ...)`` writes (T, P_ext, P_diss), for the guard when guard[2] is finite.
+    ``W`` (nt, 2), or (0, 2) for no audit: the audit's running [W_ext, D] (J) at the output
+    times from the running ``total`` (``_audit_step``: 3 evaluations for the dense output on
+    every step, GAUSS_NODES evaluations of ``mechanics`` per step and per output time).
+    Events (E has rows): a crossing at an accepted step located on the dense output
+    (``dop853_events.locate``), outputs and audit taken up to it; returns ``EVENT`` at its
+    time, its index in hit[0] and the state there in hit[1:] (the caller applies the jump).
 
     Returns (number of output times written, nfev, accepted steps, code, t reached).
     """
-    rtol, atol, max_step, first_step = controls[0], controls[1], controls[2], controls[3]
+    P, S, M, L, E, directions = arrays
     N = y0.shape[0]
-    y = y0.copy()
-    K = np.empty((16, N))
-    y_new = np.empty(N)
-    tmp = np.empty(N)
-    f1 = np.empty(N)
-    F = np.empty((7, N))
-    zero = np.zeros(N)
-    nt = times.shape[0]
+    mon, total, hit = carry
+    buffers = _buffers(y0, total, E.shape[0])
+    y, y_new, K, F, tmp, zero, mech, total, g, g_old, g_new = buffers
     n_out = 0
     cnt = np.zeros(2, np.int64)  # evaluations, and the count at the next clock read
     nsteps = 0
     guarded = np.isfinite(guard[2])
-    total = np.zeros(2)
-    mech = np.zeros(3)
-    buffers = (y, y_new, K, F, tmp, zero, mech, total)
     t = edges[0]
-    if guarded:
-        mechanics(t, y, P, S, M, L, mech)
-        mon[3] = max(mech[1], 0.0)
-    while n_out < nt and times[n_out] <= t:
+    while n_out < times.shape[0] and times[n_out] <= t:
         Y[n_out] = y
         n_out += 1
+    if E.shape[0] > 0:
+        events(t, y, P, S, M, L, E, g_old)
     for seg in range(edges.shape[0] - 1):
-        t = edges[seg]
-        t_bound = edges[seg + 1]
-        rhs(t, y, P, S, M, L, K[0])
-        cnt[0] += 1
-        if first_step > 0:
-            h_abs = min(first_step, t_bound - t)
-        else:
-            h_abs = _initial_step(
-                rhs, P, S, M, L, t, y, K[0], t_bound, rtol, atol, max_step, tmp, f1
-            )
-            cnt[0] += 1
+        t, t_bound = edges[seg], edges[seg + 1]
+        h_abs = _segment_start(rhs, P, S, M, L, t, t_bound, y, K, tmp, controls, cnt)
         while t < t_bound:
             code, t_new, h_abs = _step_control(
                 rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, reporting, cnt
@@ -374,13 +399,18 @@ def run(rhs, mechanics, P, S, M, L, y0, edges, times, controls, guard, reporting
             code = guard_step(guard, mon, h, mech, guarded)
             if code != OK:
                 return n_out, cnt[0], nsteps, code, t
-            n_out = _record_step(
-                rhs, mechanics, (P, S, M, L), t, t_new, buffers, times, n_out, Y, W, cnt
+            n_out, index, t_cut = _record_step(
+                rhs, mechanics, events, arrays, t, t_new, buffers, times, n_out, Y, W, cnt
             )
+            if index >= 0:
+                hit[0] = index
+                interpolate(F, y, (t_cut - t) / h, hit[1:])
+                return n_out, cnt[0], nsteps, EVENT, t_cut
             t = t_new
             for i in range(N):
                 y[i] = y_new[i]
                 K[0, i] = K[N_STAGES, i]
+            g_old[:] = g_new
     return n_out, cnt[0], nsteps, OK, t
 
 
@@ -390,10 +420,22 @@ class CompiledRun(NamedTuple):
     n_out: int  #: output times written
     nfev: int  #: right-hand-side evaluations
     nsteps: int  #: accepted steps
-    code: int  #: how the loop ended (OK, STEP_TOO_SMALL, ...)
-    t: float  #: time reached (s)
+    code: int  #: how the loop ended (OK, STEP_TOO_SMALL, ..., EVENT)
+    t: float  #: time reached (s): the event's time for EVENT
     monitor: np.ndarray  #: the guard's figures (``guard_step``)
     work: np.ndarray  #: the audit's [W_ext, D] (J) at the output times written, (n_out, 2)
+    event: int  #: the event's index (EVENT), else -1
+    y: np.ndarray  #: the state at the event (before its jump; EVENT), else empty
+
+
+def start_monitor(form, t: float, y: np.ndarray, guard: GuardSpec) -> np.ndarray:
+    """The guard's monitor for a run of ``form`` from (t, y): the load power there in it
+    when the guard checks energy (``rodval.solvers.guard.new_monitor``)."""
+    if form.mechanics is None or not guard.checks_energy:
+        return new_monitor()
+    mech = np.zeros(3)
+    form.mechanics(t, np.array(y, float), form.P, form.S, form.M, form.L, mech)
+    return new_monitor(mech[1])
 
 
 def integrate_compiled(
@@ -411,30 +453,38 @@ def integrate_compiled(
     deadline: float = math.inf,
     reporting: bool = False,
     audit: bool = False,
+    monitor: np.ndarray | None = None,
+    total: np.ndarray | None = None,
 ) -> CompiledRun:
     """Run ``run`` on a CompiledForm (see ``run``; without ``form.mechanics`` there is no
     blow-up check and no audit; ``deadline``: a ``time.perf_counter()`` value, s;
-    ``reporting``: report progress; ``audit``: integrate the load and damper powers)."""
+    ``reporting``: report progress; ``audit``: integrate the load and damper powers).
+    A run continued after an event passes the guard's ``monitor`` and the audit's running
+    ``total`` [W_ext, D] (J) on (both updated in place); new ones start from (edges[0], y0)."""
     g = guard.as_array()
     if form.mechanics is None:
         g[2] = math.inf
         if audit:
             raise ValueError("an energy audit needs the compiled form's mechanics")
     mechanics = form.mechanics if form.mechanics is not None else form.rhs
+    events = form.events if form.events is not None else no_events
+    E = form.E if form.events is not None else np.zeros((0, 2))
+    directions = form.directions if form.events is not None else np.zeros(0)
     controls = np.array(
         [rtol, atol, max_step, -1.0 if first_step is None else first_step, max_nfev, deadline],
         float,
     )
-    mon = np.zeros(6)
+    y0 = np.array(y0, float)
+    mon = start_monitor(form, float(edges[0]), y0, guard) if monitor is None else monitor
+    total = np.zeros(2) if total is None else total
     W = np.zeros((len(times) if audit else 0, 2))
+    hit = np.zeros(y0.size + 1)
     n_out, nfev, nsteps, code, t = run(
         form.rhs,
         mechanics,
-        form.P,
-        form.S,
-        form.M,
-        form.L,
-        np.array(y0, float),
+        events,
+        (form.P, form.S, form.M, form.L, E, directions),
+        y0,
         np.array(edges, float),
         np.array(times, float),
         controls,
@@ -442,6 +492,10 @@ def integrate_compiled(
         bool(reporting),
         Y,
         W,
-        mon,
+        (mon, total, hit),
     )
-    return CompiledRun(int(n_out), int(nfev), int(nsteps), int(code), float(t), mon, W[:n_out])
+    event = int(hit[0]) if code == EVENT else -1
+    y_event = hit[1:].copy() if code == EVENT else np.zeros(0)
+    return CompiledRun(
+        int(n_out), int(nfev), int(nsteps), int(code), float(t), mon, W[:n_out], event, y_event
+    )

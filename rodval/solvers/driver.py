@@ -3,8 +3,8 @@
 Small parts, each in its own place:
 
 * method choice (``choose_method``): "auto" takes the compiled DOP853 when the system has a
-  compiled form and nothing the compiled loop cannot do is asked for (energy audit, events),
-  scipy's DOP853 otherwise;
+  compiled form that can do what is asked (its mechanics for an energy audit, its event
+  functions for a system with events), scipy's DOP853 otherwise;
 * stepping: a scipy ``OdeSolver`` across the scene's load breakpoints (``_ScipyRun``), or a
   compiled loop (``rodval.solvers.compiled``);
 * budgets and non-finite derivatives, checked on every evaluation, including those of rejected
@@ -40,7 +40,7 @@ from rodval.core.status import (
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.core.validity import SMALL_BENDING_RAD
 from rodval.solvers.audit import PowerLedger, audit_quantities
-from rodval.solvers.events import EventMonitor
+from rodval.solvers.events import EventMonitor, apply_hit
 from rodval.solvers.guard import DivergenceGuard
 from rodval.solvers.progress import report
 from rodval.solvers.system import OdeSystem
@@ -70,7 +70,11 @@ def choose_method(system: OdeSystem, scene: Scene, settings: IntegratorSettings)
     events = bool(system.event_functions())
     form = system.compiled()
     if settings.method == AUTO:
-        if not events and form is not None and (form.mechanics is not None or not audit):
+        if (
+            form is not None
+            and (form.mechanics is not None or not audit)
+            and (form.events is not None or not events)
+        ):
             return "DOP853-numba"
         return "DOP853"
     if settings.compiled:
@@ -86,10 +90,10 @@ def choose_method(system: OdeSystem, scene: Scene, settings: IntegratorSettings)
                 f"method {settings.method!r} cannot audit energy for this system (its "
                 "compiled form has no mechanics); use a scipy method or 'auto'"
             )
-        if events:
+        if events and form.events is None:
             raise ValueError(
-                f"method {settings.method!r} cannot handle this scene's events; "
-                "use a scipy method or 'auto'"
+                f"method {settings.method!r} cannot handle this system's events (its "
+                "compiled form has no event functions); use a scipy method or 'auto'"
             )
     return settings.method
 
@@ -238,11 +242,9 @@ class _ScipyRun:
                 if hit:
                     index, t_event = hit
                     y_event = solver.dense_output()(t_event)
-                    y_new, record = self.system.apply_event(index, t_event, y_event)
-                    self.events.append(record.as_dict())
-                    if self.ledger and "kinetic_before" in record.data:
-                        # an impact's kinetic energy loss is dissipated energy of the audit
-                        lost = record.data["kinetic_before"] - record.data["kinetic_after"]
+                    y_new, record, lost = apply_hit(self.system, index, t_event, y_event)
+                    self.events.append(record)
+                    if self.ledger:  # an impact's kinetic energy loss is dissipated energy
                         self.ledger.total = self.ledger.total + np.array([0.0, lost])
                     events.reset(t_event, y_new)
                     self._count(solver)
@@ -358,7 +360,9 @@ def integrate(
             for _ in at_zero:
                 ledger.record()
         if form is not None:
-            out.n = run_compiled(form, y, edges, scene, settings, guard.spec, out.Y, stats, ledger)
+            out.n = run_compiled(
+                system, y, edges, scene, settings, guard.spec, out.Y, stats, ledger, events
+            )
             t_now = stats.t_reached
         else:
             scipy_run = _ScipyRun(system, scene, settings, method, stats, out, ledger, guard)

@@ -1,6 +1,11 @@
-"""The numba type of a compiled right-hand side (``CompiledForm.rhs``, ``.mechanics``):
-``f(t, y, P, S, M, L, out)`` writing into ``out``. Kept apart from the integrators so that
-kernels can declare it without loading the compiled integrator loop."""
+"""The numba types of a system's compiled functions (``CompiledForm``):
+
+* ``RHS_TYPE`` (``.rhs``, ``.mechanics``): ``f(t, y, P, S, M, L, out)`` writing into ``out``;
+* ``EVENTS_TYPE`` (``.events``): ``g(t, y, P, S, M, L, E, out)`` writing the value of each
+  event function (one per row of the model's event table E) into ``out``.
+
+Kept apart from the integrators so that kernels can declare them without loading the compiled
+integrator loop."""
 
 from __future__ import annotations
 
@@ -11,3 +16,5 @@ F2 = types.float64[:, ::1]
 F3 = types.float64[:, :, ::1]
 RHS_SIGNATURE = types.void(types.float64, F1, F2, F1, F3, F2, F1)
 RHS_TYPE = types.FunctionType(RHS_SIGNATURE)
+EVENTS_SIGNATURE = types.void(types.float64, F1, F2, F1, F3, F2, F2, F1)
+EVENTS_TYPE = types.FunctionType(EVENTS_SIGNATURE)

@@ -44,6 +44,15 @@ class CompiledForm:
     of the loads (W) and power taken out by the dampers (W, ``OdeSystem.power``) — into a
     length-3 ``out``, for the divergence guard and the energy audit inside the loop; None
     disables both (the energy blow-up check, and "auto" then runs an audit on scipy).
+
+    ``events`` (optional, ``rodval.solvers.signature.EVENTS_TYPE``): ``events(t, y, P, S, M,
+    L, E, out)`` writes the value g_i(t, y) of each state event of the current mode into
+    ``out``, one per row of the model's event table ``E`` (float64 2-D, what a row holds is
+    the model's business), in the order of ``OdeSystem.event_functions()`` (so the index the
+    loop reports is the one ``apply_event`` takes); ``directions`` (float64, one per row)
+    are their ``EventSpec.direction``. None: a system with events has no compiled event
+    form (its runs with events go to scipy). A form describes one mode: after an event the
+    integrator asks the system for its form again.
     """
 
     rhs: Any
@@ -53,6 +62,9 @@ class CompiledForm:
     L: np.ndarray
     mechanics: Any = None
     name: str = ""
+    events: Any = None
+    E: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    directions: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
         for label, arr, ndim in (
@@ -60,6 +72,8 @@ class CompiledForm:
             ("S", self.S, 1),
             ("M", self.M, 3),
             ("L", self.L, 2),
+            ("E", self.E, 2),
+            ("directions", self.directions, 1),
         ):
             if not (
                 isinstance(arr, np.ndarray)
@@ -71,6 +85,11 @@ class CompiledForm:
                     f"CompiledForm.{label} must be a C-contiguous float64 array "
                     f"with {ndim} dimensions"
                 )
+        if self.directions.shape[0] != self.E.shape[0]:
+            raise ValueError(
+                f"CompiledForm.directions has {self.directions.shape[0]} entries for "
+                f"{self.E.shape[0]} event rows"
+            )
 
 
 @dataclass(frozen=True)
