@@ -61,12 +61,12 @@ def test_auto_takes_the_compiled_integrator_and_records_it():
     # a plain Python callable has no compiled form: scipy's DOP853 runs, and says so
     callable_load = scene.with_(loads=(NodalForce(3, fy=math.cos),))
     assert simulate(callable_load, "reduced").settings["method"] == "DOP853"
-    # the energy audit runs inside the compiled loop (tests/test_compiled_audit.py: the same
-    # W, D as scipy's); events (a latch) still run on scipy's DOP853
+    # the energy audit and events run inside the compiled loop (tests/test_compiled_audit.py,
+    # tests/test_compiled_events.py: the same W, D and events as scipy's)
     audited = simulate(scene.with_(outputs=("phi", "energy")), "reduced")
     assert audited.settings["method"] == "DOP853-numba"
     latched = scene.with_(latches=(Latch(1, 0.5),))
-    assert simulate(latched, "reduced").settings["method"] == "DOP853"
+    assert simulate(latched, "reduced").settings["method"] == "DOP853-numba"
 
 
 @pytest.mark.parametrize(
