@@ -10,7 +10,9 @@ imports no model and is compiled (and cached on disk) once for every model.
 
 Cost: 12 right-hand-side evaluations per accepted step (+3 on steps holding output times), and
 O(N) work per stage combination. Arithmetic is IEEE (numba's numpy error model): a huge
-state gives inf or NaN, never an exception, and the run ends as ``NON_FINITE`` at the time it
+state gives inf or NaN, never an exception: an attempt with non-finite stages is rejected and
+the step cut (``_step_control``); when that continues down to the smallest step, or an
+accepted state is not finite, the run ends as ``NON_FINITE`` at the time it
 reached (a division by zero in the initial-step choice raised ZeroDivisionError). The
 wall-clock budget reads the clock (a call back into Python, ~1 us) once every
 ``WALL_CHECK_EVALUATIONS`` evaluations, not on every step.
@@ -216,7 +218,12 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
     accepted (its stages in K, its solution in y_new). ``controls`` as in ``run``; ``cnt``:
     [evaluations used, evaluation count at the next clock read], updated. Returns (code, t
     of the accepted step's end, the next step size): ``OK``, or ``STEP_TOO_SMALL``,
-    ``BUDGET``, ``WALL`` or ``NON_FINITE`` with t unchanged."""
+    ``BUDGET``, ``WALL`` or ``NON_FINITE`` with t unchanged.
+
+    An attempt whose stages are not finite (a step far beyond the stability limit of a stiff
+    transient, e.g. just after a lock) is rejected and the step cut by MIN_FACTOR, as scipy's
+    DOP853 does with its infinite error norm; a state whose attempts stay non-finite down to
+    the smallest step is ``NON_FINITE`` (diverged), not ``STEP_TOO_SMALL``."""
     rtol, atol, max_step, max_nfev, deadline = (
         controls[0],
         controls[1],
@@ -228,9 +235,10 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
     min_step = 10.0 * (np.nextafter(t, np.inf) - t)
     h_abs = min(max(h_abs, min_step), max_step)
     rejected = False
+    finite = True  # whether the last attempt's stages were finite
     while True:
         if h_abs < min_step:
-            return STEP_TOO_SMALL, t, h_abs
+            return (STEP_TOO_SMALL if finite else NON_FINITE), t, h_abs
         if cnt[0] >= max_nfev:
             return BUDGET, t, h_abs
         if clocked and cnt[0] >= cnt[1]:
@@ -242,14 +250,13 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
         h_abs = t_new - t
         err = _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol)
         cnt[0] += N_STAGES
-        if not np.isfinite(err):
-            return NON_FINITE, t, h_abs
-        if err < 1.0:
+        finite = np.isfinite(err)
+        if finite and err < 1.0:
             factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
             if rejected:
                 factor = min(1.0, factor)
             return OK, t_new, h_abs * factor
-        h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
+        h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT) if finite else MIN_FACTOR
         rejected = True
 
 
@@ -384,6 +391,8 @@ def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, repor
     for seg in range(edges.shape[0] - 1):
         t, t_bound = edges[seg], edges[seg + 1]
         h_abs = _segment_start(rhs, P, S, M, L, t, t_bound, y, K, tmp, controls, cnt)
+        if not np.all(np.isfinite(K[0])):  # the derivative at an accepted state
+            return n_out, cnt[0], nsteps, NON_FINITE, t
         while t < t_bound:
             code, t_new, h_abs = _step_control(
                 rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, reporting, cnt

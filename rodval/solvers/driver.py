@@ -8,7 +8,9 @@ Small parts, each in its own place:
 * stepping: a scipy ``OdeSolver`` across the scene's load breakpoints (``_ScipyRun``), or a
   compiled loop (``rodval.solvers.compiled``);
 * budgets and non-finite derivatives, checked on every evaluation, including those of rejected
-  step attempts (so a NaN step size never loops);
+  step attempts (so a NaN step size never loops): an explicit Runge-Kutta method rejects a
+  non-finite attempt and cuts its step (a stiff transient), and the run ends as diverged when
+  the attempts stay non-finite down to the smallest step; the other methods stop at once;
 * events (``rodval.solvers.events``): crossing located, state jump applied, step restarted;
 * divergence guard (``rodval.solvers.guard``) after every accepted step;
 * energy audit (``rodval.solvers.audit``) on the dense output of every accepted step;
@@ -53,6 +55,10 @@ _SOLVERS = {
     "BDF": BDF,
     "LSODA": LSODA,
 }
+
+
+#: scipy methods that reject a step attempt whose error norm is not finite and cut the step.
+_REJECTS_NON_FINITE = ("RK23", "RK45", "DOP853")
 
 
 class _Stop(Exception):
@@ -150,6 +156,15 @@ class _ScipyRun:
             self.extra["jac"] = self.jac
         if settings.first_step is not None:
             self.extra["first_step"] = settings.first_step
+        #: scipy's explicit Runge-Kutta methods reject an attempt whose error norm is not
+        #: finite and cut the step (as the compiled loop does): they are given the attempt's
+        #: non-finite values; the other methods stop at the first one
+        self.rejects_non_finite = method in _REJECTS_NON_FINITE
+        #: the message of the last evaluation if it was not finite (None after a finite one)
+        self.non_finite: str | None = None
+        #: set before a solver starts: its first evaluation is at the accepted state, where a
+        #: non-finite value is a divergence for every method
+        self.at_start = False
 
     def fun(self, t: float, y: np.ndarray) -> np.ndarray:
         self.nfev += 1
@@ -157,17 +172,29 @@ class _ScipyRun:
             raise _Stop(STATUS_BUDGET, self.settings.budget_message("max_evaluations", t))
         if time.perf_counter() > self.deadline:
             raise _Stop(STATUS_WALL, self.settings.budget_message("max_wall_s", t))
+        start, self.at_start = self.at_start, False
         if not np.all(np.isfinite(y)):
-            raise _Stop(
-                STATUS_DIVERGED, f"diverged: non-finite state in a step attempt at t = {t:.6g} s"
+            return self._non_finite(
+                y, f"diverged: non-finite state in a step attempt at t = {t:.6g} s", start
             )
         try:
             f = self.system.rhs(t, y)
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
             raise _Stop(*_failure(exc, t)) from exc
         if not np.all(np.isfinite(f)):
-            raise _Stop(STATUS_DIVERGED, f"diverged: non-finite derivative at t = {t:.6g} s")
+            return self._non_finite(f, f"diverged: non-finite derivative at t = {t:.6g} s", start)
+        self.non_finite = None
         return f
+
+    def _non_finite(self, values: np.ndarray, message: str, start: bool) -> np.ndarray:
+        """A non-finite evaluation: infinite values for a method that rejects the attempt
+        (``rejects_non_finite``; the run ends as diverged with ``message`` if the attempts
+        stay non-finite down to the smallest step), else, or at the accepted state a solver
+        starts from (``start``), the run stops here as diverged."""
+        if not self.rejects_non_finite or start:
+            raise _Stop(STATUS_DIVERGED, message)
+        self.non_finite = message
+        return np.full_like(values, np.inf, dtype=float)
 
     def jac(self, t: float, y: np.ndarray) -> np.ndarray:
         """The system's Jacobian for implicit methods; a non-finite one stops the run as
@@ -198,6 +225,7 @@ class _ScipyRun:
         """Step from a towards b; returns (state, time reached, where to restart): b at the
         segment's end, the event time after a jump."""
         s = self.settings
+        self.at_start = True
         try:  # scipy evaluates fun (and may choose the first step) while it is set up
             solver = self.cls(
                 self.fun, a, y, b, rtol=s.rtol, atol=s.atol, max_step=s.max_step, **self.extra
@@ -213,11 +241,15 @@ class _ScipyRun:
         t_now = a
         try:
             while solver.status == "running":
-                msg = solver.step()
+                with np.errstate(invalid="ignore", over="ignore"):  # non-finite attempts
+                    msg = solver.step()
                 self.stats.nsteps += 1
                 if solver.status == "failed":
-                    self.stats.status = STATUS_FAILED
-                    self.stats.message = f"{msg} (t = {solver.t:.6g} s)"
+                    if self.non_finite:  # non-finite at every step size: diverged
+                        self.stats.status, self.stats.message = STATUS_DIVERGED, self.non_finite
+                    else:
+                        self.stats.status = STATUS_FAILED
+                        self.stats.message = f"{msg} (t = {solver.t:.6g} s)"
                     break
                 verdict = self.guard.check(solver.t_old, solver.t, solver.y)
                 if verdict:
