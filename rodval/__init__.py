@@ -5,6 +5,11 @@ the imports: core <- solvers <- models, reference_models <- analysis <- report <
 <- cli (see docs/architecture.md).
 """
 
+# First, before any kernel is decorated: a change of rodval's sources recompiles its cached
+# kernels (rodval/core/jit_cache.py).
+import rodval.core.jit_cache  # noqa: F401
+
+# isort: split
 from rodval.analysis.metrics import discrepancies as compare
 from rodval.analysis.modes import model_modes as modes
 from rodval.core.contract import Model
