@@ -26,7 +26,6 @@ import numpy as np
 from numba import njit
 from scipy.linalg import solveh_banded
 
-from rodval.core.loads import load_sums
 from rodval.models.kernels import (
     V_L,
     V_OUTER,
@@ -34,10 +33,16 @@ from rodval.models.kernels import (
     _full_solve,
     _generator_solve,
     full_accel,
+    rhs_head,
 )
 from rodval.models.paper_matrices import rod_momenta
 from rodval.models.reduced_band_lu import _band_size, _solve_band
-from rodval.models.reduced_banded import _forces, _solve_sweep, reduced_rhs, track_bending
+from rodval.models.reduced_banded import (
+    _forces,
+    _solve_sweep,
+    reduced_rhs,
+    track_bending,
+)
 from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE
 
 #: Another armed latch locks together with the one whose crossing was located when its
@@ -285,15 +290,13 @@ def _locks(S):
 @njit(RHS_SIGNATURE, cache=True)
 def full_rhs_locked(t, y, P, S, M, L, out):
     """y' of the full model with the hinges of S held (``full_accel_locked``); O(n m)."""
-    half = y.shape[0] // 2
-    out[:half] = y[half:]
     n = P.shape[1]
     SX = np.empty(n)
     SY = np.empty(n)
-    has_load = load_sums(L, t, SX, SY)
+    has_load = rhs_head(t, y, L, SX, SY, out)
     locks, _ = _locks(S)
     lam = np.empty(locks.shape[0])
-    full_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[half:], lam)
+    full_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * n :], lam)
 
 
 @njit(RHS_SIGNATURE, cache=True)
@@ -303,12 +306,11 @@ def reduced_rhs_locked(t, y, P, S, M, L, out):
     as ``reduced_banded.reduced_rhs`` does; a singular solve gives NaN (the run ends as
     diverged). O(n m)."""
     half = y.shape[0] // 2
-    out[:half] = y[half:]
     work = M[0, 0]
     SX = work[:half]
     SY = work[half : 2 * half]
     gamma = work[2 * half : 4 * half]
-    has_load = load_sums(L, t, SX, SY)
+    has_load = rhs_head(t, y, L, SX, SY, out)
     locks, angles = _locks(S)
     lam = np.empty(locks.shape[0])
     ddphi = np.empty(half)

@@ -296,16 +296,24 @@ def full_accel(V, y, has_load, SX, SY, damped, out):
     _full_solve(V, c, s, fp, fa, fb, out)
 
 
+@njit(cache=True, inline="always")
+def rhs_head(t, y, L, SX, SY, out):
+    """The start of a compiled right-hand side y' = [v; a] of a state y = [q; v]: out's first
+    half = v, the load suffix sums at t (N) into SX, SY (``load_sums``); returns whether a
+    load acts. O(N)."""
+    half = y.shape[0] // 2
+    out[:half] = y[half:]
+    return load_sums(L, t, SX, SY)
+
+
 @njit(RHS_SIGNATURE, cache=True)
 def full_rhs(t, y, P, S, M, L, out):
     """y' of the full model (compiled integrators' right-hand side, loads from table L)."""
-    half = y.shape[0] // 2
-    out[:half] = y[half:]
     n = P.shape[1]
     SX = np.empty(n)
     SY = np.empty(n)
-    has_load = load_sums(L, t, SX, SY)
-    full_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[half:])
+    has_load = rhs_head(t, y, L, SX, SY, out)
+    full_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[3 * n :])
 
 
 @njit(cache=True)

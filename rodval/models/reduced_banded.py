@@ -59,7 +59,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.core.loads import load_sums
 from rodval.models.kernels import (
     V_KAPPA,
     V_KB,
@@ -72,6 +71,7 @@ from rodval.models.kernels import (
     _hinge_forces,
     _rows,
     _upper_t_times,
+    rhs_head,
 )
 from rodval.models.paper_matrices import DEFAULT_VARIANT, chain_constants
 from rodval.models.reduced_band_lu import (
@@ -436,12 +436,11 @@ def reduced_rhs(t, y, P, S, M, L, out):
     (``rhs_work_size``; ``ReducedSystem.compiled_scratch``), whose last slot keeps the largest
     |alpha|, |beta| of the solves (the run's small-bending check, at no extra solve)."""
     half = y.shape[0] // 2
-    out[:half] = y[half:]
     work = M[0, 0]
     SX = work[:half]
     SY = work[half : 2 * half]
     gamma = work[2 * half : 4 * half]
-    has_load = load_sums(L, t, SX, SY)
+    has_load = rhs_head(t, y, L, SX, SY, out)
     reduced_solve_work(
         P,
         y[:half],

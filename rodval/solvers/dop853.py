@@ -297,7 +297,6 @@ def _buffers(y0, total, n_events):
     """The loop's buffers: state, trial state, stages, interpolant, scratch, zeros, mechanics,
     the audit's totals, event values (scratch, at the step's start, at its end). O(N)."""
     N = y0.shape[0]
-    e = n_events
     return (
         y0.copy(),
         np.empty(N),
@@ -307,9 +306,9 @@ def _buffers(y0, total, n_events):
         np.zeros(N),
         np.zeros(3),
         total,
-        np.empty(e),
-        np.empty(e),
-        np.empty(e),
+        np.empty(n_events),
+        np.empty(n_events),
+        np.empty(n_events),
     )
 
 
@@ -477,8 +476,6 @@ def integrate_compiled(
             raise ValueError("an energy audit needs the compiled form's mechanics")
     mechanics = form.mechanics if form.mechanics is not None else form.rhs
     events = form.events if form.events is not None else no_events
-    E = form.E if form.events is not None else np.zeros((0, 2))
-    directions = form.directions if form.events is not None else np.zeros(0)
     controls = np.array(
         [rtol, atol, max_step, -1.0 if first_step is None else first_step, max_nfev, deadline],
         float,
@@ -492,7 +489,7 @@ def integrate_compiled(
         form.rhs,
         mechanics,
         events,
-        (form.P, form.S, form.M, form.L, E, directions),
+        (form.P, form.S, form.M, form.L, form.E, form.directions),
         y0,
         np.array(edges, float),
         np.array(times, float),

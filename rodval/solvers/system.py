@@ -85,6 +85,8 @@ class CompiledForm:
                     f"CompiledForm.{label} must be a C-contiguous float64 array "
                     f"with {ndim} dimensions"
                 )
+        if self.events is None and self.E.shape[0]:
+            raise ValueError("CompiledForm.E has event rows but no event function")
         if self.directions.shape[0] != self.E.shape[0]:
             raise ValueError(
                 f"CompiledForm.directions has {self.directions.shape[0]} entries for "
