@@ -37,7 +37,7 @@ def test_compiled_mechanics_equal_the_python_energy_and_power(model, coefficient
 def test_compiled_loop_stops_when_kinetic_energy_exceeds_its_budget():
     # Physically T <= E(0) + W+; a budget of half the load work (factor 0.5, allowed only in
     # this direct call) is exceeded as soon as the pulse has set the chain moving.
-    from rodval.solvers import dop853
+    from rodval.solvers import budget, dop853
 
     scene = paper_scene(2, t_end=0.5)
     system = get_model("full").system(scene)
@@ -48,11 +48,11 @@ def test_compiled_loop_stops_when_kinetic_energy_exceeds_its_budget():
     n_out, _, _, code, t, *_ = dop853.integrate_compiled(
         *args, GuardSpec(stall_steps=1000, blowup_factor=0.5), Y
     )
-    assert code == dop853.BLOWUP and 0 < t < 0.5 and n_out < scene.times.size
+    assert code == budget.BLOWUP and 0 < t < 0.5 and n_out < scene.times.size
     n_out, _, _, code, t, *_ = dop853.integrate_compiled(
         *args, GuardSpec(stall_steps=1000, blowup_factor=1.0001), Y
     )
-    assert code == dop853.OK and t == 0.5 and n_out == scene.times.size
+    assert code == budget.OK and t == 0.5 and n_out == scene.times.size
 
 
 def test_compiled_loop_reports_a_stall():

@@ -1,5 +1,6 @@
 """Performance measurements: work-precision, cost per evaluation against n, the cost of what a
-scene may skip, and reduced-vs-full speed-up at equal accuracy.
+scene may skip, reduced-vs-full speed-up at equal accuracy, the fast path (events, energy)
+and stiff chains on the default method.
 
 Conventions
 -----------
@@ -39,12 +40,17 @@ from rodval.bench.scale import (
     speedup_scale,
     subnormal_count,
 )
+from rodval.bench.stiffness import growth, rigid_latch, stiff_paper, stiffness_rows
 
 __all__ = [
     "eight_rod_wing",
     "fast_path_rows",
     "feature_costs",
     "four_panel_wing",
+    "growth",
+    "rigid_latch",
+    "stiff_paper",
+    "stiffness_rows",
     "SCALE_N",
     "SCALE_REFERENCE_RTOL",
     "baseline_ratios",

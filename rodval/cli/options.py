@@ -99,8 +99,9 @@ def add_integrator_options(p: argparse.ArgumentParser) -> None:
         default=d["method"],
         choices=METHODS,
         help="auto (default: the compiled DOP853 where the model and scene have a "
-        "compiled form, scipy's DOP853 otherwise), a scipy solve_ivp method, or "
-        "DOP853-numba (native models)",
+        "compiled form, going on with the compiled Radau IIA when stiffness limits its "
+        "steps; scipy's DOP853 otherwise), a scipy solve_ivp method, or DOP853-numba / "
+        "Radau-numba (native models)",
     )
     p.add_argument(
         "--rtol",

@@ -17,10 +17,13 @@ from rodval.core.checks import check_number
 SCIPY_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 #: rodval's compiled integrators (``rodval.solvers.compiled``): the whole run in one compiled
 #: loop, for systems that have a compiled form (native models, tabulated load laws).
-COMPILED_METHODS = ("DOP853-numba",)
-#: "auto": the compiled DOP853 when the model and scene have a compiled form and nothing the
-#: compiled loop cannot do is asked for (events: stops, latches), scipy's DOP853 otherwise;
-#: the energy audit runs inside the compiled loop. The Trajectory records the method that ran.
+COMPILED_METHODS = ("DOP853-numba", "Radau-numba")
+#: "auto": the compiled DOP853 when the model and scene have a compiled form (events and the
+#: energy audit run inside the compiled loop), scipy's DOP853 otherwise. The compiled DOP853
+#: of "auto" goes on with the compiled Radau IIA once Hairer's stiffness test finds its steps
+#: limited by stability (``rodval.solvers.dop853.SWITCHING_STEPPER``; stiff panels, locked
+#: hinges); "DOP853-numba" asked by name never switches. The Trajectory records the method
+#: that ran, and ``stats.switch`` where and why it switched.
 AUTO = "auto"
 #: Every method name accepted by IntegratorSettings (simulate, CLI, studies).
 METHODS = (AUTO,) + SCIPY_METHODS + COMPILED_METHODS

@@ -40,6 +40,10 @@ class SolverStats:
     valid: bool | None = None
     #: Every check made: assumption, figure, bound, unit, holds, reason.
     validity: list[dict[str, Any]] = field(default_factory=list)
+    #: Where "auto"'s compiled DOP853 found its steps limited by stability and went on with
+    #: Radau IIA (``rodval.solvers.dop853.SWITCHING_STEPPER``): {"to", "t" (s), "h_lambda",
+    #: "h" (s), "reason"}; None when it did not switch.
+    switch: dict[str, Any] | None = None
 
     def __setattr__(self, name: str, value: Any) -> None:
         if name == "status":
@@ -66,6 +70,7 @@ class SolverStats:
             "small_bending": self.small_bending,
             "valid": self.valid,
             "validity": [dict(c) for c in self.validity],
+            "switch": None if self.switch is None else dict(self.switch),
         }
 
 

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from rodval.core.scene import Scene
-from rodval.core.settings import IntegratorSettings
+from rodval.core.settings import AUTO, IntegratorSettings
 from rodval.core.status import (
     STATUS_BUDGET,
     STATUS_DIVERGED,
@@ -22,7 +22,7 @@ from rodval.core.status import (
     numerical_failure,
 )
 from rodval.core.trajectory import SolverStats
-from rodval.solvers import dop853, progress
+from rodval.solvers import budget, dop853, progress, stiffness
 from rodval.solvers.audit import PowerLedger
 from rodval.solvers.events import apply_hit
 from rodval.solvers.guard import GuardSpec, diverged_message, verdict
@@ -32,9 +32,9 @@ from rodval.solvers.system import OdeSystem
 def verdict_message(code: int, mon: np.ndarray, t: float, spec: GuardSpec) -> tuple[int, str]:
     """Status and message of a compiled run that ended with ``code`` at t (s), the start of
     the last step; the guard's verdicts (``rodval.solvers.guard.verdict``) at its end."""
-    if code == dop853.STEP_TOO_SMALL:
+    if code == budget.STEP_TOO_SMALL:
         return STATUS_FAILED, "Required step size is less than spacing between numbers."
-    if code == dop853.NON_FINITE:
+    if code == budget.NON_FINITE:
         return STATUS_DIVERGED, diverged_message(t)
     judged = verdict(code, mon, t + mon[1], spec)
     if judged is None:
@@ -44,9 +44,49 @@ def verdict_message(code: int, mon: np.ndarray, t: float, spec: GuardSpec) -> tu
 
 #: Codes of the budgets: status and the setting named in the message.
 _BUDGETS = {
-    dop853.BUDGET: (STATUS_BUDGET, "max_evaluations"),
-    dop853.WALL: (STATUS_WALL, "max_wall_s"),
+    budget.BUDGET: (STATUS_BUDGET, "max_evaluations"),
+    budget.WALL: (STATUS_WALL, "max_wall_s"),
 }
+
+
+#: The compiled loop's stepper for each method that runs on it.
+_STEPPERS = {
+    "DOP853-numba": dop853.DOP853_STEPPER,
+    "Radau-numba": dop853.RADAU_STEPPER,
+    AUTO: dop853.SWITCHING_STEPPER,
+}
+
+
+def switch_record(sw: np.ndarray) -> dict[str, Any] | None:
+    """``SolverStats.switch`` from the switching state (``stiffness.new_state``): None when
+    "auto" never left DOP853."""
+    if np.isnan(sw[stiffness.T_FIRST]):
+        return None
+    t, h, rho = sw[stiffness.T_SWITCH], sw[stiffness.H_SWITCH], sw[stiffness.RHO]
+    explicit, implicit = sw[stiffness.RATE_EXPLICIT], sw[stiffness.RATE_IMPLICIT]
+    ended = "Radau-numba" if sw[stiffness.IMPLICIT] == 1.0 else "DOP853-numba"
+    reason = (
+        f"DOP853's steps spent on the fastest mode at t = {t:.6g} s: h rho = {h * rho:.3g} > "
+        f"{stiffness.STIFF_H_RHO:g} on {stiffness.STIFF_STEPS} steps (h = {h:.3g} s, "
+        f"spectral radius {rho:.4g} 1/s; stability limit h rho = "
+        f"{stiffness.STABILITY_IMAG:.3g}), {explicit:.4g} evaluations per simulated second"
+    )
+    if not np.isnan(implicit):
+        reason += f"; Radau IIA {implicit:.4g} per simulated second"
+    reason += f"; ended on {ended}"
+    return {
+        "to": "Radau-numba",
+        "first_t": float(sw[stiffness.T_FIRST]),
+        "switches": int(sw[stiffness.SWITCHES]),
+        "failed_trials": int(sw[stiffness.FAILED]),
+        "t": float(t),
+        "h": float(h),
+        "spectral_radius": float(rho),
+        "explicit_cost_per_s": float(explicit),
+        "implicit_cost_per_s": None if np.isnan(implicit) else float(implicit),
+        "ended_on": ended,
+        "reason": reason,
+    }
 
 
 def run_compiled(
@@ -66,16 +106,18 @@ def run_compiled(
     output times into Y; fills ``stats`` (status, message, t_reached, nfev, nsteps) and
     returns the number of output times reached. The divergence guard ``guard`` runs inside
     the loop, with the verdicts and messages of ``rodval.solvers.guard``; with a ``ledger``
-    the energy audit too (its records become the loop's running W_ext, D at the output times
-    reached). Events are located inside the loop; each one's jump is the system's
-    (``rodval.solvers.events.apply_hit``, as on the scipy path), its record appended to
-    ``events``, and the loop continues from there in the system's new mode."""
+    the energy audit too (its records become the loop's running W_ext, D). Events are
+    located inside the loop; each one's jump is the system's (``events.apply_hit``, as on
+    the scipy path), its record appended to ``events``; the loop goes on in the new mode.
+    The stepper: ``_STEPPERS[settings.method]`` (its switches in ``stats.switch``)."""
     times = np.asarray(scene.times, float)
     W = np.zeros((times.size, 2))
     total = np.zeros(2)
     deadline = time.perf_counter() + settings.max_wall_s
     t, y, n_out = float(edges[0]), np.array(y0, float), 0
     monitor = None
+    stepper = _STEPPERS[settings.method]
+    switch = stiffness.new_state()
     while True:
         form = system.compiled()
         assert form is not None  # choose_method took the compiled path for this system
@@ -97,6 +139,8 @@ def run_compiled(
                 audit=ledger is not None,
                 monitor=monitor,
                 total=total,
+                stepper=stepper,
+                switch=switch,
             )
         except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
             # raised by a model's kernel: the loop's time is lost, t_reached stays at its start
@@ -113,7 +157,9 @@ def run_compiled(
         stats.nfev += res.nfev
         stats.nsteps += res.nsteps
         stats.t_reached = t = res.t
-        if res.code != dop853.EVENT:
+        switch = res.switch  # a restart goes on with the stepper the run ended with
+        stats.switch = switch_record(switch)
+        if res.code != budget.EVENT:
             _ending(res, settings, guard, stats)
             break
         y, record, lost = apply_hit(system, res.event, res.t, res.y)
@@ -128,7 +174,7 @@ def run_compiled(
 def _ending(res: dop853.CompiledRun, settings: IntegratorSettings, guard, stats) -> None:
     """Status and message of a compiled run that ended with ``res.code`` (not an event)."""
     if res.code in _BUDGETS:
-        stats.status, budget = _BUDGETS[res.code]
-        stats.message = settings.budget_message(budget, res.t)
-    elif res.code != dop853.OK:
+        stats.status, setting = _BUDGETS[res.code]
+        stats.message = settings.budget_message(setting, res.t)
+    elif res.code != budget.OK:
         stats.status, stats.message = verdict_message(res.code, res.monitor, res.t, guard)

@@ -15,24 +15,24 @@ the step cut (``_step_control``); when that continues down to the smallest step,
 accepted state is not finite, the run ends as ``NON_FINITE`` at the time it
 reached (a division by zero in the initial-step choice raised ZeroDivisionError). The
 wall-clock budget reads the clock (a call back into Python, ~1 us) once every
-``WALL_CHECK_EVALUATIONS`` evaluations, not on every step.
+``budget.WALL_CHECK_EVALUATIONS`` evaluations, not on every step.
 """
 
 from __future__ import annotations
 
 import math
-import time
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, objmode, types
+from numba import njit, types
 from scipy.integrate._ivp import dop853_coefficients as dc
 
-from rodval.solvers import guard as _guard
+from rodval.solvers import radau, stiffness
 from rodval.solvers.audit import GAUSS_NODES
+from rodval.solvers.budget import EVENT, NON_FINITE, OK, STEP_TOO_SMALL, exhausted
 from rodval.solvers.dop853_events import any_crossing, interpolate, locate, no_events
 from rodval.solvers.guard import GuardSpec, guard_step, new_monitor
-from rodval.solvers.progress import report
+from rodval.solvers.limits import MAX_IMPLICIT_SIZE
 from rodval.solvers.signature import EVENTS_TYPE, RHS_TYPE
 from rodval.solvers.signature import F1 as _F1
 from rodval.solvers.signature import F2 as _F2
@@ -47,15 +47,11 @@ _E5 = np.ascontiguousarray(dc.E5)
 _D = np.ascontiguousarray(dc.D)
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(GAUSS_NODES)
 
-#: Return codes of ``run``: the guard's (``rodval.solvers.guard.guard_step``) and the loop's own.
-OK, BLOWUP, STALLED = _guard.OK, _guard.BLOWUP, _guard.STALLED
-STEP_TOO_SMALL, NON_FINITE, BUDGET, WALL, EVENT = 1, 2, 3, 6, 7
+#: Steppers of ``run`` (controls[6]): this module's DOP853, ``rodval.solvers.radau``'s Radau
+#: IIA, or DOP853 that switches to Radau IIA when its steps are limited by stability and
+#: Radau IIA proves cheaper (``rodval.solvers.stiffness``: "auto").
+DOP853_STEPPER, RADAU_STEPPER, SWITCHING_STEPPER = 0, 1, 2
 
-
-#: Evaluations between two reads of the clock for the wall-clock budget: the read costs about
-#: one evaluation of the smallest system, so this keeps it below 1 % of a run, and the run
-#: overshoots its budget by at most this many evaluations (milliseconds up to n ~ 1e3).
-WALL_CHECK_EVALUATIONS = 100
 
 SAFETY, MIN_FACTOR, MAX_FACTOR, ERROR_EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
 
@@ -82,27 +78,10 @@ def _rms(x):
     return np.sqrt(np.mean(x * x))
 
 
-@njit(cache=True)
-def _now():
-    """``time.perf_counter()`` (s), read from inside the compiled loop."""
-    with objmode(now="float64"):
-        now = time.perf_counter()
-    return now
-
-
-@njit(cache=True)
-def _report_and_now(t):
-    """Tell the progress reporter (``rodval.solvers.progress``) that the run reached t (s),
-    then read the clock; one call back into Python."""
-    with objmode(now="float64"):
-        report(t)
-        now = time.perf_counter()
-    return now
-
-
 @njit(cache=True, error_model="numpy")
-def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, tmp, f1):
-    """scipy's select_initial_step (Hairer, Sec. II.4) for order 7; uses one evaluation."""
+def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, order, tmp, f1):
+    """scipy's select_initial_step (Hairer, Sec. II.4) for a method of the given order; uses
+    one evaluation."""
     scale = atol + np.abs(y0) * rtol
     d0 = _rms(y0 / scale)
     d1 = _rms(f0 / scale)
@@ -114,7 +93,7 @@ def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, tm
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1.0))
     return min(100.0 * h0, h1, t_bound - t0, max_step)
 
 
@@ -143,6 +122,29 @@ def _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol):
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
     return h * err5 / np.sqrt((err5 + 0.01 * err3) * N)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _check_state(mechanics, P, S, M, L, t, t_new, y_new, guard, mon, mech):
+    """The accepted state y_new at t_new (step from t): ``NON_FINITE`` if it is not finite,
+    else the guard's code (``guard_step``; the mechanics evaluated when it checks energy)."""
+    if not np.all(np.isfinite(y_new)):
+        return NON_FINITE
+    guarded = np.isfinite(guard[2])
+    if guarded:
+        mechanics(t_new, y_new, P, S, M, L, mech)
+    return guard_step(guard, mon, t_new - t, mech, guarded)
+
+
+@njit(cache=True, inline="always")
+def _flip(sw, implicit, h, t_new, evaluations, sc, N):
+    """Whether the switching stepper changes stepper after the accepted step h (s) ending at
+    t_new (s) (``stiffness.watch_explicit``/``watch_implicit`` on the cost so far; sc:
+    Radau's scalars, for its factorizations and Newton iterations)."""
+    if implicit:
+        cost = stiffness.implicit_cost(evaluations, sc[radau.NLU], sc[radau.NITER], N)
+        return stiffness.watch_implicit(sw, t_new, cost)
+    return stiffness.watch_explicit(sw, h, t_new, float(evaluations))
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -224,14 +226,7 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
     transient, e.g. just after a lock) is rejected and the step cut by MIN_FACTOR, as scipy's
     DOP853 does with its infinite error norm; a state whose attempts stay non-finite down to
     the smallest step is ``NON_FINITE`` (diverged), not ``STEP_TOO_SMALL``."""
-    rtol, atol, max_step, max_nfev, deadline = (
-        controls[0],
-        controls[1],
-        controls[2],
-        controls[4],
-        controls[5],
-    )
-    clocked = deadline < np.inf or reporting
+    rtol, atol, max_step = controls[0], controls[1], controls[2]
     min_step = 10.0 * (np.nextafter(t, np.inf) - t)
     h_abs = min(max(h_abs, min_step), max_step)
     rejected = False
@@ -239,13 +234,9 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
     while True:
         if h_abs < min_step:
             return (STEP_TOO_SMALL if finite else NON_FINITE), t, h_abs
-        if cnt[0] >= max_nfev:
-            return BUDGET, t, h_abs
-        if clocked and cnt[0] >= cnt[1]:
-            cnt[1] = cnt[0] + WALL_CHECK_EVALUATIONS
-            now = _report_and_now(t) if reporting else _now()
-            if now > deadline:
-                return WALL, t, h_abs
+        code = exhausted(controls, reporting, cnt, t)
+        if code != OK:
+            return code, t, h_abs
         t_new = min(t + h_abs, t_bound)
         h_abs = t_new - t
         err = _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol)
@@ -261,10 +252,11 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _record_step(rhs, mechanics, events, arrays, t, t_new, buffers, times, n_out, Y, W, cnt):
+def _record_step(rhs, mechanics, events, arrays, t, t_new, buffers, times, n_out, Y, W, cnt, dense):
     """After the accepted step [t, t_new]: the events at its end (g_new, against g_old at
-    its start); the dense output when an output time falls in it, the audit runs (W with
-    rows: ``_audit_step``) or an event crosses; the crossing located
+    its start); the dense output (unless the stepper wrote it: ``dense``) when an output time
+    falls in it, the audit runs (W with rows: ``_audit_step``) or an event crosses; the
+    crossing located
     (``dop853_events.locate``), then the outputs written and the audit advanced up to it.
     Returns (next output row, event index or -1, the time the step is cut at: the event's
     or t_new). ``arrays``: the form's (P, S, M, L, E, directions); ``buffers``: the loop's
@@ -277,7 +269,7 @@ def _record_step(rhs, mechanics, events, arrays, t, t_new, buffers, times, n_out
         crossing = any_crossing(g_old, g_new, directions)
     outputs = n_out < times.shape[0] and times[n_out] <= t_new
     audited = W.shape[0] > 0
-    if outputs or audited or crossing:
+    if not dense and (outputs or audited or crossing):
         _dense_coefficients(rhs, P, S, M, L, t, t_new, y, y_new, K, F, tmp, zero)
         cnt[0] += 3
     index, t_cut = -1, t_new
@@ -313,17 +305,49 @@ def _buffers(y0, total, n_events):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _segment_start(rhs, P, S, M, L, t, t_bound, y, K, tmp, controls, cnt):
+def _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper, implicit):
     """The derivative at a segment's start into K[0] and the first step size (s): the given
-    one (controls[3] > 0) or ``_initial_step``'s; 1 or 2 evaluations, counted in cnt[0]."""
+    one (controls[3] > 0) or ``_initial_step``'s for the stepper's order; 1 or 2
+    evaluations, counted in cnt[0]. ``stepper``: (Radau's work, its scalars, the switching
+    state): Radau IIA starts (``radau.start``) when ``implicit``; the switching stepper
+    estimates the spectral radius (``stiffness.spectral_radius``) when it runs DOP853."""
+    y, y_new, K, F, tmp = buffers[0], buffers[1], buffers[2], buffers[3], buffers[4]
+    rw, sc, switch = stepper
     rhs(t, y, P, S, M, L, K[0])
     cnt[0] += 1
+    if not np.all(np.isfinite(K[0])):
+        return 0.0
+    if implicit:
+        radau.start(rhs, P, S, M, L, t, y, K[0], rw, sc, cnt)
+    elif controls[6] == SWITCHING_STEPPER and y.shape[0] <= MAX_IMPLICIT_SIZE:
+        switch[stiffness.RHO] = stiffness.spectral_radius(
+            rhs, P, S, M, L, t, y, K[0], y_new, F[3], tmp
+        )
+        cnt[0] += 2 * stiffness.POWER_ITERATIONS
     if controls[3] > 0:
         return min(controls[3], t_bound - t)
     cnt[0] += 1
     rtol, atol, max_step = controls[0], controls[1], controls[2]
+    order = radau.ERROR_ORDER if implicit else 7
     return _initial_step(
-        rhs, P, S, M, L, t, y, K[0], t_bound, rtol, atol, max_step, tmp, np.empty(y.shape[0])
+        rhs, P, S, M, L, t, y, K[0], t_bound, rtol, atol, max_step, order, tmp, np.empty(y.shape[0])
+    )
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _advance(rhs, P, S, M, L, args):
+    """One accepted step from (t, y) by the stepper in use (Radau IIA when ``implicit``,
+    which also writes the dense output F): ``_step_control``'s or ``radau.step``'s return.
+    ``args``: (t, t_bound, h_abs, buffers, controls, reporting, cnt, rw, sc, implicit)."""
+    t, t_bound, h_abs, buffers, controls, reporting, cnt, rw, sc, implicit = args
+    y, y_new, K, F, tmp = buffers[0], buffers[1], buffers[2], buffers[3], buffers[4]
+    if implicit:
+        return radau.step(
+            rhs, P, S, M, L, t, t_bound, h_abs, y, K[0], y_new, K[N_STAGES], F,
+            controls, reporting, cnt, rw, sc,
+        )  # fmt: skip
+    return _step_control(
+        rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, reporting, cnt
     )
 
 
@@ -344,7 +368,7 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
     types.boolean,
     _F2,
     _F2,
-    types.Tuple((_F1, _F1, _F1)),
+    types.Tuple((_F1, _F1, _F1, _F1)),
 )
 
 
@@ -355,12 +379,11 @@ def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, repor
     ``mechanics``, ``events`` and ``arrays`` (P, S, M, L, E, directions): a
     ``CompiledForm``'s functions and arrays. ``controls``: [rtol, atol, max_step (s),
     first_step (s; <= 0 selects it), max_nfev, deadline (a ``time.perf_counter()`` value, s;
-    inf: none)]: ``BUDGET`` once max_nfev evaluations are used, ``WALL`` once the clock
-    passes the deadline (read before the first attempt, then every
-    ``WALL_CHECK_EVALUATIONS`` evaluations, when the time reached goes to the progress
-    reporter if ``reporting``).
+    inf: none), stepper (``DOP853_STEPPER``, or ``RADAU_STEPPER``: ``rodval.solvers.radau``,
+    which writes its own dense output)]: the budgets' codes (``budget.exhausted``: ``BUDGET``,
+    ``WALL``; the time reached goes to the progress reporter if ``reporting``).
 
-    ``carry``: (mon, total, hit), carried over restarts. ``guard``: ``GuardSpec.as_array()``,
+    ``carry``: (mon, total, hit, switch), carried over restarts. ``guard``: ``GuardSpec.as_array()``,
     checked by ``guard_step`` after every accepted step (``mon``: its monitor);
     ``mechanics(t, y, ...)`` writes (T, P_ext, P_diss), for the guard when guard[2] is finite.
     ``W`` (nt, 2), or (0, 2) for no audit: the audit's running [W_ext, D] (J) at the output
@@ -370,17 +393,24 @@ def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, repor
     (``dop853_events.locate``), outputs and audit taken up to it; returns ``EVENT`` at its
     time, its index in hit[0] and the state there in hit[1:] (the caller applies the jump).
 
+    The ``SWITCHING_STEPPER`` (N <= ``MAX_IMPLICIT_SIZE``) runs DOP853, switches to Radau
+    IIA when its steps are limited by stability and back when Radau IIA proves dearer
+    (``rodval.solvers.stiffness``; ``switch``: its state, ``stiffness.new_state``).
+
     Returns (number of output times written, nfev, accepted steps, code, t reached).
     """
     P, S, M, L, E, directions = arrays
     N = y0.shape[0]
-    mon, total, hit = carry
+    mon, total, hit, switch = carry
     buffers = _buffers(y0, total, E.shape[0])
     y, y_new, K, F, tmp, zero, mech, total, g, g_old, g_new = buffers
+    switching = controls[6] == SWITCHING_STEPPER and N <= MAX_IMPLICIT_SIZE
+    implicit = controls[6] == RADAU_STEPPER or (switching and switch[stiffness.IMPLICIT] == 1.0)
+    rw = radau.work(N, implicit)
+    sc = np.zeros(7)
     n_out = 0
     cnt = np.zeros(2, np.int64)  # evaluations, and the count at the next clock read
     nsteps = 0
-    guarded = np.isfinite(guard[2])
     t = edges[0]
     while n_out < times.shape[0] and times[n_out] <= t:
         Y[n_out] = y
@@ -389,26 +419,23 @@ def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, repor
         events(t, y, P, S, M, L, E, g_old)
     for seg in range(edges.shape[0] - 1):
         t, t_bound = edges[seg], edges[seg + 1]
-        h_abs = _segment_start(rhs, P, S, M, L, t, t_bound, y, K, tmp, controls, cnt)
+        h_abs = _segment_start(
+            rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, (rw, sc, switch), implicit
+        )
         if not np.all(np.isfinite(K[0])):  # the derivative at an accepted state
             return n_out, cnt[0], nsteps, NON_FINITE, t
         while t < t_bound:
-            code, t_new, h_abs = _step_control(
-                rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, reporting, cnt
-            )
+            args = (t, t_bound, h_abs, buffers, controls, reporting, cnt, rw, sc, implicit)
+            code, t_new, h_abs = _advance(rhs, P, S, M, L, args)
+            nsteps += code == OK
+            if code == OK:
+                code = _check_state(mechanics, P, S, M, L, t, t_new, y_new, guard, mon, mech)
             if code != OK:
                 return n_out, cnt[0], nsteps, code, t
             h = t_new - t
-            nsteps += 1
-            if not np.all(np.isfinite(y_new)):
-                return n_out, cnt[0], nsteps, NON_FINITE, t
-            if guarded:
-                mechanics(t_new, y_new, P, S, M, L, mech)
-            code = guard_step(guard, mon, h, mech, guarded)
-            if code != OK:
-                return n_out, cnt[0], nsteps, code, t
+            flip = switching and _flip(switch, implicit, h, t_new, cnt[0], sc, N)
             n_out, index, t_cut = _record_step(
-                rhs, mechanics, events, arrays, t, t_new, buffers, times, n_out, Y, W, cnt
+                rhs, mechanics, events, arrays, t, t_new, buffers, times, n_out, Y, W, cnt, implicit
             )
             if index >= 0:
                 hit[0] = index
@@ -419,6 +446,11 @@ def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, repor
                 y[i] = y_new[i]
                 K[0, i] = K[N_STAGES, i]
             g_old[:] = g_new
+            if flip:  # the other stepper from here on (see above)
+                implicit = not implicit
+                if implicit:
+                    rw = radau.work(N, True)
+                    radau.start(rhs, P, S, M, L, t, y, K[0], rw, sc, cnt)
     return n_out, cnt[0], nsteps, OK, t
 
 
@@ -434,6 +466,8 @@ class CompiledRun(NamedTuple):
     work: np.ndarray  #: the audit's [W_ext, D] (J) at the output times written, (n_out, 2)
     event: int  #: the event's index (EVENT), else -1
     y: np.ndarray  #: the state at the event (before its jump; EVENT), else empty
+    #: the switching stepper's state (``stiffness.new_state``; carried over restarts)
+    switch: np.ndarray
 
 
 def start_monitor(form, t: float, y: np.ndarray, guard: GuardSpec) -> np.ndarray:
@@ -463,10 +497,14 @@ def integrate_compiled(
     audit: bool = False,
     monitor: np.ndarray | None = None,
     total: np.ndarray | None = None,
+    stepper: int = DOP853_STEPPER,
+    switch: np.ndarray | None = None,
 ) -> CompiledRun:
     """Run ``run`` on a CompiledForm (see ``run``; without ``form.mechanics`` there is no
     blow-up check and no audit; ``deadline``: a ``time.perf_counter()`` value, s;
-    ``reporting``: report progress; ``audit``: integrate the load and damper powers).
+    ``reporting``: report progress; ``audit``: integrate the load and damper powers;
+    ``stepper``: ``DOP853_STEPPER``, ``RADAU_STEPPER`` or ``SWITCHING_STEPPER``, see ``run``;
+    ``switch``: the switching state, carried on like ``monitor``).
     A run continued after an event passes the guard's ``monitor`` and the audit's running
     ``total`` [W_ext, D] (J) on (both updated in place); new ones start from (edges[0], y0)."""
     g = guard.as_array()
@@ -476,15 +514,14 @@ def integrate_compiled(
             raise ValueError("an energy audit needs the compiled form's mechanics")
     mechanics = form.mechanics if form.mechanics is not None else form.rhs
     events = form.events if form.events is not None else no_events
-    controls = np.array(
-        [rtol, atol, max_step, -1.0 if first_step is None else first_step, max_nfev, deadline],
-        float,
-    )
+    first = -1.0 if first_step is None else first_step
+    controls = np.array([rtol, atol, max_step, first, max_nfev, deadline, stepper], float)
     y0 = np.array(y0, float)
     mon = start_monitor(form, float(edges[0]), y0, guard) if monitor is None else monitor
     total = np.zeros(2) if total is None else total
     W = np.zeros((len(times) if audit else 0, 2))
     hit = np.zeros(y0.size + 1)
+    switch = stiffness.new_state() if switch is None else switch
     n_out, nfev, nsteps, code, t = run(
         form.rhs,
         mechanics,
@@ -498,10 +535,19 @@ def integrate_compiled(
         bool(reporting),
         Y,
         W,
-        (mon, total, hit),
+        (mon, total, hit, switch),
     )
     event = int(hit[0]) if code == EVENT else -1
     y_event = hit[1:].copy() if code == EVENT else np.zeros(0)
     return CompiledRun(
-        int(n_out), int(nfev), int(nsteps), int(code), float(t), mon, W[:n_out], event, y_event
+        int(n_out),
+        int(nfev),
+        int(nsteps),
+        int(code),
+        float(t),
+        mon,
+        W[:n_out],
+        event,
+        y_event,
+        switch,
     )

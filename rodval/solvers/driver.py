@@ -4,7 +4,8 @@ Small parts, each in its own place:
 
 * method choice (``choose_method``): "auto" takes the compiled DOP853 when the system has a
   compiled form that can do what is asked (its mechanics for an energy audit, its event
-  functions for a system with events), scipy's DOP853 otherwise;
+  functions for a system with events), scipy's DOP853 otherwise; the compiled loop of "auto"
+  switches to its Radau IIA when the steps are limited by stability (``settings.AUTO``);
 * stepping: a scipy ``OdeSolver`` across the scene's load breakpoints (``_ScipyRun``), or a
   compiled loop (``rodval.solvers.compiled``);
 * budgets and non-finite derivatives, checked on every evaluation, including those of rejected
@@ -44,6 +45,7 @@ from rodval.core.validity import SMALL_BENDING_RAD
 from rodval.solvers.audit import PowerLedger, audit_quantities
 from rodval.solvers.events import EventMonitor, apply_hit
 from rodval.solvers.guard import DivergenceGuard
+from rodval.solvers.limits import MAX_IMPLICIT_SIZE
 from rodval.solvers.progress import report
 from rodval.solvers.system import OdeSystem
 
@@ -95,6 +97,12 @@ def choose_method(system: OdeSystem, scene: Scene, settings: IntegratorSettings)
             raise ValueError(
                 f"method {settings.method!r} cannot audit energy for this system (its "
                 "compiled form has no mechanics); use a scipy method or 'auto'"
+            )
+        if settings.method == "Radau-numba" and system.y0.size > MAX_IMPLICIT_SIZE:
+            raise ValueError(
+                f"method 'Radau-numba' factorizes dense N x N matrices (O(N^3)): this system "
+                f"has N = {system.y0.size} states, allowed N <= {MAX_IMPLICIT_SIZE}; use "
+                "'auto' or 'DOP853-numba'"
             )
         if events and form.events is None:
             raise ValueError(
