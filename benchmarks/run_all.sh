@@ -14,4 +14,6 @@ $PY -m rodval bench scale --out "$OUT/scale"
 # Study runner overhead (cold fresh process per case vs warm workers) and the subnormal check:
 $PY benchmarks/study_overhead.py studies/scale_study.toml --out "$OUT/study_overhead" --workers 1,2 --cold 10
 $PY -m rodval bench fast-path --out "$OUT/fast_path"
+$PY -m rodval bench stiffness --out "$OUT/stiffness"
+$PY benchmarks/stiffness_evidence.py
 $PY benchmarks/subnormal_cost.py --reduced-only 128 1024 8192 32768

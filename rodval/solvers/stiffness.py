@@ -11,8 +11,10 @@ The test is the one an engineer would make, done by the loop itself on its own f
    step is set by that mode, either at DOP853's stability boundary (h rho =
    ``STABILITY_IMAG`` = 5.96 on the imaginary axis, from its stability polynomial) or by the
    tolerance on the mode's own motion. Hairer's test of dop853.f (h |f(y1) - f(s12)| /
-   |y1 - s12| > 6.1) proved blind here: on the paper chain at EI = 1e9 it reads 1.7 at its
-   median while the steps are pinned at the boundary (h = 6e-6 s, rho = 2.7e5 1/s).
+   |y1 - s12| > 6.1) asks only the first: on the paper chain at EI = 1e9 its estimate is
+   right (1.7 at the median, h rho = 1.6) but DOP853 is not at its boundary, it resolves the
+   bending mode to the tolerance (about 4 steps per period), so the test never fires while
+   Radau IIA, which damps that mode, needs 46x fewer evaluations.
 2. **Is Radau IIA cheaper on this motion?** A fast mode that the motion excites above the
    tolerance must be resolved by either method (the paper chain at EI = 1e5 sits at
    h rho = 2-4, yet Radau IIA needs 6x DOP853's evaluations there). So Radau IIA's cost
