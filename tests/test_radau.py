@@ -2,24 +2,18 @@
 (``rodval.solvers.stiffness``): the method's algebra, agreement with scipy's Radau and with
 tight references, and the switch's choices on the scenes that motivated it (issue 20)."""
 
-import dataclasses
-
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from rodval import Chain, InitialState, Latch, Scene, paper_scene, simulate
+from rodval import paper_scene, simulate
+from rodval.bench.stiffness import rigid_latch, stiff_paper
 from rodval.core.settings import IntegratorSettings
 from rodval.models import get_model
 from rodval.solvers import radau, stiffness
 from rodval.solvers.dop853 import RADAU_STEPPER, integrate_compiled
 from rodval.solvers.dop853_events import interpolate
 from rodval.solvers.guard import GuardSpec
-
-
-def _paper(EI: float) -> Scene:
-    scene = paper_scene(4)
-    return dataclasses.replace(scene, chain=dataclasses.replace(scene.chain, EI=np.full(4, EI)))
 
 
 @pytest.mark.parametrize("dtype", [float, complex])
@@ -79,7 +73,7 @@ def test_auto_switches_to_radau_on_near_rigid_panels_and_stays_accurate():
     figures; it needs < 1/10 of DOP853's evaluations (measured 1/46) and its phi is within
     the tolerance of a tight reference (Radau IIA at rtol 1e-11; measured 4.1e-9 against
     rtol |phi| = 5.8e-8)."""
-    scene = _paper(1e9)
+    scene = stiff_paper(1e9)
     auto = simulate(scene, "full")
     dop = simulate(scene, "full", method="DOP853-numba")
     tight = IntegratorSettings("Radau-numba", rtol=1e-11, atol=1e-13, max_evaluations=10**8)
@@ -98,7 +92,7 @@ def test_auto_comes_back_to_dop853_where_radau_is_dearer():
     """Paper chain at EI = 1e5: DOP853 sits near the fastest mode (h rho = 2-4), but the motion
     excites it, so Radau IIA is dearer (6x the evaluations by name). "auto" tries it, comes
     back, and costs within 10 % of DOP853 (measured +1.8 %) with the same phi to 1e-9."""
-    scene = _paper(1e5)
+    scene = stiff_paper(1e5)
     auto = simulate(scene, "full")
     dop = simulate(scene, "full", method="DOP853-numba")
     switch = auto.stats.switch
@@ -112,7 +106,7 @@ def test_a_switch_is_the_same_on_every_run_and_recorded_in_run_files(tmp_path):
     record survives run.json."""
     from rodval.report.run_files import read_run, write_run
 
-    scene = _paper(1e8)
+    scene = stiff_paper(1e8)
     a, b = simulate(scene, "full"), simulate(scene, "full")
     np.testing.assert_array_equal(a["phi"], b["phi"])
     assert a.stats.switch is not None and a.stats.nfev == b.stats.nfev
@@ -127,15 +121,7 @@ def test_the_rigid_two_rod_latch_runs_cheaply_in_the_reduced_model():
     on with Radau IIA after the lock and needs < 1/100 of DOP853's evaluations (measured
     647 vs 300,583); the hinge stays locked and the rate after the lock is H / I (rigid
     body about the root: I = sum of the rods' inertia about it), to 1e-6."""
-    chain = Chain.uniform(2, l=1.0, m=1.0, EI=1e9, mu=0.5, kappa=[0.0, 5.0], nu=0.0)
-    scene = Scene(
-        chain=chain,
-        t_end=1.5,
-        times=np.linspace(0.0, 1.5, 31),
-        initial=InitialState(phi=[0.0, -2.5], dphi=[1.0, 1.5]),
-        latches=(Latch(1, 0.0),),
-        outputs=("phi", "dphi", "hinge_angle", "angular_momentum"),
-    )
+    scene = rigid_latch()  # the scene of ``rodval bench stiffness``
     auto = simulate(scene, "reduced")
     dop = simulate(scene, "reduced", method="DOP853-numba")
     assert auto.success and auto.stats.switch["ended_on"] == "Radau-numba"
@@ -157,7 +143,7 @@ def test_radau_numba_refuses_systems_too_large_for_dense_algebra():
 def test_spectral_radius_finds_the_bending_frequency():
     """The power iteration on J^2 against the eigenvalues of the finite-difference Jacobian:
     within 10 % on the paper chain (its top pairs cluster; measured within 1 %)."""
-    system = get_model("full").system(_paper(1e7))
+    system = get_model("full").system(stiff_paper(1e7))
     form = system.compiled()
     y = system.y0.copy()
     N = y.size

@@ -55,3 +55,16 @@ def exhausted(controls, reporting, cnt, t):
         if now > controls[5]:
             return WALL
     return OK
+
+
+@njit(cache=True, inline="always")
+def next_attempt(t, t_bound, h_abs, min_step, finite, controls, reporting, cnt):
+    """Before a step attempt of h_abs (s) from t (s): (``STEP_TOO_SMALL``, or
+    ``NON_FINITE`` when the last attempt was not ``finite``) below min_step (s), the
+    budgets' codes (``exhausted``), else (``OK``, the attempt's end min(t + h_abs, t_bound))."""
+    if h_abs < min_step:
+        return (STEP_TOO_SMALL if finite else NON_FINITE), t
+    code = exhausted(controls, reporting, cnt, t)
+    if code != OK:
+        return code, t
+    return OK, min(t + h_abs, t_bound)

@@ -29,7 +29,7 @@ from scipy.integrate._ivp import dop853_coefficients as dc
 
 from rodval.solvers import radau, stiffness
 from rodval.solvers.audit import GAUSS_NODES
-from rodval.solvers.budget import EVENT, NON_FINITE, OK, STEP_TOO_SMALL, exhausted
+from rodval.solvers.budget import EVENT, NON_FINITE, OK, next_attempt
 from rodval.solvers.dop853_events import any_crossing, interpolate, locate, no_events
 from rodval.solvers.guard import GuardSpec, guard_step, new_monitor
 from rodval.solvers.limits import MAX_IMPLICIT_SIZE
@@ -232,12 +232,9 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
     rejected = False
     finite = True  # whether the last attempt's stages were finite
     while True:
-        if h_abs < min_step:
-            return (STEP_TOO_SMALL if finite else NON_FINITE), t, h_abs
-        code = exhausted(controls, reporting, cnt, t)
+        code, t_new = next_attempt(t, t_bound, h_abs, min_step, finite, controls, reporting, cnt)
         if code != OK:
             return code, t, h_abs
-        t_new = min(t + h_abs, t_bound)
         h_abs = t_new - t
         err = _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol)
         cnt[0] += N_STAGES

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.solvers.budget import NON_FINITE, OK, STEP_TOO_SMALL, exhausted
+from rodval.solvers.budget import OK, next_attempt
 from rodval.solvers.dop853_events import interpolate
 
 S6 = 6.0**0.5
@@ -377,12 +377,9 @@ def step(
     rejected = False
     finite = True  # whether the last attempt's stages were finite
     while True:
-        if h_abs < min_step:
-            return (STEP_TOO_SMALL if finite else NON_FINITE), t, h_abs
-        code = exhausted(controls, reporting, cnt, t)
+        code, t_new = next_attempt(t, t_bound, h_abs, min_step, finite, controls, reporting, cnt)
         if code != OK:
             return code, t, h_abs
-        t_new = min(t + h_abs, t_bound)
         h = t_new - t
         h_abs = h
         for a in range(3):
