@@ -311,23 +311,3 @@ def test_backward_error_on_a_long_chain():
     band = rb.bending_at(Cst, phi, dphi, (SX, SY), True, rb.METHOD_BAND)
     assert band_residual(Cst, phi, dphi, SX, SY, *sweep) < 1e-13
     assert band_residual(Cst, phi, dphi, SX, SY, *band) < 1e-8
-
-
-def test_bending_over_output_times_is_one_compiled_loop_with_the_same_values():
-    """``ReducedSystem.bending`` recovers gamma at all output times in one compiled loop
-    (``bending_history``, loads from the compiled table) instead of one Python call per
-    time; it gives ``recover_bending``'s values: the same O(n) solve, the load sums evaluated
-    from the table instead of the Python laws (round-off: bound 1e-12 of the largest angle)."""
-    from rodval.bench.fast_path import eight_rod_wing
-    from rodval.models import get_model
-
-    scene = eight_rod_wing()  # a pulse at the tip and a constant force at node 4
-    system = get_model("reduced").system(scene)
-    rng = np.random.default_rng(7)
-    n = system.n
-    Y = np.column_stack([rng.normal(size=(40, n)), rng.normal(size=(40, n))])
-    times = np.linspace(0.0, scene.t_end, 40)
-    alpha, beta, _, _ = system.bending(times, Y)
-    ref = np.array([system.recover_bending(t, y) for t, y in zip(times, Y)])
-    scale = np.max(np.abs(ref))
-    np.testing.assert_allclose(np.hstack([alpha, beta]), ref, rtol=0, atol=1e-12 * scale)

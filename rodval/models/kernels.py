@@ -399,24 +399,3 @@ def reduced_mechanics(t, y, P, S, M, L, out):
     out[1] = _load_power(P, c, s, dphi, L, t)
     zero = np.zeros(n)
     out[2] = _damper_power(P, S, dphi, zero, zero)
-
-
-@njit(cache=True)
-def kinetic_rows(mechanics, args, phi, v, full):
-    """T (J) at each row of phi (nt, n) and q' = v (nt, 3n): ``mechanics`` (a compiled
-    form's, RHS_SIGNATURE, writing (T, P_ext, P_diss)) at the state [phi; 0; 0; v] (full
-    model) or [phi; phi'] (reduced), with args = (V, flags, M, L). O(n) per row."""
-    V, flags, M, L = args
-    nt, n = phi.shape
-    y = np.zeros(6 * n if full else 2 * n)
-    mech = np.zeros(3)
-    out = np.empty(nt)
-    for i in range(nt):
-        y[:n] = phi[i]
-        if full:
-            y[3 * n :] = v[i]
-        else:
-            y[n:] = v[i, :n]
-        mechanics(0.0, y, V, flags, M, L, mech)
-        out[i] = mech[0]
-    return out

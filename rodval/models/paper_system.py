@@ -15,7 +15,6 @@ from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
 from rodval.models import deployment
-from rodval.models.kernels import kinetic_rows
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
     VARIANTS,
@@ -129,6 +128,7 @@ class PaperSystem(OdeSystem):
             self.V = self.kernel_constants()
             self._no_load = np.zeros(self.n)
             self._flags = np.array([1.0 if self.damped else 0.0])
+            self._mech = np.zeros(3)
         self.rhs(0.0, self.y0)
 
     def kernel_constants(self) -> np.ndarray:
@@ -297,16 +297,20 @@ class PaperSystem(OdeSystem):
             out["angular_momentum"] = (H, np.arange(2))
         return out
 
-    def _kinetic_rows(self, phi: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """T (J) per row of phi and v = q' by the compiled mechanics (``kinetic_rows``)."""
-        args = (self.V, self._flags, _NO_MATRICES, _NO_LOADS)
-        return kinetic_rows(self.compiled_mechanics, args, phi, v, self.full)
-
     def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
-        """1/2 v^T M(phi) v with the kinematic mass matrix: the compiled O(n) form
-        (``kinetic_rows`` for many), or the dense one with the numpy kernel (the reference)."""
+        """1/2 v^T M(phi) v with the kinematic mass matrix: the compiled O(n) form, or the
+        dense one with the numpy kernel (the reference)."""
         if self.kernel == "numba":
-            return float(self._kinetic_rows(phi[None, :], v[None, :])[0])
+            n = self.n
+            y = (
+                np.concatenate([phi, np.zeros(2 * n), v])
+                if self.full
+                else np.concatenate([phi, v[:n]])
+            )
+            self.compiled_mechanics(
+                0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech
+            )
+            return float(self._mech[0])
         return 0.5 * float(v @ assemble_mass(self.cc_kinetic, angle_differences(phi)[0]) @ v)
 
     def kinetic_energy(self, t: float, y: np.ndarray) -> float:
@@ -318,11 +322,7 @@ class PaperSystem(OdeSystem):
         """Kinetic T = 1/2 q'^T M(phi) q' with the kinematic (printed) mass matrix, and
         Pi = 1/2 sum kappa (D - rest)^2 + bending (J), per output time; O(n) each."""
         v = np.concatenate([dphi, dalpha, dbeta], axis=1)
-        kin = (  # one compiled loop over the output times, or the numpy reference
-            self._kinetic_rows(phi, v)
-            if self.kernel == "numba"
-            else np.array([self._kinetic(p, vi) for p, vi in zip(phi, v)])
-        )
+        kin = np.array([self._kinetic(p, vi) for p, vi in zip(phi, v)])
         return kin, self.potential(phi, alpha, beta)
 
     def potential(self, phi, alpha, beta) -> np.ndarray:

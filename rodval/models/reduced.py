@@ -305,16 +305,7 @@ class ReducedSystem(PaperSystem):
 
     def bending(self, times, Y):
         n = self.n
-        table = self._load_table if self.kernel == "numba" and not self.locked else None
-        if table is not None:  # one compiled loop over the output times
-            Y = np.ascontiguousarray(Y, dtype=float)
-            times = np.ascontiguousarray(times, dtype=float)
-            gamma = reduced_banded.bending_history(
-                self.V, table, times, Y, self.damped, reduced_banded.METHOD_AUTO
-            )
-        else:
-            gamma = np.array([self.recover_bending(t, y) for t, y in zip(times, Y)])
-        gamma = gamma.reshape(-1, 2 * n)
+        gamma = np.array([self.recover_bending(t, y) for t, y in zip(times, Y)]).reshape(-1, 2 * n)
         zeros = np.zeros_like(gamma[:, :n])
         # alpha', beta' are dropped by the reduced model: they carry no kinetic energy in it.
         return gamma[:, :n], gamma[:, n:], zeros, zeros

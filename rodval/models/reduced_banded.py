@@ -59,7 +59,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.core.loads import load_sums
 from rodval.models.kernels import (
     V_KAPPA,
     V_KB,
@@ -404,23 +403,6 @@ def bending_at(
         Cst, phi, dphi, sums is not None, SX, SY, bool(damped), ddphi, gamma, work, method
     )
     return ddphi, gamma
-
-
-@njit(cache=True)
-def bending_history(Cst, L, times, Y, damped, method):
-    """gamma = [alpha; beta] (rad) at every output time (rows of Y = [phi; phi'], loads from
-    the compiled table L): ``bending_at`` in one compiled loop, without the per-time Python
-    calls (load sums, allocations). O(n) per output time, one work array for all."""
-    nt, n = Y.shape[0], Cst.shape[1]
-    gamma = np.empty((nt, 2 * n))
-    ddphi, SX, SY = np.empty(n), np.empty(n), np.empty(n)
-    work = np.empty(sweep_work_size(n))
-    for i in range(nt):
-        has_load = load_sums(L, times[i], SX, SY)
-        reduced_solve_work(
-            Cst, Y[i, :n], Y[i, n:], has_load, SX, SY, damped, ddphi, gamma[i], work, method
-        )
-    return gamma
 
 
 @njit(cache=True)
