@@ -160,3 +160,16 @@ def test_spectral_radius_finds_the_bending_frequency():
         form.rhs, form.P, form.S, form.M, form.L, 0.0, y, f, np.empty(N), np.empty(N), np.empty(N)
     )
     assert abs(rho / exact - 1) < 0.1, (rho, exact)
+
+
+def test_dop853_stability_boundary_on_the_imaginary_axis():
+    """``stiffness.STABILITY_IMAG`` is DOP853's: the first y where |R(i y)| > 1 for its
+    stability function R(z) = 1 + z b^T (I - z A)^-1 1 (scipy's coefficients), on a grid of
+    0.002 (the constant's stated 3 digits)."""
+    from scipy.integrate._ivp import dop853_coefficients as dc
+
+    A, b, one = dc.A[: dc.N_STAGES, : dc.N_STAGES], dc.B, np.ones(dc.N_STAGES)
+    grid = np.arange(0.002, 12.0, 0.002)
+    R = [abs(1 + 1j * y * b @ np.linalg.solve(np.eye(dc.N_STAGES) - 1j * y * A, one)) for y in grid]
+    first = grid[np.argmax(np.array(R) > 1.0 + 1e-9)]
+    assert abs(first - stiffness.STABILITY_IMAG) < 0.005, first

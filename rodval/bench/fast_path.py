@@ -86,9 +86,12 @@ CASES: tuple[tuple[str, str, Callable[[bool], Scene]], ...] = (
 )
 
 
-def best_run(scene: Scene, model: str, method: str, repeats: int) -> Trajectory:
-    """The run with the smallest ``stats.wall_s`` of ``repeats`` after a warm-up."""
-    settings = IntegratorSettings(method=method)
+def best_run(
+    scene: Scene, model: str, method: str | IntegratorSettings, repeats: int
+) -> Trajectory:
+    """The run with the smallest ``stats.wall_s`` of ``repeats`` after a warm-up (``method``:
+    a method name, or whole settings)."""
+    settings = method if isinstance(method, IntegratorSettings) else IntegratorSettings(method)
     simulate(scene, model, settings=settings)
     runs = [simulate(scene, model, settings=settings) for _ in range(repeats)]
     return min(runs, key=lambda tr: tr.stats.wall_s)

@@ -22,6 +22,7 @@ import dataclasses
 import numpy as np
 import pandas as pd
 
+from rodval.bench.fast_path import best_run
 from rodval.core.scene import Chain, InitialState, Latch, Scene, paper_scene
 from rodval.core.settings import AUTO, IntegratorSettings
 from rodval.core.status import Status
@@ -53,12 +54,6 @@ def rigid_latch(EI: float = 1e9) -> Scene:
         latches=(Latch(1, 0.0),),
         outputs=("phi", "dphi", "hinge_angle", "angular_momentum"),
     )
-
-
-def _best(scene: Scene, model: str, settings: IntegratorSettings, repeats: int) -> Trajectory:
-    simulate(scene, model, settings=settings)
-    runs = [simulate(scene, model, settings=settings) for _ in range(repeats)]
-    return min(runs, key=lambda tr: tr.stats.wall_s)
 
 
 def reference(scene: Scene, model: str, EI: float) -> Trajectory:
@@ -98,7 +93,7 @@ def stiffness_rows(repeats: int = 3, progress=print, budget_s: float = 20.0) -> 
             ref = reference(scene, model, EI) if EI is not None else None
             for method in METHODS:
                 settings = IntegratorSettings(method, max_wall_s=budget_s)
-                tr = _best(scene, model, settings, repeats)
+                tr = best_run(scene, model, settings, repeats)
                 rows.append(_row(scene, model, method, tr, ref))
                 progress(f"{scene.name}, {model}, {method}: {tr.stats.wall_s:.3f} s")
     return pd.DataFrame(rows)

@@ -302,12 +302,14 @@ def _buffers(y0, total, n_events):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper, implicit):
+def _segment_start(
+    rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper, implicit, switching
+):
     """The derivative at a segment's start into K[0] and the first step size (s): the given
     one (controls[3] > 0) or ``_initial_step``'s for the stepper's order; 1 or 2
     evaluations, counted in cnt[0]. ``stepper``: (Radau's work, its scalars, the switching
-    state): Radau IIA starts (``radau.start``) when ``implicit``; the switching stepper
-    estimates the spectral radius (``stiffness.spectral_radius``) when it runs DOP853."""
+    state): Radau IIA starts (``radau.start``) when ``implicit``; else, when ``switching``,
+    the spectral radius is estimated (``stiffness.spectral_radius``)."""
     y, y_new, K, F, tmp = buffers[0], buffers[1], buffers[2], buffers[3], buffers[4]
     rw, sc, switch = stepper
     rhs(t, y, P, S, M, L, K[0])
@@ -316,7 +318,7 @@ def _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper,
         return 0.0
     if implicit:
         radau.start(rhs, P, S, M, L, t, y, K[0], rw, sc, cnt)
-    elif controls[6] == SWITCHING_STEPPER and y.shape[0] <= MAX_IMPLICIT_SIZE:
+    elif switching:
         switch[stiffness.RHO] = stiffness.spectral_radius(
             rhs, P, S, M, L, t, y, K[0], y_new, F[3], tmp
         )
@@ -417,7 +419,19 @@ def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, repor
     for seg in range(edges.shape[0] - 1):
         t, t_bound = edges[seg], edges[seg + 1]
         h_abs = _segment_start(
-            rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, (rw, sc, switch), implicit
+            rhs,
+            P,
+            S,
+            M,
+            L,
+            t,
+            t_bound,
+            buffers,
+            controls,
+            cnt,
+            (rw, sc, switch),
+            implicit,
+            switching,
         )
         if not np.all(np.isfinite(K[0])):  # the derivative at an accepted state
             return n_out, cnt[0], nsteps, NON_FINITE, t

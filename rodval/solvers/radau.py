@@ -158,17 +158,17 @@ def _factor(J, h, LUr, pr, LUc, pc):
 
 @njit(cache=True, error_model="numpy")
 def _norm(x, scale):
-    """rms of x / scale over all entries (scipy's ``norm``)."""
+    """rms of x / scale over all entries (scipy's ``norm``): x (N,) or (3, N), scale (N,)."""
+    rows = x.reshape((-1, scale.shape[0]))
     acc = 0.0
-    flat = x.ravel()
-    sflat = scale.ravel()
-    for i in range(flat.shape[0]):
-        acc += (flat[i] / sflat[i]) ** 2
-    return np.sqrt(acc / flat.shape[0])
+    for r in range(rows.shape[0]):
+        for i in range(scale.shape[0]):
+            acc += (rows[r, i] / scale[i]) ** 2
+    return np.sqrt(acc / rows.size)
 
 
 @njit(cache=True, error_model="numpy")
-def _collocation(rhs, P_, S, M, L, t, y, h, Z, scale3, tol, work):
+def _collocation(rhs, P_, S, M, L, t, y, h, Z, scale, tol, work):
     """The collocation system by simplified Newton (scipy's ``solve_collocation_system``):
     Z (3, N) holds the guess on entry, the solution on exit. Returns (converged, iterations,
     rate: -1 before two iterations, inf when stage values are not finite); 3 evaluations per
@@ -200,7 +200,7 @@ def _collocation(rhs, P_, S, M, L, t, y, h, Z, scale3, tol, work):
             dW[0, i] = fr[i]
             dW[1, i] = fc[i].real
             dW[2, i] = fc[i].imag
-        dW_norm = _norm(dW, scale3)
+        dW_norm = _norm(dW, scale)
         if not np.isfinite(dW_norm):  # a singular iteration matrix
             return False, k + 1, np.inf
         if dW_norm_old >= 0.0:
@@ -252,10 +252,11 @@ def dense_coefficients(Z, F):
 
 @njit(cache=True, inline="always")
 def work(N, implicit):
-    """The stepper's buffers for N states (all empty unless ``implicit``): Jacobian, real
-    and complex LU factors and pivots, stage increments Z (3, N), a copy of the predictor,
-    Newton work (W, stage derivatives, increments, real and complex right-hand sides),
-    scratch, the previous step's start state, error. O(N^2) memory when implicit."""
+    """The stepper's buffers for N states (all empty unless ``implicit``): [0] Jacobian,
+    [1-4] real and complex LU factors and pivots, [5] stage increments Z (3, N), [6-10]
+    Newton work (W, stage derivatives, increments (3, N each), real and complex right-hand
+    sides), [11-12] scratch, [13] the previous step's start state, [14] the tolerance scale
+    atol + rtol |y|, [15] error. O(N^2) memory when implicit."""
     n = N if implicit else 0
     return (
         np.empty((n, n)),
@@ -272,7 +273,7 @@ def work(N, implicit):
         np.empty(n),
         np.empty(n),
         np.empty(n),
-        np.empty((3, n)),
+        np.empty(n),
         np.empty(n),
     )
 
@@ -336,7 +337,7 @@ def _newton(rhs, P_, S, M, L, t, y, f, h, F, tol, rw, sc, cnt):
     Jacobian when Newton fails on an old one (scipy's inner loop). Returns
     ``_collocation``'s (converged, iterations, rate); evaluations counted in cnt[0]."""
     J, LUr, pr, LUc, pc, Z = rw[0], rw[1], rw[2], rw[3], rw[4], rw[5]
-    tmp, f1, scale3 = rw[11], rw[12], rw[14]
+    tmp, f1, scale = rw[11], rw[12], rw[14]
     newton = (LUr, pr, LUc, pc, rw[6], rw[7], rw[8], rw[9], rw[10], tmp)
     while True:
         if sc[LU_VALID] == 0.0:
@@ -344,7 +345,7 @@ def _newton(rhs, P_, S, M, L, t, y, f, h, F, tol, rw, sc, cnt):
             sc[LU_VALID] = 1.0
             sc[NLU] += 1.0
         _predict(t, h, y, F, rw, sc)
-        converged, n_iter, rate = _collocation(rhs, P_, S, M, L, t, y, h, Z, scale3, tol, newton)
+        converged, n_iter, rate = _collocation(rhs, P_, S, M, L, t, y, h, Z, scale, tol, newton)
         cnt[0] += 3 * n_iter
         sc[NITER] += n_iter
         if converged or sc[CURRENT_JAC] == 1.0:
@@ -365,7 +366,7 @@ def step(
     (code, t of the step's end, the next step size): ``OK``, or ``STEP_TOO_SMALL``,
     ``BUDGET``, ``WALL`` or ``NON_FINITE`` (attempts non-finite down to the smallest step)
     with t unchanged."""
-    J, Z, tmp, f1, scale3 = rw[0], rw[5], rw[11], rw[12], rw[14]
+    J, Z, tmp, f1, scale = rw[0], rw[5], rw[11], rw[12], rw[14]
     rtol, atol, max_step = controls[0], controls[1], controls[2]
     N = y.shape[0]
     tol = max(10.0 * _EPS / rtol, min(0.03, rtol**0.5))
@@ -382,9 +383,8 @@ def step(
             return code, t, h_abs
         h = t_new - t
         h_abs = h
-        for a in range(3):
-            for i in range(N):
-                scale3[a, i] = atol + abs(y[i]) * rtol
+        for i in range(N):
+            scale[i] = atol + abs(y[i]) * rtol
         converged, n_iter, rate = _newton(rhs, P_, S, M, L, t, y, f, h, F, tol, rw, sc, cnt)
         finite = rate < np.inf
         if not converged:
