@@ -7,6 +7,8 @@
 2. The rigid two-rod latch scene (``rodval.bench.rigid_latch``, free motion before the lock):
    the bending vibration the unbent start excites (0..2e-4 s), and the steps the compiled
    Radau IIA takes over 0..0.01 s at rtol 1e-6.
+3. The switch records of "auto" on the paper chain at EI = 1e5 (tried, came back) and on the
+   reduced rigid latch (the constraint mode after the lock).
 
     OMP_NUM_THREADS=1 python benchmarks/stiffness_evidence.py
 """
@@ -77,6 +79,18 @@ def rigid_latch_vibration() -> None:
     print(f"  Radau IIA, rtol 1e-6, 0..0.01 s: {run.nsteps} steps (mean {0.01 / run.nsteps:.3g} s)")
 
 
+def switch_records() -> None:
+    """What "auto" recorded (``stats.switch``) where it tried Radau IIA and came back (paper
+    chain, EI = 1e5, full model) and where the stiffness arrives with a lock (the rigid latch,
+    reduced model)."""
+    for label, scene, model in (
+        ("paper chain, EI = 1e5, full", stiff_paper(1e5), "full"),
+        ("rigid latch, reduced", rigid_latch(), "reduced"),
+    ):
+        print(f"{label}: {simulate(scene, model).stats.switch['reason']}")
+
+
 if __name__ == "__main__":
     hairer_test()
     rigid_latch_vibration()
+    switch_records()
