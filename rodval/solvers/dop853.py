@@ -302,16 +302,16 @@ def _buffers(y0, total, n_events):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _segment_start(
-    rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper, implicit, switching
-):
+def _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper, mode):
     """The derivative at a segment's start into K[0] and the first step size (s): the given
     one (controls[3] > 0) or ``_initial_step``'s for the stepper's order; 1 or 2
     evaluations, counted in cnt[0]. ``stepper``: (Radau's work, its scalars, the switching
-    state): Radau IIA starts (``radau.start``) when ``implicit``; else, when ``switching``,
-    the spectral radius is estimated (``stiffness.spectral_radius``)."""
+    state); ``mode``: (implicit, switching): Radau IIA starts (``radau.start``) when
+    implicit; else, when switching, the spectral radius is estimated
+    (``stiffness.spectral_radius``)."""
     y, y_new, K, F, tmp = buffers[0], buffers[1], buffers[2], buffers[3], buffers[4]
     rw, sc, switch = stepper
+    implicit, switching = mode
     rhs(t, y, P, S, M, L, K[0])
     cnt[0] += 1
     if not np.all(np.isfinite(K[0])):
@@ -418,21 +418,8 @@ def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, repor
         events(t, y, P, S, M, L, E, g_old)
     for seg in range(edges.shape[0] - 1):
         t, t_bound = edges[seg], edges[seg + 1]
-        h_abs = _segment_start(
-            rhs,
-            P,
-            S,
-            M,
-            L,
-            t,
-            t_bound,
-            buffers,
-            controls,
-            cnt,
-            (rw, sc, switch),
-            implicit,
-            switching,
-        )
+        stepper, mode = (rw, sc, switch), (implicit, switching)
+        h_abs = _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper, mode)
         if not np.all(np.isfinite(K[0])):  # the derivative at an accepted state
             return n_out, cnt[0], nsteps, NON_FINITE, t
         while t < t_bound:
