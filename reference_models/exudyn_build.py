@@ -99,6 +99,7 @@ def _add_rods(mbs, scene: Scene, E: int, EA: float, initial) -> tuple[list, list
                         length=le,
                         massPerLength=float(chain.m[k]),
                         bendingStiffness=float(chain.EI[k]),
+                        bendingDamping=float(chain.bending_damping[k]),
                         axialStiffness=EA,
                     )
                 )

@@ -16,9 +16,9 @@ geometric stiffness is included), the velocity Jacobian (damping) and the constr
 there, as ``exudyn.solver.ComputeODE2Eigenvalues`` obtains them. The joints' constraints are
 eliminated on the exact 0/1 basis of ``rodval.core.eigen.coordinate_null_space`` and the
 pencils solved by ``rodval.core.eigen`` (``_eigen``: the same digits on every BLAS kernel,
-docs/modes.md); eigenvectors are mapped back to ODE2 coordinates. With hinge dampers
-(nu > 0) each undamped mode is paired with the complex eigenvalue s (Im s > 0) of nearest |s|,
-damping ratio -Re(s) / |s|.
+docs/modes.md); eigenvectors are mapped back to ODE2 coordinates. With hinge dampers or
+bending damping (``Chain.damped``) each undamped mode is paired with the complex eigenvalue
+s (Im s > 0) of nearest |s|, damping ratio -Re(s) / |s|.
 
 The measures are taken by definition from the eigenvectors, independently of the paper's
 equations: node k (k = 1..n) is the end node of rod k's beam (node 0 the pinned root), its
@@ -154,7 +154,7 @@ def exudyn_modes(
         matrices = _linear_matrices(exu, mbs)
     finally:
         exu.config.printToConsole = console
-    lam, V, s_damped, basis = _eigen(*matrices, damped=bool(np.any(scene.chain.nu > 0)))
+    lam, V, s_damped, basis = _eigen(*matrices, damped=scene.chain.damped)
     idx, state = _node_states(exu, mbs, nodes, n)
     lam, U, axial = _bending_modes(lam, V, idx, state, axial_tol, count)
     dx, dy, hinge = _node_shapes(U, state)

@@ -103,4 +103,6 @@ def run(args) -> int:
         f"t_reached = {traj.stats.t_reached:g} s, nfev = {traj.stats.nfev}, "
         f"wall = {traj.stats.wall_s:.3f} s -> {args.out}"
     )
+    for note in traj.stats.notes:
+        print(f"note: {note}")
     return 0 if traj.success else 1

@@ -43,6 +43,7 @@ class Model(ABC):
         trajectory.scene = scene
         stats = trajectory.stats
         stats.valid, stats.validity = verdict(self.validity_checks(scene, trajectory))
+        stats.notes = self.scene_notes(scene)
         return trajectory
 
     @abstractmethod
@@ -53,6 +54,12 @@ class Model(ABC):
         """The checks of this model's assumptions on a run of ``scene`` (over the output times
         it reached). By default the energy balance where the run was audited."""
         return energy_balance(trajectory.stats.energy_residual, self.energy_residual_bound)
+
+    def scene_notes(self, scene: Scene) -> list[str]:
+        """What this model leaves out of ``scene`` by its premise, one sentence each with the
+        reason (recorded in ``SolverStats.notes``, so nothing a user gives is dropped
+        silently); none by default."""
+        return []
 
     def options(self) -> dict[str, Any]:
         """Model options (recorded in ``Trajectory.options``)."""

@@ -12,7 +12,9 @@ Conventions (used throughout rodval)
   ``kappa[i]``, ``nu[i]`` belong to hinge i. The tip node n has no hinge.
 * ``mu[i]`` (kg) is the point mass at node i+1.
 * Units: m, kg, s, N, rad. ``m`` is mass per length (kg/m), ``EI`` in N m^2, ``kappa`` in
-  N m/rad, ``nu`` in N m s/rad.
+  N m/rad, ``nu`` in N m s/rad, ``bending_damping`` in N m^2 s.
+* A rod's bending moment is EI kappa_b + bending_damping dkappa_b/dt (Kelvin-Voigt material
+  damping; kappa_b the curvature, 1/m), the same law in every model (docs/model.md).
 """
 
 from __future__ import annotations
@@ -139,6 +141,19 @@ def _bounded_number(name: str, value: Any, *, positive: bool | None) -> float:
     return v
 
 
+#: ``Chain.uniform``'s values where a field is not given (the paper's example, SI units).
+UNIFORM_DEFAULTS: dict[str, float] = {
+    "l": 2.0,
+    "m": 3.0,
+    "EI": 1e5,
+    "mu": 3.0,
+    "kappa": 100.0,
+    "nu": 0.01,
+    "rest_angle": 0.0,
+    "bending_damping": 0.0,
+}
+
+
 @dataclass(frozen=True, eq=False)
 class Chain:
     """Physical data of a plane chain of n rods (see module docstring for conventions).
@@ -155,23 +170,36 @@ class Chain:
     kappa: np.ndarray
     nu: np.ndarray
     rest_angle: np.ndarray
+    bending_damping: np.ndarray
 
     #: The per-rod / per-hinge arrays, in order.
-    FIELDS = ("l", "m", "EI", "mu", "kappa", "nu", "rest_angle")
+    FIELDS = ("l", "m", "EI", "mu", "kappa", "nu", "rest_angle", "bending_damping")
 
     @classmethod
-    def uniform(
-        cls, n: int, *, l=2.0, m=3.0, EI=1e5, mu=3.0, kappa=100.0, nu=0.01, rest_angle=0.0
-    ) -> Chain:
-        """Chain of n rods; each argument is a scalar or a length-n sequence."""
+    def uniform(cls, n: int, **values: Any) -> Chain:
+        """Chain of n rods; each field (``FIELDS``) a scalar or a length-n sequence, the paper's
+        example values (``UNIFORM_DEFAULTS``) where not given."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
             raise ValueError(f"n (number of rods) must be an integer >= 1, got {n!r}")
-        return cls(l=l, m=m, EI=EI, mu=mu, kappa=kappa, nu=nu, rest_angle=rest_angle, _n=int(n))
+        check_keys(values, cls.FIELDS, "Chain.uniform", noun="field")
+        return cls(**{**UNIFORM_DEFAULTS, **values}, _n=int(n))
 
-    def __init__(self, l, m, EI, mu, kappa, nu, rest_angle=0.0, _n: int | None = None):
+    def __init__(
+        self,
+        l,
+        m,
+        EI,
+        mu,
+        kappa,
+        nu,
+        rest_angle=0.0,
+        bending_damping=0.0,
+        _n: int | None = None,
+    ):
         n = _n
         if n is None:
-            sizes = [np.size(v) for v in (l, m, EI, mu, kappa, nu, rest_angle) if np.ndim(v) > 0]
+            given = (l, m, EI, mu, kappa, nu, rest_angle, bending_damping)
+            sizes = [np.size(v) for v in given if np.ndim(v) > 0]
             n = sizes[0] if sizes else 1
         if n < 1:
             raise ValueError(f"n (number of rods) must be >= 1, got {n}")
@@ -188,10 +216,23 @@ class Chain:
             "rest_angle",
             _as_rod_array("rest_angle (hinge rest angle, rad)", rest_angle, n, positive=None),
         )
+        set_(
+            self,
+            "bending_damping",
+            _as_rod_array(
+                "bending_damping (rod bending damping, N m^2 s)", bending_damping, n, positive=False
+            ),
+        )
 
     @property
     def n(self) -> int:
         return self.l.shape[0]
+
+    @property
+    def damped(self) -> bool:
+        """Whether any hinge damper or rod bending damping acts (the models skip the damping
+        terms otherwise)."""
+        return bool(np.any(self.nu > 0) or np.any(self.bending_damping > 0))
 
     def as_dict(self) -> dict[str, list[float]]:
         return {k: getattr(self, k).tolist() for k in self.FIELDS}

@@ -44,6 +44,10 @@ class SolverStats:
     #: Radau IIA (``rodval.solvers.dop853.SWITCHING_STEPPER``): {"to", "t" (s), "h_lambda",
     #: "h" (s), "reason"}; None when it did not switch.
     switch: dict[str, Any] | None = None
+    #: What the model did not take from the scene, one sentence each with the reason (e.g. the
+    #: reduced model's quasi-static bending has no bending rates for the rods' bending
+    #: damping to act on): ``rodval.core.contract.Model.scene_notes``.
+    notes: list[str] = field(default_factory=list)
 
     def __setattr__(self, name: str, value: Any) -> None:
         if name == "status":
@@ -71,6 +75,7 @@ class SolverStats:
             "valid": self.valid,
             "validity": [dict(c) for c in self.validity],
             "switch": None if self.switch is None else dict(self.switch),
+            "notes": list(self.notes),
         }
 
 

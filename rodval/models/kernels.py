@@ -33,13 +33,14 @@ from rodval.core.loads import load_sums
 from rodval.solvers.signature import RHS_SIGNATURE
 
 # Rows of V (per-rod vectors). Shared by both models.
-V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST = range(8)
+V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB = range(9)
 # Full model only: Schur-complement constants per rod (see full_constants).
-V_PA, V_PB, V_AP, V_BP, V_AA, V_AB, V_EPS, V_PI, V_RHO, V_TAU = range(8, 18)
+V_PA, V_PB, V_AP, V_BP, V_AA, V_AB, V_EPS, V_PI, V_RHO, V_TAU = range(9, 19)
 
 
 def _rows(cc, chain) -> list[np.ndarray]:
-    """The rows V_L .. V_REST shared by every kernel (and by reduced_banded's constants)."""
+    """The rows V_L .. V_CB shared by every kernel (and by reduced_banded's constants); V_KB
+    = 4 EI/l (N m) and V_CB = 4 bending_damping/l (N m s), see paper_matrices.bending_blocks."""
     return [
         cc.l,
         cc.outer_mass,
@@ -49,6 +50,7 @@ def _rows(cc, chain) -> list[np.ndarray]:
         chain.nu,
         4.0 * chain.EI / chain.l,
         chain.rest_angle,
+        4.0 * chain.bending_damping / chain.l,
     ]
 
 
@@ -225,7 +227,8 @@ def _schur_solve(V, c, s, r, x):
 @njit(cache=True)
 def _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
     """f = [Q; 0; 0] - h - C q' - K q + A^T kappa rest of the full model (N m) into fp, fa, fb
-    (zeroed here), O(n)."""
+    (zeroed here), O(n). C q' (hinge dampers and the rods' bending damping) only when
+    ``damped``."""
     n = V.shape[1]
     q, v = y[: 3 * n], y[3 * n :]
     phi, alpha, beta = q[:n], q[n : 2 * n], q[2 * n :]
@@ -236,10 +239,13 @@ def _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
     _hinge_forces(V, phi, alpha, beta, V_KAPPA, fp, fa, fb)
     if damped:
         _hinge_forces(V, dphi, dalpha, dbeta, V_NU, fp, fa, fb)
-    kb = V[V_KB]
+    kb, cb = V[V_KB], V[V_CB]
     for k in range(n):
         fa[k] += kb[k] * (alpha[k] + 0.5 * beta[k])
         fb[k] += kb[k] * (0.5 * alpha[k] + beta[k])
+        if damped and cb[k] != 0.0:
+            fa[k] += cb[k] * (dalpha[k] + 0.5 * dbeta[k])
+            fb[k] += cb[k] * (0.5 * dalpha[k] + dbeta[k])
         fp[k] = -fp[k]
         fa[k] = -fa[k]
         fb[k] = -fb[k]
@@ -349,17 +355,20 @@ def _load_power(V, c, s, dphi, L, t):
 
 @njit(cache=True)
 def _damper_power(V, S, dphi, dalpha, dbeta):
-    """sum_k nu_k (dD_k/dt)^2 (W), dD_k/dt = phi'_k + alpha'_k - phi'_{k-1} - beta'_{k-1}
-    (the hinge rates, ``rodval.core.scene.hinge_angles`` of the rates); 0 unless S[0] (the
+    """q'^T C q' = sum_k nu_k (dD_k/dt)^2 + sum_k cb_k (a'^2 + a' b' + b'^2) (W), dD_k/dt =
+    phi'_k + alpha'_k - phi'_{k-1} - beta'_{k-1} (the hinge rates,
+    ``rodval.core.scene.hinge_angles`` of the rates), cb = 4 bending_damping/l on the bending
+    rates a' = alpha'_k, b' = beta'_k (``paper_matrices.damper_power``); 0 unless S[0] (the
     damped flag). O(n)."""
     if S[0] == 0.0:
         return 0.0
-    nu = V[V_NU]
+    nu, cb = V[V_NU], V[V_CB]
     p = 0.0
     left = 0.0
     for k in range(dphi.shape[0]):
         rate = dphi[k] + dalpha[k] - left
         p += nu[k] * rate * rate
+        p += cb[k] * (dalpha[k] * dalpha[k] + dalpha[k] * dbeta[k] + dbeta[k] * dbeta[k])
         left = dphi[k] + dbeta[k]
     return p
 

@@ -180,19 +180,26 @@ def hinge_matrix(n: int) -> np.ndarray:
     return A
 
 
+def bending_blocks(coefficient: np.ndarray, l: np.ndarray, n: int) -> np.ndarray:
+    """(4 c/l) [[1, 1/2], [1/2, 1]] on each rod's (alpha_k, beta_k) (3n, 3n; zero elsewhere):
+    the cubic shape's integral of c kappa_b^2 over the rod, 1/2 x^T B x = (2 c/l)(a^2 + a b +
+    b^2). c = EI gives the bending stiffness (N m), c = bending_damping the Kelvin-Voigt
+    damping (N m s) on the bending rates."""
+    B = np.zeros((3 * n, 3 * n))
+    kb = 4.0 * coefficient / l
+    d = np.arange(n)
+    B[n + d, n + d] = kb
+    B[2 * n + d, 2 * n + d] = kb
+    B[n + d, 2 * n + d] = kb / 2.0
+    B[2 * n + d, n + d] = kb / 2.0
+    return B
+
+
 def stiffness_matrix(chain: Chain) -> np.ndarray:
     """K = Hessian of Pi (3n, 3n): hinge springs A^T diag(kappa) A plus bending blocks
     (4 EI/l) [[1, 1/2], [1/2, 1]] on (alpha_k, beta_k)."""
-    n = chain.n
-    A = hinge_matrix(n)
-    K = A.T @ (chain.kappa[:, None] * A)
-    kb = 4.0 * chain.EI / chain.l
-    d = np.arange(n)
-    K[n + d, n + d] += kb
-    K[2 * n + d, 2 * n + d] += kb
-    K[n + d, 2 * n + d] += kb / 2.0
-    K[2 * n + d, n + d] += kb / 2.0
-    return K
+    A = hinge_matrix(chain.n)
+    return A.T @ (chain.kappa[:, None] * A) + bending_blocks(chain.EI, chain.l, chain.n)
 
 
 def rest_forces(chain: Chain) -> np.ndarray:
@@ -242,15 +249,19 @@ def quasi_static_bending(chain: Chain, phi: np.ndarray) -> np.ndarray:
 
 
 def damper_power(chain: Chain, dphi: np.ndarray, dalpha: np.ndarray, dbeta: np.ndarray) -> float:
-    """P_diss = sum_k nu_k (dD_k/dt)^2 >= 0 (W), O(n)."""
+    """P_diss = q'^T C q' = sum_k nu_k (dD_k/dt)^2 + sum_k (4 c_k/l_k)(a'^2 + a' b' + b'^2)
+    >= 0 (W; c = bending_damping, a', b' the bending rates alpha'_k, beta'_k), O(n)."""
     rates = hinge_angles(dphi, dalpha, dbeta)
-    return float(np.sum(chain.nu * rates * rates))
+    cb = 4.0 * chain.bending_damping / chain.l
+    bending = cb * (dalpha * dalpha + dalpha * dbeta + dbeta * dbeta)
+    return float(np.sum(chain.nu * rates * rates) + np.sum(bending))
 
 
 def damping_matrix(chain: Chain) -> np.ndarray:
-    """C = Hessian of the dissipation function, A^T diag(nu) A (3n, 3n)."""
+    """C = Hessian of the dissipation function (3n, 3n): the hinge dampers A^T diag(nu) A plus
+    the rods' Kelvin-Voigt blocks (4 c/l) [[1, 1/2], [1/2, 1]] on (alpha'_k, beta'_k)."""
     A = hinge_matrix(chain.n)
-    return A.T @ (chain.nu[:, None] * A)
+    return A.T @ (chain.nu[:, None] * A) + bending_blocks(chain.bending_damping, chain.l, chain.n)
 
 
 def generalized_forces(

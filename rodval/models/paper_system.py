@@ -79,7 +79,7 @@ class PaperSystem(OdeSystem):
         self.n = chain.n
         self.l = chain.l
         self.cc = chain_constants(chain, coefficients)
-        self.damped = bool(np.any(chain.nu > 0))
+        self.damped = chain.damped
         self.loads = LoadSet(scene.loads, chain.n)
         self.initial = scene.initial.resolve(chain.n)
         self.latches = tuple(scene.latches)
@@ -360,7 +360,7 @@ class PaperSystem(OdeSystem):
         self.chain = base.with_(kappa=kappa, nu=nu, rest_angle=rest)
         for name in ("K", "C", "rest", "_dense"):
             self.__dict__.pop(name, None)
-        self.damped = bool(np.any(nu > 0))
+        self.damped = self.chain.damped
         if self.kernel == "numba" and hasattr(self, "V"):
             self.V[:] = self.kernel_constants()
             self._flags[0] = 1.0 if self.damped else 0.0

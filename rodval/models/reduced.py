@@ -311,9 +311,33 @@ class ReducedSystem(PaperSystem):
         return gamma[:, :n], gamma[:, n:], zeros, zeros
 
 
+#: The initial-state entries of the bending coordinates (the full model's alone).
+BENDING_STATE = ("alpha", "beta", "dalpha", "dbeta")
+
+
 class ReducedModel(PaperModel):
     """Reduced model (n ODEs). ``coefficients``: "printed" (default) or "published"."""
 
     name = "reduced"
     system_class = ReducedSystem
     MODAL_ANALYSIS = "rodval.models.linear_modes:reduced_modes"
+
+    def scene_notes(self, scene: Scene) -> list[str]:
+        """The scene data the quasi-static bending has nowhere to put: the rods' bending
+        damping (it acts on bending rates, which the model drops with the bending inertia and
+        the hinge dampers' bending-rate part, docs/model.md) and initial bending angles or
+        rates (the bending follows phi)."""
+        notes = []
+        c = scene.chain.bending_damping
+        if np.any(c > 0):
+            notes.append(
+                f"bending_damping (up to {float(c.max()):g} N m^2 s) has no effect in the reduced "
+                "model: its bending is quasi-static, without bending rates to damp"
+            )
+        given = [k for k in BENDING_STATE if getattr(scene.initial, k) is not None]
+        if any(np.any(np.asarray(getattr(scene.initial, k)) != 0) for k in given):
+            notes.append(
+                "initial alpha, beta, dalpha, dbeta are not used by the reduced model: its "
+                "bending is quasi-static, set by phi"
+            )
+        return notes

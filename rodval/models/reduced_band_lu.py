@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 from rodval.models.kernels import (
+    V_CB,
     V_KAPPA,
     V_KB,
     V_L,
@@ -38,7 +39,7 @@ from rodval.models.kernels import (
 
 # Rows of Cst: the first rows are laid out like kernels.V (so that the kernels' O(n) helpers
 # read them), then the bending-row diagonals and the equilibration scales.
-_BASE = max(V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST) + 1
+_BASE = max(V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB) + 1
 C_AP, C_BP = _BASE, _BASE + 1
 #: first of 7 rows of row scales (one per local equation) and of 7 rows of column scales
 C_RSCALE = _BASE + 2
