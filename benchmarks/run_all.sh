@@ -16,4 +16,5 @@ $PY benchmarks/study_overhead.py studies/scale_study.toml --out "$OUT/study_over
 $PY -m rodval bench fast-path --out "$OUT/fast_path"
 $PY -m rodval bench stiffness --out "$OUT/stiffness"
 $PY benchmarks/stiffness_evidence.py
+$PY benchmarks/rigid_lock_scale.py
 $PY benchmarks/subnormal_cost.py --reduced-only 128 1024 8192 32768

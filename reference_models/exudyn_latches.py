@@ -10,6 +10,7 @@ import numpy as np
 from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, _hermite, _wrap, stop_moment
 from reference_models.exudyn_build import _Built
 from reference_models.exudyn_guard import _Guard
+from rodval.core.rigid import rigid_lock
 from rodval.core.scene import Scene
 
 #: Steps after the activation step at which a lock's "after" state is taken (the index-3
@@ -150,11 +151,15 @@ class _Latches:
         h = np.bincount(self.rod_of, self.w * (x * vy - y * vx), n)
         return np.stack([px, py], -1), h
 
-    def _chord_rate(self, j: int, q, v) -> float:
-        """d(phi)/dt of rod j (0-based): (d x d') / |d|^2, d the chord vector."""
+    def _chord(self, j: int, q, v) -> tuple[float, float]:
+        """Angle (rad, in (-pi, pi]) and rate d(phi)/dt = (d x d') / |d|^2 (rad/s) of rod j's
+        chord (0-based; d the vector from its root node to its end node)."""
         a, b = self.ltg[j][0][:2], self.ltg[j][self.E][:2]
         d, dd = q[b] - q[a], v[b] - v[a]
-        return float((d[0] * dd[1] - d[1] * dd[0]) / (d @ d))
+        return math.atan2(d[1], d[0]), float((d[0] * dd[1] - d[1] * dd[0]) / (d @ d))
+
+    def _chord_rate(self, j: int, q, v) -> float:
+        return self._chord(j, q, v)[1]
 
     def _root_moment(self, j: int, q) -> float:
         """EI kappa_b (N m) at the root of rod j (0-based): the moment the hinge there
@@ -257,6 +262,10 @@ class _Latches:
             item["state"] = "locking"
             self.lock_times[item["k"]] = t0
             before = self._measures(t0, item, q, v, a)
+            # the chords just before the lock and the hinges held after it: the rigid-panel
+            # lock's data (rodval.core.rigid)
+            before["chords"] = np.array([self._chord(j, q, v) for j in range(self.scene.n)])
+            before["held"] = [it["k"] for it in self.items if it["state"] != "armed"]
             self.pending.append(
                 {
                     "item": item,
@@ -288,7 +297,7 @@ class _Latches:
         else:
             frac = last["rel"] / (last["rel"] - now["rel"]) if last["rel"] != now["rel"] else 1.0
             frac = min(max(frac, 0.0), 1.0)
-            after = {key: last[key] + frac * (now[key] - last[key]) for key in last}
+            after = {key: last[key] + frac * (now[key] - last[key]) for key in now}
             closed = True
             # the integral holds the whole last step: take back the part beyond the crossing
             h = now["t"] - last["t"]
@@ -299,6 +308,8 @@ class _Latches:
         impulse = after["H_out"] - before["H_out"] - ev["integral"]
         root_jump = after["H_root"] - before["H_root"] - ev["root_integral"]
         latch = item["latch"]
+        chords = before["chords"]
+        rigid = rigid_lock(self.scene.chain, chords[:, 0], chords[:, 1], before["held"], item["k"])
         self.events.append(
             {
                 "t": float(ev["t_lock"]),
@@ -318,6 +329,7 @@ class _Latches:
                 "lock_duration": float(after["t"] - before["t"]),
                 "window_closed": closed,
                 "step": float(ev["step"]),
+                **rigid,
             }
         )
         item["state"] = "locked"

@@ -142,16 +142,9 @@ def _bounded_number(name: str, value: Any, *, positive: bool | None) -> float:
 
 
 #: ``Chain.uniform``'s values where a field is not given (the paper's example, SI units).
-UNIFORM_DEFAULTS: dict[str, float] = {
-    "l": 2.0,
-    "m": 3.0,
-    "EI": 1e5,
-    "mu": 3.0,
-    "kappa": 100.0,
-    "nu": 0.01,
-    "rest_angle": 0.0,
-    "bending_damping": 0.0,
-}
+UNIFORM_DEFAULTS: dict[str, float] = dict(
+    l=2.0, m=3.0, EI=1e5, mu=3.0, kappa=100.0, nu=0.01, rest_angle=0.0, bending_damping=0.0
+)
 
 
 @dataclass(frozen=True, eq=False)

@@ -11,6 +11,7 @@ import numpy as np
 
 from rodval.core.checks import check_choice
 from rodval.core.loads import LOAD_COLUMNS, LoadSet, load_table
+from rodval.core.rigid import rigid_lock
 from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
@@ -208,8 +209,7 @@ class PaperSystem(OdeSystem):
         raise NotImplementedError
 
     def max_bending(self, times: np.ndarray, Y: np.ndarray) -> float | None:
-        """max |alpha|, |beta| (rad) over the states Y (the reduced model recovers them, O(n)
-        per state)."""
+        """max |alpha|, |beta| (rad) over the states Y (the reduced model's: O(n) per state)."""
         largest = 0.0
         for t, y in zip(times, Y):
             with self._mode_at(t):  # the mode (locked hinges, stops) in effect at t
@@ -514,9 +514,12 @@ class PaperSystem(OdeSystem):
         """The state after the plastic lock of the latches ``new`` with ``locked`` (all held
         after it) and the event's data: angular impulses (N m s, on the outboard rod k+1,
         counter-clockwise positive: the convention of every model's event records), joint
-        linear impulses (N s), kinetic energy before and after (J)."""
+        linear impulses (N s), kinetic energy before and after (J), and the rigid-panel lock
+        of the chords before it (``rodval.core.rigid.rigid_lock``)."""
         hinges = np.array([self.latches[j].hinge for j in locked], dtype=np.int64)
         angles = np.array([self.latches[j].angle for j in locked])
+        phi, dphi = (a[0] for a in self.rigid(y[None, :]))
+        rigid = rigid_lock(self.base_chain, phi, dphi, hinges.tolist(), int(hinges[-len(new)]))
         T0 = self.kinetic_energy(t, y)
         P0 = self.momenta(y)
         y_new, mu = self.plastic_jump(y, hinges, angles)
@@ -533,6 +536,7 @@ class PaperSystem(OdeSystem):
             "root_impulse": S[0].tolist(),
             "kinetic_before": T0,
             "kinetic_after": T1,
+            **rigid,
         }
 
     def momenta(self, y: np.ndarray) -> np.ndarray:

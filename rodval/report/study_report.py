@@ -35,6 +35,8 @@ EVENT_REPORT_COLUMNS = (
     "label",
     "t",
     "angular_impulse",
+    "rigid_impulse",
+    "impulse_to_rigid",
     "kinetic_before",
     "kinetic_after",
     "energy_lost",
@@ -62,9 +64,20 @@ def read_events(out: Path) -> pd.DataFrame:
 def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
     """Each model's events against the reference's event of the same case and label: lock
     time difference dt (s, model - reference), angular impulse difference and its ratio to
-    the reference's |impulse| (impulse_rel), energy_lost difference (J). Events the reference
+    the reference's |impulse| (impulse_rel), the same ratio of the rigid-panel impulses
+    (rigid_rel, where recorded), energy_lost difference (J). Events the reference
     lacks (or the model lacks) are listed with blanks."""
-    cols = ["case", "label", "model", "reference", "dt", "impulse_abs", "impulse_rel", "dE_lost"]
+    cols = [
+        "case",
+        "label",
+        "model",
+        "reference",
+        "dt",
+        "impulse_abs",
+        "impulse_rel",
+        "rigid_rel",
+        "dE_lost",
+    ]
     if events.empty:
         return pd.DataFrame(columns=cols)
     ref = events[events["model"] == reference].set_index(["case", "label"])
@@ -85,6 +98,9 @@ def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
                 d = float(ev["angular_impulse"]) - float(r["angular_impulse"])
                 row["impulse_abs"] = d
                 row["impulse_rel"] = abs(d) / abs(float(r["angular_impulse"]))
+            if "rigid_impulse" in events:
+                d = float(ev["rigid_impulse"]) - float(r["rigid_impulse"])
+                row["rigid_rel"] = abs(d) / abs(float(r["rigid_impulse"]))
             if "energy_lost" in events:
                 row["dE_lost"] = float(ev["energy_lost"]) - float(r["energy_lost"])
         rows.append(row)
@@ -160,7 +176,13 @@ def _deployment_section(
         "after the lock and their difference (J); exudyn adds the lock window's peak hinge "
         "moment (N m), its duration (s) and the jump of the angular momentum about the root "
         "through it (N m s; an internal impulse leaves it unchanged). See docs/deployment.md "
-        "for how each model measures them.\n",
+        "for how each model measures them. **The models' angular impulses are different "
+        "quantities**: the full model's is its instantaneous plastic impulse on the end "
+        "tangents, the reduced model's on the chords, exudyn's the reaction over its lock "
+        "window. `rigid_impulse` is the same quantity in every model: the plastic lock of "
+        "rigid rods with the model's chord angles and rates just before the lock "
+        "(`rodval.core.rigid`); `impulse_to_rigid` is each model's own impulse over it (1 in "
+        "the rigid-panel limit).\n",
         to_markdown(events[[c for c in EVENT_REPORT_COLUMNS if c in events]], ".5g"),
     ]
     silent = [lab for lab in labels if not (events["model"] == lab).any()]
@@ -172,8 +194,9 @@ def _deployment_section(
     disc = event_discrepancies(events, ref)
     if not disc.empty:
         lines += [
-            f"Lock discrepancies against `{ref}` (dt in s, impulse_rel = |dS| / |S_ref|, "
-            "dE_lost in J):\n",
+            f"Lock discrepancies against `{ref}` (dt in s, impulse_rel = |dS| / |S_ref| of the "
+            "models' own impulses, rigid_rel = the same of the rigid-panel impulses, the "
+            "comparable one; dE_lost in J):\n",
             to_markdown(disc, ".3g"),
         ]
     peaks = peak_hinge_moments(tables["trajectories"], events)

@@ -9,7 +9,9 @@
   status, message.
 
 * ``events``: case, n, horizon, axes, model, then one row per state event of a run
-  (``Trajectory.events``: t (s), label, hinge, angular_impulse (N m s), kinetic_before,
+  (``Trajectory.events``: t (s), label, hinge, angular_impulse (N m s), rigid_impulse (N m s,
+  the rigid-panel lock of the model's chords, ``rodval.core.rigid``), impulse_to_rigid =
+  angular_impulse / rigid_impulse, kinetic_before,
   kinetic_after (J), energy_lost = kinetic_before - kinetic_after (J), and every further key
   a model records, e.g. exudyn's lock_duration, angular_momentum_root_jump). Written only when
   some run has events.
@@ -133,6 +135,8 @@ EVENT_COLUMNS = (
     "label",
     "hinge",
     "angular_impulse",
+    "rigid_impulse",
+    "impulse_to_rigid",
     "kinetic_before",
     "kinetic_after",
     "energy_lost",
@@ -150,6 +154,8 @@ def events_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFram
                 before, after = ev.get("kinetic_before"), ev.get("kinetic_after")
                 if isinstance(before, (int, float)) and isinstance(after, (int, float)):
                     row["energy_lost"] = before - after
+                if ev.get("rigid_impulse") and "angular_impulse" in ev:
+                    row["impulse_to_rigid"] = ev["angular_impulse"] / ev["rigid_impulse"]
                 rows.append(row)
     lead = [*(_case_columns(records[0], axes) if records else {}), "model", *EVENT_COLUMNS]
     extra = [c for c in dict.fromkeys(k for row in rows for k in row) if c not in lead]
