@@ -32,8 +32,12 @@ curve (dphi, dalpha, dbeta).
 
 Solver: exudyn's implicit generalized-alpha (or trapezoidal index-2) integrator with a fixed
 step (halved, down to step/64, only if Newton fails), sparse linear solver (EigenSparse), no
-solution files, no graphics and no console output. Newton's absolute tolerance is ``newton_atol_per_EA * EA``
-(N): the default absolute tolerance lies below the round-off of the stiff axial forces.
+solution files, no graphics and no console output. Newton's absolute tolerance is
+``newton_atol_per_EA * EA`` (N): the default absolute tolerance lies below the round-off of the
+stiff axial forces. With latches the (modified) Newton Jacobian is renewed every step: a
+Jacobian kept from before a latch's joint was switched on leaves the joint without effect
+until Newton restarts (0.17 ms late on the two-rod scene of tests/test_rigid_lock.py, the
+hinge passing its latch angle by 3.7 mrad).
 rodval's native integrator settings are refused unless at their defaults (``check_settings``;
 ``blowup_factor`` applies). Before every step ``_Guard`` checks the state: non-finite
 (STATUS_DIVERGED), kinetic energy above blowup_factor x (E(0) + W+ + 1e-6 J) (STATUS_BLOWUP),
@@ -203,9 +207,10 @@ class ExudynModel(Model):
         """The beam model of ``scene`` with this model's discretization (``build``)."""
         return build(scene, self.elements, self.EA)
 
-    def _settings(self, t_end: float):
+    def _settings(self, scene: Scene):
         import exudyn as exu
 
+        t_end = scene.t_end
         s = exu.SimulationSettings()
         ti = s.timeIntegration
         nsteps = max(1, math.ceil(t_end / self.step - 1e-9))
@@ -219,6 +224,7 @@ class ExudynModel(Model):
         ti.verboseModeFile = 0
         ti.newton.relativeTolerance = self.newton_rtol
         ti.newton.absoluteTolerance = self.newton_atol_per_EA * self.EA
+        ti.newton.modifiedNewtonJacUpdatePerStep = bool(scene.latches)
         ti.generalizedAlpha.spectralRadius = self.spectral_radius
         s.solution.file.write = False
         s.solution.sensors.writePeriod = 0.25 * t_end / nsteps
@@ -284,7 +290,7 @@ class ExudynModel(Model):
         run_info: dict[str, Any] = {"blowup_factor": factor}
         try:
             built = self._build(scene)
-            sim = self._settings(scene.t_end)
+            sim = self._settings(scene)
             guard = _Guard(built, scene, self.elements, self.EA, factor, self.max_rotation_per_step)
         except Exception as exc:  # noqa: BLE001 - a failed build is data
             status, message = numerical_failure(exc, 0.0) or (

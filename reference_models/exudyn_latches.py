@@ -10,6 +10,7 @@ import numpy as np
 from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, _hermite, _wrap, stop_moment
 from reference_models.exudyn_build import _Built
 from reference_models.exudyn_guard import _Guard
+from rodval.core.lock_window import lock_window
 from rodval.core.rigid import rigid_lock
 from rodval.core.scene import Scene
 
@@ -33,14 +34,16 @@ class _Latches:
     two states when D is already past (bracketed between steps either way).
 
     Measures of each lock, on the beam solution: the kinetic energy v^T M v / 2 of the whole
-    chain (consistent mass), the angular momentum about the root (node 0) and the angular
-    momentum H_k of the outboard part (rods k+1..n and their node masses) about the hinge node
-    k, just before the activation step and ``LOCK_SETTLE_STEPS`` steps after it. The angular
-    impulse of the latch on the outboard part is
-    S = H_k(after) - H_k(before) - int M_k dt, with M_k the finite moments on the outboard part
-    about the moving hinge node (hinge k's spring, damper and stops, the outboard loads, and
-    -v_P x p of the moving reference point), integrated by the trapezoid rule: the jump of the
-    relative angular momentum (N m s, counter-clockwise positive on rod k+1)."""
+    chain (consistent mass) just before the activation step and ``LOCK_SETTLE_STEPS`` steps
+    after it, the angular momentum about the root (node 0) and the angular momentum H_k of the
+    outboard part (rods k+1..n and their node masses) about the hinge node k. The latch's
+    cumulative angular impulse on the outboard part is
+    S(tau) = H_k(tau) - H_k(before) - int M_k dt, with M_k the finite moments on the outboard
+    part about the moving hinge node (hinge k's spring, damper and stops, the outboard loads,
+    and -v_P x p of the moving reference point), integrated by the trapezoid rule (N m s,
+    counter-clockwise positive on rod k+1). The reported ``impulse`` is its mean over the lock
+    window [t_lock, t_lock + w] (``rodval.core.lock_window``, the same window and measure as
+    the native models'), by the trapezoid rule on the steps."""
 
     def __init__(self, built: _Built, guard: _Guard, scene: Scene, E: int):
         self.mbs, self.guard, self.scene, self.E = built.mbs, guard, scene, E
@@ -227,19 +230,7 @@ class _Latches:
             item["D"] = D
             now[item["k"]] = (D, dD, ddD)
         for ev in list(self.pending):
-            ev["steps"] += 1
-            now_m = self._measures(t0, ev["item"], q, v, a)
-            last = ev["last"]
-            ev["integral"] += 0.5 * (now_m["t"] - last["t"]) * (last["finite"] + now_m["finite"])
-            ev["root_integral"] += (
-                0.5 * (now_m["t"] - last["t"]) * (last["root_moment"] + now_m["root_moment"])
-            )
-            ev["peak"] = max(ev["peak"], abs(now_m["M_beam"]))
-            s0 = np.sign(ev["before"]["rel"])
-            if ev["steps"] > LOCK_SETTLE_STEPS and np.sign(now_m["rel"]) != s0:
-                self._finish(ev, last, now_m)
-            else:
-                ev["last"] = now_m
+            self._advance(ev, self._measures(t0, ev["item"], q, v, a))
         for item in self.items:
             if item["state"] != "armed":
                 continue
@@ -270,43 +261,60 @@ class _Latches:
                 {
                     "item": item,
                     "t_lock": t_lock,
+                    "window": lock_window(self.scene.chain, item["latch"]),
                     "steps": 0,
                     "before": before,
                     "last": before,
+                    "settled": None,
                     "integral": 0.0,
                     "root_integral": 0.0,
+                    "S": 0.0,
+                    "mean": 0.0,
                     "peak": abs(before["M_beam"]),
                     "step": h,
                 }
             )
         self.prev = {"t": t0, "D": now}
 
-    def close(self) -> None:
-        """At the end of the run: locks whose window has not closed are recorded with the
-        last state (``window_closed`` False)."""
-        for ev in list(self.pending):
-            self._finish(ev, ev["last"], None)
+    def _advance(self, ev: dict, now: dict) -> None:
+        """One accepted step of a lock's window: the trapezoid integrals of the finite moments
+        and of S(tau) = H_out(tau) - H_out(before) - int finite (linear between the steps,
+        over the part of the step inside [t_lock, t_lock + w]; in the activation step, whose
+        constraint takes the impact, S is its value at the step's end from t_lock on: the
+        plastic part is at t_lock, as in the native models); the window closes on the
+        first step that reaches its end."""
+        last = ev["last"]
+        ev["steps"] += 1
+        h = now["t"] - last["t"]
+        ev["integral"] += 0.5 * h * (last["finite"] + now["finite"])
+        ev["root_integral"] += 0.5 * h * (last["root_moment"] + now["root_moment"])
+        ev["peak"] = max(ev["peak"], abs(now["M_beam"]))
+        S1 = now["H_out"] - ev["before"]["H_out"] - ev["integral"]
+        # the activation step holds the impact: S jumps at t_lock, not along the step
+        S0 = S1 if ev["steps"] == 1 else ev["S"]
+        lo, hi = max(last["t"], ev["t_lock"]), min(now["t"], ev["t_lock"] + ev["window"])
+        if hi > lo and h > 0:
+            f0, f1 = (lo - last["t"]) / h, (hi - last["t"]) / h
+            ev["mean"] += 0.5 * (hi - lo) * (2 * S0 + (f0 + f1) * (S1 - S0))
+        ev["S"], ev["last"] = S1, now
+        if ev["steps"] == LOCK_SETTLE_STEPS:
+            ev["settled"] = now
+        if now["t"] >= ev["t_lock"] + ev["window"]:
+            self._finish(ev, closed=True)
 
-    def _finish(self, ev: dict, last: dict, now: dict | None) -> None:
-        """Record a lock. The lock window ends where the relative chord rate of the two rods
-        (d phi_{k+1}/dt - d phi_k/dt) first reaches zero after the activation (linear
-        interpolation between ``last`` and ``now``; the last state if it never does)."""
-        item, before = ev["item"], ev["before"]
-        if now is None:
-            after, frac, closed = last, 0.0, False
-        else:
-            frac = last["rel"] / (last["rel"] - now["rel"]) if last["rel"] != now["rel"] else 1.0
-            frac = min(max(frac, 0.0), 1.0)
-            after = {key: last[key] + frac * (now[key] - last[key]) for key in now}
-            closed = True
-            # the integral holds the whole last step: take back the part beyond the crossing
-            h = now["t"] - last["t"]
-            ev["integral"] -= 0.5 * (1 - frac) * h * (after["finite"] + now["finite"])
-            ev["root_integral"] -= (
-                0.5 * (1 - frac) * h * (after["root_moment"] + now["root_moment"])
-            )
-        impulse = after["H_out"] - before["H_out"] - ev["integral"]
-        root_jump = after["H_root"] - before["H_root"] - ev["root_integral"]
+    def close(self) -> None:
+        """At the end of the run: locks whose window has not closed are recorded over the part
+        reached (``window_closed`` False)."""
+        for ev in list(self.pending):
+            self._finish(ev, closed=False)
+
+    def _finish(self, ev: dict, closed: bool) -> None:
+        """Record a lock: the impulse is the window mean of S(tau) (``lock_window``); the
+        kinetic energy after it is taken ``LOCK_SETTLE_STEPS`` steps after the activation,
+        the root's angular momentum jump over the whole window."""
+        item, before, last = ev["item"], ev["before"], ev["last"]
+        settled = ev["settled"] or last
+        root_jump = last["H_root"] - before["H_root"] - ev["root_integral"]
         latch = item["latch"]
         chords = before["chords"]
         rigid = rigid_lock(self.scene.chain, chords[:, 0], chords[:, 1], before["held"], item["k"])
@@ -316,18 +324,18 @@ class _Latches:
                 "label": f"latch hinge {latch.hinge}",
                 "hinge": int(latch.hinge),
                 "angle": float(latch.angle),
-                "angular_impulse": float(impulse),
+                "impulse": float(ev["mean"] / ev["window"]),
+                "impulse_window": float(ev["window"]),
+                "window_closed": closed,
                 "kinetic_before": float(before["T"]),
-                "kinetic_after": float(after["T"]),
+                "kinetic_after": float(settled["T"]),
                 "rate_before": float(before["dD"]),
                 "chord_rate_before": float(before["rel"]),
                 "angular_momentum_root_before": float(before["H_root"]),
-                "angular_momentum_root_after": float(after["H_root"]),
+                "angular_momentum_root_after": float(last["H_root"]),
                 "angular_momentum_root_jump": float(root_jump),
                 "peak_moment": float(ev["peak"]),
                 "t_activated": float(before["t"]),
-                "lock_duration": float(after["t"] - before["t"]),
-                "window_closed": closed,
                 "step": float(ev["step"]),
                 **rigid,
             }

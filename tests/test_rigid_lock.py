@@ -109,30 +109,32 @@ def two_rod_latch(EI: float) -> Scene:
 
 
 def test_every_native_lock_record_carries_the_rigid_impulse():
-    """At EI = 1e7 the reduced model's own plastic impulse is the rigid one to 5e-6 (falling as
-    1/EI: its hinge rate c_k differs from the chords' by the bending compliance; bound 1e-4);
-    the full model's own impulse acts on the end tangents and is a different quantity (0.17
-    against 22 N m s, docs/deployment_native.md), but its rigid_impulse, from its chords, is
-    within 1e-3 of the reduced model's (measured 5e-4: the chord rates carry the full model's
-    bending vibration)."""
+    """At EI = 1e7 (undamped) the reduced model's lock impulse is the rigid one to 5e-6
+    (falling as 1/EI: its hinge rate c_k differs from the chords' by the bending compliance;
+    bound 1e-4); the full model's rigid_impulse, from its chords, is within 1e-3 of the
+    reduced model's (measured 5e-4: the chord rates carry the full model's bending
+    vibration), and its windowed impulse within 1 % of it (measured -0.27 %: undamped, the
+    ring of the higher bending modes is not averaged out; tests/test_lock_impulse.py has the
+    damped scene). Its instantaneous part acts on the end tangents: 0.17 N m s."""
     scene = two_rod_latch(1e7)
     full, reduced = (simulate(scene, m).events[0] for m in ("full", "reduced"))
-    assert reduced["angular_impulse"] == pytest.approx(reduced["rigid_impulse"], rel=1e-4)
+    assert reduced["impulse"] == pytest.approx(reduced["rigid_impulse"], rel=1e-4)
     assert full["rigid_impulse"] == pytest.approx(reduced["rigid_impulse"], rel=1e-3)
-    assert full["angular_impulse"] < 0.01 * full["rigid_impulse"]
+    assert full["impulse"] == pytest.approx(full["rigid_impulse"], rel=1e-2)
+    assert full["impulse_instant"] < 0.01 * full["rigid_impulse"]
     for ev in (full, reduced):
         assert ev["rigid_kinetic_after"] < ev["rigid_kinetic_before"]
 
 
 @pytest.mark.exudyn
 def test_exudyn_lock_records_carry_the_rigid_impulse():
-    """exudyn (2 elements per rod, h = 1e-4 s, spectral radius 0) at EI = 1e7: its rigid
-    impulse, from its beam's chords one step before the lock, within 1e-3 of the reduced
-    model's (measured 1.5e-5), and its own windowed impulse within 1 % of it (measured 0.4 %,
-    docs/deployment.md)."""
+    """exudyn (2 elements per rod, h = 2.5e-5 s, spectral radius 0) at EI = 1e7, undamped:
+    its rigid impulse, from its beam's chords one step before the lock, within 1e-3 of the
+    reduced model's (measured 1e-5), and its lock impulse within 1 % of it (measured
+    +0.15 %)."""
     pytest.importorskip("exudyn")
     scene = two_rod_latch(1e7)
-    ex = simulate(scene, "exudyn", elements=2, step=1e-4, spectral_radius=0.0).events[0]
+    ex = simulate(scene, "exudyn", elements=2, step=2.5e-5, spectral_radius=0.0).events[0]
     reduced = simulate(scene, "reduced").events[0]
     assert ex["rigid_impulse"] == pytest.approx(reduced["rigid_impulse"], rel=1e-3)
-    assert ex["angular_impulse"] == pytest.approx(ex["rigid_impulse"], rel=1e-2)
+    assert ex["impulse"] == pytest.approx(ex["rigid_impulse"], rel=1e-2)

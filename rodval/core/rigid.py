@@ -1,8 +1,8 @@
 """The rigid-panel lock: the model-independent yardstick of a latch's impulse.
 
-Every model measures its own lock impulse on its own kinematics (the full model's plastic
-impulse on the end tangents, the reduced model's on the chords, exudyn's over a window on the
-beam). Beside it each lock record carries ``rigid_impulse``: the angular impulse of the same
+Every model measures its lock impulse on its own solution (the mean over the lock window of
+the latch's cumulative impulse, ``rodval.core.lock_window``). Beside it each lock record
+carries ``rigid_impulse``: the angular impulse of the same
 lock on a chain of **rigid** rods with the model's chord angles and chord rates just before
 the lock (docs/deployment_native.md, "The rigid-panel impulse"). It depends on the scene's
 masses and lengths and on those 2n numbers only, so the three models' values are comparable,
@@ -22,7 +22,7 @@ omega_1 = 0) are linear constraints. The KKT system
 is banded (each row couples neighbouring nodes), so one sparse LU solves it in O(n). The
 multiplier of hinge h's row is the angular impulse on rod h+1 (N m s, counter-clockwise
 positive: a couple mu on rod h+1 is the pair of forces +-mu/l n at its ends), the convention
-of every model's ``angular_impulse``.
+of every model's ``impulse``.
 """
 
 from __future__ import annotations

@@ -295,11 +295,14 @@ class Latch:
     """A latch on hinge ``hinge`` (0..n-1): the hinge locks when its angle D reaches
     ``angle`` (rad) moving in ``direction`` (+1: D increasing, -1: decreasing; None: towards
     the angle from the initial state). At the lock the hinge's relative rate drops to zero
-    (a plastic impact) and D stays at ``angle`` afterwards."""
+    (a plastic impact) and D stays at ``angle`` afterwards. ``window`` (s, > 0): the window
+    over which the models measure the lock impulse (None: the first bending period of the
+    locked pair, ``rodval.core.lock_window``)."""
 
     hinge: int
     angle: float
     direction: int | None = None
+    window: float | None = None
 
     def __post_init__(self) -> None:
         if (
@@ -318,6 +321,8 @@ class Latch:
                 f"latch direction must be the integer +1 or -1, or omitted (None), "
                 f"got {self.direction!r}"
             )
+        if self.window is not None:
+            check_number("latch window", self.window, low=0.0, low_open=True, finite=True, unit="s")
 
 
 @dataclass(frozen=True)

@@ -45,7 +45,7 @@ TOP_KEYS = {
     "latches",
     "stops",
 }
-LATCH_KEYS = ("hinge", "angle", "direction")
+LATCH_KEYS = ("hinge", "angle", "direction", "window")
 STOP_KEYS = ("hinge", "angle", "side", "stiffness", "damping")
 CHAIN_KEYS = set(Chain.FIELDS)
 INITIAL_KEYS = {"phi", "dphi", "alpha", "beta", "dalpha", "dbeta"}

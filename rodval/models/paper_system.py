@@ -11,11 +11,11 @@ import numpy as np
 
 from rodval.core.checks import check_choice
 from rodval.core.loads import LOAD_COLUMNS, LoadSet, load_table
-from rodval.core.rigid import rigid_lock
 from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
 from rodval.models import deployment
+from rodval.models.lock_records import lock_record, window_terms
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
     VARIANTS,
@@ -511,33 +511,12 @@ class PaperSystem(OdeSystem):
     def lock_impulse(
         self, t: float, y: np.ndarray, locked: tuple[int, ...], new: tuple[int, ...]
     ) -> tuple[np.ndarray, dict]:
-        """The state after the plastic lock of the latches ``new`` with ``locked`` (all held
-        after it) and the event's data: angular impulses (N m s, on the outboard rod k+1,
-        counter-clockwise positive: the convention of every model's event records), joint
-        linear impulses (N s), kinetic energy before and after (J), and the rigid-panel lock
-        of the chords before it (``rodval.core.rigid.rigid_lock``)."""
-        hinges = np.array([self.latches[j].hinge for j in locked], dtype=np.int64)
-        angles = np.array([self.latches[j].angle for j in locked])
-        phi, dphi = (a[0] for a in self.rigid(y[None, :]))
-        rigid = rigid_lock(self.base_chain, phi, dphi, hinges.tolist(), int(hinges[-len(new)]))
-        T0 = self.kinetic_energy(t, y)
-        P0 = self.momenta(y)
-        y_new, mu = self.plastic_jump(y, hinges, angles)
-        T1 = self.kinetic_energy(t, y_new)
-        S = self.momenta(y_new) - P0
-        impulses = [float(m) for m in mu]  # A^T mu: +mu on the outboard rod's coordinates
-        return y_new, {
-            "hinge": self.latches[new[0]].hinge,
-            "hinges": [self.latches[j].hinge for j in new],
-            "angular_impulse": impulses[len(locked) - len(new)],
-            "held_hinges": [int(h) for h in hinges],
-            "angular_impulses": impulses,
-            "joint_impulses": S.tolist(),
-            "root_impulse": S[0].tolist(),
-            "kinetic_before": T0,
-            "kinetic_after": T1,
-            **rigid,
-        }
+        """The state after the plastic lock of ``new`` and its record (``lock_records``)."""
+        return lock_record(self, t, y, locked, new)
+
+    def window_terms(self, t: float, y: np.ndarray, hinge: int) -> tuple[float, ...]:
+        """The lock window's integrands at one state (``lock_records.window_terms``)."""
+        return window_terms(self, t, y, hinge)
 
     def momenta(self, y: np.ndarray) -> np.ndarray:
         """Linear momentum beyond each node (N s, (n, 2)), see deployment.outer_momenta."""

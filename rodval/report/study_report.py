@@ -34,14 +34,14 @@ EVENT_REPORT_COLUMNS = (
     "model",
     "label",
     "t",
-    "angular_impulse",
+    "impulse",
+    "impulse_window",
     "rigid_impulse",
     "impulse_to_rigid",
     "kinetic_before",
     "kinetic_after",
     "energy_lost",
-    "peak_moment",
-    "lock_duration",
+    "window_closed",
     "angular_momentum_root_jump",
 )
 
@@ -63,7 +63,7 @@ def read_events(out: Path) -> pd.DataFrame:
 
 def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
     """Each model's events against the reference's event of the same case and label: lock
-    time difference dt (s, model - reference), angular impulse difference and its ratio to
+    time difference dt (s, model - reference), lock impulse difference and its ratio to
     the reference's |impulse| (impulse_rel), the same ratio of the rigid-panel impulses
     (rigid_rel, where recorded), energy_lost difference (J). Events the reference
     lacks (or the model lacks) are listed with blanks."""
@@ -94,10 +94,10 @@ def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
             r = ref.loc[key]
             r = r.iloc[0] if isinstance(r, pd.DataFrame) else r
             row["dt"] = float(ev["t"]) - float(r["t"])
-            if "angular_impulse" in events:
-                d = float(ev["angular_impulse"]) - float(r["angular_impulse"])
+            if "impulse" in events:
+                d = float(ev["impulse"]) - float(r["impulse"])
                 row["impulse_abs"] = d
-                row["impulse_rel"] = abs(d) / abs(float(r["angular_impulse"]))
+                row["impulse_rel"] = abs(d) / abs(float(r["impulse"]))
             if "rigid_impulse" in events:
                 d = float(ev["rigid_impulse"]) - float(r["rigid_impulse"])
                 row["rigid_rel"] = abs(d) / abs(float(r["rigid_impulse"]))
@@ -110,7 +110,7 @@ def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
 def residual_vibration(
     traj: pd.DataFrame, events: pd.DataFrame, cases: pd.DataFrame
 ) -> pd.DataFrame:
-    """Per case and model, after its last lock (t_last + lock_duration where recorded): the
+    """Per case and model, after its last lock's window (t_last + impulse_window): the
     tip's y amplitude (max - min) / 2 and mean (m), the largest |alpha| and |beta| (rad), and
     the chord angles' spread max - min of phi over the rods at the last output time (rad, 0
     for a straight chain). Models without events are measured after the last lock of any
@@ -123,8 +123,8 @@ def residual_vibration(
         if use.empty:
             continue
         ends = use["t"].astype(float)
-        if "lock_duration" in use:
-            ends = ends + use["lock_duration"].astype(float).fillna(0.0)
+        if "impulse_window" in use:
+            ends = ends + use["impulse_window"].astype(float).fillna(0.0)
         t_last = float(ends.max())
         after = part[part["t"] > t_last]
         row = {"case": case, "model": model, "last_lock_end": t_last, "locks": len(own)}
@@ -171,18 +171,19 @@ def _deployment_section(
     ref, labels = meta["reference"], [m["label"] for m in meta["models"]]
     lines = [
         "## Deployment: locks, impulses and residual vibration\n",
-        "Every recorded event (`events.csv`): lock time t (s), angular impulse of the latch "
-        "(N m s, on the outboard rod, counter-clockwise positive), kinetic energy before and "
-        "after the lock and their difference (J); exudyn adds the lock window's peak hinge "
-        "moment (N m), its duration (s) and the jump of the angular momentum about the root "
-        "through it (N m s; an internal impulse leaves it unchanged). See docs/deployment.md "
-        "for how each model measures them. **The models' angular impulses are different "
-        "quantities**: the full model's is its instantaneous plastic impulse on the end "
-        "tangents, the reduced model's on the chords, exudyn's the reaction over its lock "
-        "window. `rigid_impulse` is the same quantity in every model: the plastic lock of "
-        "rigid rods with the model's chord angles and rates just before the lock "
-        "(`rodval.core.rigid`); `impulse_to_rigid` is each model's own impulse over it (1 in "
-        "the rigid-panel limit).\n",
+        "Every recorded event (`events.csv`): lock time t (s); the lock impulse (N m s, on "
+        "the outboard rod, counter-clockwise positive), one definition in every model: the "
+        "latch reaction's impulse, instantaneous part included, averaged over the lock "
+        "window of `impulse_window` s after the lock (the first bending period of the locked "
+        "pair unless the scene sets it; `window_closed` false: the run ended inside it); "
+        "`rigid_impulse`, the plastic lock of rigid rods with the model's chord angles and "
+        "rates just before the lock (`rodval.core.rigid`), and `impulse_to_rigid`, their "
+        "ratio (1 in the rigid-panel limit); the kinetic energy just before and just after "
+        "the lock's instantaneous part and their difference (J: the full model's tangent "
+        "impact takes out little, the reduced model's chord impact the whole rigid-panel "
+        "loss, exudyn's is taken two steps after the lock); the jump of the angular "
+        "momentum about the root through the lock (N m s; an internal impulse leaves it "
+        "unchanged while hinge 0 is free). docs/deployment.md defines each.\n",
         to_markdown(events[[c for c in EVENT_REPORT_COLUMNS if c in events]], ".5g"),
     ]
     silent = [lab for lab in labels if not (events["model"] == lab).any()]
@@ -195,8 +196,8 @@ def _deployment_section(
     if not disc.empty:
         lines += [
             f"Lock discrepancies against `{ref}` (dt in s, impulse_rel = |dS| / |S_ref| of the "
-            "models' own impulses, rigid_rel = the same of the rigid-panel impulses, the "
-            "comparable one; dE_lost in J):\n",
+            "lock impulses, rigid_rel = the same of the rigid-panel impulses; dE_lost in J, "
+            "of different quantities, see above):\n",
             to_markdown(disc, ".3g"),
         ]
     peaks = peak_hinge_moments(tables["trajectories"], events)

@@ -26,6 +26,7 @@ from rodval.solvers import budget, dop853, progress, stiffness
 from rodval.solvers.audit import PowerLedger
 from rodval.solvers.events import apply_hit
 from rodval.solvers.guard import GuardSpec, diverged_message, verdict
+from rodval.solvers.outputs import Outputs
 from rodval.solvers.system import OdeSystem
 
 
@@ -96,44 +97,45 @@ def run_compiled(
     scene: Scene,
     settings: IntegratorSettings,
     guard: GuardSpec,
-    Y: np.ndarray,
+    out: Outputs,
     stats: SolverStats,
     ledger: PowerLedger | None = None,
     events: list[dict[str, Any]] | None = None,
-) -> int:
+) -> None:
     """Integrate ``system`` (its ``compiled()`` form) over [edges[0], edges[-1]] restarting at
     each interior edge (the scene's breakpoints) and after each event, writing states at the
-    output times into Y; fills ``stats`` (status, message, t_reached, nfev, nsteps) and
-    returns the number of output times reached. The divergence guard ``guard`` runs inside
+    output and lock-window probe times into ``out``; fills ``stats`` (status, message,
+    t_reached, nfev, nsteps). The divergence guard ``guard`` runs inside
     the loop, with the verdicts and messages of ``rodval.solvers.guard``; with a ``ledger``
     the energy audit too (its records become the loop's running W_ext, D). Events are
     located inside the loop; each one's jump is the system's (``events.apply_hit``, as on
     the scipy path), its record appended to ``events``; the loop goes on in the new mode.
     The stepper: ``_STEPPERS[settings.method]`` (its switches in ``stats.switch``)."""
-    times = np.asarray(scene.times, float)
-    W = np.zeros((times.size, 2))
+    W = np.zeros((out.times.size, 2))
     total = np.zeros(2)
     deadline = time.perf_counter() + settings.max_wall_s
-    t, y, n_out = float(edges[0]), np.array(y0, float), 0
+    t, y = float(edges[0]), np.array(y0, float)
     monitor = None
     stepper = _STEPPERS[settings.method]
     switch = stiffness.new_state()
     while True:
         form = system.compiled()
         assert form is not None  # choose_method took the compiled path for this system
+        times = out.remaining()
+        buffer = np.empty((times.size, y.size))
         try:
             res = dop853.integrate_compiled(
                 form,
                 y,
                 np.concatenate([[t], edges[edges > t]]),
-                times[n_out:],
+                times,
                 settings.rtol,
                 settings.atol,
                 settings.max_step,
                 settings.first_step,
                 settings.max_evaluations - stats.nfev,
                 guard,
-                Y[n_out:],
+                buffer,
                 deadline=deadline,
                 reporting=progress.reporting(),
                 audit=ledger is not None,
@@ -150,9 +152,10 @@ def run_compiled(
             )
             stats.t_reached = t
             break
+        n_out = out.n
+        written = out.write(buffer[: res.n_out])
         if ledger is not None:
-            W[n_out : n_out + res.n_out] = res.work
-        n_out += res.n_out
+            W[n_out : out.n] = res.work[written]
         monitor = res.monitor
         stats.nfev += res.nfev
         stats.nsteps += res.nsteps
@@ -166,9 +169,10 @@ def run_compiled(
         total[1] += lost  # an impact's kinetic energy loss is dissipated energy of the audit
         if events is not None:
             events.append(record)
+        if out.windows:
+            out.windows.event(record)
     if ledger is not None:
-        ledger.replace(W[:n_out])
-    return n_out
+        ledger.replace(W[: out.n])
 
 
 def _ending(res: dop853.CompiledRun, settings: IntegratorSettings, guard, stats) -> None:

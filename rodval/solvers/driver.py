@@ -46,6 +46,7 @@ from rodval.solvers.audit import PowerLedger, audit_quantities
 from rodval.solvers.events import EventMonitor, apply_hit
 from rodval.solvers.guard import DivergenceGuard
 from rodval.solvers.limits import MAX_IMPLICIT_SIZE
+from rodval.solvers.outputs import LockWindows, Outputs
 from rodval.solvers.progress import report
 from rodval.solvers.system import OdeSystem
 
@@ -119,25 +120,6 @@ def segment_edges(scene: Scene) -> np.ndarray:
     return np.concatenate([[0.0], scene.breakpoints, [end]])
 
 
-class _Outputs:
-    """States at the output times, filled in time order."""
-
-    def __init__(self, times: np.ndarray, size: int):
-        self.times = times
-        self.Y = np.empty((times.size, size))
-        self.n = 0
-
-    def upto(self, t: float) -> np.ndarray:
-        """The output times not yet written that are <= t."""
-        end = int(np.searchsorted(self.times, t, side="right"))
-        return self.times[self.n : end]
-
-    def write(self, values: np.ndarray) -> None:
-        """values (k, N) for the next k output times."""
-        self.Y[self.n : self.n + len(values)] = values
-        self.n += len(values)
-
-
 class _ScipyRun:
     """One run on a scipy OdeSolver with evaluation and wall budgets, events, guard and audit."""
 
@@ -148,7 +130,7 @@ class _ScipyRun:
         settings: IntegratorSettings,
         method: str,
         stats: SolverStats,
-        out: _Outputs,
+        out: Outputs,
         ledger: PowerLedger | None,
         guard: DivergenceGuard,
     ):
@@ -273,10 +255,9 @@ class _ScipyRun:
                 pending = self.out.upto(t_end)
                 if pending.size or self.ledger or hit:
                     dense = solver.dense_output()
-                    if pending.size:
-                        self.out.write(dense(pending).T)
+                    own = self.out.write(dense(pending).T) if pending.size else pending > t_end
                     if self.ledger:
-                        self.ledger.step(dense, t0, t_end, pending)
+                        self.ledger.step(dense, t0, t_end, pending[own])
                 t_now = t_end
                 report(t_now)
                 if hit:
@@ -284,6 +265,8 @@ class _ScipyRun:
                     y_event = solver.dense_output()(t_event)
                     y_new, record, lost = apply_hit(self.system, index, t_event, y_event)
                     self.events.append(record)
+                    if self.out.windows:
+                        self.out.windows.event(record)
                     if self.ledger:  # an impact's kinetic energy loss is dissipated energy
                         self.ledger.total = self.ledger.total + np.array([0.0, lost])
                     events.reset(t_event, y_new)
@@ -383,7 +366,8 @@ def integrate(
     if form is not None:
         from rodval.solvers.compiled import run_compiled  # loads the compiled loop once
     times = np.asarray(scene.times)
-    out = _Outputs(times, system.y0.size)
+    windows = LockWindows(system)
+    out = Outputs(times, system.y0.size, windows)
     stats = SolverStats()
     y = system.y0.astype(float).copy()
     audit = scene.wants("energy") and system.has_energy
@@ -400,9 +384,7 @@ def integrate(
             for _ in at_zero:
                 ledger.record()
         if form is not None:
-            out.n = run_compiled(
-                system, y, edges, scene, settings, guard.spec, out.Y, stats, ledger, events
-            )
+            run_compiled(system, y, edges, scene, settings, guard.spec, out, stats, ledger, events)
             t_now = stats.t_reached
         else:
             scipy_run = _ScipyRun(system, scene, settings, method, stats, out, ledger, guard)
@@ -411,6 +393,7 @@ def integrate(
     except Exception as exc:  # noqa: BLE001 - e.g. the model's energy at y0: a run never raises
         stats.status, stats.message = _failure(exc, t_now)
     stats.t_reached = float(t_now)
+    windows.close()
     if stats.status == 0:
         stats.message = "reached t_end"
     reached = times[: out.n]

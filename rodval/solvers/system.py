@@ -170,6 +170,12 @@ class OdeSystem(ABC):
         may change)."""
         raise NotImplementedError
 
+    def window_terms(self, t: float, y: np.ndarray, hinge: int) -> tuple[float, ...]:
+        """(lambda (N m), H_out (N m s), M_fin (N m)) of the held ``hinge`` at one state: the
+        integrands of a lock window (``rodval.solvers.outputs.LockWindows``); a system whose
+        lock records declare an ``impulse_window`` implements it."""
+        raise NotImplementedError
+
     def reset(self) -> None:
         """Return to the initial mode before a run (a system whose events switch its
         equations forgets them here); the driver calls it first. Nothing by default."""

@@ -9,12 +9,12 @@
   status, message.
 
 * ``events``: case, n, horizon, axes, model, then one row per state event of a run
-  (``Trajectory.events``: t (s), label, hinge, angular_impulse (N m s), rigid_impulse (N m s,
-  the rigid-panel lock of the model's chords, ``rodval.core.rigid``), impulse_to_rigid =
-  angular_impulse / rigid_impulse, kinetic_before,
-  kinetic_after (J), energy_lost = kinetic_before - kinetic_after (J), and every further key
-  a model records, e.g. exudyn's lock_duration, angular_momentum_root_jump). Written only when
-  some run has events.
+  (``Trajectory.events``: t (s), label, hinge, impulse (N m s, the lock impulse over the lock
+  window, ``rodval.core.lock_window``), impulse_window (s), rigid_impulse (N m s, the
+  rigid-panel lock of the model's chords, ``rodval.core.rigid``), impulse_to_rigid =
+  impulse / rigid_impulse, kinetic_before, kinetic_after (J), energy_lost = kinetic_before -
+  kinetic_after (J), and every further key a model records, e.g. impulse_momentum,
+  angular_momentum_root_jump). Written only when some run has events.
 
 ``provenance.json`` (machine and package versions) and ``study.json`` lie beside them.
 """
@@ -134,7 +134,8 @@ EVENT_COLUMNS = (
     "t",
     "label",
     "hinge",
-    "angular_impulse",
+    "impulse",
+    "impulse_window",
     "rigid_impulse",
     "impulse_to_rigid",
     "kinetic_before",
@@ -154,8 +155,8 @@ def events_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFram
                 before, after = ev.get("kinetic_before"), ev.get("kinetic_after")
                 if isinstance(before, (int, float)) and isinstance(after, (int, float)):
                     row["energy_lost"] = before - after
-                if ev.get("rigid_impulse") and "angular_impulse" in ev:
-                    row["impulse_to_rigid"] = ev["angular_impulse"] / ev["rigid_impulse"]
+                if ev.get("rigid_impulse") and ev.get("impulse") is not None:
+                    row["impulse_to_rigid"] = ev["impulse"] / ev["rigid_impulse"]
                 rows.append(row)
     lead = [*(_case_columns(records[0], axes) if records else {}), "model", *EVENT_COLUMNS]
     extra = [c for c in dict.fromkeys(k for row in rows for k in row) if c not in lead]

@@ -1,0 +1,118 @@
+"""The native models' lock records: what a latch's lock did (the plastic impact, the rigid-panel
+yardstick) and the terms of the windowed lock impulse (``rodval.core.lock_window``) the driver
+integrates over the window after it (``rodval.solvers.outputs.LockWindows``).
+
+The windowed impulse is measured twice on the model's own solution (docs/deployment.md, "The
+lock impulse"):
+
+* ``impulse``: the latch's reaction, mu + int lambda (1 - s/w) ds, with mu the instantaneous
+  plastic impulse and lambda the multiplier of the held hinge (N m, on the outboard rod,
+  counter-clockwise positive);
+* ``impulse_momentum``: the same from the outboard part's angular momentum about the hinge
+  node k, H_out, whose rate is lambda plus the finite moments on it,
+  M_fin = -(hinge k's spring, damper and acting stops) - v_k x p_out + the moments of the
+  loads on nodes beyond k about node k (v_k: node k's velocity, p_out: the outboard linear
+  momentum); the window mean of H_out(tau) - H_out(0-) - int_0^tau M_fin ds.
+
+Both use the model's velocity field (``paper_matrices.rod_momenta``); they agree when the
+model's equations are the Newton-Euler equations of that field, and the gap is reported.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from rodval.core.lock_window import lock_window
+from rodval.core.rigid import rigid_lock
+from rodval.models.paper_matrices import node_positions, rod_momenta
+
+if TYPE_CHECKING:
+    from rodval.models.paper_system import PaperSystem
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> float:
+    return float(a[0] * b[1] - a[1] * b[0])
+
+
+def outboard_momentum(
+    system: PaperSystem, y: np.ndarray, k: int
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+    """(H_out (N m s): the angular momentum of rods k+1..n (1-based) and their far nodes about
+    node k; p_out (N s, (2,)): their linear momentum; r (m, (n+1, 2)): the node positions;
+    v_k (m/s, (2,)): node k's velocity). O(n)."""
+    n = system.n
+    v = system.generalized_rates(y)
+    phi = system.rigid(y[None, :])[0][0]
+    chain = system.base_chain
+    p, h, _ = rod_momenta(chain, phi, v[:n], v[n : 2 * n], v[2 * n :])
+    x, yy = node_positions(chain.l, phi)
+    r = np.stack([x, yy], axis=-1)
+    normals = np.stack([-np.sin(phi), np.cos(phi)], axis=-1)
+    v_k = (chain.l[:k, None] * v[:k, None] * normals[:k]).sum(axis=0)
+    p_out = p[k:].sum(axis=0)
+    return float(h[k:].sum()) - _cross(r[k], p_out), p_out, r, v_k
+
+
+def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[float, ...]:
+    """(lambda (N m): the held hinge k's reaction on the outboard rod; H_out (N m s); M_fin
+    (N m)) at one state in the current mode (see the module docstring). O(n)."""
+    lam = system.accel_locked(t, y)[1]
+    held = [int(h) for h in system._lock_h]
+    H, p_out, r, v_k = outboard_momentum(system, y, k)
+    ch = system.chain  # the mode's effective chain: acting stops are in its kappa, nu, rest
+    D = system.hinge_angles_at(t, y)[k]
+    rate = system.hinge_rates(y)[k]
+    finite = -(ch.kappa[k] * (D - ch.rest_angle[k]) + ch.nu[k] * rate) - _cross(v_k, p_out)
+    forces = system.loads.nodal(t)
+    if forces is not None:
+        X, Y = forces  # at nodes 1..n
+        arm = r[k + 1 :] - r[k]
+        finite += float(np.sum(arm[:, 0] * Y[k:] - arm[:, 1] * X[k:]))
+    return float(lam[held.index(k)]), H, float(finite)
+
+
+def lock_record(
+    system: PaperSystem, t: float, y: np.ndarray, locked: tuple[int, ...], new: tuple[int, ...]
+) -> tuple[np.ndarray, dict[str, Any]]:
+    """The state after the plastic lock of the latches ``new`` with ``locked`` (all held
+    after it) and the event's data: the instantaneous angular impulses (N m s, on the
+    outboard rod k+1, counter-clockwise positive: the convention of every model's event
+    records), joint linear impulses (N s), kinetic energy before and after (J), the
+    rigid-panel lock of the chords before it (``rodval.core.rigid.rigid_lock``), the angular
+    momentum about the root just before and after (N m s; the impact is internal, so it is
+    kept while hinge 0 is free) and what the lock window needs (its length, the
+    instantaneous impulse, H_out just before)."""
+    latches = system.latches
+    hinges = np.array([latches[j].hinge for j in locked], dtype=np.int64)
+    angles = np.array([latches[j].angle for j in locked])
+    phi, dphi = (a[0] for a in system.rigid(y[None, :]))
+    k = latches[new[0]].hinge
+    rigid = rigid_lock(system.base_chain, phi, dphi, hinges.tolist(), int(hinges[-len(new)]))
+    T0 = system.kinetic_energy(t, y)
+    P0 = system.momenta(y)
+    H0 = outboard_momentum(system, y, k)[0]
+    root0 = outboard_momentum(system, y, 0)[0]  # node 0 is the root
+    y_new, mu = system.plastic_jump(y, hinges, angles)
+    root1 = outboard_momentum(system, y_new, 0)[0]
+    T1 = system.kinetic_energy(t, y_new)
+    S = system.momenta(y_new) - P0
+    impulses = [float(m) for m in mu]  # A^T mu: +mu on the outboard rod's coordinates
+    return y_new, {
+        "hinge": k,
+        "hinges": [latches[j].hinge for j in new],
+        "impulse_instant": impulses[len(locked) - len(new)],
+        "impulse_window": lock_window(system.base_chain, latches[new[0]]),
+        "outboard_momentum_before": H0,
+        "held_hinges": [int(h) for h in hinges],
+        "angular_impulses": impulses,
+        "joint_impulses": S.tolist(),
+        "root_impulse": S[0].tolist(),
+        "kinetic_before": T0,
+        "kinetic_after": T1,
+        "angular_momentum_root_before": root0,
+        "angular_momentum_root_after": root1,
+        "angular_momentum_root_jump": root1 - root0,
+        **rigid,
+    }

@@ -1,0 +1,147 @@
+"""Where a run's states go: the scene's output times (the trajectory) and the probe times of the
+lock windows (``LockWindows``: the integrals a latch's lock record needs over the window after
+the lock, ``rodval.core.lock_window``).
+
+Probe times are output times the integrators interpolate on their dense output like the
+scene's own (every path: scipy's steps and the compiled loop): they never change a step, so a
+run's trajectory is the same with or without them. A probe's state goes to its window at once,
+while the system is still in the mode of that time.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from rodval.core.lock_window import window_nodes
+from rodval.solvers.system import OdeSystem
+
+
+class _Window:
+    """One lock's window: its probes, and the running sums of the lock record's impulses."""
+
+    def __init__(self, record: dict[str, Any]):
+        self.record = record
+        self.t0 = float(record["t"])
+        self.w = float(record["impulse_window"])
+        self.hinge = int(record["hinge"])
+        self.times, self.taper, self.mean = window_nodes(self.t0, self.w)
+        self.i = 0
+        #: mu + int lambda (1 - s/w) ds, mean H_out, int finite (1 - s/w) ds
+        self.impulse = float(record["impulse_instant"])
+        self.H = 0.0
+        self.finite = 0.0
+        self.taken = 0.0
+
+    def later_impulse(self, record: dict[str, Any]) -> None:
+        """A later lock inside the window adds its instantaneous impulse on this hinge,
+        weighted by the taper at its time."""
+        s = float(record["t"]) - self.t0
+        held = record.get("held_hinges", [])
+        if 0 <= s < self.w and self.hinge in held:
+            mu = record["angular_impulses"][held.index(self.hinge)]
+            self.impulse += float(mu) * (1.0 - s / self.w)
+
+    def take(self, system: OdeSystem, y: np.ndarray) -> None:
+        t = float(self.times[self.i])
+        lam, H, finite = system.window_terms(t, y, self.hinge)
+        self.impulse += self.taper[self.i] * lam
+        self.H += self.mean[self.i] * H
+        self.finite += self.taper[self.i] * finite
+        self.taken += self.mean[self.i]
+        self.i += 1
+
+    def finish(self) -> None:
+        """Write the window's measures into the lock record (a window the run did not reach
+        to its end: over the part reached, ``window_closed`` False)."""
+        rec = self.record
+        rec["impulse"] = float(self.impulse)
+        # mean over the window of H_out(tau) - H_out(0-) - int_0^tau finite ds
+        rec["impulse_momentum"] = float(
+            self.H - self.taken * rec["outboard_momentum_before"] - self.finite
+        )
+        rec["window_closed"] = self.i == self.times.size
+
+
+class LockWindows:
+    """The open lock windows of one run of ``system``."""
+
+    def __init__(self, system: OdeSystem):
+        self.system = system
+        self.open: list[_Window] = []
+
+    def event(self, record: dict[str, Any]) -> None:
+        """After an event: its instantaneous impulses go to the windows still open; a lock
+        whose record declares an ``impulse_window`` opens one."""
+        for win in self.open:
+            win.later_impulse(record)
+        if "impulse_window" in record:
+            self.open.append(_Window(record))
+
+    def pending(self) -> np.ndarray:
+        """The probe times not yet taken, sorted."""
+        if not self.open:
+            return np.zeros(0)
+        return np.sort(np.concatenate([w.times[w.i :] for w in self.open]))
+
+    def take(self, t: float, y: np.ndarray) -> None:
+        """The state y at probe time t to every window probing there."""
+        for win in list(self.open):
+            if win.i < win.times.size and win.times[win.i] == t:
+                win.take(self.system, y)
+                if win.i == win.times.size:
+                    win.finish()
+                    self.open.remove(win)
+
+    def close(self) -> None:
+        """At the end of the run: the windows not completed are written over the part
+        reached."""
+        for win in self.open:
+            win.finish()
+        self.open = []
+
+
+class Outputs:
+    """States at the scene's output times ``times`` (rows of Y, filled in time order) and at
+    the lock windows' probe times (handed to ``windows``)."""
+
+    def __init__(self, times: np.ndarray, size: int, windows: LockWindows | None = None):
+        self.times = times
+        self.Y = np.empty((times.size, size))
+        self.n = 0
+        self.windows = windows
+
+    def _merged(self, scene: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(times, is-scene mask) of ``scene`` times and the probes up to their last one."""
+        probes = self.windows.pending() if self.windows else np.zeros(0)
+        times = np.concatenate([scene, probes])
+        is_scene = np.concatenate([np.ones(scene.size, bool), np.zeros(probes.size, bool)])
+        order = np.argsort(times, kind="stable")
+        return times[order], is_scene[order]
+
+    def upto(self, t: float) -> np.ndarray:
+        """The output and probe times not yet written that are <= t, sorted."""
+        end = int(np.searchsorted(self.times, t, side="right"))
+        times, mask = self._merged(self.times[self.n : end])
+        keep = times <= t
+        self._plan = times[keep], mask[keep]
+        return self._plan[0]
+
+    def remaining(self) -> np.ndarray:
+        """All output and probe times not yet written, sorted (for a loop that writes them
+        in order, ``write`` after it)."""
+        self._plan = self._merged(self.times[self.n :])
+        return self._plan[0]
+
+    def write(self, values: np.ndarray) -> np.ndarray:
+        """values (k, N) for the first k times of the last ``upto`` / ``remaining``; returns
+        the mask of those that are scene output times."""
+        times, mask = self._plan[0][: len(values)], self._plan[1][: len(values)]
+        scene = values[mask]
+        self.Y[self.n : self.n + len(scene)] = scene
+        self.n += len(scene)
+        if self.windows:
+            for t, y in zip(times[~mask], values[~mask]):
+                self.windows.take(float(t), y)
+        return mask
