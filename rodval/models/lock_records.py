@@ -20,7 +20,7 @@ model's equations are the Newton-Euler equations of that field, and the gap is r
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -28,8 +28,9 @@ from rodval.core.lock_window import lock_window
 from rodval.core.rigid import rigid_lock
 from rodval.models.paper_matrices import node_positions, rod_momenta
 
-if TYPE_CHECKING:
-    from rodval.models.paper_system import PaperSystem
+#: The systems these functions read: ``rodval.models.paper_system.PaperSystem`` (which imports
+#: this module, so it is not imported here).
+PaperSystem = Any
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> float:

@@ -165,14 +165,22 @@ def run_compiled(
         if res.code != budget.EVENT:
             _ending(res, settings, guard, stats)
             break
-        y, record, lost = apply_hit(system, res.event, res.t, res.y)
-        total[1] += lost  # an impact's kinetic energy loss is dissipated energy of the audit
-        if events is not None:
-            events.append(record)
-        if out.windows:
-            out.windows.event(record)
+        y = _event(system, res, total, events, out)
     if ledger is not None:
         ledger.replace(W[: out.n])
+
+
+def _event(system: OdeSystem, res, total: np.ndarray, events, out: Outputs) -> np.ndarray:
+    """The located event of ``res``: the system's jump (its state returned), the impact's
+    kinetic energy loss booked as dissipated energy of the audit (``total``), the record
+    appended to ``events`` and given to the lock windows."""
+    y, record, lost = apply_hit(system, res.event, res.t, res.y)
+    total[1] += lost
+    if events is not None:
+        events.append(record)
+    if out.windows:
+        out.windows.event(record)
+    return y
 
 
 def _ending(res: dop853.CompiledRun, settings: IntegratorSettings, guard, stats) -> None:
