@@ -120,6 +120,7 @@ def test_exudyn_measures_the_same_impulse():
     assert abs(ex["angular_momentum_root_jump"]) <= 1e-6 * abs(H)
 
 
+@pytest.mark.slow
 @pytest.mark.exudyn
 def test_the_shipped_flexible_deployment_compares_like_with_like(tmp_path):
     """studies/deployment.toml (four panels, EI = 5e3, exudyn reference: 4 elements per rod,
