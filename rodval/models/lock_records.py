@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from rodval.core.lock_window import lock_window
-from rodval.core.rigid import rigid_lock
+from rodval.core.rigid import node_velocities, rigid_lock
 from rodval.models.paper_matrices import node_positions, rod_momenta
 
 #: The systems these functions read: ``rodval.models.paper_system.PaperSystem`` (which imports
@@ -50,8 +50,7 @@ def outboard_momentum(
     p, h, _ = rod_momenta(chain, phi, v[:n], v[n : 2 * n], v[2 * n :])
     x, yy = node_positions(chain.l, phi)
     r = np.stack([x, yy], axis=-1)
-    normals = np.stack([-np.sin(phi), np.cos(phi)], axis=-1)
-    v_k = (chain.l[:k, None] * v[:k, None] * normals[:k]).sum(axis=0)
+    v_k = node_velocities(chain.l, phi, v[:n])[k - 1] if k > 0 else np.zeros(2)
     p_out = p[k:].sum(axis=0)
     return float(h[k:].sum()) - _cross(r[k], p_out), p_out, r, v_k
 

@@ -502,17 +502,11 @@ class PaperSystem(OdeSystem):
             and abs(D[la.hinge] - la.angle) <= deployment.SIMULTANEOUS_RAD
         ]
         locked = self.locked + tuple(group)
-        y_new, data = self.lock_impulse(t, y, locked, tuple(group))
+        y_new, data = lock_record(self, t, y, locked, tuple(group))
         self._set_mode((self.stop_active, locked), t)
         hinges = [self.latches[i].hinge for i in group]
         label = "latch hinge " + ", ".join(str(h) for h in hinges)
         return y_new, EventRecord(t, label, data)
-
-    def lock_impulse(
-        self, t: float, y: np.ndarray, locked: tuple[int, ...], new: tuple[int, ...]
-    ) -> tuple[np.ndarray, dict]:
-        """The state after the plastic lock of ``new`` and its record (``lock_records``)."""
-        return lock_record(self, t, y, locked, new)
 
     def window_terms(self, t: float, y: np.ndarray, hinge: int) -> tuple[float, ...]:
         """The lock window's integrands at one state (``lock_records.window_terms``)."""

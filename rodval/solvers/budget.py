@@ -58,6 +58,12 @@ def exhausted(controls, reporting, cnt, t):
 
 
 @njit(cache=True, inline="always")
+def smallest_step(t):
+    """The smallest step (s) either stepper attempts from t (s): 10 ulp of t (scipy's rule)."""
+    return 10.0 * (np.nextafter(t, np.inf) - t)
+
+
+@njit(cache=True, inline="always")
 def next_attempt(t, t_bound, h_abs, min_step, finite, controls, reporting, cnt):
     """Before a step attempt of h_abs (s) from t (s): (``STEP_TOO_SMALL``, or
     ``NON_FINITE`` when the last attempt was not ``finite``) below min_step (s), the

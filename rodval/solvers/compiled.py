@@ -178,7 +178,7 @@ def _event(system: OdeSystem, res, total: np.ndarray, events, out: Outputs) -> n
     total[1] += lost
     if events is not None:
         events.append(record)
-    if out.windows:
+    if out.windows is not None:
         out.windows.event(record)
     return y
 

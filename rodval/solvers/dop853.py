@@ -29,7 +29,7 @@ from scipy.integrate._ivp import dop853_coefficients as dc
 
 from rodval.solvers import radau, stiffness
 from rodval.solvers.audit import GAUSS_NODES
-from rodval.solvers.budget import EVENT, NON_FINITE, OK, next_attempt
+from rodval.solvers.budget import EVENT, NON_FINITE, OK, next_attempt, smallest_step
 from rodval.solvers.dop853_events import any_crossing, interpolate, locate, no_events
 from rodval.solvers.guard import GuardSpec, guard_step, new_monitor
 from rodval.solvers.limits import MAX_IMPLICIT_SIZE
@@ -227,7 +227,7 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
     DOP853 does with its infinite error norm; a state whose attempts stay non-finite down to
     the smallest step is ``NON_FINITE`` (diverged), not ``STEP_TOO_SMALL``."""
     rtol, atol, max_step = controls[0], controls[1], controls[2]
-    min_step = 10.0 * (np.nextafter(t, np.inf) - t)
+    min_step = smallest_step(t)
     h_abs = min(max(h_abs, min_step), max_step)
     rejected = False
     finite = True  # whether the last attempt's stages were finite

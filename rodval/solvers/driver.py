@@ -255,7 +255,7 @@ class _ScipyRun:
                 pending = self.out.upto(t_end)
                 if pending.size or self.ledger or hit:
                     dense = solver.dense_output()
-                    own = self.out.write(dense(pending).T) if pending.size else pending > t_end
+                    own = self.out.write(dense(pending).T) if pending.size else np.zeros(0, bool)
                     if self.ledger:
                         self.ledger.step(dense, t0, t_end, pending[own])
                 t_now = t_end
@@ -265,7 +265,7 @@ class _ScipyRun:
                     y_event = solver.dense_output()(t_event)
                     y_new, record, lost = apply_hit(self.system, index, t_event, y_event)
                     self.events.append(record)
-                    if self.out.windows:
+                    if self.out.windows is not None:
                         self.out.windows.event(record)
                     if self.ledger:  # an impact's kinetic energy loss is dissipated energy
                         self.ledger.total = self.ledger.total + np.array([0.0, lost])

@@ -114,7 +114,9 @@ class Outputs:
 
     def _merged(self, scene: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(times, is-scene mask) of ``scene`` times and the probes up to their last one."""
-        probes = self.windows.pending() if self.windows else np.zeros(0)
+        probes = self.windows.pending() if self.windows is not None else np.zeros(0)
+        if not probes.size:
+            return scene, np.ones(scene.size, bool)
         times = np.concatenate([scene, probes])
         is_scene = np.concatenate([np.ones(scene.size, bool), np.zeros(probes.size, bool)])
         order = np.argsort(times, kind="stable")
@@ -141,7 +143,7 @@ class Outputs:
         scene = values[mask]
         self.Y[self.n : self.n + len(scene)] = scene
         self.n += len(scene)
-        if self.windows:
+        if self.windows is not None:
             for t, y in zip(times[~mask], values[~mask]):
                 self.windows.take(float(t), y)
         return mask

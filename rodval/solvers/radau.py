@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.solvers.budget import OK, next_attempt
+from rodval.solvers.budget import OK, next_attempt, smallest_step
 from rodval.solvers.dop853_events import interpolate
 
 S6 = 6.0**0.5
@@ -370,7 +370,7 @@ def step(
     rtol, atol, max_step = controls[0], controls[1], controls[2]
     N = y.shape[0]
     tol = max(10.0 * _EPS / rtol, min(0.03, rtol**0.5))
-    min_step = 10.0 * (np.nextafter(t, np.inf) - t)
+    min_step = smallest_step(t)
     h_old, err_old = sc[H_OLD], sc[ERR_OLD]
     if h_abs > max_step or h_abs < min_step:
         h_abs = max_step if h_abs > max_step else min_step
