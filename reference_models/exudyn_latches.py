@@ -261,7 +261,7 @@ class _Latches:
                 {
                     "item": item,
                     "t_lock": t_lock,
-                    "window": lock_window(self.scene.chain, item["latch"]),
+                    "window": lock_window(self.scene.chain, item["latch"], before["held"]),
                     "steps": 0,
                     "before": before,
                     "last": before,

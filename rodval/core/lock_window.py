@@ -18,13 +18,17 @@ exactly (undamped) or to O(zeta^2) (damped), and it equals S_pl for rigid rods u
 smooth reaction's lambda w / 2.
 
 The window w (s) is the latch's ``window`` when the scene sets one; by default the period of
-the first bending mode of the **locked pair**: the two rods the hinge joins (rods k and k+1
-for hinge k), clamped together into one Euler-Bernoulli beam with their node masses, pinned at
-the inboard end (hinge 0: rod 1 clamped at the root). ``ELEMENTS_PER_ROD`` cubic Hermite
-elements per rod give its period to 3e-6 relative (the element's error falls as h^4; from
-above in frequency), far below what the window's length needs. One period is the smallest window over
-which the first ring averages out; a chain whose longer locked parts ring lower than the pair
-should set ``window`` (docs/deployment.md).
+the first bending mode of the **locked segment** the lock completes: the rods joined to the
+hinge's two rods through held hinges (the new one and those locked before it), clamped
+together into one Euler-Bernoulli beam with their node masses, pinned at its inboard node
+(clamped at the root when hinge 0 is held and the segment reaches it); the hinge springs are
+left out (soft against the panels' bending, the deployable's regime) and so are the rods
+beyond the segment. The segment's first bending mode is the lowest ring the lock excites in
+it, so one period of it is the smallest window over which the ring averages out: the locked
+pair alone rings 3.5x higher than a four-panel segment, and a pair window left most of that
+segment's ring in S_w (docs/deployment.md). Cubic Hermite elements, ``ELEMENTS_PER_ROD`` per
+rod of a pair and at least ``MIN_ELEMENTS`` in all, give the period to 3e-6 relative (the
+element's error falls as h^4; from above in frequency), far below what the window needs.
 """
 
 from __future__ import annotations
@@ -34,8 +38,12 @@ import scipy.linalg
 
 from rodval.core.scene import Chain, Latch
 
-#: Cubic Hermite Euler-Bernoulli elements per rod of the locked pair's beam.
+#: Cubic Hermite Euler-Bernoulli elements per rod of a locked pair's beam; a longer segment
+#: gets ceil(MIN_ELEMENTS / rods) per rod (at least 1).
 ELEMENTS_PER_ROD = 8
+MIN_ELEMENTS = 2 * ELEMENTS_PER_ROD
+#: A longer locked segment is cut into this many uniform sections (``_sections``).
+MAX_SECTIONS = 128
 #: The window's quadrature: Gauss-Legendre on equal panels (degree 2 * NODES - 1 per panel).
 WINDOW_PANELS = 64
 WINDOW_NODES = 4
@@ -64,41 +72,84 @@ def _element(EI: float, rho: float, h: float) -> tuple[np.ndarray, np.ndarray]:
     return k, m
 
 
-def first_bending_period(chain: Chain, hinge: int) -> float:
-    """Period (s) of the first bending mode of the locked pair at ``hinge`` (see the module
-    docstring): rods hinge, hinge+1 (1-based; rod 1 alone for hinge 0) as one Euler-Bernoulli
+def locked_segment(n: int, hinge: int, held: tuple[int, ...] | list[int]) -> tuple[range, bool]:
+    """The locked segment a lock at ``hinge`` completes among n rods: the 0-based indices of its
+    rods (rod r + 1 is index r; hinge k joins indices k - 1 and k) and whether its inboard end
+    is clamped (it reaches the root and hinge 0 is held). ``held``: the hinges held after the
+    lock (``hinge`` is added if missing). O(n)."""
+    if not 0 <= hinge < n:
+        raise ValueError(f"hinge must be 0..{n - 1}, got {hinge!r}")
+    locked = set(int(h) for h in held) | {hinge}
+    first = max(hinge - 1, 0)
+    while first > 0 and first in locked:
+        first -= 1
+    last = hinge
+    while last + 1 < n and last + 1 in locked:
+        last += 1
+    return range(first, last + 1), first == 0 and 0 in locked
+
+
+def _sections(chain: Chain, rods: range) -> tuple[np.ndarray, ...]:
+    """The segment's beam sections: lengths (m), EI (N m^2), mass per length (kg/m) and the
+    node mass at each section's far end (kg). The rods themselves up to MAX_SECTIONS; a
+    longer segment is cut into MAX_SECTIONS runs of consecutive rods, each one uniform
+    section (compliances l/EI add, masses add, the inner node masses spread along it): the
+    first mode's wavelength spans many rods, and the beam's condition number stays
+    MAX_SECTIONS^4 (round-off 1e-8) instead of growing as rods^4. O(rods)."""
+    l, EI, m, mu = (
+        np.asarray(a, dtype=float)[rods.start : rods.stop]
+        for a in (chain.l, chain.EI, chain.m, chain.mu)
+    )
+    if len(l) <= MAX_SECTIONS:
+        return l, EI, m, mu
+    starts = np.linspace(0, len(l), MAX_SECTIONS + 1).astype(np.int64)[:-1]
+    length = np.add.reduceat(l, starts)
+    inner = np.add.reduceat(mu, starts) - mu[np.r_[starts[1:], len(l)] - 1]
+    return (
+        length,
+        length / np.add.reduceat(l / EI, starts),
+        (np.add.reduceat(m * l, starts) + inner) / length,
+        mu[np.r_[starts[1:], len(l)] - 1],
+    )
+
+
+def first_bending_period(chain: Chain, hinge: int, held: tuple[int, ...] | list[int] = ()) -> float:
+    """Period (s) of the first bending mode of the locked segment a lock at ``hinge``
+    completes (``locked_segment``; the module docstring): its rods as one Euler-Bernoulli
     beam, EI and mass per length m of each rod, the node masses mu at the rods' far ends,
-    pinned (hinge 0: clamped) at the inboard end. O(1): a 2 * 8-element beam, one dense
-    generalized eigenproblem of at most 34 x 34."""
-    if not 0 <= hinge < chain.n:
-        raise ValueError(f"hinge must be 0..{chain.n - 1}, got {hinge!r}")
-    rods = [0] if hinge == 0 else [hinge - 1, hinge]
-    size = 2 * (ELEMENTS_PER_ROD * len(rods) + 1)
+    pinned at its inboard node (clamped at a held root). ``held``: the hinges held after the
+    lock; () gives the locked pair. O(rods in the segment) to form the sections, then one
+    dense generalized eigenproblem of at most 2 * (max(MIN_ELEMENTS, MAX_SECTIONS) + 1)
+    dofs (``_sections``)."""
+    rods, clamped = locked_segment(chain.n, hinge, held)
+    lengths, EI, m, mu = _sections(chain, rods)
+    per = max(1, -(-MIN_ELEMENTS // len(lengths)))  # elements per section
+    size = 2 * (per * len(lengths) + 1)
     K, M = np.zeros((size, size)), np.zeros((size, size))
     e = 0
-    for r in rods:
-        h = chain.l[r] / ELEMENTS_PER_ROD
-        k, m = _element(float(chain.EI[r]), float(chain.m[r]), h)
-        for _ in range(ELEMENTS_PER_ROD):
+    for j in range(len(lengths)):
+        k, me = _element(float(EI[j]), float(m[j]), lengths[j] / per)
+        for _ in range(per):
             K[2 * e : 2 * e + 4, 2 * e : 2 * e + 4] += k
-            M[2 * e : 2 * e + 4, 2 * e : 2 * e + 4] += m
+            M[2 * e : 2 * e + 4, 2 * e : 2 * e + 4] += me
             e += 1
-        M[2 * e, 2 * e] += chain.mu[r]  # the rod's far node
-    free = np.arange(2 if hinge == 0 else 1, size)  # clamped: w, theta; pinned: w
+        M[2 * e, 2 * e] += mu[j]  # the section's far node
+    free = np.arange(2 if clamped else 1, size)  # clamped: w, theta; pinned: w
     values = scipy.linalg.eigh(
         K[np.ix_(free, free)], M[np.ix_(free, free)], eigvals_only=True, subset_by_index=[0, 1]
     )
     # pinned: the rigid rotation about the pin is the zero eigenvalue, the first bending
     # mode the next one; clamped: the first one
-    lam = float(values[0] if hinge == 0 else values[1])
+    lam = float(values[0] if clamped else values[1])
     return 2.0 * np.pi / np.sqrt(lam)
 
 
-def lock_window(chain: Chain, latch: Latch) -> float:
-    """The latch's window w (s): its ``window``, or ``first_bending_period`` of its hinge."""
+def lock_window(chain: Chain, latch: Latch, held: tuple[int, ...] | list[int] = ()) -> float:
+    """The latch's window w (s): its ``window``, or ``first_bending_period`` of the segment
+    its lock completes with the hinges ``held`` after it."""
     if latch.window is not None:
         return float(latch.window)
-    return first_bending_period(chain, latch.hinge)
+    return first_bending_period(chain, latch.hinge, held)
 
 
 def window_nodes(t_lock: float, w: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -297,7 +297,7 @@ class Latch:
     the angle from the initial state). At the lock the hinge's relative rate drops to zero
     (a plastic impact) and D stays at ``angle`` afterwards. ``window`` (s, > 0): the window
     over which the models measure the lock impulse (None: the first bending period of the
-    locked pair, ``rodval.core.lock_window``)."""
+    locked segment, ``rodval.core.lock_window``)."""
 
     hinge: int
     angle: float

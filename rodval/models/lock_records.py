@@ -103,7 +103,7 @@ def lock_record(
         "hinge": k,
         "hinges": [latches[j].hinge for j in new],
         "impulse_instant": impulses[len(locked) - len(new)],
-        "impulse_window": lock_window(system.base_chain, latches[new[0]]),
+        "impulse_window": lock_window(system.base_chain, latches[new[0]], hinges.tolist()),
         "outboard_momentum_before": H0,
         "held_hinges": [int(h) for h in hinges],
         "angular_impulses": impulses,
