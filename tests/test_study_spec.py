@@ -101,6 +101,7 @@ def test_shipped_studies_and_the_readme_example_are_valid():
     assert sizes == {
         "companion_three_panel": 1,
         "deployment": 1,
+        "deployment_stiff": 1,
         "deployment_sample": 256,
         "exudyn_convergence": 80,
         "n_sweep": 20,
