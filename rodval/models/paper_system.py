@@ -219,9 +219,14 @@ class PaperSystem(OdeSystem):
 
     def energy(self, t: float, y: np.ndarray) -> float:
         """E = T + Pi (J) at one state (the same energy ``observe`` reports)."""
-        Y = y[None, :]
         with self._mode_at(t):
-            kin, pot = self.energies(*self.rigid(Y), *self.bending(np.array([t]), Y))
+            return self._energy_in_mode(t, y)
+
+    def _energy_in_mode(self, t: float, y: np.ndarray) -> float:
+        """E = T + Pi (J) at one state in the current mode (active stops, locked hinges); O(n)
+        with the compiled kernels."""
+        Y = y[None, :]
+        kin, pot = self.energies(*self.rigid(Y), *self.bending(np.array([t]), Y))
         return float(kin[0] + pot[0])
 
     def power(self, t: float, y: np.ndarray) -> tuple[float, float]:
@@ -479,7 +484,23 @@ class PaperSystem(OdeSystem):
 
     def apply_event(self, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:
         """A stop switching (no jump: the integrator restarts at the kink) or a latch locking
-        (a plastic impact, then the hinge is held); see docs/deployment_native.md."""
+        (a plastic impact, then the hinge is held); see docs/deployment_native.md. The record
+        carries the energy E = T + Pi (J) in the mode before the event (``energy_before``) and
+        after it, at the state after the jump (``energy_after``), and their difference
+        ``instant_energy_loss`` (J, positive: taken out), which the energy audit books as
+        dissipation: a lock's plastic loss, and in the reduced model the jump of its
+        quasi-static bending when a moment switches (docs/deployment_native.md, "Energy
+        through events")."""
+        before = self._energy_in_mode(t, y)
+        y_new, record = self._switch(index, t, y)
+        after = self._energy_in_mode(t, y_new)
+        record.data.update(
+            energy_before=before, energy_after=after, instant_energy_loss=before - after
+        )
+        return y_new, record
+
+    def _switch(self, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:
+        """Event ``index`` at (t, y): the new mode, the state after the jump and the record."""
         row = self.event_rows()[index]
         kind, j = row.kind, row.item
         if kind == "stop":

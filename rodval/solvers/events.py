@@ -49,11 +49,10 @@ def crosses(g0: float, g1: float, direction: float) -> bool:
 
 
 def impact_loss(data: dict[str, Any]) -> float:
-    """Kinetic energy (J) an event took out of the motion (an impact's ``kinetic_before`` -
-    ``kinetic_after``): dissipated energy of the energy audit; 0 for events without."""
-    if "kinetic_before" not in data:
-        return 0.0
-    return float(data["kinetic_before"] - data["kinetic_after"])
+    """Energy (J) an event took out at once (its record's ``instant_energy_loss``, E = T + Pi
+    before minus after; negative: added): dissipated energy of the energy audit; 0 for an
+    event without one."""
+    return float(data.get("instant_energy_loss", 0.0))
 
 
 def apply_hit(
