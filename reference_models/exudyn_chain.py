@@ -79,7 +79,7 @@ DEFAULTS: dict[str, Any] = {
     "EA": 1e10,
     "element": "cable2d",
     "solver": "generalized-alpha",
-    "spectral_radius": 0.9,
+    "spectral_radius": "auto",
     "newton_rtol": 1e-8,
     "newton_atol_per_EA": 1e-12,
     "max_rotation_per_step": 0.1,
@@ -114,8 +114,10 @@ class ExudynModel(Model):
         docs/reference_model.md).
     solver : "generalized-alpha" or "trapezoidal"
         exudyn's implicit integrator (trapezoidal = Newmark beta 1/4, index-2 constraints).
-    spectral_radius : float in [0, 1]
-        Generalized-alpha numerical damping at infinite frequency (1 = none).
+    spectral_radius : float in [0, 1] or "auto"
+        Generalized-alpha numerical damping at infinite frequency (1 = none). "auto" (the
+        default): ``SPECTRAL_RADIUS_FREE`` = 0.9, or ``SPECTRAL_RADIUS_LATCHES`` = 0 for a
+        scene with latches (``spectral_radius_for``; the run records the value it used).
     newton_rtol : float in (0, 1e-2]
         Newton relative tolerance.
     newton_atol_per_EA : float in (0, 1e-6]
@@ -149,7 +151,7 @@ class ExudynModel(Model):
         EA: float = DEFAULTS["EA"],
         element: str = DEFAULTS["element"],
         solver: str = DEFAULTS["solver"],
-        spectral_radius: float = DEFAULTS["spectral_radius"],
+        spectral_radius: float | str = DEFAULTS["spectral_radius"],
         newton_rtol: float = DEFAULTS["newton_rtol"],
         newton_atol_per_EA: float = DEFAULTS["newton_atol_per_EA"],
         max_rotation_per_step: float = DEFAULTS["max_rotation_per_step"],
@@ -166,13 +168,17 @@ class ExudynModel(Model):
         if solver not in SOLVERS:
             raise ValueError(f"solver must be one of {SOLVERS}, got {solver!r}")
         self.solver = solver
-        if (
+        if spectral_radius != "auto" and (
             isinstance(spectral_radius, bool)
             or not isinstance(spectral_radius, (int, float))
             or not 0 <= spectral_radius <= 1
         ):
-            raise ValueError(f"spectral_radius must be a number in [0, 1], got {spectral_radius!r}")
-        self.spectral_radius = float(spectral_radius)
+            raise ValueError(
+                f"spectral_radius must be a number in [0, 1] or 'auto', got {spectral_radius!r}"
+            )
+        self.spectral_radius: float | str = (
+            "auto" if spectral_radius == "auto" else float(spectral_radius)
+        )
         self.newton_rtol = _positive("newton_rtol", newton_rtol, upper=1e-2)
         self.newton_atol_per_EA = _positive("newton_atol_per_EA", newton_atol_per_EA, upper=1e-6)
         self.max_rotation_per_step = _positive(
@@ -225,7 +231,7 @@ class ExudynModel(Model):
         ti.newton.relativeTolerance = self.newton_rtol
         ti.newton.absoluteTolerance = self.newton_atol_per_EA * self.EA
         ti.newton.modifiedNewtonJacUpdatePerStep = bool(scene.latches)
-        ti.generalizedAlpha.spectralRadius = self.spectral_radius
+        ti.generalizedAlpha.spectralRadius = self.spectral_radius_for(scene)
         s.solution.file.write = False
         s.solution.sensors.writePeriod = 0.25 * t_end / nsteps
         s.show.statistics = False
@@ -257,6 +263,18 @@ class ExudynModel(Model):
     #: lock leaves a slowly decaying step-to-step oscillation of the relative rate
     #: (docs/deployment.md); 0 damps it within two steps.
     LATCH_MAX_SPECTRAL_RADIUS = 0.5
+    #: The spectral radius "auto" gives: 0.9 (little numerical damping) for free motion, 0
+    #: with latches (docs/reference_model.md, docs/deployment.md).
+    SPECTRAL_RADIUS_FREE = 0.9
+    SPECTRAL_RADIUS_LATCHES = 0.0
+
+    def spectral_radius_for(self, scene: Scene) -> float:
+        """The generalized-alpha spectral radius a run of ``scene`` uses: the option's value,
+        or for "auto" ``SPECTRAL_RADIUS_LATCHES`` when the scene has latches and
+        ``SPECTRAL_RADIUS_FREE`` otherwise."""
+        if self.spectral_radius != "auto":
+            return float(self.spectral_radius)
+        return self.SPECTRAL_RADIUS_LATCHES if scene.latches else self.SPECTRAL_RADIUS_FREE
 
     def check_scene(self, scene: Scene) -> None:
         """Refuse, before any work, what this model cannot honour in ``scene``: latches with the
@@ -271,11 +289,12 @@ class ExudynModel(Model):
                 "solver='generalized-alpha' (the trapezoidal solver's index-2 constraints would "
                 "hold the hinge at the angle of activation, not at the latch angle)"
             )
-        if self.spectral_radius > self.LATCH_MAX_SPECTRAL_RADIUS:
+        if self.spectral_radius_for(scene) > self.LATCH_MAX_SPECTRAL_RADIUS:
             raise ValueError(
                 f"scenes with latches need spectral_radius <= {self.LATCH_MAX_SPECTRAL_RADIUS} "
-                f"(0 recommended), got {self.spectral_radius}: with less numerical damping the "
-                "locked hinge's relative rate oscillates from step to step after the lock"
+                f"(0 recommended, or 'auto'), got {self.spectral_radius}: with less numerical "
+                "damping the locked hinge's relative rate oscillates from step to step after "
+                "the lock"
             )
 
     def run(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
@@ -417,7 +436,7 @@ class ExudynModel(Model):
         """``settings``: the integrator, every option, and what the run used (``run_info``:
         steps_planned, step_used (s, the fixed step), steps (taken), min_step_used (s, smaller
         than step_used only if Newton failures halved it), max_rotation_per_step_seen (rad),
-        blowup_factor)."""
+        blowup_factor) and ``spectral_radius`` (the value used, ``spectral_radius_for``)."""
         return Trajectory(
             model=self.name,
             scene_name=scene.name,
@@ -425,7 +444,12 @@ class ExudynModel(Model):
             values={q: v for q, (v, _) in observed.items()},
             k_index={q: k for q, (_, k) in observed.items()},
             stats=stats,
-            settings={"method": f"exudyn {self.solver}", "step": self.step, **(run_info or {})},
+            settings={
+                "method": f"exudyn {self.solver}",
+                "step": self.step,
+                "spectral_radius": self.spectral_radius_for(scene),
+                **(run_info or {}),
+            },
             options=self.options(),
             events=[dict(ev) for ev in events],
         )

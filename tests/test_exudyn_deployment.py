@@ -4,6 +4,7 @@ angular impulse, kinetic energy, angular momentum about the root) taken on the b
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -163,6 +164,22 @@ def test_stiff_rods_lock_with_the_rigid_plastic_impulse(hinge_quantities):
     assert ev["impulse"] == pytest.approx(rigid, rel=0.01)
     assert ev["impulse_window"] == pytest.approx(7.21e-3, rel=1e-3)
     assert ev["window_closed"]
+
+
+def test_default_options_run_a_latch_scene_with_spectral_radius_zero():
+    """exudyn's defaults work with latches (issue 19): spectral_radius "auto" is 0 for a
+    scene with latches and 0.9 without, and the run records the value it used; the lock is
+    the one the explicit setting gives (same options, the same numbers to round-off)."""
+    scene = two_rod_latch(t_end=0.45, num=10, outputs=("phi",))
+    auto = simulate(scene, "exudyn")
+    assert auto.success, auto.stats.message
+    assert auto.settings["spectral_radius"] == 0.0 and auto.options["spectral_radius"] == "auto"
+    explicit = simulate(scene, "exudyn", spectral_radius=0.0)
+    assert [ev["label"] for ev in auto.events] == ["latch hinge 1"]
+    assert auto.events[0]["t"] == explicit.events[0]["t"]
+    np.testing.assert_array_equal(auto.values["phi"], explicit.values["phi"])
+    free = dataclasses.replace(scene, latches=())
+    assert simulate(free, "exudyn").settings["spectral_radius"] == 0.9
 
 
 @pytest.mark.parametrize(
