@@ -56,7 +56,7 @@ from reference_models.exudyn_beam import _positive
 from reference_models.exudyn_build import _Built, build
 from reference_models.exudyn_guard import _Guard
 from reference_models.exudyn_latches import _Latches
-from reference_models.exudyn_observe import _observe
+from reference_models.exudyn_observe import _observe, stop_events
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
@@ -334,6 +334,9 @@ class ExudynModel(Model):
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         times = _ended(scene, stats, guard, t_rec, diverged)
         events, lock_steps = _lock_records(latches)
+        reached = t_rec[t_rec <= times[-1]] if times.size else t_rec[:0]
+        stops = stop_events(scene, self.elements, reached, records, lock_steps)
+        events = sorted(events + stops, key=lambda ev: ev["t"])
         try:
             observed = (
                 _observe(scene, self.elements, self.EA, times, t_rec, records, lock_steps)

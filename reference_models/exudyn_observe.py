@@ -13,7 +13,7 @@ from reference_models.exudyn_beam import (
     _wrap,
     stop_moment,
 )
-from rodval.core.scene import QUANTITIES, Scene
+from rodval.core.scene import QUANTITIES, Scene, hinge_angles
 
 
 def _observe(
@@ -128,3 +128,46 @@ def _root_bending_moment(chain, E: int, at: dict, k: int) -> np.ndarray:
     r2 = np.einsum("i,tic->tc", ddS, Q)
     curv = (r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]) / np.sum(r1**2, -1)
     return chain.EI[k] * curv
+
+
+def stop_events(
+    scene: Scene, E: int, t_rec: np.ndarray, records: dict, lock_times: dict[int, float]
+) -> list[dict]:
+    """The limit stops' contacts as events, as the native models record them: "stop hinge k
+    on" when hinge k's angle D_k enters the stop's side, "stop hinge k off" when it leaves
+    (``hinge``, ``active``), none for a stop that acts from the start (it is in the initial
+    mode) and none on a hinge after its latch has locked (``lock_times``: hinge -> s). exudyn
+    integrates the stop law as a spring, without events: each crossing is found afterwards
+    between two recorded states (every quarter step) and located by linear interpolation of
+    D_k - angle (an O(h^2) time; ``located`` says so). O(steps) per stop."""
+    if not scene.stops or t_rec.size < 2:
+        return []
+    n = scene.n
+    tangent = {  # tangent angle (rad) of the rod ends that meet at each hinge
+        key: np.unwrap(np.arctan2(*records[key][0][: t_rec.size, [3, 2]].T))
+        for key in {(k, 0) for k in range(n)} | {(k, E) for k in range(n - 1)}
+    }
+    initial = scene.initial.resolve(n)
+    D0 = hinge_angles(initial["phi"], initial["alpha"], initial["beta"])
+    events = []
+    for stop in scene.stops:
+        k = stop.hinge
+        D = tangent[(k, 0)] - (tangent[(k - 1, E)] if k > 0 else 0.0)
+        D += 2 * np.pi * np.round((D0[k] - D[0]) / (2 * np.pi))
+        g = D - stop.angle
+        inside = g > 0 if stop.side == "upper" else g < 0
+        for i in np.flatnonzero(inside[1:] != inside[:-1]):
+            t = t_rec[i] + (t_rec[i + 1] - t_rec[i]) * g[i] / (g[i] - g[i + 1])
+            if t >= lock_times.get(k, np.inf):
+                break
+            on = bool(inside[i + 1])
+            events.append(
+                {
+                    "t": float(t),
+                    "label": f"stop hinge {k} {'on' if on else 'off'}",
+                    "hinge": k,
+                    "active": on,
+                    "located": "linear between recorded states",
+                }
+            )
+    return events

@@ -83,8 +83,9 @@ def _comparability(ev: pd.Series, r: pd.Series, earlier: list[tuple[str, float]]
 
 
 def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
-    """Each model's events against the reference's event of the same case and label: lock
-    time difference dt (s, model - reference), lock impulse difference and its ratio to
+    """Each model's events against the reference's event of the same case and label (the
+    k-th of a repeated label, e.g. a stop's k-th contact, against the reference's k-th;
+    labelled "#k" from the second on): time difference dt (s, model - reference), lock impulse difference and its ratio to
     the reference's |impulse| (impulse_rel), the same ratio of the rigid-panel impulses
     (rigid_rel, where recorded), energy_lost difference (J), and ``not_comparable``: why the
     lock cannot be compared pointwise (``_comparability``; blank when it can). Events the
@@ -103,13 +104,16 @@ def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
     ]
     if events.empty:
         return pd.DataFrame(columns=cols)
-    ref = events[events["model"] == reference].set_index(["case", "label"])
+    # the k-th event of a label (a stop's contacts repeat) is compared with the reference's k-th
+    nth = events.sort_values("t", kind="stable").groupby(["case", "model", "label"]).cumcount()
+    events = events.assign(nth=nth.reindex(events.index))
+    ref = events[events["model"] == reference].set_index(["case", "label", "nth"])
     rows = []
     for _, ev in events[events["model"] != reference].iterrows():
-        key = (ev["case"], ev["label"])
+        key = (ev["case"], ev["label"], ev["nth"])
         row = {
             "case": ev["case"],
-            "label": ev["label"],
+            "label": ev["label"] + (f" #{ev['nth'] + 1}" if ev["nth"] else ""),
             "model": ev["model"],
             "reference": reference,
         }
@@ -138,7 +142,7 @@ def _earlier_gaps(
 ) -> list[tuple[str, float]]:
     """(label, |dt| s) of the reference's locks of ev's case before t_ref against the same
     model's (nan where the model lacks one)."""
-    case = events[events["case"] == ev["case"]]
+    case = events[(events["case"] == ev["case"]) & events["label"].str.startswith("latch")]
     own = case[case["model"] == ev["model"]].set_index("label")["t"]
     out = []
     for _, r in case[(case["model"] == reference) & (case["t"] < t_ref)].iterrows():
