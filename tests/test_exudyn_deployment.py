@@ -8,7 +8,6 @@ import dataclasses
 import math
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from rodval import Chain, InitialState, Scene, simulate
@@ -281,24 +280,6 @@ def test_stop_contacts_are_events_in_exudyn_as_in_the_native_models():
     assert [ev["active"] for ev in ex.events] == [True, False]
     assert ex.events[0]["t"] == pytest.approx(0.25, abs=1e-5)
     assert ex.events[1]["t"] == pytest.approx(full.events[1]["t"], abs=1e-4)
-
-
-def test_repeated_event_labels_are_paired_in_order():
-    """A stop's k-th contact is compared with the reference's k-th, not its first."""
-    from rodval.report.study_report import event_discrepancies
-
-    rows = [
-        ("ref", 0.10, "stop hinge 1 on"),
-        ("ref", 0.30, "stop hinge 1 on"),
-        ("full", 0.11, "stop hinge 1 on"),
-        ("full", 0.32, "stop hinge 1 on"),
-    ]
-    events = pd.DataFrame(
-        [{"case": "base", "model": m, "t": t, "label": lab} for m, t, lab in rows]
-    )
-    disc = event_discrepancies(events, "ref")
-    assert disc["label"].tolist() == ["stop hinge 1 on", "stop hinge 1 on #2"]
-    assert disc["dt"].tolist() == pytest.approx([0.01, 0.02])
 
 
 def test_report_renders_the_deployment_section(tmp_path):

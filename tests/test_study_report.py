@@ -85,3 +85,51 @@ def test_report_of_a_folder_without_tables_exits_2(tmp_path):
         [sys.executable, "-m", "rodval", "report", str(tmp_path)], capture_output=True, text=True
     )
     assert res.returncode == 2 and "not a study folder" in res.stderr
+
+
+def _events(rows):
+    import pandas as pd
+
+    return pd.DataFrame(
+        [{"case": "base", "model": m, "t": t, "label": lab, **kw} for m, t, lab, kw in rows]
+    )
+
+
+def test_repeated_event_labels_are_paired_in_order():
+    """A stop's k-th contact is compared with the reference's k-th, not its first."""
+    from rodval.report.study_report import event_discrepancies
+
+    events = _events(
+        [
+            ("ref", 0.10, "stop hinge 1 on", {}),
+            ("ref", 0.30, "stop hinge 1 on", {}),
+            ("full", 0.11, "stop hinge 1 on", {}),
+            ("full", 0.32, "stop hinge 1 on", {}),
+        ]
+    )
+    disc = event_discrepancies(events, "ref")
+    assert disc["label"].tolist() == ["stop hinge 1 on", "stop hinge 1 on #2"]
+    assert disc["dt"].tolist() == pytest.approx([0.01, 0.02])
+
+
+@pytest.mark.parametrize(
+    "ref_after, model_after, grazing",
+    [(50.0, 50.0, ""), (99.5, 50.0, "the reference's"), (50.0, 99.5, "its")],
+)
+def test_a_grazing_lock_is_not_compared_pointwise(ref_after, model_after, grazing):
+    """A lock whose rigid-panel lock takes less than 1 % of the kinetic energy (the hinge
+    creeps onto the latch angle) is marked not comparable, whichever model grazes."""
+    from rodval.report.study_report import event_discrepancies
+
+    lock = {"rigid_kinetic_before": 100.0, "kinetic_before": 100.0, "impulse": 1.0}
+    events = _events(
+        [
+            ("ref", 0.5, "latch hinge 1", {**lock, "rigid_kinetic_after": ref_after}),
+            ("full", 0.5, "latch hinge 1", {**lock, "rigid_kinetic_after": model_after}),
+        ]
+    )
+    why = event_discrepancies(events, "ref")["not_comparable"].iloc[0]
+    if grazing:
+        assert why.startswith(f"grazing: {grazing} rigid-panel lock takes 0.50%")
+    else:
+        assert why == ""
