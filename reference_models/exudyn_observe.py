@@ -13,7 +13,7 @@ from reference_models.exudyn_beam import (
     _wrap,
     stop_moment,
 )
-from rodval.core.scene import QUANTITIES, Scene, hinge_angles
+from rodval.core.scene import QUANTITIES, Scene
 
 
 def _observe(
@@ -142,17 +142,15 @@ def stop_events(
     D_k - angle (an O(h^2) time; ``located`` says so). O(steps) per stop."""
     if not scene.stops or t_rec.size < 2:
         return []
-    n = scene.n
-    tangent = {  # tangent angle (rad) of the rod ends that meet at each hinge
-        key: np.unwrap(np.arctan2(*records[key][0][: t_rec.size, [3, 2]].T))
-        for key in {(k, 0) for k in range(n)} | {(k, E) for k in range(n - 1)}
-    }
-    initial = scene.initial.resolve(n)
-    D0 = hinge_angles(initial["phi"], initial["alpha"], initial["beta"])
+    D0 = scene.initial_hinge_angles()
+
+    def tangent(key):  # tangent angle (rad, wrapped) of a rod end at the recorded times
+        return np.arctan2(*records[key][0][: t_rec.size, [3, 2]].T)
+
     events = []
     for stop in scene.stops:
         k = stop.hinge
-        D = tangent[(k, 0)] - (tangent[(k - 1, E)] if k > 0 else 0.0)
+        D = np.unwrap(tangent((k, 0)) - (tangent((k - 1, E)) if k > 0 else 0.0))
         D += 2 * np.pi * np.round((D0[k] - D[0]) / (2 * np.pi))
         g = D - stop.angle
         inside = g > 0 if stop.side == "upper" else g < 0

@@ -103,13 +103,14 @@ def _sections(chain: Chain, rods: range) -> tuple[np.ndarray, ...]:
     if len(l) <= MAX_SECTIONS:
         return l, EI, m, mu
     starts = np.linspace(0, len(l), MAX_SECTIONS + 1).astype(np.int64)[:-1]
+    far = mu[np.r_[starts[1:], len(l)] - 1]  # each run's far node mass
     length = np.add.reduceat(l, starts)
-    inner = np.add.reduceat(mu, starts) - mu[np.r_[starts[1:], len(l)] - 1]
+    inner = np.add.reduceat(mu, starts) - far
     return (
         length,
         length / np.add.reduceat(l / EI, starts),
         (np.add.reduceat(m * l, starts) + inner) / length,
-        mu[np.r_[starts[1:], len(l)] - 1],
+        far,
     )
 
 

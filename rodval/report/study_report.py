@@ -128,7 +128,7 @@ def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
         return pd.DataFrame(columns=cols)
     # the k-th event of a label (a stop's contacts repeat) is compared with the reference's k-th
     nth = events.sort_values("t", kind="stable").groupby(["case", "model", "label"]).cumcount()
-    events = events.assign(nth=nth.reindex(events.index))
+    events = events.assign(nth=nth)  # aligned on the index
     ref = events[events["model"] == reference].set_index(["case", "label", "nth"])
     rows = []
     for _, ev in events[events["model"] != reference].iterrows():
