@@ -12,7 +12,8 @@ Printed per model, EI and tolerance (every energy relative to the scale max(E, |
     does not book (the audit books each event's ``instant_energy_loss``: a lock's plastic
     loss, the reduced model's quasi-static bending re-equilibrating when a moment switches);
   * ``locks``, ``switches``: the booked instantaneous losses, J (switches: the stops' on/off
-    events; negative: energy the event added);
+    events; negative: energy the event added); ``first on``: the energy the first stop
+    switch-on added, J (the reduced model's quasi-static bending jump);
   * ``contacts``, ``elsewhere``: R accumulated inside the stop contacts and outside them;
   * ``R_end``, ``max|R|``: the run's residual.
 Two tolerances tell integration from the model's own residual; three EI tell the quasi-static
@@ -63,6 +64,7 @@ def audit_row(model: str, EI: float, rtol: float, damping: float = 0.0) -> list:
 
     jumps = [at(t + DELTA) - at(t - DELTA) for t in t_ev]
     losses = {"latch": 0.0, "stop": 0.0}
+    first_on = next(0.0 - ev["instant_energy_loss"] for ev in tr.events if ev.get("active"))
     contacts, on = 0.0, None
     for ev in tr.events:
         losses[ev["label"].split()[0]] += ev["instant_energy_loss"]
@@ -79,6 +81,7 @@ def audit_row(model: str, EI: float, rtol: float, damping: float = 0.0) -> list:
         max(map(abs, jumps)) / scale,
         losses["latch"],
         losses["stop"],
+        first_on,
         contacts / scale,
         (R[-1] - contacts) / scale,
         R[-1] / scale,
@@ -94,8 +97,10 @@ def main() -> None:
         for rtol in (1e-8, 1e-10)
     ]
     rows += [audit_row("full", 1e5, 1e-8, damping) for damping in (200.0, 1000.0)]
-    head = ["model", "EI", "rtol", "events", "event", "locks J", "switches J", "contacts"]
-    print(tabulate(rows, headers=[*head, "elsewhere", "R_end", "max|R|"], floatfmt=".3g"))
+    head = ["model", "EI", "rtol", "events", "event", "locks J", "switches J", "first on J"]
+    print(
+        tabulate(rows, headers=[*head, "contacts", "elsewhere", "R_end", "max|R|"], floatfmt=".3g")
+    )
 
 
 if __name__ == "__main__":

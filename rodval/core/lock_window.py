@@ -25,7 +25,7 @@ together into one Euler-Bernoulli beam with their node masses, pinned at its inb
 left out (soft against the panels' bending, the deployable's regime) and so are the rods
 beyond the segment. The segment's first bending mode is the lowest ring the lock excites in
 it, so one period of it is the smallest window over which the ring averages out: the locked
-pair alone rings 3.5x higher than a four-panel segment, and a pair window left most of that
+pair alone rings 3.8x higher than a four-panel segment, and a pair window left most of that
 segment's ring in S_w (docs/deployment.md). Cubic Hermite elements, ``ELEMENTS_PER_ROD`` per
 rod of a pair and at least ``MIN_ELEMENTS`` in all, give the period to 3e-6 relative (the
 element's error falls as h^4; from above in frequency), far below what the window needs.
