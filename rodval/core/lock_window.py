@@ -1,5 +1,6 @@
 """The lock window: the declared stretch of time after a latch locks over which every model
-measures the lock's impulse (docs/deployment.md, "The lock impulse").
+measures the lock's impulse (docs/deployment.md, "The lock impulse") and at whose end it
+accounts for the lock's energy (``window_energies``; "Where the lock energy goes").
 
 A latch joins two elastic rods; at the lock the relative rate of the rods' end tangents drops
 to zero, but the rods' chords keep turning against each other and the latch's reaction rings
@@ -32,6 +33,8 @@ element's error falls as h^4; from above in frequency), far below what the windo
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 import scipy.linalg
@@ -163,3 +166,25 @@ def window_nodes(t_lock: float, w: float) -> tuple[np.ndarray, np.ndarray, np.nd
     s = (edges[:-1, None] + half[:, None] * (_GL_X + 1.0)).ravel()
     base = (half[:, None] * _GL_W).ravel()
     return t_lock + s, base * (1.0 - s / w), base / w
+
+
+def window_energies(
+    record: dict[str, Any], t_end: float, energies: tuple[float, ...], work: float, lost: float
+) -> dict[str, float]:
+    """The energy accounts of a lock window (docs/deployment.md, "Where the lock energy
+    goes"), every model's definition: at its end ``t_end`` (s) the kinetic, hinge and bending
+    energy (J) ``energies`` (none if no probe was reached: the values before the lock), the
+    work of the loads ``work`` and the energy dissipated ``lost`` since just before the lock
+    (J; the instantaneous losses included), and the balance's residual
+    E(end) - E(before) - work + dissipated (J)."""
+    before = [float(record[f"{name}_before"]) for name in ("kinetic", "hinge", "bending")]
+    end = list(energies) if energies else before
+    return {
+        "window_end": float(t_end),
+        "kinetic_window_end": float(end[0]),
+        "hinge_window_end": float(end[1]),
+        "bending_window_end": float(end[2]),
+        "work_window_end": float(work),
+        "dissipated_window_end": float(lost),
+        "energy_residual_window_end": float(sum(end) - sum(before) - work + lost),
+    }

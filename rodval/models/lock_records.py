@@ -26,7 +26,7 @@ import numpy as np
 
 from rodval.core.lock_window import lock_window
 from rodval.core.rigid import node_velocities, rigid_lock
-from rodval.models.paper_matrices import node_positions, rod_momenta
+from rodval.models.paper_matrices import bending_energy, node_positions, rod_momenta
 
 #: The systems these functions read: ``rodval.models.paper_system.PaperSystem`` (which imports
 #: this module, so it is not imported here).
@@ -55,9 +55,21 @@ def outboard_momentum(
     return float(h[k:].sum()) - _cross(r[k], p_out), p_out, r, v_k
 
 
+def energy_parts(system: PaperSystem, t: float, y: np.ndarray) -> tuple[float, float, float]:
+    """(kinetic, hinge, bending) energy (J) at one state in the current mode: T, the hinge
+    springs and acting stops, the rods' bending; their sum is the model's E = T + Pi. O(n)."""
+    Y = y[None, :]
+    rigid, bending = system.rigid(Y), system.bending(np.array([t]), Y)
+    kin, pot = system.energies(*rigid, *bending)
+    bend = float(bending_energy(system.base_chain, bending[0], bending[1])[0])
+    return float(kin[0]), float(pot[0]) - bend, bend
+
+
 def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[float, ...]:
     """(lambda (N m): the held hinge k's reaction on the outboard rod; H_out (N m s); M_fin
-    (N m)) at one state in the current mode (see the module docstring). O(n)."""
+    (N m); P_ext, P_diss (W): the power of the loads and of the dampers (``power``);
+    kinetic, hinge, bending energy (J, ``energy_parts``)) at one state in the current mode
+    (see the module docstring). O(n)."""
     lam = system.accel_locked(t, y)[1]
     held = [int(h) for h in system._lock_h]
     H, p_out, r, v_k = outboard_momentum(system, y, k)
@@ -70,7 +82,13 @@ def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[
         X, Y = forces  # at nodes 1..n
         arm = r[k + 1 :] - r[k]
         finite += float(np.sum(arm[:, 0] * Y[k:] - arm[:, 1] * X[k:]))
-    return float(lam[held.index(k)]), H, float(finite)
+    return (
+        float(lam[held.index(k)]),
+        H,
+        float(finite),
+        *system.power(t, y),
+        *energy_parts(system, t, y),
+    )
 
 
 def lock_record(
@@ -90,7 +108,7 @@ def lock_record(
     phi, dphi = (a[0] for a in system.rigid(y[None, :]))
     k = latches[new[0]].hinge
     rigid = rigid_lock(system.base_chain, phi, dphi, hinges.tolist(), int(hinges[-len(new)]))
-    T0 = system.kinetic_energy(t, y)
+    T0, hinge0, bending0 = energy_parts(system, t, y)
     P0 = system.momenta(y)
     H0 = outboard_momentum(system, y, k)[0]
     root0 = outboard_momentum(system, y, 0)[0]  # node 0 is the root
@@ -110,6 +128,8 @@ def lock_record(
         "joint_impulses": S.tolist(),
         "root_impulse": S[0].tolist(),
         "kinetic_before": T0,
+        "hinge_before": hinge0,
+        "bending_before": bending0,
         "kinetic_after": T1,
         "angular_momentum_root_before": root0,
         "angular_momentum_root_after": root1,

@@ -217,13 +217,20 @@ def rest_forces(chain: Chain) -> np.ndarray:
 def potential_energy(
     chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray
 ) -> np.ndarray:
-    """Pi = 1/2 sum_k kappa_k (D_k - rest_k)^2 + 1/2 sum_k (4 EI_k/l_k)(a^2 + a b + b^2) (J),
-    per row of (..., n) arrays, O(n)."""
+    """Pi = hinge_energy + bending_energy (J), per row of (..., n) arrays, O(n)."""
+    return hinge_energy(chain, phi, alpha, beta) + bending_energy(chain, alpha, beta)
+
+
+def hinge_energy(chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """1/2 sum_k kappa_k (D_k - rest_k)^2 (J): the hinge springs, per row, O(n)."""
     D = hinge_angles(phi, alpha, beta) - chain.rest_angle
+    return 0.5 * np.sum(chain.kappa * D * D, axis=-1)
+
+
+def bending_energy(chain: Chain, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """1/2 sum_k (4 EI_k/l_k)(a^2 + a b + b^2) (J): the rods' bending, per row, O(n)."""
     kb = 4.0 * chain.EI / chain.l
-    return 0.5 * np.sum(
-        chain.kappa * D * D + kb * (alpha * alpha + alpha * beta + beta * beta), axis=-1
-    )
+    return 0.5 * np.sum(kb * (alpha * alpha + alpha * beta + beta * beta), axis=-1)
 
 
 def quasi_static_bending(chain: Chain, phi: np.ndarray) -> np.ndarray:

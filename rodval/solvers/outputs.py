@@ -14,47 +14,63 @@ from typing import Any
 
 import numpy as np
 
-from rodval.core.lock_window import window_nodes
+from rodval.core.lock_window import window_energies, window_nodes
 from rodval.solvers.system import OdeSystem
 
 
 class _Window:
-    """One lock's window: its probes, and the running sums of the lock record's impulses."""
+    """One lock's window: its probes (the quadrature nodes of ``window_nodes`` and its end),
+    the running sums of the lock record's impulses and the energy accounts at its end."""
 
     def __init__(self, record: dict[str, Any]):
         self.record = record
         self.t0 = float(record["t"])
         self.w = float(record["impulse_window"])
         self.hinge = int(record["hinge"])
-        self.times, self.taper, self.mean = window_nodes(self.t0, self.w)
+        times, taper, mean = window_nodes(self.t0, self.w)
+        # the window's end: a probe with zero weights, for the energies there
+        self.times = np.append(times, self.t0 + self.w)
+        self.taper, self.mean = np.append(taper, 0.0), np.append(mean, 0.0)
         self.i = 0
         #: mu + int lambda (1 - s/w) ds, mean H_out, int finite (1 - s/w) ds
         self.impulse = float(record["impulse_instant"])
         self.H = 0.0
         self.finite = 0.0
         self.taken = 0.0
+        #: int P_ext ds, the lock's and later events' losses + int P_diss ds (J)
+        self.work = 0.0
+        self.dissipated = float(record.get("instant_energy_loss", 0.0))
+        self.energies: tuple[float, ...] = ()
+        self.t_last = self.t0
 
-    def later_impulse(self, record: dict[str, Any]) -> None:
-        """A later lock inside the window adds its instantaneous impulse on this hinge,
-        weighted by the taper at its time."""
+    def later_event(self, record: dict[str, Any]) -> None:
+        """A later event inside the window: a lock adds its instantaneous impulse on this
+        hinge, weighted by the taper at its time; any event its instantaneous energy loss."""
         s = float(record["t"]) - self.t0
+        if not 0 <= s < self.w:
+            return
+        self.dissipated += float(record.get("instant_energy_loss", 0.0))
         held = record.get("held_hinges", [])
-        if 0 <= s < self.w and self.hinge in held:
+        if self.hinge in held:
             mu = record["angular_impulses"][held.index(self.hinge)]
             self.impulse += float(mu) * (1.0 - s / self.w)
 
     def take(self, system: OdeSystem, y: np.ndarray) -> None:
         t = float(self.times[self.i])
-        lam, H, finite = system.window_terms(t, y, self.hinge)
+        lam, H, finite, p_ext, p_diss, *energies = system.window_terms(t, y, self.hinge)
         self.impulse += self.taper[self.i] * lam
         self.H += self.mean[self.i] * H
         self.finite += self.taper[self.i] * finite
         self.taken += self.mean[self.i]
+        self.work += self.w * self.mean[self.i] * p_ext
+        self.dissipated += self.w * self.mean[self.i] * p_diss
+        self.energies, self.t_last = tuple(energies), t
         self.i += 1
 
     def finish(self) -> None:
         """Write the window's measures into the lock record (a window the run did not reach
-        to its end: over the part reached, ``window_closed`` False)."""
+        to its end: over the part reached, ``window_closed`` False, the energies at the last
+        probe reached, ``window_end`` its time)."""
         rec = self.record
         rec["impulse"] = float(self.impulse)
         # mean over the window of H_out(tau) - H_out(0-) - int_0^tau finite ds
@@ -62,6 +78,7 @@ class _Window:
             self.H - self.taken * rec["outboard_momentum_before"] - self.finite
         )
         rec["window_closed"] = self.i == self.times.size
+        rec.update(window_energies(rec, self.t_last, self.energies, self.work, self.dissipated))
 
 
 class LockWindows:
@@ -72,10 +89,10 @@ class LockWindows:
         self.open: list[_Window] = []
 
     def event(self, record: dict[str, Any]) -> None:
-        """After an event: its instantaneous impulses go to the windows still open; a lock
-        whose record declares an ``impulse_window`` opens one."""
+        """After an event: its instantaneous impulses and losses go to the windows still
+        open; a lock whose record declares an ``impulse_window`` opens one."""
         for win in self.open:
-            win.later_impulse(record)
+            win.later_event(record)
         if "impulse_window" in record:
             self.open.append(_Window(record))
 
