@@ -259,10 +259,11 @@ def _elements(chain, E: int, at: dict):
 
 def _energies(
     scene: Scene, E: int, EA: float, at: dict, phi, alpha, beta
-) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and potential energy (J) per output time: beam kinetic, bending (EI kappa^2/2),
-    axial (EA eps^2/2, EA of the run), point masses and hinge springs (kappa D^2/2 with the
-    continuous tangent angles phi + alpha, phi + beta)."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Kinetic, rod strain and hinge energy (J) per output time: beam and point-mass kinetic;
+    the rods' bending (EI kappa^2/2) and axial (EA eps^2/2, EA of the run) strain; the hinge
+    springs (kappa D^2/2 with the continuous tangent angles phi + alpha, phi + beta) and the
+    acting stops. The potential energy is strain + hinge."""
     chain = scene.chain
     kin = np.zeros(phi.shape[0])
     pot = np.zeros(phi.shape[0])
@@ -280,12 +281,12 @@ def _energies(
         kin += 0.5 * chain.mu[k] * np.sum(vt**2, -1)
     left = np.concatenate([np.zeros((phi.shape[0], 1)), (phi + beta)[:, :-1]], 1)
     D = (phi + alpha) - left
-    pot += 0.5 * np.sum(chain.kappa * (D - chain.rest_angle) ** 2, -1)
+    hinge = 0.5 * np.sum(chain.kappa * (D - chain.rest_angle) ** 2, -1)
     for stop in scene.stops:
         pen = D[:, stop.hinge] - stop.angle
         inside = pen > 0 if stop.side == "upper" else pen < 0
-        pot += np.where(inside, 0.5 * stop.stiffness * pen**2, 0.0)
-    return kin, pot
+        hinge += np.where(inside, 0.5 * stop.stiffness * pen**2, 0.0)
+    return kin, pot, hinge
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

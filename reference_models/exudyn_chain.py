@@ -52,6 +52,7 @@ from typing import Any
 
 import numpy as np
 
+from reference_models.exudyn_audit import account
 from reference_models.exudyn_beam import _positive
 from reference_models.exudyn_build import _Built, build
 from reference_models.exudyn_guard import _Guard
@@ -343,12 +344,16 @@ class ExudynModel(Model):
                 if times.size
                 else {}
             )
+            stats.energy_residual, audit = account(
+                scene, self.elements, self.EA, times, t_rec, records, events, observed
+            )
         except Exception as exc:  # noqa: BLE001
             stats.status, stats.message = (
                 STATUS_ERROR,
                 f"observation failed: {type(exc).__name__}: {exc}",
             )
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
+        run_info.update(audit)
         return self._trajectory(scene, times, observed, stats, run_info, events)
 
     def _solve(self, scene: Scene, built: _Built, sim, guard: _Guard, latches, stats) -> None:

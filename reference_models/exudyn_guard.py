@@ -79,10 +79,10 @@ class _Guard:
             for k in range(chain.n)
             for j in range(E + 1)
         }
-        kin0, pot0 = _energies(
+        parts = _energies(
             scene, E, EA, at0, ini["phi"][None], ini["alpha"][None], ini["beta"][None]
         )
-        self.spec = GuardSpec(blowup_factor=float(factor), energy0_J=float(kin0[0] + pot0[0]))
+        self.spec = GuardSpec(blowup_factor=float(factor), energy0_J=float(np.sum(parts)))
         self.energy = Monitor(self.spec)
         self.verdict: tuple | None = None
         self.min_step, self.max_rotation_seen = math.inf, 0.0

@@ -42,24 +42,8 @@ def _observe(
     out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     if not scene.wants(*QUANTITIES):
         return out
-    left = [records[(k, 0)] for k in range(n)]
-    right = [records[(k, E)] for k in range(n)]
-    # chord angles on every recorded step, unwrapped in time from the initial phi
-    chord_rec = np.stack([r[0][:, :2] - lft[0][:, :2] for lft, r in zip(left, right)], 1)
-    raw_rec = np.arctan2(chord_rec[..., 1], chord_rec[..., 0])
-    phi_rec = np.unwrap(raw_rec, axis=0)
-    phi0 = scene.initial.resolve(n)["phi"]
-    phi_rec += 2 * np.pi * np.round((phi0 - phi_rec[0]) / (2 * np.pi))
-    i = np.clip(np.searchsorted(t_rec, times, side="right") - 1, 0, t_rec.size - 1)
-    qL = np.stack([at[(k, 0)][0] for k in range(n)], 1)  # (nt, n, 4)
-    qR = np.stack([at[(k, E)][0] for k in range(n)], 1)
-    vL = np.stack([at[(k, 0)][1] for k in range(n)], 1)
-    vR = np.stack([at[(k, E)][1] for k in range(n)], 1)
-    d, dd = qR[..., :2] - qL[..., :2], vR[..., :2] - vL[..., :2]
-    phi = phi_rec[i] + _wrap(np.arctan2(d[..., 1], d[..., 0]) - phi_rec[i])
-    dphi = (d[..., 0] * dd[..., 1] - d[..., 1] * dd[..., 0]) / np.sum(d**2, -1)
-    alpha = _wrap(np.arctan2(qL[..., 3], qL[..., 2]) - phi)
-    beta = _wrap(np.arctan2(qR[..., 3], qR[..., 2]) - phi)
+    phi, dphi, alpha, beta = _chord_angles(scene, E, times, t_rec, records, at)
+    qL, vL, qR, vR = _ends(n, E, at)
     for name, val in (("phi", phi), ("dphi", dphi), ("alpha", alpha), ("beta", beta)):
         if scene.wants(name):
             out[name] = (val, rods)
@@ -76,14 +60,46 @@ def _observe(
             scene, E, times, at, (phi, alpha, beta), (qL, vL, qR, vR), lock_steps, out
         )
     if scene.wants("energy"):
-        kin, pot = _energies(scene, E, EA, at, phi, alpha, beta)
+        kin, strain, hinge = _energies(scene, E, EA, at, phi, alpha, beta)
         zero = np.zeros(1, dtype=int)
         out["kinetic"] = (kin[:, None], zero)
-        out["potential"] = (pot[:, None], zero)
-        out["energy"] = ((kin + pot)[:, None], zero)
+        out["potential"] = ((strain + hinge)[:, None], zero)
+        out["energy"] = ((kin + strain + hinge)[:, None], zero)
     if scene.wants("angular_momentum"):
         out["angular_momentum"] = (_angular_momentum(scene.chain, E, at), np.arange(2))
     return out
+
+
+def _ends(n: int, E: int, at: dict) -> tuple[np.ndarray, ...]:
+    """The rods' left and right node states and rates (qL, vL, qR, vR), (nt, n, 4)."""
+    qL = np.stack([at[(k, 0)][0] for k in range(n)], 1)
+    qR = np.stack([at[(k, E)][0] for k in range(n)], 1)
+    vL = np.stack([at[(k, 0)][1] for k in range(n)], 1)
+    vR = np.stack([at[(k, E)][1] for k in range(n)], 1)
+    return qL, vL, qR, vR
+
+
+def _chord_angles(scene: Scene, E: int, times, t_rec, records: dict, at: dict):
+    """(phi, dphi, alpha, beta) (rad, rad/s; (nt, n)) at ``times`` from the node states ``at``
+    there: the chord angles continuous in time (unwrapped along every recorded step from the
+    initial phi) and the end tangents' angles to the chord."""
+    n = scene.n
+    left = [records[(k, 0)] for k in range(n)]
+    right = [records[(k, E)] for k in range(n)]
+    # chord angles on every recorded step, unwrapped in time from the initial phi
+    chord_rec = np.stack([r[0][:, :2] - lft[0][:, :2] for lft, r in zip(left, right)], 1)
+    raw_rec = np.arctan2(chord_rec[..., 1], chord_rec[..., 0])
+    phi_rec = np.unwrap(raw_rec, axis=0)
+    phi0 = scene.initial.resolve(n)["phi"]
+    phi_rec += 2 * np.pi * np.round((phi0 - phi_rec[0]) / (2 * np.pi))
+    i = np.clip(np.searchsorted(t_rec, times, side="right") - 1, 0, t_rec.size - 1)
+    qL, vL, qR, vR = _ends(n, E, at)
+    d, dd = qR[..., :2] - qL[..., :2], vR[..., :2] - vL[..., :2]
+    phi = phi_rec[i] + _wrap(np.arctan2(d[..., 1], d[..., 0]) - phi_rec[i])
+    dphi = (d[..., 0] * dd[..., 1] - d[..., 1] * dd[..., 0]) / np.sum(d**2, -1)
+    alpha = _wrap(np.arctan2(qL[..., 3], qL[..., 2]) - phi)
+    beta = _wrap(np.arctan2(qR[..., 3], qR[..., 2]) - phi)
+    return phi, dphi, alpha, beta
 
 
 def _hinge_quantities(scene: Scene, E: int, times, at: dict, angles, ends, lock_steps, out):
@@ -95,13 +111,7 @@ def _hinge_quantities(scene: Scene, E: int, times, at: dict, angles, ends, lock_
     hinges = np.arange(scene.n)
     left = np.concatenate([np.zeros((phi.shape[0], 1)), (phi + beta)[:, :-1]], 1)
     D = (phi + alpha) - left
-
-    def rate(q, v):
-        return (q[..., 2] * v[..., 3] - q[..., 3] * v[..., 2]) / (q[..., 2] ** 2 + q[..., 3] ** 2)
-
-    rate_left = rate(qL, vL)
-    rate_right = np.concatenate([np.zeros((phi.shape[0], 1)), rate(qR, vR)[:, :-1]], 1)
-    dD = rate_left - rate_right
+    dD = hinge_rates(qL, vL, qR, vR)
     if scene.wants("hinge_angle"):
         out["hinge_angle"] = (D, hinges)
     if scene.wants("hinge_moment"):
@@ -114,6 +124,17 @@ def _hinge_quantities(scene: Scene, E: int, times, at: dict, angles, ends, lock_
             if after.any():
                 M[after, k] = _root_bending_moment(chain, E, at, k)[after]
         out["hinge_moment"] = (M, hinges)
+
+
+def hinge_rates(qL, vL, qR, vR) -> np.ndarray:
+    """dD_k/dt (rad/s, (nt, n)): the rate of rod k+1's left end tangent minus rod k's right
+    one (0 for the root) from the rods' end node states and rates (nt, n, 4)."""
+
+    def rate(q, v):
+        return (q[..., 2] * v[..., 3] - q[..., 3] * v[..., 2]) / (q[..., 2] ** 2 + q[..., 3] ** 2)
+
+    right = rate(qR, vR)[:, :-1]
+    return rate(qL, vL) - np.concatenate([np.zeros((right.shape[0], 1)), right], 1)
 
 
 def _root_bending_moment(chain, E: int, at: dict, k: int) -> np.ndarray:
@@ -143,16 +164,10 @@ def stop_events(
     if not scene.stops or t_rec.size < 2:
         return []
     D0 = scene.initial_hinge_angles()
-
-    def tangent(key):  # tangent angle (rad, wrapped) of a rod end at the recorded times
-        return np.arctan2(*records[key][0][: t_rec.size, [3, 2]].T)
-
     events = []
     for stop in scene.stops:
         k = stop.hinge
-        D = np.unwrap(tangent((k, 0)) - (tangent((k - 1, E)) if k > 0 else 0.0))
-        D += 2 * np.pi * np.round((D0[k] - D[0]) / (2 * np.pi))
-        g = D - stop.angle
+        g = recorded_hinge_angle(records, E, k, D0[k], t_rec.size) - stop.angle
         inside = g > 0 if stop.side == "upper" else g < 0
         for i in np.flatnonzero(inside[1:] != inside[:-1]):
             t = t_rec[i] + (t_rec[i + 1] - t_rec[i]) * g[i] / (g[i] - g[i + 1])
@@ -169,3 +184,14 @@ def stop_events(
                 }
             )
     return events
+
+
+def recorded_hinge_angle(records: dict, E: int, k: int, D0: float, nt: int) -> np.ndarray:
+    """D_k (rad) at the first ``nt`` recorded steps: the difference of the end tangents'
+    angles, unwrapped in time from the initial hinge angle D0 (rad)."""
+
+    def tangent(key):  # tangent angle (rad, wrapped) of a rod end at the recorded times
+        return np.arctan2(*records[key][0][:nt, [3, 2]].T)
+
+    D = np.unwrap(tangent((k, 0)) - (tangent((k - 1, E)) if k > 0 else 0.0))
+    return D + 2 * np.pi * np.round((D0 - D[0]) / (2 * np.pi))

@@ -80,7 +80,8 @@ def test_bad_option_names_the_option(option, value):
 
 
 def test_outputs_labels_and_stats():
-    """Exactly the requested quantities at the requested times, with the native k labels."""
+    """Exactly the requested quantities at the requested times, with the native k labels
+    ("energy" brings the energy audit, as in the native models)."""
     scene = paper_scene(
         2,
         t_end=0.1,
@@ -100,6 +101,9 @@ def test_outputs_labels_and_stats():
         "kinetic",
         "potential",
         "energy",
+        "work",
+        "dissipated",
+        "energy_residual",
     }
     assert tr.k_index["phi"].tolist() == [1, 2]
     assert tr.k_index["x"].tolist() == [0, 1, 2]

@@ -42,6 +42,8 @@ EVENT_REPORT_COLUMNS = (
     "kinetic_before",
     "kinetic_after",
     "energy_lost",
+    "dissipated_window_end",
+    "energy_residual_window_end",
     "window_closed",
     "angular_momentum_root_jump",
 )
@@ -249,8 +251,12 @@ def _deployment_section(
         "ratio (1 in the rigid-panel limit); the kinetic energy just before and just after "
         "the lock's instantaneous part and their difference (J: the full model's tangent "
         "impact takes out little, the reduced model's chord impact the whole rigid-panel "
-        "loss, exudyn's is taken two steps after the lock); the jump of the angular "
-        "momentum about the root through the lock (N m s; an internal impulse leaves it "
+        "loss, exudyn's is taken two steps after the lock); the energy dissipated from "
+        "just before the lock to the window's end (instantaneous losses and dampers) and the "
+        "residual of that window's energy balance (J: exudyn's is its integrator's numerical "
+        "dissipation; the kinetic, hinge and bending parts are in `events.csv`); the jump of "
+        "the angular momentum about the root through the lock (N m s; an internal impulse "
+        "leaves it "
         "unchanged while hinge 0 is free). docs/deployment.md defines each.\n",
         to_markdown(events[[c for c in EVENT_REPORT_COLUMNS if c in events]], ".5g"),
     ]

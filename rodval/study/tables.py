@@ -13,7 +13,10 @@
   window, ``rodval.core.lock_window``), impulse_window (s), rigid_impulse (N m s, the
   rigid-panel lock of the model's chords, ``rodval.core.rigid``), impulse_to_rigid =
   impulse / rigid_impulse, kinetic_before, kinetic_after (J), energy_lost = kinetic_before -
-  kinetic_after (J), and every further key a model records, e.g. impulse_momentum,
+  kinetic_after (J), the lock window's energy accounts (instant_energy_loss, the hinge and
+  bending energy before the lock, kinetic, hinge, bending energy, work and dissipated energy
+  at the window's end and the balance's residual, J: docs/deployment.md, "Where the lock
+  energy goes"), and every further key a model records, e.g. impulse_momentum,
   angular_momentum_root_jump). Written only when some run has events.
 
 ``provenance.json`` (machine and package versions) and ``study.json`` lie beside them.
@@ -141,6 +144,15 @@ EVENT_COLUMNS = (
     "kinetic_before",
     "kinetic_after",
     "energy_lost",
+    "instant_energy_loss",
+    "hinge_before",
+    "bending_before",
+    "kinetic_window_end",
+    "hinge_window_end",
+    "bending_window_end",
+    "work_window_end",
+    "dissipated_window_end",
+    "energy_residual_window_end",
 )
 
 

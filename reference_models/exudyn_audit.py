@@ -1,0 +1,157 @@
+"""The exudyn model's energy audit and the energy accounts of its lock windows, with rodval's
+definitions (``rodval.solvers.audit``, ``rodval.core.lock_window.window_energies``), from
+the node states exudyn recorded at every step.
+
+* W_ext(t) = int P_ext dt, P_ext = sum of the nodal forces . the node velocities (W);
+* D(t) = int P_diss dt, P_diss (W) the power of the scene's dampers on
+  the beam: the hinge dampers nu_k (dD_k/dt)^2, the acting stops' dampers d (dD_k/dt)^2 and
+  the rods' Kelvin-Voigt bending damping int c (dK/dt)^2 ds (exudyn's ``bendingDamping``: the
+  virtual work int c K' delta K ds of its material curvature K; 5 Gauss points per element).
+  The powers are integrated by the trapezoidal rule over exudyn's steps: second order, as
+  its generalized-alpha integrator.
+* A lock: exudyn has no instantaneous impact (its latch joint, switched on at the step
+  where the hinge crosses the latch angle, ``t_activated``, holds the hinge from the next
+  steps on), so its ``instant_energy_loss`` is 0 and D has no lock term: the energy the
+  switched-on joint takes out is in R. (Over the first steps after the switch the recorded
+  velocities do not yet satisfy the held hinge: E dips by several J and comes back, so no
+  energy difference across the switch measures a loss.)
+* R(t) = E(t) - E(0) - W_ext(t) + D(t) is then what the integrator itself took out or put in:
+  generalized-alpha's numerical dissipation (R < 0) plus the quadrature's O(h^2). The run
+  records ``numerical_dissipation`` = -R(t_end) (J) in its settings, and max |R| over the
+  energy scale (``rodval.solvers.audit.balance``) as its ``energy_residual``, which the
+  validity verdict bounds as every model's (docs/deployment.md, "Where the lock energy
+  goes").
+
+Cost: O(steps x n x elements) array operations, once after the run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reference_models.exudyn_beam import _elements, _energies, _interpolate
+from reference_models.exudyn_observe import (
+    _chord_angles,
+    _ends,
+    hinge_rates,
+    recorded_hinge_angle,
+)
+from rodval.core.lock_window import window_energies
+from rodval.core.scene import Scene
+from rodval.solvers.audit import balance
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def step_powers(scene: Scene, E: int, t_rec: np.ndarray, records: dict) -> tuple[np.ndarray, ...]:
+    """(P_ext, P_diss) (W, (steps,)) at the recorded steps (see the module docstring)."""
+    chain = scene.chain
+    qv = {key: (q, v) for key, (q, v, _) in records.items()}
+    p_ext = np.zeros(t_rec.size)
+    for f in scene.loads:
+        v = qv[(f.node - 1, E)][1][:, :2]
+        for i, t in enumerate(t_rec):
+            if f.active(t):
+                fx = f.fx(t) if f.fx is not None else 0.0
+                fy = f.fy(t) if f.fy is not None else 0.0
+                p_ext[i] += fx * v[i, 0] + fy * v[i, 1]
+    dD = hinge_rates(*_ends(scene.n, E, qv))
+    p_diss = np.sum(chain.nu * dD**2, -1)
+    D0 = scene.initial_hinge_angles()
+    for stop in scene.stops:
+        k = stop.hinge
+        pen = recorded_hinge_angle(records, E, k, D0[k], t_rec.size) - stop.angle
+        inside = pen > 0 if stop.side == "upper" else pen < 0
+        p_diss += np.where(inside, stop.damping * dD[:, k] ** 2, 0.0)
+    for k, w, _, dS, ddS, Q, V in _elements(chain, E, qv):
+        c = chain.bending_damping[k]
+        if c == 0:
+            continue
+        r1, r2 = np.einsum("gi,tic->tgc", dS, Q), np.einsum("gi,tic->tgc", ddS, Q)
+        v1, v2 = np.einsum("gi,tic->tgc", dS, V), np.einsum("gi,tic->tgc", ddS, V)
+        n2 = np.sum(r1**2, -1)
+        curv_rate = (_cross(v1, r2) + _cross(r1, v2)) / n2 - 2 * _cross(r1, r2) * np.sum(
+            r1 * v1, -1
+        ) / n2**2
+        p_diss += c * np.sum(w * curv_rate**2, -1)
+    return p_ext, p_diss
+
+
+def _cumulative(t: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """int_0^t p dt (J) at every recorded step by the trapezoidal rule."""
+    return np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))])
+
+
+def energy_parts(scene: Scene, E: int, EA: float, times, t_rec, records) -> np.ndarray:
+    """(kinetic, hinge, rod strain) energy (J), (3, len(times)), at any times (s) inside the
+    recorded steps (``_energies`` on the node states interpolated there); the rod strain is
+    the bending and the (small) axial strain energy."""
+    times = np.asarray(times, float)
+    at = {
+        key: (_interpolate(times, t_rec, q, v), _interpolate(times, t_rec, v, a))
+        for key, (q, v, a) in records.items()
+    }
+    phi, _, alpha, beta = _chord_angles(scene, E, times, t_rec, records, at)
+    kin, strain, hinge = _energies(scene, E, EA, at, phi, alpha, beta)
+    return np.array([kin, hinge, strain])
+
+
+def ledger(
+    scene: Scene, E: int, EA: float, t_rec, records, events: list[dict]
+) -> tuple[np.ndarray, np.ndarray]:
+    """W_ext and D (J) at the recorded steps; the lock records in ``events`` get their
+    ``instant_energy_loss`` (0) and window energies (module docstring)."""
+    p_ext, p_diss = step_powers(scene, E, t_rec, records)
+    W, D = _cumulative(t_rec, p_ext), _cumulative(t_rec, p_diss)
+
+    def parts(ts) -> np.ndarray:
+        return energy_parts(scene, E, EA, ts, t_rec, records)
+
+    for ev in (ev for ev in events if "t_activated" in ev):  # the locks
+        ev["instant_energy_loss"] = 0.0
+        ta, te = ev["t_activated"], min(ev["t"] + ev["impulse_window"], float(t_rec[-1]))
+        ev.update(
+            zip(("kinetic_before", "hinge_before", "bending_before"), parts([ta])[:, 0].tolist())
+        )
+        (w0, w1), (d0, d1) = np.interp([ta, te], t_rec, W), np.interp([ta, te], t_rec, D)
+        ev.update(window_energies(ev, te, tuple(parts([te])[:, 0].tolist()), w1 - w0, d1 - d0))
+    return W, D
+
+
+def audit_quantities(
+    times: np.ndarray, energy: np.ndarray, t_rec: np.ndarray, W: np.ndarray, D: np.ndarray
+) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], float, float]:
+    """ "work", "dissipated" and "energy_residual" at the output ``times`` (``energy``: E
+    there; W, D at the recorded steps, interpolated linearly), the scalar residual of
+    ``rodval.solvers.audit.balance`` and the numerical dissipation -R(t_end) (J)."""
+    W_out, D_out = np.interp(times, t_rec, W), np.interp(times, t_rec, D)
+    R, scalar = balance(energy, float(energy[0]), W_out, D_out)
+    k = np.zeros(1, dtype=int)
+    quantities = {
+        "work": (W_out[:, None], k),
+        "dissipated": (D_out[:, None], k),
+        "energy_residual": (R[:, None], k),
+    }
+    return quantities, scalar, float(-R[-1])
+
+
+def account(
+    scene: Scene, E: int, EA: float, times, t_rec, records, events: list[dict], observed: dict
+) -> tuple[float | None, dict[str, float]]:
+    """The audit of a run that reached ``times``: the lock records completed (``ledger``)
+    and, where the scene asks for "energy", the audit quantities added to ``observed``;
+    returns the scalar residual (None without the audit) and the settings entry
+    {"numerical_dissipation": J} (empty without the audit)."""
+    n = int(np.searchsorted(t_rec, times[-1], side="right")) if times.size else 0
+    if n < 2 or not (scene.latches or "energy" in observed):  # nothing to account for
+        return None, {}
+    reached = {key: tuple(x[:n] for x in arrs) for key, arrs in records.items()}
+    W, D = ledger(scene, E, EA, t_rec[:n], reached, events)
+    if "energy" not in observed:
+        return None, {}
+    energy = observed["energy"][0][:, 0]
+    quantities, scalar, lost = audit_quantities(times, energy, t_rec[:n], W, D)
+    observed.update(quantities)
+    return scalar, {"numerical_dissipation": lost}
