@@ -133,3 +133,27 @@ def test_a_grazing_lock_is_not_compared_pointwise(ref_after, model_after, grazin
         assert why.startswith(f"grazing: {grazing} rigid-panel lock takes 0.50%")
     else:
         assert why == ""
+
+
+def test_a_quantity_without_a_relative_discrepancy_keeps_its_columns():
+    """A quantity whose reference is zero throughout (the loads' work in a deployment without
+    loads) has max_abs but no max_rel; the Discrepancies table keeps both columns, the second
+    blank, instead of failing on the missing one (the deployment studies did, once exudyn
+    output the work)."""
+    import numpy as np
+    import pandas as pd
+
+    from rodval.report.study_summary import _discrepancies
+
+    disc = pd.DataFrame(
+        {
+            "case": ["a", "a"],
+            "model": ["full", "full"],
+            "quantity": ["phi", "work"],
+            "max_abs": [0.1, 0.0],
+            "max_rel": [0.01, np.nan],
+            "status": ["ok", "ok"],
+        }
+    )
+    table = "\n".join(_discrepancies(disc, pd.DataFrame(), "exudyn", 2, []))
+    assert "work max_abs" in table and "work max_rel" in table

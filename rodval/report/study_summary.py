@@ -130,7 +130,9 @@ def _discrepancies(
         )
         wide.columns = [f"{q} {m}" for m, q in wide.columns]
         order = [f"{q} {m}" for q in dict.fromkeys(ok["quantity"]) for m in ("max_abs", "max_rel")]
-        lines.append(to_markdown(wide[order].reset_index()))
+        # reindex: a quantity whose reference is zero throughout (the work of a scene without
+        # loads) has no max_rel, a column pivot_table drops; it stays, blank
+        lines.append(to_markdown(wide.reindex(columns=order).reset_index()))
     return lines
 
 
