@@ -7,8 +7,6 @@ ids stay under 60 characters and every figure title fits its figure."""
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pandas as pd
 import pytest
