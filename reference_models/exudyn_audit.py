@@ -29,35 +29,32 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference_models.exudyn_beam import _elements, _energies, _interpolate
+from reference_models.exudyn_beam import _cross, _elements, _energies, _interpolate
 from reference_models.exudyn_observe import (
     _chord_angles,
     _ends,
     hinge_rates,
     recorded_hinge_angle,
 )
+from rodval.core.loads import LoadSet
 from rodval.core.lock_window import window_energies
 from rodval.core.scene import Scene
 from rodval.solvers.audit import balance
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
 def step_powers(scene: Scene, E: int, t_rec: np.ndarray, records: dict) -> tuple[np.ndarray, ...]:
     """(P_ext, P_diss) (W, (steps,)) at the recorded steps (see the module docstring)."""
     chain = scene.chain
     qv = {key: (q, v) for key, (q, v, _) in records.items()}
+    qL, vL, qR, vR = _ends(scene.n, E, qv)
     p_ext = np.zeros(t_rec.size)
-    for f in scene.loads:
-        v = qv[(f.node - 1, E)][1][:, :2]
-        for i, t in enumerate(t_rec):
-            if f.active(t):
-                fx = f.fx(t) if f.fx is not None else 0.0
-                fy = f.fy(t) if f.fy is not None else 0.0
-                p_ext[i] += fx * v[i, 0] + fy * v[i, 1]
-    dD = hinge_rates(*_ends(scene.n, E, qv))
+    if scene.loads:
+        loads = LoadSet(scene.loads, scene.n)
+        for i, t in enumerate(t_rec):  # nodes 1..n are the rods' right ends
+            forces = loads.nodal(float(t))
+            if forces is not None:
+                p_ext[i] = float(forces[0] @ vR[i, :, 0] + forces[1] @ vR[i, :, 1])
+    dD = hinge_rates(qL, vL, qR, vR)
     p_diss = np.sum(chain.nu * dD**2, -1)
     D0 = scene.initial_hinge_angles()
     for stop in scene.stops:
@@ -102,21 +99,27 @@ def ledger(
     scene: Scene, E: int, EA: float, t_rec, records, events: list[dict]
 ) -> tuple[np.ndarray, np.ndarray]:
     """W_ext and D (J) at the recorded steps; the lock records in ``events`` get their
-    ``instant_energy_loss`` (0) and window energies (module docstring)."""
+    ``instant_energy_loss`` (0), hinge and bending energy before the lock and, for a window
+    the recorded steps reach to its end, its energy accounts (module docstring)."""
     p_ext, p_diss = step_powers(scene, E, t_rec, records)
     W, D = _cumulative(t_rec, p_ext), _cumulative(t_rec, p_diss)
 
-    def parts(ts) -> np.ndarray:
-        return energy_parts(scene, E, EA, ts, t_rec, records)
-
-    for ev in (ev for ev in events if "t_activated" in ev):  # the locks
-        ev["instant_energy_loss"] = 0.0
-        ta, te = ev["t_activated"], min(ev["t"] + ev["impulse_window"], float(t_rec[-1]))
-        ev.update(
-            zip(("kinetic_before", "hinge_before", "bending_before"), parts([ta])[:, 0].tolist())
-        )
-        (w0, w1), (d0, d1) = np.interp([ta, te], t_rec, W), np.interp([ta, te], t_rec, D)
-        ev.update(window_energies(ev, te, tuple(parts([te])[:, 0].tolist()), w1 - w0, d1 - d0))
+    locks = [ev for ev in events if "t_activated" in ev]
+    # every lock's two times at once: one interpolation of the records, O(steps x n)
+    ta = np.array([ev["t_activated"] for ev in locks])
+    te = np.array([ev["t"] + ev["impulse_window"] for ev in locks])
+    closed = te <= t_rec[-1]
+    parts = energy_parts(scene, E, EA, np.concatenate([ta, te[closed]]), t_rec, records)
+    before, end = parts[:, : ta.size].T.tolist(), iter(parts[:, ta.size :].T.tolist())
+    work, lost = (
+        np.interp(te, t_rec, W) - np.interp(ta, t_rec, W),
+        np.interp(te, t_rec, D) - np.interp(ta, t_rec, D),
+    )
+    for i, ev in enumerate(locks):
+        # kinetic_before is the latches' v^T M v / 2 at the same state
+        ev.update(instant_energy_loss=0.0, hinge_before=before[i][1], bending_before=before[i][2])
+        if closed[i]:
+            ev.update(window_energies(ev, tuple(next(end)), work[i], lost[i]))
     return W, D
 
 

@@ -169,18 +169,18 @@ def window_nodes(t_lock: float, w: float) -> tuple[np.ndarray, np.ndarray, np.nd
 
 
 def window_energies(
-    record: dict[str, Any], t_end: float, energies: tuple[float, ...], work: float, lost: float
+    record: dict[str, Any], energies: tuple[float, ...], work: float, lost: float
 ) -> dict[str, float]:
-    """The energy accounts of a lock window (docs/deployment.md, "Where the lock energy
-    goes"), every model's definition: at its end ``t_end`` (s) the kinetic, hinge and bending
-    energy (J) ``energies`` (none if no probe was reached: the values before the lock), the
-    work of the loads ``work`` and the energy dissipated ``lost`` since just before the lock
-    (J; the instantaneous losses included), and the balance's residual
-    E(end) - E(before) - work + dissipated (J)."""
+    """The energy accounts of a lock window the run reached to its end (docs/deployment.md,
+    "Where the lock energy goes"), every model's definition: at the window's end the kinetic,
+    hinge and bending energy (J) ``energies``, the work of the loads ``work`` and the energy
+    dissipated ``lost`` since just before the lock (J; the instantaneous losses included),
+    and the balance's residual E(end) - E(before) - work + dissipated (J). A window the run
+    did not reach to its end has none (``window_closed`` False)."""
     before = [float(record[f"{name}_before"]) for name in ("kinetic", "hinge", "bending")]
-    end = list(energies) if energies else before
+    end = list(energies)
     return {
-        "window_end": float(t_end),
+        "window_end": float(record["t"]) + float(record["impulse_window"]),
         "kinetic_window_end": float(end[0]),
         "hinge_window_end": float(end[1]),
         "bending_window_end": float(end[2]),

@@ -67,9 +67,8 @@ def energy_parts(system: PaperSystem, t: float, y: np.ndarray) -> tuple[float, f
 
 def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[float, ...]:
     """(lambda (N m): the held hinge k's reaction on the outboard rod; H_out (N m s); M_fin
-    (N m); P_ext, P_diss (W): the power of the loads and of the dampers (``power``);
-    kinetic, hinge, bending energy (J, ``energy_parts``)) at one state in the current mode
-    (see the module docstring). O(n)."""
+    (N m); P_ext, P_diss (W): the power of the loads and of the dampers (``power``)) at one
+    state in the current mode (see the module docstring). O(n)."""
     lam = system.accel_locked(t, y)[1]
     held = [int(h) for h in system._lock_h]
     H, p_out, r, v_k = outboard_momentum(system, y, k)
@@ -82,13 +81,7 @@ def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[
         X, Y = forces  # at nodes 1..n
         arm = r[k + 1 :] - r[k]
         finite += float(np.sum(arm[:, 0] * Y[k:] - arm[:, 1] * X[k:]))
-    return (
-        float(lam[held.index(k)]),
-        H,
-        float(finite),
-        *system.power(t, y),
-        *energy_parts(system, t, y),
-    )
+    return (float(lam[held.index(k)]), H, float(finite), *system.power(t, y))
 
 
 def lock_record(

@@ -15,7 +15,7 @@ from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
 from rodval.models import deployment
-from rodval.models.lock_records import lock_record, window_terms
+from rodval.models.lock_records import energy_parts, lock_record, window_terms
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
     VARIANTS,
@@ -532,6 +532,10 @@ class PaperSystem(OdeSystem):
     def window_terms(self, t: float, y: np.ndarray, hinge: int) -> tuple[float, ...]:
         """The lock window's integrands at one state (``lock_records.window_terms``)."""
         return window_terms(self, t, y, hinge)
+
+    def energy_parts(self, t: float, y: np.ndarray) -> tuple[float, float, float]:
+        """(kinetic, hinge, bending) energy (J) in the current mode (``lock_records``)."""
+        return energy_parts(self, t, y)
 
     def momenta(self, y: np.ndarray) -> np.ndarray:
         """Linear momentum beyond each node (N s, (n, 2)), see deployment.outer_momenta."""

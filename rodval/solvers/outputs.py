@@ -41,7 +41,6 @@ class _Window:
         self.work = 0.0
         self.dissipated = float(record.get("instant_energy_loss", 0.0))
         self.energies: tuple[float, ...] = ()
-        self.t_last = self.t0
 
     def later_event(self, record: dict[str, Any]) -> None:
         """A later event inside the window: a lock adds its instantaneous impulse on this
@@ -57,20 +56,21 @@ class _Window:
 
     def take(self, system: OdeSystem, y: np.ndarray) -> None:
         t = float(self.times[self.i])
-        lam, H, finite, p_ext, p_diss, *energies = system.window_terms(t, y, self.hinge)
+        lam, H, finite, p_ext, p_diss = system.window_terms(t, y, self.hinge)
         self.impulse += self.taper[self.i] * lam
         self.H += self.mean[self.i] * H
         self.finite += self.taper[self.i] * finite
         self.taken += self.mean[self.i]
         self.work += self.w * self.mean[self.i] * p_ext
         self.dissipated += self.w * self.mean[self.i] * p_diss
-        self.energies, self.t_last = tuple(energies), t
         self.i += 1
+        if self.i == self.times.size:  # the window's end
+            self.energies = system.energy_parts(t, y)
 
     def finish(self) -> None:
         """Write the window's measures into the lock record (a window the run did not reach
-        to its end: over the part reached, ``window_closed`` False, the energies at the last
-        probe reached, ``window_end`` its time)."""
+        to its end: the impulses over the part reached, ``window_closed`` False, no energy
+        accounts)."""
         rec = self.record
         rec["impulse"] = float(self.impulse)
         # mean over the window of H_out(tau) - H_out(0-) - int_0^tau finite ds
@@ -78,7 +78,8 @@ class _Window:
             self.H - self.taken * rec["outboard_momentum_before"] - self.finite
         )
         rec["window_closed"] = self.i == self.times.size
-        rec.update(window_energies(rec, self.t_last, self.energies, self.work, self.dissipated))
+        if rec["window_closed"]:
+            rec.update(window_energies(rec, self.energies, self.work, self.dissipated))
 
 
 class LockWindows:

@@ -171,9 +171,14 @@ class OdeSystem(ABC):
         raise NotImplementedError
 
     def window_terms(self, t: float, y: np.ndarray, hinge: int) -> tuple[float, ...]:
-        """(lambda (N m), H_out (N m s), M_fin (N m)) of the held ``hinge`` at one state: the
-        integrands of a lock window (``rodval.solvers.outputs.LockWindows``); a system whose
-        lock records declare an ``impulse_window`` implements it."""
+        """(lambda (N m), H_out (N m s), M_fin (N m), P_ext, P_diss (W)) of the held ``hinge``
+        at one state: the integrands of a lock window (``rodval.solvers.outputs.LockWindows``);
+        a system whose lock records declare an ``impulse_window`` implements it."""
+        raise NotImplementedError
+
+    def energy_parts(self, t: float, y: np.ndarray) -> tuple[float, float, float]:
+        """(kinetic, hinge, bending) energy (J) at one state, summing to ``energy``: a lock
+        window's accounts at its end (``rodval.core.lock_window.window_energies``)."""
         raise NotImplementedError
 
     def reset(self) -> None:
