@@ -35,7 +35,6 @@ from rodval.models.kernels import (
     full_accel,
     rhs_head,
 )
-from rodval.models.paper_matrices import rod_momenta
 from rodval.models.reduced_band_lu import _band_size, _solve_band
 from rodval.models.reduced_banded import (
     _forces,
@@ -129,6 +128,16 @@ def full_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
         return
     U = np.empty((m, 3 * n))
     full_unit_responses(V, y[:n], locks, U)
+    superpose(out, U, locks, n, lam)
+
+
+@njit(cache=True)
+def superpose(out, U, locks, n, lam):
+    """q'' = u_0 + sum_j lambda_j u_j with the hinges ``locks`` held: ``out`` holds the free
+    accelerations u_0 on entry, U[j] = M^-1 a_{locks[j]}; the capacitance system
+    (A_L U) lambda = -A_L u_0 (m x m) gives the multipliers (N m) into ``lam``. O(N m + m^3)
+    for N coordinates ordered [phi; alpha; beta; ...]."""
+    m = locks.shape[0]
     G = np.empty((m, m))
     r = np.empty(m)
     for i in range(m):
@@ -255,14 +264,6 @@ def reduced_hinge_gradient(chain, k: int) -> np.ndarray:
     if k > 0:
         c[k - 1] -= 1.0
     return c
-
-
-def outer_momenta(chain, phi, dphi, dalpha, dbeta) -> np.ndarray:
-    """Linear momentum (N s, (n, 2)) of everything beyond node k (rods k+1..n and their far
-    nodes), k = 0..n-1, with the model's velocity field (``paper_matrices.rod_momenta``).
-    Row 0 is the whole chain's momentum."""
-    p = rod_momenta(chain, phi, dphi, dalpha, dbeta)[0]
-    return np.cumsum(p[::-1], axis=0)[::-1]
 
 
 # ------------------------------------------------------------------ compiled event forms

@@ -195,6 +195,14 @@ def _generator_solve(d, a, b, e, r, x):
 def _schur_solve(V, c, s, r, x):
     """Solve S x = r for the full model's Schur complement S = M_pp - M_pg M_gg^-1 M_gp in
     O(n): S = diag(d) + tril(a b^T) + triu(b e^T) with 2-vectors a_k, b_k, e_k per rod."""
+    d, a, b, e = schur_generators(V, c, s)
+    _generator_solve(d, a, b, e, r, x)
+
+
+@njit(cache=True)
+def schur_generators(V, c, s):
+    """(d, a, b, e) of the Schur complement S = diag(d) + tril(a b^T) + triu(b e^T) (see
+    ``_generator_solve``) from the rows V_L, V_OUTER, V_W, V_PPDIAG, V_EPS .. V_TAU; O(n)."""
     n = c.shape[0]
     l, outer, w = V[V_L], V[V_OUTER], V[V_W]
     eps, pi, rho, tau = V[V_EPS], V[V_PI], V[V_RHO], V[V_TAU]
@@ -221,7 +229,7 @@ def _schur_solve(V, c, s, r, x):
         scc += we * c[k] * c[k]
         scs += we * c[k] * s[k]
         sss += we * s[k] * s[k]
-    _generator_solve(d, a, b, e, r, x)
+    return d, a, b, e
 
 
 @njit(cache=True)

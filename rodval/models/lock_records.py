@@ -14,7 +14,7 @@ lock impulse"):
   loads on nodes beyond k about node k (v_k: node k's velocity, p_out: the outboard linear
   momentum); the window mean of H_out(tau) - H_out(0-) - int_0^tau M_fin ds.
 
-Both use the model's velocity field (``paper_matrices.rod_momenta``); they agree when the
+Both use the model's velocity field (its ``rod_momenta_at``); they agree when the
 model's equations are the Newton-Euler equations of that field, and the gap is reported.
 """
 
@@ -26,7 +26,7 @@ import numpy as np
 
 from rodval.core.lock_window import lock_window
 from rodval.core.rigid import node_velocities, rigid_lock
-from rodval.models.paper_matrices import bending_energy, node_positions, rod_momenta
+from rodval.models.paper_matrices import node_positions
 
 #: The systems these functions read: ``rodval.models.paper_system.PaperSystem`` (which imports
 #: this module, so it is not imported here).
@@ -43,14 +43,13 @@ def outboard_momentum(
     """(H_out (N m s): the angular momentum of rods k+1..n (1-based) and their far nodes about
     node k; p_out (N s, (2,)): their linear momentum; r (m, (n+1, 2)): the node positions;
     v_k (m/s, (2,)): node k's velocity). O(n)."""
-    n = system.n
     v = system.generalized_rates(y)
     phi = system.rigid(y[None, :])[0][0]
     chain = system.base_chain
-    p, h, _ = rod_momenta(chain, phi, v[:n], v[n : 2 * n], v[2 * n :])
+    p, h, _ = system.rod_momenta_at(y)
     x, yy = node_positions(chain.l, phi)
     r = np.stack([x, yy], axis=-1)
-    v_k = node_velocities(chain.l, phi, v[:n])[k - 1] if k > 0 else np.zeros(2)
+    v_k = node_velocities(chain.l, phi, v[: system.n])[k - 1] if k > 0 else np.zeros(2)
     p_out = p[k:].sum(axis=0)
     return float(h[k:].sum()) - _cross(r[k], p_out), p_out, r, v_k
 
@@ -58,10 +57,8 @@ def outboard_momentum(
 def energy_parts(system: PaperSystem, t: float, y: np.ndarray) -> tuple[float, float, float]:
     """(kinetic, hinge, bending) energy (J) at one state in the current mode: T, the hinge
     springs and acting stops, the rods' bending; their sum is the model's E = T + Pi. O(n)."""
-    Y = y[None, :]
-    rigid, bending = system.rigid(Y), system.bending(np.array([t]), Y)
-    kin, pot = system.energies(*rigid, *bending)
-    bend = float(bending_energy(system.base_chain, bending[0], bending[1])[0])
+    kin, pot = system.energy_rows(np.array([t]), y[None, :])
+    bend = system.bending_energy_at(t, y)
     return float(kin[0]), float(pot[0]) - bend, bend
 
 

@@ -335,7 +335,15 @@ def angular_momentum(
     the root node (the origin), H_0 = sum int r x v dm; k = 1 about the chain's centre of mass,
     H_c = H_0 - S x P / M (S the first mass moment, P the linear momentum, M the total mass),
     in the velocity field of ``rod_momenta``. O(n) per state."""
-    p, h, first = rod_momenta(chain, phi, dphi, dalpha, dbeta)
+    return angular_momentum_rows(*rod_momenta(chain, phi, dphi, dalpha, dbeta), chain)
+
+
+def angular_momentum_rows(
+    p: np.ndarray, h: np.ndarray, first: np.ndarray, chain: Chain
+) -> np.ndarray:
+    """[H_0, H_c] (..., 2) (N m s) from the rods' momenta p (..., n, 2), their angular momenta
+    about node 0 h (..., n) and first mass moments (..., n, 2) (``rod_momenta``): H_0 =
+    sum h, H_c = H_0 - S x P / M."""
     P, S, H0 = p.sum(axis=-2), first.sum(axis=-2), h.sum(axis=-1)
     total = float(np.sum(chain.m * chain.l + chain.mu))
     Hc = H0 - (S[..., 0] * P[..., 1] - S[..., 1] * P[..., 0]) / total

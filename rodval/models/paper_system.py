@@ -10,25 +10,22 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from rodval.core.checks import check_choice
-from rodval.core.loads import LOAD_COLUMNS, LoadSet, load_table
+from rodval.core.loads import LoadSet, load_table
 from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
 from rodval.models import deployment
 from rodval.models.lock_records import energy_parts, lock_record, window_terms
+from rodval.models.paper_energy import _NO_MATRICES, PaperEnergy
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
     VARIANTS,
     ChainConstants,
-    angle_differences,
-    angular_momentum,
-    assemble_mass,
     chain_constants,
     damper_power,
     damping_matrix,
     generalized_forces,
     node_positions,
-    potential_energy,
     rest_forces,
     stiffness_matrix,
 )
@@ -51,7 +48,7 @@ class EventRow(NamedTuple):
     direction: int
 
 
-class PaperSystem(OdeSystem):
+class PaperSystem(PaperEnergy, OdeSystem):
     """Base of the paper's ODE systems. Subclasses provide ``numpy_rhs``, the compiled
     kernels (``accel_kernel``, ``compiled_rhs``) and their constants (``kernel_constants``),
     ``jacobian`` and ``bending`` (alpha, beta, alpha', beta' at output times)."""
@@ -225,8 +222,7 @@ class PaperSystem(OdeSystem):
     def _energy_in_mode(self, t: float, y: np.ndarray) -> float:
         """E = T + Pi (J) at one state in the current mode (active stops, locked hinges); O(n)
         with the compiled kernels."""
-        Y = y[None, :]
-        kin, pot = self.energies(*self.rigid(Y), *self.bending(np.array([t]), Y))
+        kin, pot = self.energy_rows(np.array([t]), y[None, :])
         return float(kin[0] + pot[0])
 
     def power(self, t: float, y: np.ndarray) -> tuple[float, float]:
@@ -241,7 +237,7 @@ class PaperSystem(OdeSystem):
                 return p_ext, 0.0
             n = self.n
             v = self.generalized_rates(y)
-            return p_ext, damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n :])
+            return p_ext, damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
 
     def observe(self, times, Y):
         """The scene's quantities; each output time is observed in the mode (active stops,
@@ -292,54 +288,14 @@ class PaperSystem(OdeSystem):
             if scene.wants("hinge_moment"):
                 out["hinge_moment"] = (self.hinge_moments(times, Y, D), hinges)
         if scene.wants("energy"):
-            kin, pot = self.energies(phi, dphi, alpha, beta, dalpha, dbeta)
+            kin, pot = self.energy_rows(times, Y)
             zero = np.zeros(1, dtype=int)
             out["kinetic"] = (kin[:, None], zero)
             out["potential"] = (pot[:, None], zero)
             out["energy"] = ((kin + pot)[:, None], zero)
         if scene.wants("angular_momentum"):
-            H = angular_momentum(self.base_chain, phi, dphi, dalpha, dbeta)
-            out["angular_momentum"] = (H, np.arange(2))
+            out["angular_momentum"] = (self.angular_momentum_rows(times, Y), np.arange(2))
         return out
-
-    def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
-        """1/2 v^T M(phi) v with the kinematic mass matrix: the compiled O(n) form, or the
-        dense one with the numpy kernel (the reference)."""
-        if self.kernel == "numba":
-            n = self.n
-            y = (
-                np.concatenate([phi, np.zeros(2 * n), v])
-                if self.full
-                else np.concatenate([phi, v[:n]])
-            )
-            self.compiled_mechanics(
-                0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech
-            )
-            return float(self._mech[0])
-        return 0.5 * float(v @ assemble_mass(self.cc_kinetic, angle_differences(phi)[0]) @ v)
-
-    def kinetic_energy(self, t: float, y: np.ndarray) -> float:
-        """T = 1/2 q'^T M(phi) q' (J) at one state, without recovering bending angles; O(n)
-        with the compiled kernels."""
-        return self._kinetic(self.rigid(y[None, :])[0][0], self.generalized_rates(y))
-
-    def energies(self, phi, dphi, alpha, beta, dalpha, dbeta) -> tuple[np.ndarray, np.ndarray]:
-        """Kinetic T = 1/2 q'^T M(phi) q' with the kinematic (printed) mass matrix, and
-        Pi = 1/2 sum kappa (D - rest)^2 + bending (J), per output time; O(n) each."""
-        v = np.concatenate([dphi, dalpha, dbeta], axis=1)
-        kin = np.array([self._kinetic(p, vi) for p, vi in zip(phi, v)])
-        return kin, self.potential(phi, alpha, beta)
-
-    def potential(self, phi, alpha, beta) -> np.ndarray:
-        """Pi (J) per row: the scene chain's springs and bending, plus 1/2 k (D - angle)^2 of
-        every limit stop acting in the current mode."""
-        pot = potential_energy(self.base_chain, phi, alpha, beta)
-        if any(self.stop_active):
-            D = hinge_angles(phi, alpha, beta)
-            for st, on in zip(self.stops, self.stop_active):
-                if on:
-                    pot = pot + 0.5 * st.stiffness * (D[..., st.hinge] - st.angle) ** 2
-        return pot
 
     # ----------------------------------------------------------------- deployment: modes
     @staticmethod
@@ -436,7 +392,7 @@ class PaperSystem(OdeSystem):
         rates being dropped)."""
         n = self.n
         v = self.generalized_rates(y)
-        return hinge_angles(v[:n], v[n : 2 * n], v[2 * n :])
+        return hinge_angles(v[:n], v[n : 2 * n], v[2 * n : 3 * n])
 
     def hinge_moments(self, times, Y, D) -> np.ndarray:
         """Hinge moments (N m, (nt, n)), positive when resisting an increase of D: spring
@@ -537,13 +493,6 @@ class PaperSystem(OdeSystem):
         """(kinetic, hinge, bending) energy (J) in the current mode (``lock_records``)."""
         return energy_parts(self, t, y)
 
-    def momenta(self, y: np.ndarray) -> np.ndarray:
-        """Linear momentum beyond each node (N s, (n, 2)), see deployment.outer_momenta."""
-        n = self.n
-        v = self.generalized_rates(y)
-        phi = self.rigid(y[None, :])[0][0]
-        return deployment.outer_momenta(self.base_chain, phi, v[:n], v[n : 2 * n], v[2 * n :])
-
     def plastic_jump(self, y, hinges, angles) -> tuple[np.ndarray, np.ndarray]:
         """(state after the impact, multiplier impulses mu (N m s))."""
         raise NotImplementedError
@@ -563,11 +512,6 @@ class PaperSystem(OdeSystem):
     def accel_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(accelerations, multipliers lambda (N m)) with the locked hinges held."""
         raise NotImplementedError
-
-
-#: Placeholders for the compiled forms' unused arrays (no dense matrices, no loads).
-_NO_MATRICES = np.zeros((0, 0, 0))
-_NO_LOADS = np.zeros((0, len(LOAD_COLUMNS)))
 
 
 class PaperModel(OdeModel):

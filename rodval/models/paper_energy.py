@@ -1,0 +1,95 @@
+"""Energies and momenta of the paper's systems (a mixin of ``paper_system.PaperSystem``): what
+the energy audit, the observation map and the lock records read, each from one state or a
+history. The model ladder (``rodval.models.ladder``) overrides the hooks that depend on its
+coordinates (``energy_rows``, ``bending_energy_at``, ``rod_momenta_at``, ``kinetic_energy``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rodval.core.loads import LOAD_COLUMNS
+from rodval.core.scene import hinge_angles
+from rodval.models.paper_matrices import (
+    angle_differences,
+    angular_momentum,
+    assemble_mass,
+    bending_energy,
+    potential_energy,
+    rod_momenta,
+)
+
+#: Placeholders for the compiled forms' unused arrays (no dense matrices, no loads).
+_NO_MATRICES = np.zeros((0, 0, 0))
+_NO_LOADS = np.zeros((0, len(LOAD_COLUMNS)))
+
+
+class PaperEnergy:
+    """T, Pi and the momenta of a paper system (attributes from ``PaperSystem``)."""
+
+    def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
+        """1/2 v^T M(phi) v with the kinematic mass matrix: the compiled O(n) form, or the
+        dense one with the numpy kernel (the reference)."""
+        if self.kernel == "numba":
+            n = self.n
+            y = (
+                np.concatenate([phi, np.zeros(2 * n), v])
+                if self.full
+                else np.concatenate([phi, v[:n]])
+            )
+            self.compiled_mechanics(
+                0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech
+            )
+            return float(self._mech[0])
+        return 0.5 * float(v @ assemble_mass(self.cc_kinetic, angle_differences(phi)[0]) @ v)
+
+    def kinetic_energy(self, t: float, y: np.ndarray) -> float:
+        """T = 1/2 q'^T M(phi) q' (J) at one state, without recovering bending angles; O(n)
+        with the compiled kernels."""
+        return self._kinetic(self.rigid(y[None, :])[0][0], self.generalized_rates(y))
+
+    def energies(self, phi, dphi, alpha, beta, dalpha, dbeta) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic T = 1/2 q'^T M(phi) q' with the kinematic (printed) mass matrix, and
+        Pi = 1/2 sum kappa (D - rest)^2 + bending (J), per output time; O(n) each."""
+        v = np.concatenate([dphi, dalpha, dbeta], axis=1)
+        kin = np.array([self._kinetic(p, vi) for p, vi in zip(phi, v)])
+        return kin, self.potential(phi, alpha, beta)
+
+    def potential(self, phi, alpha, beta) -> np.ndarray:
+        """Pi (J) per row: the scene chain's springs and bending, plus 1/2 k (D - angle)^2 of
+        every limit stop acting in the current mode."""
+        pot = potential_energy(self.base_chain, phi, alpha, beta)
+        if any(self.stop_active):
+            D = hinge_angles(phi, alpha, beta)
+            for st, on in zip(self.stops, self.stop_active):
+                if on:
+                    pot = pot + 0.5 * st.stiffness * (D[..., st.hinge] - st.angle) ** 2
+        return pot
+
+    def energy_rows(self, times: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(T, Pi) (J) per state of a history Y in the current mode; O(n) each."""
+        return self.energies(*self.rigid(Y), *self.bending(times, Y))
+
+    def bending_energy_at(self, t: float, y: np.ndarray) -> float:
+        """The rods' bending energy (J) at one state."""
+        alpha, beta = self.bending(np.array([t]), y[None, :])[:2]
+        return float(bending_energy(self.base_chain, alpha, beta)[0])
+
+    def rod_momenta_at(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(p (n, 2), h (n,), first (n, 2)) of every rod with its far node at one state, in
+        the model's velocity field (``paper_matrices.rod_momenta``); O(n)."""
+        n = self.n
+        v = self.generalized_rates(y)
+        phi = self.rigid(y[None, :])[0][0]
+        return rod_momenta(self.base_chain, phi, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
+
+    def momenta(self, y: np.ndarray) -> np.ndarray:
+        """Linear momentum (N s, (n, 2)) of everything beyond node k (rods k+1..n and their
+        far nodes), k = 0..n-1; row 0 is the whole chain's."""
+        p = self.rod_momenta_at(y)[0]
+        return np.cumsum(p[::-1], axis=0)[::-1]
+
+    def angular_momentum_rows(self, times: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        """The ``angular_momentum`` rows (nt, 2) (``paper_matrices.angular_momentum``)."""
+        phi, dphi = self.rigid(Y)
+        dalpha, dbeta = self.bending(times, Y)[2:]
+        return angular_momentum(self.base_chain, phi, dphi, dalpha, dbeta)
