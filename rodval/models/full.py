@@ -140,9 +140,10 @@ class FullSystem(PaperSystem):
         z = np.linalg.solve(K, rhs)
         return z[: 3 * n], z[3 * n :]
 
-    def unit_responses(self, phi, hinges) -> np.ndarray:
-        """M(phi)^-1 a_k for each hinge k, (m, 3n)."""
+    def unit_responses(self, q, hinges) -> np.ndarray:
+        """M(q)^-1 a_k for each hinge k, (m, 3n) (the paper's M depends on phi = q[:n])."""
         n = self.n
+        phi = q[:n]
         if self.kernel == "numba":
             U = np.empty((len(hinges), 3 * n))
             deployment.full_unit_responses(self.V, phi, np.asarray(hinges, np.int64), U)
@@ -150,15 +151,19 @@ class FullSystem(PaperSystem):
         M = assemble_mass(self.cc, angle_differences(phi)[0])
         return np.linalg.solve(M, hinge_matrix(n)[hinges].T).T
 
+    def hinge_rows(self, hinges) -> np.ndarray:
+        """The rows a_k of the hinge matrix A (D = A q) of the given hinges."""
+        return hinge_matrix(self.n)[hinges]
+
     def plastic_jump(self, y, hinges, angles):
         """Delta q' = M^-1 A^T mu, (A M^-1 A^T) mu = -A q' (the hinges' rates become zero;
         the velocity closest to the old one in the kinetic metric M); D is first projected
         onto the latch angles in the same metric (a round-off-sized correction)."""
-        n = self.n
         y = y.copy()
-        q, v = y[: 3 * n], y[3 * n :]
-        U = self.unit_responses(q[:n], hinges)
-        A = hinge_matrix(n)[hinges]
+        half = y.size // 2
+        q, v = y[:half], y[half:]
+        U = self.unit_responses(q, hinges)
+        A = self.hinge_rows(hinges)
         G = A @ U.T
         q += U.T @ np.linalg.solve(G, angles - A @ q)
         mu = np.linalg.solve(G, -(A @ v))
@@ -182,8 +187,35 @@ class FullSystem(PaperSystem):
 
 class FullModel(PaperModel):
     """Full model (3n ODEs). ``coefficients``: "printed" (default) or "published" (erratum);
-    ``kernel``: "numba" (default) or "numpy"."""
+    ``kernel``: "numba" (default) or "numpy"; the model ladder (``rodval.models.ladder``):
+    ``shapes`` p = 1..8 bending shapes per rod (default 1, the paper's cubic) and
+    ``kinematics`` "first-order" (default, the paper's) or "exact"."""
 
     name = "full"
     system_class = FullSystem
     MODAL_ANALYSIS = "rodval.models.linear_modes:full_modes"
+    OPTIONS = ("coefficients", "kernel", "shapes", "kinematics")
+    MODES_OPTIONS = ("coefficients", "shapes", "kinematics")
+
+    def __init__(
+        self,
+        coefficients: str = DEFAULT_VARIANT,
+        kernel: str = "numba",
+        shapes: int = 1,
+        kinematics: str = "first-order",
+    ):
+        from rodval.models.ladder import check_kinematics, check_shapes
+
+        super().__init__(coefficients, kernel)
+        self.shapes = check_shapes(shapes)
+        self.kinematics = check_kinematics(kinematics)
+
+    def options(self):
+        return {**super().options(), "shapes": self.shapes, "kinematics": self.kinematics}
+
+    def system(self, scene: Scene) -> PaperSystem:
+        from rodval.models.ladder import PAPER_RUNG, LadderSystem
+
+        if (self.shapes, self.kinematics) == PAPER_RUNG:
+            return FullSystem(scene, self.coefficients, self.kernel)
+        return LadderSystem(scene, self.coefficients, self.kernel, self.shapes, self.kinematics)

@@ -233,11 +233,13 @@ class PaperSystem(PaperEnergy, OdeSystem):
         Q = self.generalized_force(t, phi)
         p_ext = 0.0 if Q is None else float(Q @ dphi)
         with self._mode_at(t):
-            if not self.damped:
-                return p_ext, 0.0
-            n = self.n
-            v = self.generalized_rates(y)
-            return p_ext, damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
+            return p_ext, self.damper_power_at(y) if self.damped else 0.0
+
+    def damper_power_at(self, y: np.ndarray) -> float:
+        """q'^T C q' (W) at one state in the current mode (``paper_matrices.damper_power``)."""
+        n = self.n
+        v = self.generalized_rates(y)
+        return damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
 
     def observe(self, times, Y):
         """The scene's quantities; each output time is observed in the mode (active stops,

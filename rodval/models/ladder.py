@@ -1,0 +1,302 @@
+"""The model ladder: the full model with ``shapes = p`` bending shapes per rod
+(``rodval.models.shapes``) and ``kinematics = "first-order"`` (the paper's: every product of
+the bending coordinates g with phi'^2 or phi'' dropped) or ``"exact"`` (the assumed-mode
+kinematics r = r_{k-1} + s e_k + eta n_k kept whole in T, the forces and the momenta, so the
+model is Lagrangian and conserves energy to the integrator's tolerance). docs/model.md ("The
+model ladder") derives it; shapes = 1 with first-order kinematics is the paper's model, which
+``FullSystem`` runs unchanged (the ladder is only built for another rung).
+
+Coordinates q = [phi; alpha; beta; g_2; ...; g_p] (each n long), state [q; q'] (2 N, N =
+n (p + 2)); a bubble coordinate g_i (i >= 2, m) scales psi_i, which vanishes with its slope at
+both rod ends: hinge angles, latches, stops and node positions are the paper's.
+"""
+
+from __future__ import annotations
+
+import numbers
+from functools import cached_property
+
+import numpy as np
+
+from rodval.core.checks import check_choice
+from rodval.core.scene import Chain, Scene
+from rodval.models.full import FullSystem
+from rodval.models.kernels import V_CB, V_EPS, V_KB, V_PI, V_RHO, V_TAU, V_W, _rows
+from rodval.models.ladder_kernels import (
+    BLOCK_A,
+    BLOCK_B,
+    BLOCK_C,
+    BLOCK_K,
+    BLOCK_P,
+    BLOCK_PINV,
+    LV_EXACT,
+    LV_MASS,
+    LV_MU,
+    LV_P1,
+    LV_SHAPES,
+    ladder_accel,
+    ladder_accel_locked,
+    ladder_kinetic,
+    ladder_mechanics,
+    ladder_rhs,
+    ladder_rhs_locked,
+    ladder_unit_responses,
+)
+from rodval.models.paper_energy import _NO_LOADS, _NO_MATRICES
+from rodval.models.paper_matrices import (
+    angle_differences,
+    angular_momentum_rows,
+    chain_constants,
+    hinge_matrix,
+    mass_matrix,
+)
+from rodval.models.shapes import MAX_SHAPES, RodShapes, rod_shapes
+
+#: ``kinematics`` of the full model; the first is the paper's (the default).
+KINEMATICS = ("first-order", "exact")
+#: The paper's rung: one cubic shape per rod, first-order kinematics.
+PAPER_RUNG = (1, KINEMATICS[0])
+
+
+def check_shapes(shapes) -> int:
+    """``shapes`` (p, the bending shapes per rod beyond the rigid rotation: p + 1 shape
+    coordinates) as an int in 1..MAX_SHAPES, else a ValueError naming the range."""
+    if isinstance(shapes, bool) or not isinstance(shapes, numbers.Integral):
+        raise ValueError(f"shapes must be an integer in 1..{MAX_SHAPES}, got {shapes!r}")
+    if not 1 <= shapes <= MAX_SHAPES:
+        raise ValueError(f"shapes must be an integer in 1..{MAX_SHAPES}, got {shapes!r}")
+    return int(shapes)
+
+
+def check_kinematics(kinematics) -> str:
+    return check_choice("kinematics", kinematics, KINEMATICS)
+
+
+def shapes_of(chain: Chain, p: int) -> RodShapes:
+    """The chain's per-rod shape integrals (``shapes.rod_shapes``)."""
+    return rod_shapes(p, chain.l, chain.m, chain.EI, chain.bending_damping)
+
+
+def ladder_constants(chain: Chain, p: int, exact: bool) -> np.ndarray:
+    """The kernels' V (``ladder_kernels``): the paper model's rows with V_W = 1, the Schur
+    constants a^T P^-1 a, b^T P^-1 a, b^T P^-1 b of the shapes, V_KB = V_CB = 0, then the
+    LV_* rows and the shape blocks. O(n p^3) (one small inverse per rod)."""
+    n, P1 = chain.n, p + 1
+    sh = shapes_of(chain, p)
+    Pinv = np.linalg.inv(sh.P)
+    Pinv = 0.5 * (Pinv + np.swapaxes(Pinv, 1, 2))
+    rows = _rows(chain_constants(chain), chain)
+    rows[V_W] = np.ones(n)
+    rows[V_KB] = np.zeros(n)
+    rows[V_CB] = np.zeros(n)
+    V = np.zeros((LV_SHAPES + 2 * P1 + 4 * P1 * P1, n))
+    V[: len(rows)] = rows
+    V[V_EPS] = np.einsum("ki,kij,kj->k", sh.a, Pinv, sh.a)
+    V[V_PI] = V[V_RHO] = np.einsum("ki,kij,kj->k", sh.b, Pinv, sh.a)
+    V[V_TAU] = np.einsum("ki,kij,kj->k", sh.b, Pinv, sh.b)
+    V[LV_MASS] = chain.m * chain.l
+    V[LV_MU] = chain.mu
+    V[LV_P1] = P1
+    V[LV_EXACT] = 1.0 if exact else 0.0
+    blocks = {BLOCK_A: sh.a, BLOCK_B: sh.b}
+    for block, B in ((BLOCK_P, sh.P), (BLOCK_PINV, Pinv), (BLOCK_K, sh.K), (BLOCK_C, sh.C)):
+        blocks[block] = B.reshape(n, P1 * P1)
+    start = LV_SHAPES
+    for block in sorted(blocks):
+        width = blocks[block].shape[1]
+        V[start : start + width] = blocks[block].T
+        start += width
+    return np.ascontiguousarray(V)
+
+
+def ladder_mass_matrix(chain: Chain, p: int, exact: bool, q: np.ndarray) -> np.ndarray:
+    """M(q) (N, N) of a rung, dense (for the modal analysis; O(N^2)): the paper's M(phi) on
+    [phi; alpha; beta], the bubbles' couplings (l_j c_kj a_k to the inboard phi_j, b_k to
+    phi_k, P_k among the rod's shapes) and, with exact kinematics, g^T P g on the diagonal
+    of M_pp and -A_k l_j s_kj (A_k = a_k . g_k) off it (docs/model.md)."""
+    n, P1 = chain.n, p + 1
+    sh = shapes_of(chain, p)
+    N = n * (P1 + 1)
+    M = np.zeros((N, N))
+    M[: 3 * n, : 3 * n] = mass_matrix(chain_constants(chain), q[:n])
+    ckj, skj = angle_differences(q[:n])
+    g = q[n:N].reshape(P1, n)
+    lower = np.tril(np.ones((n, n)), -1)  # [k, j]: k > j
+    for i in range(2, P1):
+        cols = slice(n * (1 + i), n * (2 + i))
+        # phi_j . g_{k,i}: l_j c_kj a_k,i for j < k; b_k,i for j = k
+        M[:n, cols] = (lower * ckj * chain.l[None, :] * sh.a[:, i][:, None]).T
+        M[np.arange(n), n * (1 + i) + np.arange(n)] = sh.b[:, i]
+        M[cols, :n] = M[:n, cols].T
+    for k in range(n):
+        idx = n * (1 + np.arange(P1)) + k
+        M[np.ix_(idx, idx)] = sh.P[k]
+    if exact:
+        A = np.einsum("ki,ik->k", sh.a, g)
+        off = -lower * A[:, None] * chain.l[None, :] * skj
+        M[:n, :n] += off + off.T + np.diag(np.einsum("ik,kij,jk->k", g, sh.P, g))
+    return M
+
+
+def ladder_stiffness(chain: Chain, p: int, damping: bool = False) -> np.ndarray:
+    """K (or C with ``damping``), (N, N): the hinges' springs (dampers) on D = A q and every
+    rod's shape block K_k (C_k); constant."""
+    n, P1 = chain.n, p + 1
+    sh = shapes_of(chain, p)
+    A = rung_hinge_matrix(n, p)
+    K = A.T @ np.diag(chain.nu if damping else chain.kappa) @ A
+    B = sh.C if damping else sh.K
+    for k in range(n):
+        idx = n * (1 + np.arange(P1)) + k
+        K[np.ix_(idx, idx)] += B[k]
+    return K
+
+
+def rung_hinge_matrix(n: int, p: int) -> np.ndarray:
+    """A (n, N): D = A q, the paper's hinge matrix padded with zeros for the bubbles."""
+    A = np.zeros((n, n * (p + 2)))
+    A[:, : 3 * n] = hinge_matrix(n)
+    return A
+
+
+def rod_momenta_exact(
+    chain: Chain, sh: RodShapes, exact: bool, phi, dphi, g, dg
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(p (n, 2) N s, h (n,) N m s about node 0, first moment (n, 2) kg m) of each rod with
+    its far node in the rung's velocity field: r = r_{k-1} + z_k (s + i eta), z_k = e^{i phi_k}
+    (complex plane), with the terms in g dropped for first-order kinematics. O(n p^2)."""
+    l, ml = chain.l, chain.m * chain.l
+    z = np.exp(1j * phi)
+    v_nodes = np.cumsum(1j * l * dphi * z)
+    r_nodes = np.cumsum(l * z)
+    V = np.concatenate([[0.0], v_nodes[:-1]])
+    R = np.concatenate([[0.0], r_nodes[:-1]])
+    Ag = np.einsum("ki,ik->k", sh.a, g) if exact else np.zeros_like(phi)
+    gPg = np.einsum("ik,kij,jk->k", g, sh.P, g) if exact else np.zeros_like(phi)
+    W = dphi * ml * l / 2 + np.einsum("ki,ik->k", sh.a, dg) + 1j * dphi * Ag
+    arm = ml * l / 2 + 1j * Ag  # int m (s + i eta) ds
+    p = ml * V + 1j * z * W + chain.mu * v_nodes
+    first = ml * R + z * arm + chain.mu * r_nodes
+    h = (
+        ml * np.imag(np.conj(R) * V)
+        + np.imag(np.conj(R) * 1j * z * W)
+        + np.imag(np.conj(z) * np.conj(arm) * V)
+        + dphi * (ml * l * l / 3 + gPg)
+        + np.einsum("ki,ik->k", sh.b, dg)
+        + chain.mu * np.imag(np.conj(r_nodes) * v_nodes)
+    )
+    return np.stack([p.real, p.imag], -1), h, np.stack([first.real, first.imag], -1)
+
+
+class LadderSystem(FullSystem):
+    """A rung of the ladder other than the paper's (``shapes`` p, ``kinematics``); the
+    compiled kernels only (the dense numpy kernel is the paper model's reference)."""
+
+    has_jacobian = False
+    accel_kernel = staticmethod(ladder_accel)
+    compiled_rhs = staticmethod(ladder_rhs)
+    compiled_mechanics = staticmethod(ladder_mechanics)
+    compiled_rhs_locked = staticmethod(ladder_rhs_locked)
+
+    def __init__(self, scene: Scene, coefficients: str, kernel: str, shapes: int, kinematics: str):
+        if coefficients != "printed":
+            raise ValueError(
+                "coefficients must be 'printed' with shapes > 1 or exact kinematics (the "
+                f"published erratum belongs to the paper's model), got {coefficients!r}"
+            )
+        if kernel != "numba":
+            raise ValueError(
+                "kernel must be 'numba' with shapes > 1 or exact kinematics (the numpy "
+                f"kernel is the paper model's dense reference), got {kernel!r}"
+            )
+        self.p = check_shapes(shapes)
+        self.exact = check_kinematics(kinematics) == "exact"
+        super(FullSystem, self).__init__(scene, coefficients, kernel)
+        n, i = self.n, self.initial
+        self.N = n * (self.p + 2)
+        bubbles = np.zeros(n * (self.p - 1))
+        self.y0 = np.concatenate(
+            [i["phi"], i["alpha"], i["beta"], bubbles, i["dphi"], i["dalpha"], i["dbeta"], bubbles]
+        )
+        self.use_kernel()
+
+    @cached_property
+    def shapes(self) -> RodShapes:
+        return shapes_of(self.base_chain, self.p)
+
+    def kernel_constants(self):
+        return ladder_constants(self.chain, self.p, self.exact)
+
+    def generalized_rates(self, y):
+        return y[self.N :]
+
+    def rigid(self, Y):
+        n, N = self.n, self.N
+        return Y[:, :n], Y[:, N : N + n]
+
+    def bending(self, times, Y):
+        n, N = self.n, self.N
+        return (
+            Y[:, n : 2 * n],
+            Y[:, 2 * n : 3 * n],
+            Y[:, N + n : N + 2 * n],
+            Y[:, N + 2 * n : N + 3 * n],
+        )
+
+    def _split(self, y: np.ndarray):
+        """(phi, phi', g (p+1, n), g' (p+1, n)) of one state."""
+        n, N, P1 = self.n, self.N, self.p + 1
+        return y[:n], y[N : N + n], y[n:N].reshape(P1, n), y[N + n :].reshape(P1, n)
+
+    def accel_locked(self, t, y):
+        sums = self.loads.suffix_sums(t)
+        SX, SY = (self._no_load, self._no_load) if sums is None else sums
+        out = np.empty(self.N)
+        lam = np.empty(self._lock_h.size)
+        ladder_accel_locked(
+            self.V, y, sums is not None, SX, SY, self.damped, self._lock_h, out, lam
+        )
+        return out, lam
+
+    def unit_responses(self, q, hinges) -> np.ndarray:
+        U = np.empty((len(hinges), self.N))
+        ladder_unit_responses(self.V, q, np.asarray(hinges, np.int64), U)
+        return U
+
+    def hinge_rows(self, hinges) -> np.ndarray:
+        return rung_hinge_matrix(self.n, self.p)[hinges]
+
+    def kinetic_energy(self, t, y):
+        return float(ladder_kinetic(self.V, y))
+
+    def bubble_energy(self, y: np.ndarray) -> float:
+        """1/2 sum_i>=2 K_ii g_i^2 (J): the bubbles' bending energy (their stiffness block
+        is diagonal and K-orthogonal to the cubic's, whose energy the paper's Pi holds)."""
+        g = self._split(y)[2]
+        K = np.einsum("kii->ik", self.shapes.K)
+        return 0.5 * float(np.sum(K[2:] * g[2:] ** 2))
+
+    def energy_rows(self, times, Y):
+        kin = np.array([self.kinetic_energy(t, y) for t, y in zip(times, Y)])
+        bubbles = np.array([self.bubble_energy(y) for y in Y])
+        alpha, beta = self.bending(times, Y)[:2]
+        return kin, self.potential(self.rigid(Y)[0], alpha, beta) + bubbles
+
+    def energy_budget(self, t, y):
+        return float(sum(self.energy_rows(np.array([t]), y[None, :]))[0])
+
+    def bending_energy_at(self, t, y):
+        return super().bending_energy_at(t, y) + self.bubble_energy(y)
+
+    def damper_power_at(self, y: np.ndarray) -> float:
+        self.compiled_mechanics(0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech)
+        return float(self._mech[2])
+
+    def rod_momenta_at(self, y):
+        phi, dphi, g, dg = self._split(y)
+        return rod_momenta_exact(self.base_chain, self.shapes, self.exact, phi, dphi, g, dg)
+
+    def angular_momentum_rows(self, times, Y):
+        return np.array(
+            [angular_momentum_rows(*self.rod_momenta_at(y), self.base_chain) for y in Y]
+        )

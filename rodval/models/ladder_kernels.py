@@ -1,0 +1,332 @@
+"""Compiled kernels of the model ladder (``rodval.models.ladder``): the full model with p + 1
+bending shapes per rod (``shapes = p``) and first-order or exact assumed-mode kinematics.
+
+Coordinates q = [phi (n); g_0 (n); g_1 (n); ...; g_p (n)] (g_0 = alpha, g_1 = beta, g_i
+component-major, so alpha, beta sit where the paper's model has them), state y = [q; q'],
+N = n (p + 2) coordinates. docs/model.md ("The model ladder") derives every term:
+
+* the generalized forces f = [Q; 0] - dPi/dq - C q' - c(q, q'), where the velocity terms
+  c_i = sum int dm (dr/dq_i) . a_v are accumulated along the chain (a_v: the acceleration of
+  each material point at q'' = 0; node accelerations by a forward sweep, the inertia of
+  everything beyond a node by a backward one): O(n p^2);
+* the solve M(q) q'' = f: the bending block of each rod (its Gram matrix P_k, constant) is
+  eliminated, leaving the Schur complement of the paper's model with per-rod constants
+  a^T P^-1 a, b^T P^-1 a, b^T P^-1 b and, with exact kinematics, its diagonal raised by
+  g^T P g and its generators by the rods' bending first moments a . g (the rank-2
+  semiseparable form is kept): ``kernels._generator_solve``, O(n p^2).
+
+The rows of V: the paper model's rows V_L .. V_TAU (``kernels``; V_W = 1, V_KB = V_CB = 0:
+the shapes' own blocks carry the bending), then the ``LV_*`` rows below and the per-rod shape
+blocks (``shape_row``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from rodval.models.deployment import _locks, _unit_moment, superpose
+from rodval.models.kernels import (
+    V_CB,
+    V_KAPPA,
+    V_L,
+    V_NU,
+    _damper_power,
+    _generator_solve,
+    _hinge_forces,
+    _load_power,
+    _upper_t_times,
+    _upper_times,
+    rhs_head,
+    schur_generators,
+)
+from rodval.solvers.signature import RHS_SIGNATURE
+
+#: Rows after the paper model's 19: rod mass m l (kg), node mass mu (kg), the number of
+#: shapes p + 1 and the exact-kinematics flag (the same in every column).
+LV_MASS, LV_MU, LV_P1, LV_EXACT = range(19, 23)
+#: First row of the shape blocks: a (p+1 rows), b (p+1), then P, P^-1, K, C ((p+1)^2 each,
+#: row-major).
+LV_SHAPES = 23
+BLOCK_A, BLOCK_B, BLOCK_P, BLOCK_PINV, BLOCK_K, BLOCK_C = range(6)
+
+
+@njit(cache=True, inline="always")
+def shape_row(P1, block, i, j):
+    """Row of V holding entry (i, j) of a shape block (j = 0 for the vectors a, b)."""
+    if block <= BLOCK_B:
+        return LV_SHAPES + block * P1 + i
+    return LV_SHAPES + 2 * P1 + (block - BLOCK_P) * P1 * P1 + i * P1 + j
+
+
+@njit(cache=True)
+def _quadratic(V, P1, block, k, x, z):
+    """x^T B_k z for the shape block B of rod k."""
+    total = 0.0
+    for i in range(P1):
+        for j in range(P1):
+            total += x[i, k] * V[shape_row(P1, block, i, j), k] * z[j, k]
+    return total
+
+
+@njit(cache=True)
+def _block_times(V, P1, block, k, x, out, sign):
+    """out[:, k] += sign * B_k x[:, k] for a shape block B (``shape_row``)."""
+    for i in range(P1):
+        acc = 0.0
+        for j in range(P1):
+            acc += V[shape_row(P1, block, i, j), k] * x[j, k]
+        out[i, k] += sign * acc
+
+
+@njit(cache=True)
+def _dot(V, P1, block, k, x):
+    """v_k . x[:, k] for a shape vector v (a or b) of rod k."""
+    total = 0.0
+    for i in range(P1):
+        total += V[shape_row(P1, block, i, 0), k] * x[i, k]
+    return total
+
+
+@njit(cache=True)
+def _velocity_terms(V, c, s, phi_rate, g, dg, exact, fp, fg):
+    """fp, fg -= c(q, q'), the velocity terms of the ladder (module docstring), O(n p^2).
+    First-order kinematics drops every term of c that carries g (not g')."""
+    n = c.shape[0]
+    P1 = g.shape[0]
+    l, ml, mu = V[V_L], V[LV_MASS], V[LV_MU]
+    node = np.empty((n, 2))  # velocity part of the node accelerations A_k
+    rod = np.empty((n, 2))  # int over rod k of m a_v ds
+    Ax = 0.0
+    Ay = 0.0
+    Pg = np.zeros((P1, n))
+    for k in range(n):
+        w = phi_rate[k]
+        h = 0.5 * ml[k] * l[k]  # int m s ds
+        Ad = _dot(V, P1, BLOCK_A, k, dg)
+        Ag = _dot(V, P1, BLOCK_A, k, g) if exact else 0.0
+        ur = c[k] * Ax + s[k] * Ay  # conj(z_k) A_{k-1}
+        ui = c[k] * Ay - s[k] * Ax
+        own = h * ui - Ag * ur
+        if exact:
+            own += 2.0 * w * _quadratic(V, P1, BLOCK_P, k, g, dg)
+            _block_times(V, P1, BLOCK_P, k, g, Pg, 1.0)
+        fp[k] -= own
+        for i in range(P1):
+            fg[i, k] -= V[shape_row(P1, BLOCK_A, i, 0), k] * ui - w * w * Pg[i, k]
+        Xr = w * (w * h + 2.0 * Ad)
+        Xi = w * w * Ag
+        rod[k, 0] = ml[k] * Ax - (c[k] * Xr - s[k] * Xi)
+        rod[k, 1] = ml[k] * Ay - (s[k] * Xr + c[k] * Xi)
+        Ax -= l[k] * w * w * c[k]
+        Ay -= l[k] * w * w * s[k]
+        node[k, 0] = Ax
+        node[k, 1] = Ay
+    Tx = 0.0  # inertia of everything beyond node j: sum_{k>j} (rod_k + mu_k A_k)
+    Ty = 0.0
+    for j in range(n - 1, -1, -1):
+        Fx = mu[j] * node[j, 0] + Tx
+        Fy = mu[j] * node[j, 1] + Ty
+        fp[j] -= l[j] * (c[j] * Fy - s[j] * Fx)
+        Tx = Fx + rod[j, 0]
+        Ty = Fy + rod[j, 1]
+
+
+@njit(cache=True)
+def ladder_forces(V, y, c, s, has_load, SX, SY, damped, fp, fg):
+    """f = [Q; 0] - dPi/dq - C q' - c(q, q') (N m) into fp (n) and fg (p+1, n), O(n p^2)."""
+    n = c.shape[0]
+    P1 = fg.shape[0]
+    N = n * (P1 + 1)
+    q, v = y[:N], y[N:]
+    g = q[n:].reshape((P1, n))
+    dg = v[n:].reshape((P1, n))
+    fp[:] = 0.0
+    fg[:] = 0.0
+    _hinge_forces(V, q[:n], g[0], g[1], V_KAPPA, fp, fg[0], fg[1])
+    if damped:
+        _hinge_forces(V, v[:n], dg[0], dg[1], V_NU, fp, fg[0], fg[1])
+    for k in range(n):
+        _block_times(V, P1, BLOCK_K, k, g, fg, 1.0)
+        if damped:
+            _block_times(V, P1, BLOCK_C, k, dg, fg, 1.0)
+    fp *= -1.0
+    fg *= -1.0
+    _velocity_terms(V, c, s, v[:n], g, dg, V[LV_EXACT, 0] != 0.0, fp, fg)
+    if has_load:
+        l = V[V_L]
+        for k in range(n):
+            fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
+
+
+@njit(cache=True)
+def ladder_solve(V, g, c, s, fp, fg, out):
+    """q'' = M(q)^-1 [fp; fg] into ``out`` (N), O(n p^2): per rod x_g = P^-1 (f_g - M_gp
+    x_p), the Schur complement (``kernels.schur_generators``, with exact kinematics raised
+    by g^T P g on the diagonal and by the bending first moment A = a . g in the generators:
+    M_pp[k, j] = l_j (l_k M_k c_kj - A_k s_kj), k > j) solved in generator form."""
+    n = c.shape[0]
+    P1 = fg.shape[0]
+    G = np.zeros((P1, n))
+    r = fp.copy()
+    aG = np.empty(n)
+    for k in range(n):
+        _block_times(V, P1, BLOCK_PINV, k, fg, G, 1.0)
+        aG[k] = _dot(V, P1, BLOCK_A, k, G)
+        r[k] -= _dot(V, P1, BLOCK_B, k, G)
+    _upper_times(V, c, s, aG, True, r, -1.0)  # V_W = 1: sum_{j>k} l_k c_kj a_j . G_j
+    d, a, b, e = schur_generators(V, c, s)
+    if V[LV_EXACT, 0] != 0.0:
+        for k in range(n):
+            A = _dot(V, P1, BLOCK_A, k, g)
+            d[k] += _quadratic(V, P1, BLOCK_P, k, g, g)
+            a[k, 0] -= A * s[k]
+            a[k, 1] += A * c[k]
+            e[k, 0] -= A * s[k]
+            e[k, 1] += A * c[k]
+    xp = out[:n]
+    _generator_solve(d, a, b, e, r, xp)
+    ut = np.zeros(n)
+    _upper_t_times(V, c, s, xp, True, ut, 1.0)  # sum_{j<k} l_j c_kj x_j
+    rg = np.empty((P1, n))
+    for k in range(n):
+        for i in range(P1):
+            rg[i, k] = (
+                fg[i, k]
+                - V[shape_row(P1, BLOCK_A, i, 0), k] * ut[k]
+                - V[shape_row(P1, BLOCK_B, i, 0), k] * xp[k]
+            )
+    xg = out[n:].reshape((P1, n))
+    xg[:] = 0.0
+    for k in range(n):
+        _block_times(V, P1, BLOCK_PINV, k, rg, xg, 1.0)
+
+
+@njit(cache=True)
+def _shape_count(V):
+    return int(V[LV_P1, 0])
+
+
+@njit(cache=True)
+def ladder_accel(V, y, has_load, SX, SY, damped, out):
+    """Accelerations q'' (N) of the ladder at y = [q; q'] into ``out``; SX, SY: the load
+    suffix sums (N) when ``has_load``. O(n p^2) time, O(n p) memory."""
+    n = V.shape[1]
+    P1 = _shape_count(V)
+    c = np.cos(y[:n])
+    s = np.sin(y[:n])
+    fp = np.empty(n)
+    fg = np.empty((P1, n))
+    ladder_forces(V, y, c, s, has_load, SX, SY, damped, fp, fg)
+    ladder_solve(V, y[n : n * (P1 + 1)].reshape((P1, n)), c, s, fp, fg, out)
+
+
+@njit(cache=True)
+def ladder_unit_responses(V, q, locks, U):
+    """U[j] = M(q)^-1 a_{locks[j]} (N each), O(n p^2) per hinge."""
+    n = V.shape[1]
+    P1 = _shape_count(V)
+    c = np.cos(q[:n])
+    s = np.sin(q[:n])
+    g = q[n:].reshape((P1, n))
+    fp = np.empty(n)
+    fg = np.empty((P1, n))
+    for j in range(locks.shape[0]):
+        fp[:] = 0.0
+        fg[:] = 0.0
+        _unit_moment(locks[j], fp, fg[0], fg[1])
+        ladder_solve(V, g, c, s, fp, fg, U[j])
+
+
+@njit(cache=True)
+def ladder_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
+    """q'' (N) with the hinges ``locks`` held into ``out``, their multipliers (N m) into
+    ``lam`` (``deployment.superpose``); O(n p^2 m)."""
+    n = V.shape[1]
+    ladder_accel(V, y, has_load, SX, SY, damped, out)
+    m = locks.shape[0]
+    if m == 0:
+        return
+    U = np.empty((m, out.shape[0]))
+    ladder_unit_responses(V, y[: out.shape[0]], locks, U)
+    superpose(out, U, locks, n, lam)
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def ladder_rhs(t, y, P, S, M, L, out):
+    """y' of the ladder (compiled integrators' right-hand side, loads from table L)."""
+    n = P.shape[1]
+    SX = np.empty(n)
+    SY = np.empty(n)
+    has_load = rhs_head(t, y, L, SX, SY, out)
+    half = y.shape[0] // 2
+    ladder_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[half:])
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def ladder_rhs_locked(t, y, P, S, M, L, out):
+    """y' of the ladder with the hinges of S held (``deployment.lock_scalars``)."""
+    n = P.shape[1]
+    SX = np.empty(n)
+    SY = np.empty(n)
+    has_load = rhs_head(t, y, L, SX, SY, out)
+    locks, _ = _locks(S)
+    lam = np.empty(locks.shape[0])
+    half = y.shape[0] // 2
+    ladder_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[half:], lam)
+
+
+@njit(cache=True)
+def ladder_kinetic(V, y):
+    """T = 1/2 int |r'|^2 dm + 1/2 sum mu_k |v_k|^2 (J) of the ladder's velocity field
+    (first-order kinematics: the terms in g dropped, as in its mass matrix); O(n p^2)."""
+    n = V.shape[1]
+    P1 = _shape_count(V)
+    N = n * (P1 + 1)
+    exact = V[LV_EXACT, 0] != 0.0
+    q, v = y[:N], y[N:]
+    g = q[n:].reshape((P1, n))
+    dg = v[n:].reshape((P1, n))
+    l, ml, mu = V[V_L], V[LV_MASS], V[LV_MU]
+    T = 0.0
+    Vx = 0.0  # velocity of node k-1
+    Vy = 0.0
+    for k in range(n):
+        c = np.cos(q[k])
+        s = np.sin(q[k])
+        w = v[k]
+        Wr = w * 0.5 * ml[k] * l[k] + _dot(V, P1, BLOCK_A, k, dg)  # int m (s phi' + eta')
+        Wi = w * _dot(V, P1, BLOCK_A, k, g) if exact else 0.0  # int m eta phi'
+        J = w * w * ml[k] * l[k] * l[k] / 3.0 + 2.0 * w * _dot(V, P1, BLOCK_B, k, dg)
+        J += _quadratic(V, P1, BLOCK_P, k, dg, dg)
+        if exact:
+            J += w * w * _quadratic(V, P1, BLOCK_P, k, g, g)
+        T += 0.5 * ml[k] * (Vx * Vx + Vy * Vy) + 0.5 * J
+        T += Vx * -(s * Wr + c * Wi) + Vy * (c * Wr - s * Wi)
+        Vx -= l[k] * w * s
+        Vy += l[k] * w * c
+        T += 0.5 * mu[k] * (Vx * Vx + Vy * Vy)
+    return T
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def ladder_mechanics(t, y, P, S, M, L, out):
+    """(T, P_ext, P_diss) of the ladder into out[:3]: ``ladder_kinetic`` (J), the load power
+    (W) and the dampers' power: hinges sum nu (dD/dt)^2 plus the rods' g'^T C g' (W; 0 unless
+    S[0], the damped flag). O(n p^2)."""
+    n = P.shape[1]
+    P1 = _shape_count(P)
+    N = n * (P1 + 1)
+    phi, v = y[:n], y[N:]
+    dg = v[n:].reshape((P1, n))
+    out[0] = ladder_kinetic(P, y)
+    out[1] = _load_power(P, np.cos(phi), np.sin(phi), v[:n], L, t)
+    power = _damper_power(P, S, v[:n], dg[0], dg[1])  # V_CB = 0: the hinges only
+    if S[0] != 0.0:
+        for k in range(n):
+            power += _quadratic(P, P1, BLOCK_C, k, dg, dg)
+    out[2] = power
+
+
+#: The V rows the ladder zeroes (its shape blocks carry the bending): 4 EI/l and 4 c/l.
+ZERO_ROWS = (V_CB,)
