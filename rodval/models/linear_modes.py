@@ -92,6 +92,13 @@ from rodval.core.modal import (
 )
 from rodval.core.scene import Chain, InitialState, Scene
 from rodval.models.full import FullModel
+from rodval.models.ladder import (
+    PAPER_RUNG,
+    check_kinematics,
+    check_shapes,
+    ladder_mass_matrix,
+    ladder_stiffness,
+)
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
     chain_constants,
@@ -143,15 +150,31 @@ def linear_system(
     coefficients: str = DEFAULT_VARIANT,
     SX=None,
     SY=None,
+    shapes: int = 1,
+    kinematics: str = "first-order",
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(M, C, K + K_L) of the model linearized about q0 at rest (q0: phi (n) or
     [phi; alpha; beta] (3n); default straight). The bending coordinates of q0 do not enter
-    (the first-order model's M depends on phi only and K is constant)."""
+    the paper's rung (its M depends on phi only and K is constant); a ladder rung (full
+    model, ``shapes`` > 1 or exact ``kinematics``) has N = n (p + 2) coordinates, its
+    bubbles at rest zero (node loads and hinge moments do not load them: their stiffness is
+    K-orthogonal to the cubic's) and, with exact kinematics, M(q0) with q0's bending."""
     check_choice("model", model, PAPER_MODELS)
     n = chain.n
     phi0 = np.zeros(n) if q0 is None else np.asarray(q0, float)[:n]
     if phi0.shape != (n,):
         raise ValueError(f"phi0 must have length n = {n}, got shape {phi0.shape}")
+    if model == "full" and (shapes, kinematics) != PAPER_RUNG:
+        p, exact = check_shapes(shapes), check_kinematics(kinematics) == "exact"
+        q = np.zeros(n * (p + 2))
+        if q0 is not None and len(q0) == 3 * n:
+            q[: 3 * n] = q0
+        q[:n] = phi0
+        M = ladder_mass_matrix(chain, p, exact, q)
+        K = ladder_stiffness(chain, p)
+        if SX is not None:
+            K[:n, :n] += load_stiffness(chain.l, phi0, SX, SY)
+        return M, ladder_stiffness(chain, p, damping=True), K
     if model == "full":
         M = mass_matrix(chain_constants(chain, coefficients), phi0)
         K = stiffness_matrix(chain)
@@ -350,17 +373,33 @@ def modes(
     coefficients: str = DEFAULT_VARIANT,
     load_at: float | None = None,
     allow_unbalanced: bool = False,
+    shapes: int = 1,
+    kinematics: str = "first-order",
 ) -> Modes:
-    """Linearized modes of the native ``model`` ("full" or "reduced") about the scene's
+    """Linearized modes of the native ``model`` ("full" or "reduced"; the full model on any
+    rung of the ladder: ``shapes``, ``kinematics``) about the scene's
     initial state at rest (``check_at_rest`` unless ``allow_unbalanced``) or its static
     equilibrium under its static loads (``rodval.core.modal.static_loads``: the loads acting
     for ever, or every load at ``load_at`` s) and hinge rest angles (see module docstring).
     ``count``: the lowest ``count`` modes (default all)."""
     check_arguments(scene, count)
     check_choice("model", model, PAPER_MODELS)
+    rung = (check_shapes(shapes), check_kinematics(kinematics))
+    if model != "full" and rung != PAPER_RUNG:
+        raise ValueError(
+            f"shapes and kinematics are options of the full model, not of {model!r} "
+            "(docs/model.md, 'The model ladder')"
+        )
     balance = check_configuration(scene, about, load_at, allow_unbalanced)
     m = modes_about(
-        scene, model, about=about, count=count, coefficients=coefficients, load_at=load_at
+        scene,
+        model,
+        about=about,
+        count=count,
+        coefficients=coefficients,
+        load_at=load_at,
+        shapes=shapes,
+        kinematics=kinematics,
     )
     m.info.update(balance)
     return m
@@ -374,10 +413,13 @@ def modes_about(
     count: int | None,
     coefficients: str,
     load_at: float | None,
+    shapes: int = 1,
+    kinematics: str = "first-order",
 ) -> Modes:
     """``modes`` about a configuration already checked (``check_configuration``): the
     static equilibrium when asked for, the linear system, its eigen-solution and shapes.
-    Dense: O(n^3) for the 3n (full) or n (reduced) coordinates."""
+    Dense: O(N^3) for the N = 3n (full; n (p + 2) on a ladder rung) or n (reduced)
+    coordinates."""
     chain, n = scene.chain, scene.n
     ini = scene.initial.resolve(n)
     q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
@@ -390,14 +432,15 @@ def modes_about(
         if not eq.converged:
             raise ValueError(no_equilibrium(chain, eq))
         q0 = eq.q
-    M, C, K = linear_system(chain, model, q0, coefficients, SX, SY)
+    M, C, K = linear_system(chain, model, q0, coefficients, SX, SY, shapes, kinematics)
     lam, X = eigen(K, M, chain, model)
     N = lam.size
     count = N if count is None else min(count, N)
     lam, X = lam[:count], X[:, :count]
     omega = angular_frequencies(lam)
     zeta = _damping_ratios(M, C, K, X, omega)
-    dx, dy, hinge = _shapes(chain, model, q0[:n], X, lam, coefficients=coefficients)
+    # node displacements and hinge angles need phi, alpha, beta only (bubbles: zero at the ends)
+    dx, dy, hinge = _shapes(chain, model, q0[:n], X[: 3 * n], lam, coefficients=coefficients)
     return Modes(
         model=model,
         about=about,
@@ -409,7 +452,7 @@ def modes_about(
         phi0=q0[:n].copy(),
         l=chain.l.copy(),
         equilibrium=eq,
-        info={"coefficients": coefficients, "q0": q0},
+        info={"coefficients": coefficients, "q0": q0, "shapes": shapes, "kinematics": kinematics},
     )
 
 
@@ -454,9 +497,16 @@ def _paper_modes(model: str):
         count: int | None,
         load_at: float | None,
         coefficients: str = DEFAULT_VARIANT,
+        **rung,
     ) -> Modes:
         return modes_about(
-            scene, model, about=about, count=count, coefficients=coefficients, load_at=load_at
+            scene,
+            model,
+            about=about,
+            count=count,
+            coefficients=coefficients,
+            load_at=load_at,
+            **rung,
         )
 
     return analysis
