@@ -11,6 +11,8 @@ import numpy as np
 
 from rodval.core.scene import Scene
 from rodval.models import deployment, kernels
+from rodval.models.ladder import PAPER_RUNG, LadderSystem, check_kinematics, check_shapes
+from rodval.models.lock_records import plastic_jump
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
     angle_differences,
@@ -156,19 +158,7 @@ class FullSystem(PaperSystem):
         return hinge_matrix(self.n)[hinges]
 
     def plastic_jump(self, y, hinges, angles):
-        """Delta q' = M^-1 A^T mu, (A M^-1 A^T) mu = -A q' (the hinges' rates become zero;
-        the velocity closest to the old one in the kinetic metric M); D is first projected
-        onto the latch angles in the same metric (a round-off-sized correction)."""
-        y = y.copy()
-        half = y.size // 2
-        q, v = y[:half], y[half:]
-        U = self.unit_responses(q, hinges)
-        A = self.hinge_rows(hinges)
-        G = A @ U.T
-        q += U.T @ np.linalg.solve(G, angles - A @ q)
-        mu = np.linalg.solve(G, -(A @ v))
-        v += U.T @ mu
-        return y, mu
+        return plastic_jump(self, y, hinges, angles)
 
     def energy_budget(self, t, y):
         n = self.n
@@ -204,8 +194,6 @@ class FullModel(PaperModel):
         shapes: int = 1,
         kinematics: str = "first-order",
     ):
-        from rodval.models.ladder import check_kinematics, check_shapes
-
         super().__init__(coefficients, kernel)
         self.shapes = check_shapes(shapes)
         self.kinematics = check_kinematics(kinematics)
@@ -214,8 +202,6 @@ class FullModel(PaperModel):
         return {**super().options(), "shapes": self.shapes, "kinematics": self.kinematics}
 
     def system(self, scene: Scene) -> PaperSystem:
-        from rodval.models.ladder import PAPER_RUNG, LadderSystem
-
         if (self.shapes, self.kinematics) == PAPER_RUNG:
             return FullSystem(scene, self.coefficients, self.kernel)
         return LadderSystem(scene, self.coefficients, self.kernel, self.shapes, self.kinematics)

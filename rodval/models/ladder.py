@@ -20,7 +20,7 @@ import numpy as np
 
 from rodval.core.checks import check_choice
 from rodval.core.scene import Chain, Scene
-from rodval.models.full import FullSystem
+from rodval.models import deployment
 from rodval.models.kernels import V_CB, V_EPS, V_KB, V_PI, V_RHO, V_TAU, V_W, _rows
 from rodval.models.ladder_kernels import (
     BLOCK_A,
@@ -42,6 +42,7 @@ from rodval.models.ladder_kernels import (
     ladder_rhs_locked,
     ladder_unit_responses,
 )
+from rodval.models.lock_records import plastic_jump
 from rodval.models.paper_energy import _NO_LOADS, _NO_MATRICES
 from rodval.models.paper_matrices import (
     angle_differences,
@@ -50,6 +51,7 @@ from rodval.models.paper_matrices import (
     hinge_matrix,
     mass_matrix,
 )
+from rodval.models.paper_system import PaperSystem
 from rodval.models.shapes import MAX_SHAPES, RodShapes, rod_shapes
 
 #: ``kinematics`` of the full model; the first is the paper's (the default).
@@ -188,15 +190,17 @@ def rod_momenta_exact(
     return np.stack([p.real, p.imag], -1), h, np.stack([first.real, first.imag], -1)
 
 
-class LadderSystem(FullSystem):
+class LadderSystem(PaperSystem):
     """A rung of the ladder other than the paper's (``shapes`` p, ``kinematics``); the
     compiled kernels only (the dense numpy kernel is the paper model's reference)."""
 
     has_jacobian = False
+    full = True
     accel_kernel = staticmethod(ladder_accel)
     compiled_rhs = staticmethod(ladder_rhs)
     compiled_mechanics = staticmethod(ladder_mechanics)
     compiled_rhs_locked = staticmethod(ladder_rhs_locked)
+    compiled_events = staticmethod(deployment.full_hinge_events)  # D from [phi; alpha; beta]
 
     def __init__(self, scene: Scene, coefficients: str, kernel: str, shapes: int, kinematics: str):
         if coefficients != "printed":
@@ -211,7 +215,7 @@ class LadderSystem(FullSystem):
             )
         self.p = check_shapes(shapes)
         self.exact = check_kinematics(kinematics) == "exact"
-        super(FullSystem, self).__init__(scene, coefficients, kernel)
+        super().__init__(scene, coefficients, kernel)
         n, i = self.n, self.initial
         self.N = n * (self.p + 2)
         bubbles = np.zeros(n * (self.p - 1))
@@ -265,6 +269,9 @@ class LadderSystem(FullSystem):
 
     def hinge_rows(self, hinges) -> np.ndarray:
         return rung_hinge_matrix(self.n, self.p)[hinges]
+
+    def plastic_jump(self, y, hinges, angles):
+        return plastic_jump(self, y, hinges, angles)
 
     def kinetic_energy(self, t, y):
         return float(ladder_kinetic(self.V, y))

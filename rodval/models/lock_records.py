@@ -126,3 +126,23 @@ def lock_record(
         "angular_momentum_root_jump": root1 - root0,
         **rigid,
     }
+
+
+def plastic_jump(
+    system: PaperSystem, y: np.ndarray, hinges, angles
+) -> tuple[np.ndarray, np.ndarray]:
+    """The plastic lock of ``hinges`` at ``angles`` (rad) in a model whose state is [q; q']
+    (the full model, every ladder rung): Delta q' = M^-1 A^T mu, (A M^-1 A^T) mu = -A q' (the
+    hinges' rates become zero; the velocity closest to the old one in the kinetic metric
+    M(q)); q is first projected onto the latch angles in the same metric (a round-off-sized
+    correction). Returns (state after, mu (N m s)); O(N m) with the compiled unit responses."""
+    y = y.copy()
+    half = y.size // 2
+    q, v = y[:half], y[half:]
+    U = system.unit_responses(q, hinges)
+    A = system.hinge_rows(hinges)
+    G = A @ U.T
+    q += U.T @ np.linalg.solve(G, angles - A @ q)
+    mu = np.linalg.solve(G, -(A @ v))
+    v += U.T @ mu
+    return y, mu
