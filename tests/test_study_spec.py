@@ -104,6 +104,7 @@ def test_shipped_studies_and_the_readme_example_are_valid():
         "deployment_stiff": 1,
         "deployment_sample": 256,
         "exudyn_convergence": 80,
+        "model_error_budget": 8,
         "n_sweep": 20,
         "paper": 1,
         "scale_study": 1000,

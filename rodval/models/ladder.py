@@ -46,10 +46,12 @@ from rodval.models.lock_records import plastic_jump
 from rodval.models.paper_energy import _NO_LOADS, _NO_MATRICES
 from rodval.models.paper_matrices import (
     angle_differences,
-    angular_momentum_rows,
     chain_constants,
     hinge_matrix,
     mass_matrix,
+)
+from rodval.models.paper_matrices import (
+    angular_momentum_rows as momentum_rows,
 )
 from rodval.models.paper_system import PaperSystem
 from rodval.models.shapes import MAX_SHAPES, RodShapes, rod_shapes
@@ -65,7 +67,7 @@ def check_shapes(shapes) -> int:
     coordinates) as an int in 1..MAX_SHAPES, else a ValueError naming the range."""
     if isinstance(shapes, bool) or not isinstance(shapes, numbers.Integral):
         raise ValueError(f"shapes must be an integer in 1..{MAX_SHAPES}, got {shapes!r}")
-    if not 1 <= shapes <= MAX_SHAPES:
+    if not 1 <= int(shapes) <= MAX_SHAPES:
         raise ValueError(f"shapes must be an integer in 1..{MAX_SHAPES}, got {shapes!r}")
     return int(shapes)
 
@@ -299,11 +301,9 @@ class LadderSystem(PaperSystem):
         self.compiled_mechanics(0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech)
         return float(self._mech[2])
 
-    def rod_momenta_at(self, y):
+    def rod_momenta_at(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         phi, dphi, g, dg = self._split(y)
         return rod_momenta_exact(self.base_chain, self.shapes, self.exact, phi, dphi, g, dg)
 
     def angular_momentum_rows(self, times, Y):
-        return np.array(
-            [angular_momentum_rows(*self.rod_momenta_at(y), self.base_chain) for y in Y]
-        )
+        return np.array([momentum_rows(*self.rod_momenta_at(y), self.base_chain) for y in Y])

@@ -5,6 +5,8 @@ coordinates (``energy_rows``, ``bending_energy_at``, ``rod_momenta_at``, ``kinet
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from rodval.core.loads import LOAD_COLUMNS
@@ -25,6 +27,31 @@ _NO_LOADS = np.zeros((0, len(LOAD_COLUMNS)))
 
 class PaperEnergy:
     """T, Pi and the momenta of a paper system (attributes from ``PaperSystem``)."""
+
+    kernel: str
+    n: int
+    full: bool
+    V: np.ndarray
+    _flags: np.ndarray
+    _mech: np.ndarray
+    compiled_mechanics: Any
+    cc_kinetic: Any
+    base_chain: Any
+    stops: tuple
+    stop_active: tuple[bool, ...]
+
+    def rigid(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """phi, phi' from a state history Y (nt, N)."""
+        raise NotImplementedError
+
+    def bending(self, times: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, ...]:
+        """alpha, beta, alpha', beta' (each (nt, n)) from a state history."""
+        raise NotImplementedError
+
+    def generalized_rates(self, y: np.ndarray) -> np.ndarray:
+        """q' = [phi'; alpha'; beta'] (3n; a ladder rung: all N) as the model's equations see
+        it at state y."""
+        raise NotImplementedError
 
     def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
         """1/2 v^T M(phi) v with the kinematic mass matrix: the compiled O(n) form, or the

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from contextlib import contextmanager
 from functools import cached_property
-from typing import Any, NamedTuple
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
@@ -192,18 +192,6 @@ class PaperSystem(PaperEnergy, OdeSystem):
         """Q(phi, t) (N m) on the phi coordinates, or None when no load acts at t."""
         sums = self.loads.suffix_sums(t)
         return None if sums is None else generalized_forces(self.l, phi, *sums)
-
-    def rigid(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """phi, phi' from a state history Y (nt, N)."""
-        raise NotImplementedError
-
-    def bending(self, times: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, ...]:
-        """alpha, beta, alpha', beta' (each (nt, n)) from a state history."""
-        raise NotImplementedError
-
-    def generalized_rates(self, y: np.ndarray) -> np.ndarray:
-        """q' = [phi'; alpha'; beta'] (3n) as the model's equations see it at state y."""
-        raise NotImplementedError
 
     def max_bending(self, times: np.ndarray, Y: np.ndarray) -> float | None:
         """max |alpha|, |beta| (rad) over the states Y (the reduced model's: O(n) per state)."""
@@ -523,8 +511,8 @@ class PaperModel(OdeModel):
     dense right-hand side, kept as the reference and benchmark baseline)."""
 
     system_class: type[PaperSystem]
-    OPTIONS = ("coefficients", "kernel")
-    MODES_OPTIONS = ("coefficients",)
+    OPTIONS: ClassVar[tuple[str, ...]] = ("coefficients", "kernel")
+    MODES_OPTIONS: ClassVar[tuple[str, ...]] = ("coefficients",)
 
     def __init__(self, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
         self.coefficients = check_choice("coefficients", coefficients, VARIANTS)

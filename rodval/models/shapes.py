@@ -40,7 +40,7 @@ def shape_polynomials(p: int) -> list[np.ndarray]:
     to_xi = np.array([-1.0, 2.0])
     for i in range(2, p + 1):
         B = L.leg2poly(L.legint(L.legint(np.eye(i + 1)[i], lbnd=-1), lbnd=-1))
-        coef = np.zeros(1)
+        coef: np.ndarray = np.zeros(1)
         for power, b in enumerate(B):
             coef = Poly.polyadd(coef, b * Poly.polypow(to_xi, power))
         out.append(coef / 4.0)
