@@ -263,9 +263,16 @@ def _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
     _upper_t_times(V, c, s, w2, False, fa, 1.0)  # - h_alpha = + G_pa^T w2
     _upper_t_times(V, c, s, w2, False, fb, -1.0)
     if has_load:
-        l = V[V_L]
-        for k in range(n):
-            fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
+        load_moments(V, c, s, SX, SY, fp)
+
+
+@njit(cache=True)
+def load_moments(V, c, s, SX, SY, fp):
+    """fp += Q, the loads' generalized forces on phi: Q_k = l_k (c_k SY_k - s_k SX_k) (N m)
+    from the load suffix sums SX, SY (N); O(n)."""
+    l = V[V_L]
+    for k in range(c.shape[0]):
+        fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
 
 
 @njit(cache=True)

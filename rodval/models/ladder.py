@@ -13,12 +13,11 @@ both rod ends: hinge angles, latches, stops and node positions are the paper's.
 
 from __future__ import annotations
 
-import numbers
 from functools import cached_property
 
 import numpy as np
 
-from rodval.core.checks import check_choice
+from rodval.core.checks import check_choice, check_number
 from rodval.core.scene import Chain, Scene
 from rodval.models import deployment
 from rodval.models.kernels import V_CB, V_EPS, V_KB, V_PI, V_RHO, V_TAU, V_W, _rows
@@ -36,6 +35,7 @@ from rodval.models.ladder_kernels import (
     LV_SHAPES,
     ladder_accel,
     ladder_accel_locked,
+    ladder_damper_power,
     ladder_kinetic,
     ladder_mechanics,
     ladder_rhs,
@@ -43,7 +43,6 @@ from rodval.models.ladder_kernels import (
     ladder_unit_responses,
 )
 from rodval.models.lock_records import plastic_jump
-from rodval.models.paper_energy import _NO_LOADS, _NO_MATRICES
 from rodval.models.paper_matrices import (
     angle_differences,
     chain_constants,
@@ -65,11 +64,10 @@ PAPER_RUNG = (1, KINEMATICS[0])
 def check_shapes(shapes) -> int:
     """``shapes`` (p, the bending shapes per rod beyond the rigid rotation: p + 1 shape
     coordinates) as an int in 1..MAX_SHAPES, else a ValueError naming the range."""
-    if isinstance(shapes, bool) or not isinstance(shapes, numbers.Integral):
-        raise ValueError(f"shapes must be an integer in 1..{MAX_SHAPES}, got {shapes!r}")
-    if not 1 <= int(shapes) <= MAX_SHAPES:
-        raise ValueError(f"shapes must be an integer in 1..{MAX_SHAPES}, got {shapes!r}")
-    return int(shapes)
+    allowed = f"an integer in 1..{MAX_SHAPES}"
+    return int(
+        check_number("shapes", shapes, low=1, high=MAX_SHAPES, integer=True, allowed=allowed)
+    )
 
 
 def check_kinematics(kinematics) -> str:
@@ -282,8 +280,12 @@ class LadderSystem(PaperSystem):
         """1/2 sum_i>=2 K_ii g_i^2 (J): the bubbles' bending energy (their stiffness block
         is diagonal and K-orthogonal to the cubic's, whose energy the paper's Pi holds)."""
         g = self._split(y)[2]
-        K = np.einsum("kii->ik", self.shapes.K)
-        return 0.5 * float(np.sum(K[2:] * g[2:] ** 2))
+        return 0.5 * float(np.sum(self._bubble_stiffness * g[2:] ** 2))
+
+    @cached_property
+    def _bubble_stiffness(self) -> np.ndarray:
+        """K_ii (N m) of the bubbles i = 2..p, (p - 1, n)."""
+        return np.einsum("kii->ik", self.shapes.K)[2:]
 
     def energy_rows(self, times, Y):
         kin = np.array([self.kinetic_energy(t, y) for t, y in zip(times, Y)])
@@ -298,8 +300,7 @@ class LadderSystem(PaperSystem):
         return super().bending_energy_at(t, y) + self.bubble_energy(y)
 
     def damper_power_at(self, y: np.ndarray) -> float:
-        self.compiled_mechanics(0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech)
-        return float(self._mech[2])
+        return float(ladder_damper_power(self.V, self._flags, y))
 
     def rod_momenta_at(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         phi, dphi, g, dg = self._split(y)

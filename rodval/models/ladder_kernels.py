@@ -27,7 +27,6 @@ from numba import njit
 
 from rodval.models.deployment import _locks, _unit_moment, superpose
 from rodval.models.kernels import (
-    V_CB,
     V_KAPPA,
     V_L,
     V_NU,
@@ -37,6 +36,7 @@ from rodval.models.kernels import (
     _load_power,
     _upper_t_times,
     _upper_times,
+    load_moments,
     rhs_head,
     schur_generators,
 )
@@ -89,33 +89,44 @@ def _dot(V, P1, block, k, x):
 
 
 @njit(cache=True)
-def _velocity_terms(V, c, s, phi_rate, g, dg, exact, fp, fg):
-    """fp, fg -= c(q, q'), the velocity terms of the ladder (module docstring), O(n p^2).
-    First-order kinematics drops every term of c that carries g (not g')."""
+def bending_sums(V, g):
+    """(A (n,), Pg (p+1, n)): every rod's bending first moment A_k = a_k . g_k (kg m) and
+    P_k g_k (kg m^2), the state-dependent part of exact kinematics; zeros with first-order
+    kinematics, which drops every term they carry. O(n p^2), once per evaluation."""
+    P1, n = g.shape
+    A = np.zeros(n)
+    Pg = np.zeros((P1, n))
+    if V[LV_EXACT, 0] != 0.0:
+        for k in range(n):
+            A[k] = _dot(V, P1, BLOCK_A, k, g)
+            _block_times(V, P1, BLOCK_P, k, g, Pg, 1.0)
+    return A, Pg
+
+
+@njit(cache=True)
+def _velocity_terms(V, c, s, phi_rate, dg, A, Pg, fp, fg):
+    """fp, fg -= c(q, q'), the velocity terms of the ladder (module docstring), O(n p^2);
+    A, Pg from ``bending_sums`` (zero for first-order kinematics)."""
     n = c.shape[0]
-    P1 = g.shape[0]
+    P1 = dg.shape[0]
     l, ml, mu = V[V_L], V[LV_MASS], V[LV_MU]
     node = np.empty((n, 2))  # velocity part of the node accelerations A_k
     rod = np.empty((n, 2))  # int over rod k of m a_v ds
     Ax = 0.0
     Ay = 0.0
-    Pg = np.zeros((P1, n))
     for k in range(n):
         w = phi_rate[k]
         h = 0.5 * ml[k] * l[k]  # int m s ds
         Ad = _dot(V, P1, BLOCK_A, k, dg)
-        Ag = _dot(V, P1, BLOCK_A, k, g) if exact else 0.0
         ur = c[k] * Ax + s[k] * Ay  # conj(z_k) A_{k-1}
         ui = c[k] * Ay - s[k] * Ax
-        own = h * ui - Ag * ur
-        if exact:
-            own += 2.0 * w * _quadratic(V, P1, BLOCK_P, k, g, dg)
-            _block_times(V, P1, BLOCK_P, k, g, Pg, 1.0)
-        fp[k] -= own
+        own = h * ui - A[k] * ur
         for i in range(P1):
+            own += 2.0 * w * dg[i, k] * Pg[i, k]  # 2 phi' g^T P g'
             fg[i, k] -= V[shape_row(P1, BLOCK_A, i, 0), k] * ui - w * w * Pg[i, k]
+        fp[k] -= own
         Xr = w * (w * h + 2.0 * Ad)
-        Xi = w * w * Ag
+        Xi = w * w * A[k]
         rod[k, 0] = ml[k] * Ax - (c[k] * Xr - s[k] * Xi)
         rod[k, 1] = ml[k] * Ay - (s[k] * Xr + c[k] * Xi)
         Ax -= l[k] * w * w * c[k]
@@ -133,7 +144,7 @@ def _velocity_terms(V, c, s, phi_rate, g, dg, exact, fp, fg):
 
 
 @njit(cache=True)
-def ladder_forces(V, y, c, s, has_load, SX, SY, damped, fp, fg):
+def ladder_forces(V, y, c, s, A, Pg, has_load, SX, SY, damped, fp, fg):
     """f = [Q; 0] - dPi/dq - C q' - c(q, q') (N m) into fp (n) and fg (p+1, n), O(n p^2)."""
     n = c.shape[0]
     P1 = fg.shape[0]
@@ -152,19 +163,18 @@ def ladder_forces(V, y, c, s, has_load, SX, SY, damped, fp, fg):
             _block_times(V, P1, BLOCK_C, k, dg, fg, 1.0)
     fp *= -1.0
     fg *= -1.0
-    _velocity_terms(V, c, s, v[:n], g, dg, V[LV_EXACT, 0] != 0.0, fp, fg)
+    _velocity_terms(V, c, s, v[:n], dg, A, Pg, fp, fg)
     if has_load:
-        l = V[V_L]
-        for k in range(n):
-            fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
+        load_moments(V, c, s, SX, SY, fp)
 
 
 @njit(cache=True)
-def ladder_solve(V, g, c, s, fp, fg, out):
+def ladder_solve(V, A, Pg, g, c, s, fp, fg, out):
     """q'' = M(q)^-1 [fp; fg] into ``out`` (N), O(n p^2): per rod x_g = P^-1 (f_g - M_gp
     x_p), the Schur complement (``kernels.schur_generators``, with exact kinematics raised
     by g^T P g on the diagonal and by the bending first moment A = a . g in the generators:
-    M_pp[k, j] = l_j (l_k M_k c_kj - A_k s_kj), k > j) solved in generator form."""
+    M_pp[k, j] = l_j (l_k M_k c_kj - A_k s_kj), k > j) solved in generator form. A, Pg from
+    ``bending_sums`` at q."""
     n = c.shape[0]
     P1 = fg.shape[0]
     G = np.zeros((P1, n))
@@ -178,12 +188,12 @@ def ladder_solve(V, g, c, s, fp, fg, out):
     d, a, b, e = schur_generators(V, c, s)
     if V[LV_EXACT, 0] != 0.0:
         for k in range(n):
-            A = _dot(V, P1, BLOCK_A, k, g)
-            d[k] += _quadratic(V, P1, BLOCK_P, k, g, g)
-            a[k, 0] -= A * s[k]
-            a[k, 1] += A * c[k]
-            e[k, 0] -= A * s[k]
-            e[k, 1] += A * c[k]
+            for i in range(P1):
+                d[k] += g[i, k] * Pg[i, k]
+            a[k, 0] -= A[k] * s[k]
+            a[k, 1] += A[k] * c[k]
+            e[k, 0] -= A[k] * s[k]
+            e[k, 1] += A[k] * c[k]
     xp = out[:n]
     _generator_solve(d, a, b, e, r, xp)
     ut = np.zeros(n)
@@ -215,10 +225,12 @@ def ladder_accel(V, y, has_load, SX, SY, damped, out):
     P1 = _shape_count(V)
     c = np.cos(y[:n])
     s = np.sin(y[:n])
+    g = y[n : n * (P1 + 1)].reshape((P1, n))
+    A, Pg = bending_sums(V, g)
     fp = np.empty(n)
     fg = np.empty((P1, n))
-    ladder_forces(V, y, c, s, has_load, SX, SY, damped, fp, fg)
-    ladder_solve(V, y[n : n * (P1 + 1)].reshape((P1, n)), c, s, fp, fg, out)
+    ladder_forces(V, y, c, s, A, Pg, has_load, SX, SY, damped, fp, fg)
+    ladder_solve(V, A, Pg, g, c, s, fp, fg, out)
 
 
 @njit(cache=True)
@@ -229,13 +241,14 @@ def ladder_unit_responses(V, q, locks, U):
     c = np.cos(q[:n])
     s = np.sin(q[:n])
     g = q[n:].reshape((P1, n))
+    A, Pg = bending_sums(V, g)
     fp = np.empty(n)
     fg = np.empty((P1, n))
     for j in range(locks.shape[0]):
         fp[:] = 0.0
         fg[:] = 0.0
         _unit_moment(locks[j], fp, fg[0], fg[1])
-        ladder_solve(V, g, c, s, fp, fg, U[j])
+        ladder_solve(V, A, Pg, g, c, s, fp, fg, U[j])
 
 
 @njit(cache=True)
@@ -283,10 +296,10 @@ def ladder_kinetic(V, y):
     n = V.shape[1]
     P1 = _shape_count(V)
     N = n * (P1 + 1)
-    exact = V[LV_EXACT, 0] != 0.0
     q, v = y[:N], y[N:]
     g = q[n:].reshape((P1, n))
     dg = v[n:].reshape((P1, n))
+    A, Pg = bending_sums(V, g)
     l, ml, mu = V[V_L], V[LV_MASS], V[LV_MU]
     T = 0.0
     Vx = 0.0  # velocity of node k-1
@@ -296,11 +309,11 @@ def ladder_kinetic(V, y):
         s = np.sin(q[k])
         w = v[k]
         Wr = w * 0.5 * ml[k] * l[k] + _dot(V, P1, BLOCK_A, k, dg)  # int m (s phi' + eta')
-        Wi = w * _dot(V, P1, BLOCK_A, k, g) if exact else 0.0  # int m eta phi'
+        Wi = w * A[k]  # int m eta phi'
         J = w * w * ml[k] * l[k] * l[k] / 3.0 + 2.0 * w * _dot(V, P1, BLOCK_B, k, dg)
         J += _quadratic(V, P1, BLOCK_P, k, dg, dg)
-        if exact:
-            J += w * w * _quadratic(V, P1, BLOCK_P, k, g, g)
+        for i in range(P1):
+            J += w * w * g[i, k] * Pg[i, k]  # phi'^2 g^T P g (exact kinematics)
         T += 0.5 * ml[k] * (Vx * Vx + Vy * Vy) + 0.5 * J
         T += Vx * -(s * Wr + c * Wi) + Vy * (c * Wr - s * Wi)
         Vx -= l[k] * w * s
@@ -309,24 +322,28 @@ def ladder_kinetic(V, y):
     return T
 
 
+@njit(cache=True)
+def ladder_damper_power(V, S, y):
+    """The dampers' power (W): the hinges' sum nu (dD/dt)^2 plus every rod's g'^T C g';
+    0 unless S[0] (the damped flag). O(n p^2)."""
+    n = V.shape[1]
+    P1 = _shape_count(V)
+    v = y[y.shape[0] // 2 :]
+    dg = v[n:].reshape((P1, n))
+    power = _damper_power(V, S, v[:n], dg[0], dg[1])  # V_CB = 0: the hinges only
+    if S[0] != 0.0:
+        for k in range(n):
+            power += _quadratic(V, P1, BLOCK_C, k, dg, dg)
+    return power
+
+
 @njit(RHS_SIGNATURE, cache=True)
 def ladder_mechanics(t, y, P, S, M, L, out):
     """(T, P_ext, P_diss) of the ladder into out[:3]: ``ladder_kinetic`` (J), the load power
     (W) and the dampers' power: hinges sum nu (dD/dt)^2 plus the rods' g'^T C g' (W; 0 unless
     S[0], the damped flag). O(n p^2)."""
     n = P.shape[1]
-    P1 = _shape_count(P)
-    N = n * (P1 + 1)
-    phi, v = y[:n], y[N:]
-    dg = v[n:].reshape((P1, n))
+    phi, v = y[:n], y[y.shape[0] // 2 :]
     out[0] = ladder_kinetic(P, y)
     out[1] = _load_power(P, np.cos(phi), np.sin(phi), v[:n], L, t)
-    power = _damper_power(P, S, v[:n], dg[0], dg[1])  # V_CB = 0: the hinges only
-    if S[0] != 0.0:
-        for k in range(n):
-            power += _quadratic(P, P1, BLOCK_C, k, dg, dg)
-    out[2] = power
-
-
-#: The V rows the ladder zeroes (its shape blocks carry the bending): 4 EI/l and 4 c/l.
-ZERO_ROWS = (V_CB,)
+    out[2] = ladder_damper_power(P, S, y)

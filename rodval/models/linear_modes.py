@@ -77,6 +77,7 @@ Each paper model's ``modes`` (``rodval.core.contract.Model.modes``) runs ``modes
 from __future__ import annotations
 
 import numbers
+from functools import partial
 
 import numpy as np
 import scipy.linalg
@@ -411,8 +412,8 @@ def modes_about(
     *,
     about: str,
     count: int | None,
-    coefficients: str,
-    load_at: float | None,
+    coefficients: str = DEFAULT_VARIANT,
+    load_at: float | None = None,
     shapes: int = 1,
     kinematics: str = "first-order",
 ) -> Modes:
@@ -486,32 +487,7 @@ def check_configuration(
     return {"unbalanced_residual_Nm": float(np.max(np.abs(R)))}
 
 
-def _paper_modes(model: str):
-    """The modal analysis of paper model ``model`` in the form ``Model.MODAL_ANALYSIS``
-    names: f(scene, *, about, count, load_at, coefficients) -> Modes (``modes_about``)."""
-
-    def analysis(
-        scene: Scene,
-        *,
-        about: str,
-        count: int | None,
-        load_at: float | None,
-        coefficients: str = DEFAULT_VARIANT,
-        **rung,
-    ) -> Modes:
-        return modes_about(
-            scene,
-            model,
-            about=about,
-            count=count,
-            coefficients=coefficients,
-            load_at=load_at,
-            **rung,
-        )
-
-    return analysis
-
-
-#: ``FullModel.MODAL_ANALYSIS`` and ``ReducedModel.MODAL_ANALYSIS``
-full_modes = _paper_modes(FullModel.name)
-reduced_modes = _paper_modes(ReducedModel.name)
+#: ``FullModel.MODAL_ANALYSIS`` and ``ReducedModel.MODAL_ANALYSIS``: f(scene, *, about, count,
+#: load_at, coefficients, ...) -> Modes, the form ``Model.modes`` calls
+full_modes = partial(modes_about, model=FullModel.name)
+reduced_modes = partial(modes_about, model=ReducedModel.name)
