@@ -219,7 +219,7 @@ def test_bad_callable_load_is_a_model_error(law, words, model):
 def test_absurd_magnitudes_are_refused_with_the_allowed_range(field, value):
     """Issue: m = 1e-300 raised ZeroDivisionError from the full model's set-up; the reduced
     model with kappa = 1e300 ended with a LinAlgError naming no parameter. Chain data are
-    bounded to [1e-12, 1e12] (SI, see rodval.core.scene.MAX_MAGNITUDE)."""
+    bounded to [1e-12, 1e12] (SI, see rodval.core.bounds.MAX_MAGNITUDE)."""
     with pytest.raises(ValueError, match=rf"^{field} \(.*must lie in \[.*1e\+12\].*got"):
         SMALL.chain.with_(**{field: value})
     with pytest.raises(ValueError, match=rf"\[chain\].*{field}|{field} \("):

@@ -19,14 +19,17 @@ Conventions (used throughout rodval)
 
 from __future__ import annotations
 
-import numbers
 from collections.abc import Iterable
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
 
+from rodval.core.bounds import _as_rod_array
 from rodval.core.checks import check_keys, check_number
+from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
+from rodval.core.hinges import Stop as Stop
+from rodval.core.hinges import _check_acting_stops, _check_latches, _hinge_items
 from rodval.core.loads import NodalForce
 from rodval.core.resources import check_rods, check_run_memory
 
@@ -74,71 +77,6 @@ def trajectory_quantities(outputs: Iterable[str]) -> tuple[str, ...]:
     for q in outputs:
         out.extend(("kinetic", "potential", "energy") if q == "energy" else (q,))
     return tuple(out)
-
-
-#: Allowed magnitudes of the chain's data (SI units): |value| <= MAX_MAGNITUDE, and the
-#: strictly positive ones (l, m, EI) >= MIN_POSITIVE. The models form products and quotients
-#: of several parameters (frequencies EI / (m l^4), kappa / (m l^3), inertias m l^3); beyond
-#: these bounds they leave the range where float64 arithmetic means anything and the runs
-#: failed at t = 0 with messages naming no parameter (m = 1e-200: ZeroDivisionError in the
-#: full model; kappa = 1e25 or EI = 1e-15: LinAlgError in the reduced model). No physical rod
-#: chain is near them: 1e12 N m^2 is a rigid limit already (a bridge girder is ~1e11).
-MAX_MAGNITUDE = 1e12
-MIN_POSITIVE = 1e-12
-
-
-def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndarray:
-    """A length-n float array from a scalar or sequence of real numbers; ``positive``: True
-    for > 0, False for >= 0 (both with bounded magnitudes: ``MAX_MAGNITUDE``,
-    ``MIN_POSITIVE``), None for any finite value (angles, initial state)."""
-    items = value if isinstance(value, (list, tuple)) else [value]
-    if any(isinstance(v, (bool, np.bool_, str, bytes, dict, list, tuple)) for v in items):
-        raw = np.asarray(None)  # a boolean, text or nested list among the numbers: refused
-    else:
-        raw = np.asarray(value)
-    if raw.dtype.kind not in "iuf":  # strings, booleans, complex, objects: refused
-        raise ValueError(
-            f"{name} must be a real number or a list of n = {n} real numbers, got {value!r}"
-        )
-    arr = raw.astype(float)
-    if arr.ndim == 0:
-        arr = np.full(n, float(arr))
-    if arr.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have length n = {n}, got shape {arr.shape}")
-    _check_bounds(name, arr, positive)
-    arr.setflags(write=False)
-    return arr
-
-
-def _check_bounds(name: str, arr: np.ndarray, positive: bool | None) -> None:
-    """The bounds of the chain's data on a float array: finite; ``positive`` True: in
-    [MIN_POSITIVE, MAX_MAGNITUDE], False: in [0, MAX_MAGNITUDE], None: any finite value.
-    ValueError naming ``name`` and the allowed range."""
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-    if positive is True and np.any(arr <= 0):
-        raise ValueError(f"{name} must be > 0 (allowed range (0, inf)), got {arr.tolist()}")
-    if positive is False and np.any(arr < 0):
-        raise ValueError(f"{name} must be >= 0 (allowed range [0, inf)), got {arr.tolist()}")
-    lo = MIN_POSITIVE if positive is True else 0.0
-    if positive is not None and np.any(np.abs(arr) > MAX_MAGNITUDE) or np.any(np.abs(arr) < lo):
-        bad = float(arr[(np.abs(arr) > MAX_MAGNITUDE) | (np.abs(arr) < lo)][0])
-        allowed = (
-            f"[{MIN_POSITIVE:g}, {MAX_MAGNITUDE:g}]" if positive else f"[0, {MAX_MAGNITUDE:g}]"
-        )
-        raise ValueError(
-            f"{name} must lie in {allowed} (SI units; beyond that the models' arithmetic "
-            f"overflows or underflows), got {bad:g}"
-        )
-
-
-def _bounded_number(name: str, value: Any, *, positive: bool | None) -> float:
-    """A real number within the chain's bounds (``_check_bounds``); ``name`` with its unit."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name} must be a real number, got {value!r}")
-    v = float(value)
-    _check_bounds(name, np.array([v]), positive)
-    return v
 
 
 #: ``Chain.uniform``'s values where a field is not given (the paper's example, SI units).
@@ -279,98 +217,6 @@ def hinge_angles(phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray) -> np.nda
     return (phi + alpha) - left
 
 
-def _index(name: str, value, n: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ValueError(
-            f"{name} must be an integer hinge index in 0..n-1 = 0..{n - 1}, got {value!r}"
-        )
-    index = int(value)
-    if not 0 <= index < n:
-        raise ValueError(f"{name} must be in 0..n-1 = 0..{n - 1}, got {value}")
-    return index
-
-
-@dataclass(frozen=True)
-class Latch:
-    """A latch on hinge ``hinge`` (0..n-1): the hinge locks when its angle D reaches
-    ``angle`` (rad) moving in ``direction`` (+1: D increasing, -1: decreasing; None: towards
-    the angle from the initial state). At the lock the hinge's relative rate drops to zero
-    (a plastic impact) and D stays at ``angle`` afterwards. ``window`` (s, > 0): the window
-    over which the models measure the lock impulse (None: the first bending period of the
-    locked segment, ``rodval.core.lock_window``)."""
-
-    hinge: int
-    angle: float
-    direction: int | None = None
-    window: float | None = None
-
-    def __post_init__(self) -> None:
-        if (
-            isinstance(self.hinge, bool)
-            or not isinstance(self.hinge, numbers.Integral)
-            or self.hinge < 0
-        ):
-            raise ValueError(f"latch hinge must be an integer >= 0, got {self.hinge!r}")
-        check_number("latch angle", self.angle, finite=True, unit="rad")
-        if self.direction is not None and (
-            isinstance(self.direction, bool)
-            or not isinstance(self.direction, numbers.Integral)
-            or self.direction not in (1, -1)
-        ):
-            raise ValueError(
-                f"latch direction must be the integer +1 or -1, or omitted (None), "
-                f"got {self.direction!r}"
-            )
-        if self.window is not None:
-            check_number("latch window", self.window, low=0.0, low_open=True, finite=True, unit="s")
-
-
-@dataclass(frozen=True)
-class Stop:
-    """A limit stop on hinge ``hinge``: a one-sided spring-damper acting beyond ``angle``
-    (rad) on the ``side`` "upper" (D > angle) or "lower" (D < angle), with moment
-    -stiffness (D - angle) - damping dD/dt there (N m; stiffness > 0 in N m/rad, damping >= 0
-    in N m s/rad)."""
-
-    hinge: int
-    angle: float
-    side: str = "upper"
-    stiffness: float = 1e4
-    damping: float = 0.0
-
-    def __post_init__(self) -> None:
-        if (
-            isinstance(self.hinge, bool)
-            or not isinstance(self.hinge, numbers.Integral)
-            or self.hinge < 0
-        ):
-            raise ValueError(f"stop hinge must be an integer >= 0, got {self.hinge!r}")
-        check_number("stop angle", self.angle, finite=True, unit="rad")
-        if self.side not in ("upper", "lower"):
-            raise ValueError(f"stop side must be 'upper' or 'lower', got {self.side!r}")
-        # an acting stop adds its stiffness to kappa and its damping to nu: the same bounds
-        _bounded_number("stop stiffness (N m/rad)", self.stiffness, positive=True)
-        _bounded_number("stop damping (N m s/rad)", self.damping, positive=False)
-
-
-def _check_acting_stops(chain: Chain, stops: tuple[Stop, ...]) -> None:
-    """An acting stop adds its stiffness to its hinge's kappa and its damping to nu: the sums
-    (all of a hinge's stops acting at once) must stay within the chain's bounds."""
-    for field_name, attr, unit in (
-        ("kappa", "stiffness", "N m/rad"),
-        ("nu", "damping", "N m s/rad"),
-    ):
-        total = getattr(chain, field_name).copy()
-        for st in stops:
-            total[st.hinge] += getattr(st, attr)
-        for st in stops:
-            _check_bounds(
-                f"stop {attr} + {field_name} of hinge {st.hinge} ({unit})",
-                total[st.hinge : st.hinge + 1],
-                positive=False,
-            )
-
-
 #: Output times when a scene gives none, and the most a scene may ask for.
 DEFAULT_NUM_TIMES = 201
 MAX_TIMES = 1_000_000
@@ -443,37 +289,6 @@ def _scene_outputs(outputs: Any) -> tuple[str, ...]:
     if bad or not names:
         raise ValueError(f"outputs must be a non-empty subset of {QUANTITIES}, got {list(names)}")
     return tuple(dict.fromkeys(names))
-
-
-def _hinge_items(label: str, cls: type[Latch] | type[Stop], items: Any, n: int) -> tuple[Any, ...]:
-    """The scene's latches or stops (``label``) as a tuple of ``cls`` on hinges 0..n-1."""
-    if isinstance(items, (str, bytes, dict)) or not isinstance(items, Iterable):
-        raise ValueError(f"{label} must be a sequence of rodval.{cls.__name__}")
-    out: tuple[Any, ...] = tuple(items)
-    for item in out:
-        if not isinstance(item, cls):
-            raise ValueError(
-                f"{label} must be rodval.{cls.__name__} objects, got {type(item).__name__}"
-            )
-        _index(f"{label[:-1] if label == 'stops' else 'latch'} hinge", item.hinge, n)
-    return out
-
-
-def _check_latches(latches: tuple[Latch, ...], D0: np.ndarray) -> None:
-    """At most one latch per hinge, each ahead of its hinge's initial angle D0 (rad) in its
-    direction."""
-    hinges = [latch.hinge for latch in latches]
-    if len(set(hinges)) != len(hinges):
-        raise ValueError(f"at most one latch per hinge, got hinges {hinges}")
-    for latch in latches:
-        d0 = D0[latch.hinge]
-        side = np.sign(latch.angle - d0)
-        if side == 0 or (latch.direction is not None and side != latch.direction):
-            raise ValueError(
-                f"latch on hinge {latch.hinge}: the hinge starts at D = {d0:.6g} rad, at or "
-                f"beyond its latch angle {latch.angle:.6g} rad"
-                + (f" in direction {latch.direction:+d}" if latch.direction else "")
-            )
 
 
 @dataclass(frozen=True, eq=False)
