@@ -12,6 +12,7 @@ import rodval.core.jit_cache  # noqa: F401
 # isort: split
 from rodval.analysis.metrics import discrepancies as compare
 from rodval.analysis.modes import model_modes as modes
+from rodval.core.base import Base
 from rodval.core.contract import Model
 from rodval.core.loads import NodalForce, constant, harmonic, pulse, ramp, tabulated
 from rodval.core.scene import TABLE1_TIMES, Chain, InitialState, Latch, Scene, Stop, paper_scene
@@ -32,6 +33,7 @@ __all__ = [
     "Scene",
     "Latch",
     "Stop",
+    "Base",
     "NodalForce",
     "pulse",
     "constant",

@@ -39,6 +39,7 @@ class Model(ABC):
         never raise for a failed integration (report it in the stats)."""
         settings = IntegratorSettings() if settings is None else settings
         settings.check_horizon(scene.t_end)
+        self.check_base(scene)
         trajectory = self.run(scene, settings)
         trajectory.scene = scene
         stats = trajectory.stats
@@ -49,6 +50,15 @@ class Model(ABC):
     @abstractmethod
     def run(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
         """Run the scene; never raise for a failed integration (report it in the stats)."""
+
+    def check_base(self, scene: Scene) -> None:
+        """ValueError (before any work) unless this model, with its options, has the scene's
+        kind of base (``rodval.core.base``); by default a pinned base only."""
+        if scene.base.free:
+            raise ValueError(
+                f"model {self.name!r} has no free base (base kind 'free'); docs/base.md lists "
+                "the models that do"
+            )
 
     def validity_checks(self, scene: Scene, trajectory: Trajectory) -> list[Check]:
         """The checks of this model's assumptions on a run of ``scene`` (over the output times
@@ -88,6 +98,11 @@ class Model(ABC):
         )
         if cls.MODAL_ANALYSIS is None:
             raise ValueError(f"model {cls.name!r} has no modal analysis")
+        if scene.base.free:
+            raise ValueError(
+                f"model {cls.name!r}: modes of a chain on a free base (the free spacecraft) are "
+                "not built yet (docs/base.md)"
+            )
         module, function = cls.MODAL_ANALYSIS.split(":")
         analysis = getattr(importlib.import_module(module), function)
         return analysis(scene, about=about, count=count, load_at=load_at, **options)

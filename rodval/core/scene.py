@@ -2,7 +2,8 @@
 
 Conventions (used throughout rodval)
 -----------------------------------
-* Rods k = 1..n join node k-1 to node k; node 0 is pinned at the origin. Arrays indexed by rod
+* Rods k = 1..n join node k-1 to node k; node 0 is pinned at the origin, or belongs to a free
+  body (``Scene.base``, ``rodval.core.base``). Arrays indexed by rod
   are 0-based numpy arrays of length n (entry i is rod i+1).
 * ``phi_k`` (rad) is the angle of the chord node k-1 -> node k from the global x axis,
   counter-clockwise positive. ``alpha_k``, ``beta_k`` (rad) are the angles from that chord to
@@ -25,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from rodval.core.base import PINNED, Base
 from rodval.core.bounds import _as_rod_array
 from rodval.core.checks import check_keys, check_number
 from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
@@ -37,7 +39,11 @@ from rodval.core.resources import check_rods, check_run_memory
 #: kinetic, potential and total energy (k = 0); "angular_momentum" (N m s, counter-clockwise
 #: positive) has k = 0: H about the root node, sum int (r - r_0) x v dm over rods and point
 #: masses, and k = 1: H about the chain's centre of mass, H_0 - (S x P) / M (S first mass
-#: moment about the root, P linear momentum, M total mass); docs/quantities.md.
+#: moment about the root, P linear momentum, M total mass); with a free base (``Base``) k = 1
+#: is about the whole system's centre of mass, body included. "momentum" (N s): the whole
+#: system's linear momentum (k = 0, 1: x, y). "base" (a free base only) yields the body's
+#: base_position, base_velocity (k = 0, 1: x, y), base_attitude and base_rate (k = 0);
+#: docs/quantities.md.
 QUANTITIES = (
     "phi",
     "dphi",
@@ -49,7 +55,14 @@ QUANTITIES = (
     "hinge_angle",
     "hinge_moment",
     "angular_momentum",
+    "momentum",
+    "base",
 )
+#: What the quantities "energy" and "base" yield in a trajectory.
+EXPANDS = {
+    "energy": ("kinetic", "potential", "energy"),
+    "base": ("base_position", "base_velocity", "base_attitude", "base_rate"),
+}
 #: Units of every trajectory quantity (the energy audit adds work, dissipated, residual).
 UNITS = {
     "phi": "rad",
@@ -67,15 +80,20 @@ UNITS = {
     "hinge_angle": "rad",
     "hinge_moment": "N m",
     "angular_momentum": "N m s",
+    "momentum": "N s",
+    "base_position": "m",
+    "base_velocity": "m/s",
+    "base_attitude": "rad",
+    "base_rate": "rad/s",
 }
 
 
 def trajectory_quantities(outputs: Iterable[str]) -> tuple[str, ...]:
-    """The trajectory quantities a scene's ``outputs`` produce: "energy" yields kinetic,
-    potential and energy (J, k = 0); the others themselves."""
+    """The trajectory quantities a scene's ``outputs`` produce: "energy" and "base" yield
+    their parts (``EXPANDS``); the others themselves."""
     out: list[str] = []
     for q in outputs:
-        out.extend(("kinetic", "potential", "energy") if q == "energy" else (q,))
+        out.extend(EXPANDS.get(q, (q,)))
     return tuple(out)
 
 
@@ -209,11 +227,16 @@ class InitialState:
         return out
 
 
-def hinge_angles(phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
+def hinge_angles(
+    phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, attitude: Any = None
+) -> np.ndarray:
     """Hinge angles D_k (rad), k = 0..n-1: D_k = (phi_{k+1} + alpha_{k+1}) - (phi_k + beta_k),
-    phi_0 = beta_0 = 0 (hinge 0 measures rod 1's root tangent from the x axis). Arrays may
-    carry leading axes (..., n)."""
+    phi_0 + beta_0 = the base's attitude theta (hinge 0 measures rod 1's root tangent from
+    the body frame; ``attitude`` None: a pinned base, theta = 0). Arrays may carry leading
+    axes (..., n); ``attitude`` (...) those axes. Of rates, the hinge rates."""
     left = np.concatenate([np.zeros(phi.shape[:-1] + (1,)), (phi + beta)[..., :-1]], axis=-1)
+    if attitude is not None:
+        left[..., 0] = attitude
     return (phi + alpha) - left
 
 
@@ -310,6 +333,8 @@ class Scene:
         Hinges that lock at an angle (at most one latch per hinge).
     stops : sequence of Stop
         One-sided limit stops in the hinges.
+    base : Base
+        The body node 0 belongs to: pinned at the origin (default) or a free rigid body.
     name : str
     """
 
@@ -324,6 +349,7 @@ class Scene:
     name: str = "scene"
     latches: tuple[Latch, ...] = ()
     stops: tuple[Stop, ...] = ()
+    base: Base = PINNED
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -353,20 +379,25 @@ class Scene:
         )
         if not isinstance(self.initial, InitialState):
             raise ValueError("initial must be a rodval.InitialState")
-        init = self.initial.resolve(n)  # validate now, before any work
+        self.initial.resolve(n)  # validate now, before any work
         object.__setattr__(self, "latches", _hinge_items("latches", Latch, self.latches, n))
         object.__setattr__(self, "stops", _hinge_items("stops", Stop, self.stops, n))
         _check_acting_stops(self.chain, self.stops)
-        _check_latches(self.latches, hinge_angles(init["phi"], init["alpha"], init["beta"]))
+        if not isinstance(self.base, Base):
+            raise ValueError(f"base must be a rodval.Base, got {type(self.base).__name__}")
+        if not self.base.free and self.wants("base"):
+            raise ValueError("output 'base' needs a free base (Base(kind='free', ...))")
+        _check_latches(self.latches, self.initial_hinge_angles())
 
     @property
     def n(self) -> int:
         return self.chain.n
 
     def initial_hinge_angles(self) -> np.ndarray:
-        """D_k at t = 0 (rad), k = 0..n-1."""
+        """D_k at t = 0 (rad), k = 0..n-1 (hinge 0 from the base's attitude)."""
         init = self.initial.resolve(self.n)
-        return hinge_angles(init["phi"], init["alpha"], init["beta"])
+        attitude = self.base.attitude if self.base.free else None
+        return hinge_angles(init["phi"], init["alpha"], init["beta"], attitude)
 
     @property
     def breakpoints(self) -> np.ndarray:

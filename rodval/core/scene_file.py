@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from rodval.core.base import PINNED, Base
 from rodval.core.checks import check_keys
 from rodval.core.loads import LOAD_FACTORIES
 from rodval.core.profiles import resolve_profiles
@@ -129,8 +130,13 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
     """
     check_keys(d, TOP_KEYS, where)
     base = d.get("base", "paper")
-    if base not in BASES:
-        raise ValueError(f"{where} key 'base': must be one of {BASES}, got {base!r}")
+    body = PINNED
+    if isinstance(base, dict):  # a [base] table: the body node 0 belongs to, on the paper's scene
+        body = Base.from_dict(base, f"{where} [base]")
+    elif base not in BASES:
+        raise ValueError(
+            f"{where} key 'base': must be one of {BASES} or a [base] table, got {base!r}"
+        )
     try:
         n = d.get("n", 8)
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
@@ -172,6 +178,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
             outputs=tuple(outputs),
             initial=InitialState(**init_spec),
             name=d.get("name", scene.name),
+            base=body,
         )
     except ValueError as exc:
         msg = str(exc)
@@ -249,6 +256,8 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "initial": {k: v.tolist() for k, v in init.items()},
         "latches": [dataclasses.asdict(latch) for latch in scene.latches],
         "stops": [dataclasses.asdict(stop) for stop in scene.stops],
+        # a free body only: a pinned scene's dict (and every record made of it) is unchanged
+        **({"base": scene.base.as_dict()} if scene.base.free else {}),
     }
 
 

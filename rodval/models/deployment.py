@@ -60,11 +60,14 @@ def _unit_moment(k, fp, fa, fb):
 
 
 @njit(cache=True)
-def _hinge_of(v, k, n):
-    """a_k . v for v = [phi; alpha; beta]-shaped (3n)."""
+def _hinge_of(v, k, n, theta=-1):
+    """a_k . v for v = [phi; alpha; beta]-shaped (3n); ``theta`` >= 0: the index of a free
+    base's attitude in v, which hinge 0 is measured from (``free_base``)."""
     r = v[k] + v[n + k]
     if k > 0:
         r -= v[k - 1] + v[2 * n + k - 1]
+    elif theta >= 0:
+        r -= v[theta]
     return r
 
 
@@ -132,18 +135,18 @@ def full_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
 
 
 @njit(cache=True)
-def superpose(out, U, locks, n, lam):
+def superpose(out, U, locks, n, lam, theta=-1):
     """q'' = u_0 + sum_j lambda_j u_j with the hinges ``locks`` held: ``out`` holds the free
     accelerations u_0 on entry, U[j] = M^-1 a_{locks[j]}; the capacitance system
     (A_L U) lambda = -A_L u_0 (m x m) gives the multipliers (N m) into ``lam``. O(N m + m^3)
-    for N coordinates ordered [phi; alpha; beta; ...]."""
+    for N coordinates ordered [phi; alpha; beta; ...] (``theta``: see ``_hinge_of``)."""
     m = locks.shape[0]
     G = np.empty((m, m))
     r = np.empty(m)
     for i in range(m):
-        r[i] = -_hinge_of(out, locks[i], n)
+        r[i] = -_hinge_of(out, locks[i], n, theta)
         for j in range(m):
-            G[i, j] = _hinge_of(U[j], locks[i], n)
+            G[i, j] = _hinge_of(U[j], locks[i], n, theta)
     x = small_solve(G, r)
     for j in range(m):
         lam[j] = x[j]

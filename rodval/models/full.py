@@ -201,7 +201,30 @@ class FullModel(PaperModel):
     def options(self):
         return {**super().options(), "shapes": self.shapes, "kinematics": self.kinematics}
 
+    def check_base(self, scene: Scene) -> None:
+        """A free base runs on the paper's rung with the printed coefficients and the compiled
+        kernel (``free_base``); other options are refused for it, naming the option."""
+        if not scene.base.free:
+            return
+        for option, value, needed in (
+            ("shapes", self.shapes, PAPER_RUNG[0]),
+            ("kinematics", self.kinematics, PAPER_RUNG[1]),
+            ("coefficients", self.coefficients, "printed"),
+            ("kernel", self.kernel, "numba"),
+        ):
+            if value != needed:
+                raise ValueError(
+                    f"full model on a free base (base kind 'free'): {option} must be "
+                    f"{needed!r} (the free base is built on the paper's rung, docs/base.md), "
+                    f"got {value!r}"
+                )
+
     def system(self, scene: Scene) -> PaperSystem:
+        if scene.base.free:
+            self.check_base(scene)
+            from rodval.models.free_base_system import FreeBaseSystem
+
+            return FreeBaseSystem(scene)
         if (self.shapes, self.kinematics) == PAPER_RUNG:
             return FullSystem(scene, self.coefficients, self.kernel)
         return LadderSystem(scene, self.coefficients, self.kernel, self.shapes, self.kinematics)

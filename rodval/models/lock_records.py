@@ -48,8 +48,9 @@ def outboard_momentum(
     chain = system.base_chain
     p, h, _ = system.rod_momenta_at(y)
     x, yy = node_positions(chain.l, phi)
-    r = np.stack([x, yy], axis=-1)
-    v_k = node_velocities(chain.l, phi, v[: system.n])[k - 1] if k > 0 else np.zeros(2)
+    r0, v0 = system.root_motion(y)  # node 0 (zero on a pinned base)
+    r = np.stack([x, yy], axis=-1) + r0
+    v_k = v0 + (node_velocities(chain.l, phi, v[: system.n])[k - 1] if k > 0 else 0.0)
     p_out = p[k:].sum(axis=0)
     return float(h[k:].sum()) - _cross(r[k], p_out), p_out, r, v_k
 
@@ -97,7 +98,12 @@ def lock_record(
     angles = np.array([latches[j].angle for j in locked])
     phi, dphi = (a[0] for a in system.rigid(y[None, :]))
     k = latches[new[0]].hinge
-    rigid = rigid_lock(system.base_chain, phi, dphi, hinges.tolist(), int(hinges[-len(new)]))
+    # the rigid-panel yardstick is a pinned chain's: none on a free base (docs/base.md)
+    rigid = (
+        {}
+        if system.scene.base.free
+        else rigid_lock(system.base_chain, phi, dphi, hinges.tolist(), int(hinges[-len(new)]))
+    )
     T0, hinge0, bending0 = energy_parts(system, t, y)
     P0 = system.momenta(y)
     H0 = outboard_momentum(system, y, k)[0]

@@ -53,6 +53,19 @@ class PaperEnergy:
         it at state y."""
         raise NotImplementedError
 
+    def attitude(self, Y: np.ndarray) -> np.ndarray | None:
+        """The base's attitude theta (rad, (nt,)) from a state history, hinge 0's reference;
+        None on a pinned base (theta = 0)."""
+        return None
+
+    def attitude_rate(self, Y: np.ndarray) -> np.ndarray | None:
+        """theta' (rad/s, (nt,)) from a history; None on a pinned base."""
+        return None
+
+    def root_motion(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(r_0 (m), v_0 (m/s)) of node 0 at one state: zero on a pinned base."""
+        return np.zeros(2), np.zeros(2)
+
     def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
         """1/2 v^T M(phi) v with the kinematic mass matrix: the compiled O(n) form, or the
         dense one with the numpy kernel (the reference)."""
@@ -81,12 +94,13 @@ class PaperEnergy:
         kin = np.array([self._kinetic(p, vi) for p, vi in zip(phi, v)])
         return kin, self.potential(phi, alpha, beta)
 
-    def potential(self, phi, alpha, beta) -> np.ndarray:
+    def potential(self, phi, alpha, beta, attitude=None) -> np.ndarray:
         """Pi (J) per row: the scene chain's springs and bending, plus 1/2 k (D - angle)^2 of
-        every limit stop acting in the current mode."""
-        pot = potential_energy(self.base_chain, phi, alpha, beta)
+        every limit stop acting in the current mode; ``attitude``: a free base's theta (rad)
+        per row, hinge 0's reference (``rodval.core.scene.hinge_angles``)."""
+        pot = potential_energy(self.base_chain, phi, alpha, beta, attitude)
         if any(self.stop_active):
-            D = hinge_angles(phi, alpha, beta)
+            D = hinge_angles(phi, alpha, beta, attitude)
             for st, on in zip(self.stops, self.stop_active):
                 if on:
                     pot = pot + 0.5 * st.stiffness * (D[..., st.hinge] - st.angle) ** 2
@@ -114,6 +128,11 @@ class PaperEnergy:
         far nodes), k = 0..n-1; row 0 is the whole chain's."""
         p = self.rod_momenta_at(y)[0]
         return np.cumsum(p[::-1], axis=0)[::-1]
+
+    def momentum_rows(self, Y: np.ndarray) -> np.ndarray:
+        """The chain's linear momentum P = sum_k p_k (N s, (nt, 2)) per state of a history, in
+        the model's velocity field (``rod_momenta_at``)."""
+        return np.array([self.rod_momenta_at(y)[0].sum(axis=0) for y in Y])
 
     def angular_momentum_rows(self, times: np.ndarray, Y: np.ndarray) -> np.ndarray:
         """The ``angular_momentum`` rows (nt, 2) (``paper_matrices.angular_momentum``)."""

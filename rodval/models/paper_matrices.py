@@ -215,15 +215,18 @@ def rest_forces(chain: Chain) -> np.ndarray:
 
 
 def potential_energy(
-    chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray
+    chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, attitude=None
 ) -> np.ndarray:
     """Pi = hinge_energy + bending_energy (J), per row of (..., n) arrays, O(n)."""
-    return hinge_energy(chain, phi, alpha, beta) + bending_energy(chain, alpha, beta)
+    return hinge_energy(chain, phi, alpha, beta, attitude) + bending_energy(chain, alpha, beta)
 
 
-def hinge_energy(chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    """1/2 sum_k kappa_k (D_k - rest_k)^2 (J): the hinge springs, per row, O(n)."""
-    D = hinge_angles(phi, alpha, beta) - chain.rest_angle
+def hinge_energy(
+    chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, attitude=None
+) -> np.ndarray:
+    """1/2 sum_k kappa_k (D_k - rest_k)^2 (J): the hinge springs, per row, O(n); ``attitude``
+    a free base's theta (rad), hinge 0's reference (``hinge_angles``)."""
+    D = hinge_angles(phi, alpha, beta, attitude) - chain.rest_angle
     return 0.5 * np.sum(chain.kappa * D * D, axis=-1)
 
 
@@ -255,10 +258,13 @@ def quasi_static_bending(chain: Chain, phi: np.ndarray) -> np.ndarray:
     return np.concatenate([x[0::2], x[1::2]])
 
 
-def damper_power(chain: Chain, dphi: np.ndarray, dalpha: np.ndarray, dbeta: np.ndarray) -> float:
+def damper_power(
+    chain: Chain, dphi: np.ndarray, dalpha: np.ndarray, dbeta: np.ndarray, attitude_rate=None
+) -> float:
     """P_diss = q'^T C q' = sum_k nu_k (dD_k/dt)^2 + sum_k (4 c_k/l_k)(a'^2 + a' b' + b'^2)
-    >= 0 (W; c = bending_damping, a', b' the bending rates alpha'_k, beta'_k), O(n)."""
-    rates = hinge_angles(dphi, dalpha, dbeta)
+    >= 0 (W; c = bending_damping, a', b' the bending rates alpha'_k, beta'_k; hinge 0's rate
+    from a free base's ``attitude_rate``, rad/s), O(n)."""
+    rates = hinge_angles(dphi, dalpha, dbeta, attitude_rate)
     cb = 4.0 * chain.bending_damping / chain.l
     bending = cb * (dalpha * dalpha + dalpha * dbeta + dbeta * dbeta)
     return float(np.sum(chain.nu * rates * rates) + np.sum(bending))

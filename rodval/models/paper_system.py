@@ -220,6 +220,9 @@ class PaperSystem(PaperEnergy, OdeSystem):
         phi, dphi = (a[0] for a in self.rigid(y[None, :]))
         Q = self.generalized_force(t, phi)
         p_ext = 0.0 if Q is None else float(Q @ dphi)
+        if Q is not None and self.scene.base.free:  # the loads' resultant on node 0's motion
+            SX, SY = self.loads.suffix_sums(t)
+            p_ext += float(SX[0] * self.root_motion(y)[1][0] + SY[0] * self.root_motion(y)[1][1])
         with self._mode_at(t):
             return p_ext, self.damper_power_at(y) if self.damped else 0.0
 
@@ -227,7 +230,9 @@ class PaperSystem(PaperEnergy, OdeSystem):
         """q'^T C q' (W) at one state in the current mode (``paper_matrices.damper_power``)."""
         n = self.n
         v = self.generalized_rates(y)
-        return damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
+        rate = self.attitude_rate(y[None, :])
+        theta = None if rate is None else rate[0]
+        return damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n : 3 * n], theta)
 
     def observe(self, times, Y):
         """The scene's quantities; each output time is observed in the mode (active stops,
@@ -271,7 +276,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
             if scene.wants("y"):
                 out["y"] = (y, nodes)
         if scene.wants("hinge_angle", "hinge_moment"):
-            D = hinge_angles(phi, alpha, beta)
+            D = hinge_angles(phi, alpha, beta, self.attitude(Y))
             hinges = np.arange(n)
             if scene.wants("hinge_angle"):
                 out["hinge_angle"] = (D, hinges)
@@ -285,6 +290,8 @@ class PaperSystem(PaperEnergy, OdeSystem):
             out["energy"] = ((kin + pot)[:, None], zero)
         if scene.wants("angular_momentum"):
             out["angular_momentum"] = (self.angular_momentum_rows(times, Y), np.arange(2))
+        if scene.wants("momentum"):
+            out["momentum"] = (self.momentum_rows(Y), np.arange(2))
         return out
 
     # ----------------------------------------------------------------- deployment: modes
@@ -367,7 +374,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
         Y = y[None, :]
         phi = self.rigid(Y)[0]
         alpha, beta = self.bending(np.array([t]), Y)[:2]
-        return hinge_angles(phi, alpha, beta)[0]
+        return hinge_angles(phi, alpha, beta, self.attitude(Y))[0]
 
     def _hinge_crossing(self, hinge: int, angle: float) -> Callable[[float, np.ndarray], float]:
         """The event function g(t, y) = D_hinge - angle (rad) of a latch or stop."""
@@ -382,7 +389,10 @@ class PaperSystem(PaperEnergy, OdeSystem):
         rates being dropped)."""
         n = self.n
         v = self.generalized_rates(y)
-        return hinge_angles(v[:n], v[n : 2 * n], v[2 * n : 3 * n])
+        rate = self.attitude_rate(y[None, :])
+        return hinge_angles(
+            v[:n], v[n : 2 * n], v[2 * n : 3 * n], None if rate is None else rate[0]
+        )
 
     def hinge_moments(self, times, Y, D) -> np.ndarray:
         """Hinge moments (N m, (nt, n)), positive when resisting an increase of D: spring

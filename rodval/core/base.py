@@ -1,0 +1,121 @@
+"""The body the chain hangs from (``Scene.base``): a fixed pin (``"pinned"``, the default) or
+a free-floating rigid body (``"free"``: a spacecraft), docs/base.md.
+
+Conventions (with ``rodval.core.scene``'s): the body's centre of mass is at ``position`` (m,
+global frame), its attitude theta (rad) is the angle of its body frame from the global x
+axis, counter-clockwise positive; node 0 (hinge 0, the root of rod 1) sits at
+``hinge_offset`` in the body frame, r_0 = position + R(theta) hinge_offset. Hinge 0's angle
+is measured from the body frame: D_0 = phi_1 + alpha_1 - theta (theta = 0 for a pin), so its
+spring, damper, rest angle, stops and latch act between the body and rod 1. ``inertia``
+(kg m^2) is about the body's centre of mass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from rodval.core.bounds import _check_bounds
+from rodval.core.checks import check_choice, check_keys, check_number
+
+#: The kinds of base: a fixed pin at the origin, or a free rigid body.
+BASE_KINDS = ("pinned", "free")
+#: Fields that describe a free body (a pinned base takes none of them).
+BODY_FIELDS = ("mass", "inertia", "hinge_offset", "position", "velocity", "attitude", "rate")
+
+
+def _vector(name: str, value: Any, unit: str) -> tuple[float, float]:
+    """A 2-vector of finite real numbers (ValueError naming ``name`` otherwise)."""
+    if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__len__") or len(value) != 2:
+        raise ValueError(
+            f"base {name} must be a pair [x, y] of real numbers ({unit}), got {value!r}"
+        )
+    x, y = (check_number(f"base {name} ({unit})", v, finite=True) for v in value)
+    _check_bounds(f"base {name} ({unit})", np.array([x, y]), None)
+    return (x, y)
+
+
+@dataclass(frozen=True)
+class Base:
+    """The body node 0 belongs to. ``kind``: "pinned" (node 0 fixed at the origin, no body
+    coordinates: every model's equations as without a base) or "free" (a rigid body of
+    ``mass`` (kg) and ``inertia`` (kg m^2, about its centre of mass), free in the plane:
+    three more coordinates x, y (m) of its centre and theta (rad), with initial ``position``
+    (m), ``velocity`` (m/s), ``attitude`` (rad) and ``rate`` (rad/s); node 0 at
+    ``hinge_offset`` (m, body frame)). A pinned base refuses every body field."""
+
+    kind: str = "pinned"
+    mass: float | None = None
+    inertia: float | None = None
+    hinge_offset: tuple[float, float] = (0.0, 0.0)
+    position: tuple[float, float] = (0.0, 0.0)
+    velocity: tuple[float, float] = (0.0, 0.0)
+    attitude: float = 0.0
+    rate: float = 0.0
+
+    def __post_init__(self) -> None:
+        check_choice("base kind", self.kind, BASE_KINDS)
+        set_ = object.__setattr__
+        if self.kind == "pinned":
+            given = [f.name for f in fields(self) if f.name != "kind" and self._given(f.name)]
+            if given:
+                raise ValueError(
+                    f"base {given[0]} describes a free body; a pinned base (kind 'pinned', "
+                    "node 0 fixed at the origin) takes none of " + ", ".join(BODY_FIELDS)
+                )
+            return
+        for name in ("mass", "inertia"):
+            value = getattr(self, name)
+            if value is None:
+                raise ValueError(f"a free base needs its {name} (base.{name})")
+            unit = "kg" if name == "mass" else "kg m^2"
+            v = check_number(f"base {name} ({unit})", value, low=0.0, low_open=True, finite=True)
+            _check_bounds(f"base {name} ({unit})", np.array([v]), True)
+            set_(self, name, v)
+        for name, unit in (("hinge_offset", "m"), ("position", "m"), ("velocity", "m/s")):
+            set_(self, name, _vector(name, getattr(self, name), unit))
+        for name, unit in (("attitude", "rad"), ("rate", "rad/s")):
+            v = check_number(f"base {name} ({unit})", getattr(self, name), finite=True)
+            _check_bounds(f"base {name} ({unit})", np.array([v]), None)
+            set_(self, name, v)
+
+    def _given(self, name: str) -> bool:
+        default = next(f.default for f in fields(self) if f.name == name)
+        return getattr(self, name) != default
+
+    @property
+    def free(self) -> bool:
+        return self.kind == "free"
+
+    @property
+    def root(self) -> np.ndarray:
+        """Node 0's initial position (m, (2,)): position + R(attitude) hinge_offset."""
+        return np.asarray(self.position) + rotate(self.attitude, np.asarray(self.hinge_offset))
+
+    @classmethod
+    def from_dict(cls, d: Any, where: str = "[base]") -> Base:
+        """A Base from a scene file's ``[base]`` table (unknown keys refused)."""
+        check_keys(d, ("kind", *BODY_FIELDS), where)
+        try:
+            return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+        except ValueError as exc:
+            raise ValueError(f"{where}: {exc}") from None
+
+    def as_dict(self) -> dict[str, Any]:
+        """The scene-file form (``from_dict`` rebuilds the same base)."""
+        return {
+            f.name: list(v) if isinstance(v := getattr(self, f.name), tuple) else v
+            for f in fields(self)
+        }
+
+
+def rotate(theta: Any, v: np.ndarray) -> np.ndarray:
+    """R(theta) v for body-frame vectors v (..., 2) (m), counter-clockwise theta (rad)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
+
+
+#: The default base: node 0 pinned at the origin.
+PINNED = Base()

@@ -1,0 +1,334 @@
+"""Compiled kernels of the full model on a free base (a rigid body node 0 belongs to; docs/base.md).
+
+Coordinates Q = [phi; alpha; beta; x_c, y_c, theta] (3n + 3): the chain's, then the body's
+centre of mass (m) and attitude (rad); state y = [Q; Q'].
+
+Kinetic energy, with r_0 = r_c + R(theta) h (node 0, h = hinge_offset) and rho = R(theta) h,
+v_0 = v_c + theta' rho_perp (rho_perp = k x rho = (-rho_y, rho_x)):
+T = 1/2 m_b |v_c|^2 + 1/2 J theta'^2 + 1/2 M_ch |v_0|^2 + v_0 . S' + T_chain(q, q'), with S the
+chain's first mass moment about node 0, S = sum_k [l_k M_k e_k + w_k (alpha_k - beta_k) n_k]
+(M_k = ``outer_mass``, w_k = m_k l_k^2 / 12 = int m sigma ds; e_k, n_k the chord's unit
+vectors), J_S = dS/dq, and T_chain the pinned chain's kinetic energy. Lagrange's equations:
+
+* chain: M_c q'' + J_S^T a_0 = f_c (the pinned chain's forces, hinge 0 measured from the body:
+  D_0 = phi_1 + alpha_1 - theta), a_0 = a_c + theta'' rho_perp - theta'^2 rho;
+* translation: M_ch a_0 + S'' + m_b a_c = F (the loads' resultant), S'' = J_S q'' + s_2(q, q');
+* attitude: J theta'' + rho_perp . (M_ch a_0 + S'') = T_0 + rho_perp . F, T_0 the moment of
+  hinge 0 (spring, damper, acting stops) on the body.
+
+The translation equation is d P / dt = F for P = m_b v_c + M_ch v_0 + S', whatever the chain's
+kinematics: the linear momentum is kept exactly. The total mass matrix is bordered,
+[[M_c, J_S^T E], [E^T J_S, D]] with E = [I_2, rho_perp]; it is solved by eliminating the chain
+(``_full_solve``, O(n)): q'' = u - G E x_b with u = M_c^-1 r_c, G = M_c^-1 J_S^T (two more
+O(n) solves) and the 3 x 3 Schur complement D - E^T (J_S G) E for the body's x_b. O(n) per
+evaluation, three chain solves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from rodval.core.loads import load_sums
+from rodval.models.deployment import _locks, _unit_moment, small_solve, superpose
+from rodval.models.kernels import (
+    V_KAPPA,
+    V_L,
+    V_NU,
+    V_OUTER,
+    V_REST,
+    V_W,
+    _full_forces,
+    _full_solve,
+    full_mechanics,
+    rhs_head,
+)
+from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE
+
+# Rows of V after the full model's (``kernels.full_constants``, rows 0..18), each the same
+# value in every column: the body's mass (kg), inertia (kg m^2), hinge offset (m, body frame)
+# and the chain's mass (kg).
+V_BM, V_BJ, V_HX, V_HY, V_MCH = range(19, 24)
+
+
+@njit(cache=True)
+def _rho(V, th):
+    """rho = R(theta) h (m): node 0 from the body's centre of mass."""
+    c, s = np.cos(th), np.sin(th)
+    hx, hy = V[V_HX, 0], V[V_HY, 0]
+    return c * hx - s * hy, s * hx + c * hy
+
+
+@njit(cache=True)
+def _field_forces(V, c, s, delta, gx, gy, fp, fa, fb):
+    """[fp; fa; fb] += J_S^T g (N m for g in m/s^2: the generalized force of a uniform field), O(n):
+    dS/dphi_k = l_k M_k n_k - w_k delta_k e_k, dS/dalpha_k = w_k n_k = -dS/dbeta_k, delta =
+    alpha - beta."""
+    l, outer, w = V[V_L], V[V_OUTER], V[V_W]
+    for k in range(c.shape[0]):
+        ng = c[k] * gy - s[k] * gx
+        eg = c[k] * gx + s[k] * gy
+        fp[k] += l[k] * outer[k] * ng - w[k] * delta[k] * eg
+        fa[k] += w[k] * ng
+        fb[k] -= w[k] * ng
+
+
+@njit(cache=True)
+def _first_moment_rate(V, c, s, delta, xp, xa, xb):
+    """J_S x (kg m/s for rates x): the first moment's rate along x = [xp; xa; xb], O(n)."""
+    l, outer, w = V[V_L], V[V_OUTER], V[V_W]
+    sx = 0.0
+    sy = 0.0
+    for k in range(c.shape[0]):
+        a = l[k] * outer[k] * xp[k] + w[k] * (xa[k] - xb[k])  # along n_k
+        b = -w[k] * delta[k] * xp[k]  # along e_k
+        sx += b * c[k] - a * s[k]
+        sy += b * s[k] + a * c[k]
+    return sx, sy
+
+
+@njit(cache=True)
+def _first_moment_quadratic(V, c, s, delta, ddelta, dphi):
+    """s_2 = S'' - J_S q'' (kg m/s^2): -l M phi'^2 e - 2 w delta' phi' e - w delta phi'^2 n
+    summed over the rods, O(n)."""
+    l, outer, w = V[V_L], V[V_OUTER], V[V_W]
+    sx = 0.0
+    sy = 0.0
+    for k in range(c.shape[0]):
+        w2 = dphi[k] * dphi[k]
+        ec = -l[k] * outer[k] * w2 - 2.0 * w[k] * ddelta[k] * dphi[k]
+        nc = -w[k] * delta[k] * w2
+        sx += ec * c[k] - nc * s[k]
+        sy += ec * s[k] + nc * c[k]
+    return sx, sy
+
+
+@njit(cache=True)
+def field_responses(V, c, s, delta, G):
+    """G[j] = M_c^-1 J_S^T e_j (j = x, y; 3n each) and K = J_S G (2 x 2, kg); O(n)."""
+    n = c.shape[0]
+    fp = np.empty(n)
+    fa = np.empty(n)
+    fb = np.empty(n)
+    K = np.empty((2, 2))
+    for j in range(2):
+        fp[:] = 0.0
+        fa[:] = 0.0
+        fb[:] = 0.0
+        _field_forces(V, c, s, delta, 1.0 - j, float(j), fp, fa, fb)
+        _full_solve(V, c, s, fp, fa, fb, G[j])
+        kx, ky = _first_moment_rate(V, c, s, delta, G[j, :n], G[j, n : 2 * n], G[j, 2 * n :])
+        K[0, j] = kx
+        K[1, j] = ky
+    return K
+
+
+@njit(cache=True)
+def base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out):
+    """x = M_tot^-1 [fp; fa; fb; rb] (the bordered total mass matrix, module docstring) into
+    ``out`` (3n + 3): q'' then (a_c (m/s^2), theta'' (rad/s^2)). O(n)."""
+    n = c.shape[0]
+    u = out[: 3 * n]
+    _full_solve(V, c, s, fp, fa, fb, u)
+    jx, jy = _first_moment_rate(V, c, s, delta, u[:n], u[n : 2 * n], u[2 * n :])
+    rx, ry = _rho(V, th)
+    px, py = -ry, rx  # rho_perp
+    mch, mt = V[V_MCH, 0], V[V_MCH, 0] + V[V_BM, 0]
+    E = np.array([[1.0, 0.0, px], [0.0, 1.0, py]])
+    Sig = np.empty((3, 3))  # D - E^T K E, by loops (no BLAS call: the same digits everywhere)
+    for a in range(3):
+        for b in range(3):
+            acc = 0.0
+            for i in range(2):
+                for j in range(2):
+                    acc += E[i, a] * K[i, j] * E[j, b]
+            Sig[a, b] = -acc
+    Sig[0, 0] += mt
+    Sig[1, 1] += mt
+    Sig[0, 2] += mch * px
+    Sig[2, 0] += mch * px
+    Sig[1, 2] += mch * py
+    Sig[2, 1] += mch * py
+    Sig[2, 2] += V[V_BJ, 0] + mch * (rx * rx + ry * ry)
+    r = np.array([rb[0] - jx, rb[1] - jy, rb[2] - px * jx - py * jy])
+    xb = small_solve(Sig, r)
+    g0 = xb[0] + xb[2] * px
+    g1 = xb[1] + xb[2] * py
+    for i in range(3 * n):
+        u[i] -= g0 * G[0, i] + g1 * G[1, i]
+    out[3 * n : 3 * n + 3] = xb
+
+
+@njit(cache=True)
+def _chain_state(y, n):
+    """[q; q'] of the chain (6n) from the free-base state [Q; Q'] (2 (3n + 3))."""
+    N = 3 * n + 3
+    yc = np.empty(6 * n)
+    yc[: 3 * n] = y[: 3 * n]
+    yc[3 * n :] = y[N : N + 3 * n]
+    return yc
+
+
+@njit(cache=True)
+def hinge0_moment(V, y, damped):
+    """T_0 (N m): hinge 0's moment on the body, kappa_0 (D_0 - rest_0) + nu_0 dD_0/dt with
+    D_0 = phi_1 + alpha_1 - theta (acting stops are in V's kappa, nu, rest)."""
+    n = V.shape[1]
+    N = 3 * n + 3
+    D = y[0] + y[n] - y[3 * n + 2]
+    T = V[V_KAPPA, 0] * (D - V[V_REST, 0])
+    if damped:
+        T += V[V_NU, 0] * (y[N] + y[N + n] - y[N + 3 * n + 2])
+    return T
+
+
+@njit(cache=True)
+def base_accel(V, y, has_load, SX, SY, damped, out):
+    """Q'' (3n + 3) of the full model on a free base at y = [Q; Q'] into ``out`` (module
+    docstring); SX, SY the load suffix sums (N). O(n): three chain solves."""
+    n = V.shape[1]
+    N = 3 * n + 3
+    phi = y[:n]
+    c = np.cos(phi)
+    s = np.sin(phi)
+    delta = y[n : 2 * n] - y[2 * n : 3 * n]
+    ddelta = y[N + n : N + 2 * n] - y[N + 2 * n : N + 3 * n]
+    th, dth = y[3 * n + 2], y[N + 3 * n + 2]
+    fp = np.empty(n)
+    fa = np.empty(n)
+    fb = np.empty(n)
+    _full_forces(V, _chain_state(y, n), c, s, has_load, SX, SY, damped, fp, fa, fb)
+    shift = V[V_KAPPA, 0] * th + (V[V_NU, 0] * dth if damped else 0.0)
+    fp[0] += shift  # hinge 0 measured from the body: D_0 - theta
+    fa[0] += shift
+    rx, ry = _rho(V, th)
+    w2 = dth * dth
+    _field_forces(V, c, s, delta, w2 * rx, w2 * ry, fp, fa, fb)  # a_0's -theta'^2 rho part
+    Fx = SX[0] if has_load else 0.0
+    Fy = SY[0] if has_load else 0.0
+    qx, qy = _first_moment_quadratic(V, c, s, delta, ddelta, y[N : N + n])
+    mch = V[V_MCH, 0]
+    tx = Fx - qx + mch * w2 * rx
+    ty = Fy - qy + mch * w2 * ry
+    rb = np.array([tx, ty, hinge0_moment(V, y, damped) - ry * (Fx - qx) + rx * (Fy - qy)])
+    G = np.empty((2, 3 * n))
+    K = field_responses(V, c, s, delta, G)
+    base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out)
+
+
+@njit(cache=True)
+def base_unit_responses(V, y, locks, U):
+    """U[j] = M_tot^-1 a_k^T (3n + 3) for k = locks[j]: a unit moment at hinge k (on the body
+    as well for k = 0: its row has -1 at theta). O(n) per hinge."""
+    n = V.shape[1]
+    c = np.cos(y[:n])
+    s = np.sin(y[:n])
+    delta = y[n : 2 * n] - y[2 * n : 3 * n]
+    th = y[3 * n + 2]
+    G = np.empty((2, 3 * n))
+    K = field_responses(V, c, s, delta, G)
+    fp = np.empty(n)
+    fa = np.empty(n)
+    fb = np.empty(n)
+    rb = np.zeros(3)
+    for j in range(locks.shape[0]):
+        fp[:] = 0.0
+        fa[:] = 0.0
+        fb[:] = 0.0
+        _unit_moment(locks[j], fp, fa, fb)
+        rb[2] = -1.0 if locks[j] == 0 else 0.0
+        base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, U[j])
+
+
+@njit(cache=True)
+def base_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
+    """Q'' with the hinges ``locks`` held (multipliers into ``lam``, N m); O(n m)."""
+    n = V.shape[1]
+    base_accel(V, y, has_load, SX, SY, damped, out)
+    m = locks.shape[0]
+    if m == 0:
+        return
+    U = np.empty((m, 3 * n + 3))
+    base_unit_responses(V, y, locks, U)
+    superpose(out, U, locks, n, lam, 3 * n + 2)
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def base_rhs(t, y, P, S, M, L, out):
+    """y' of the full model on a free base (compiled integrators' right-hand side)."""
+    n = P.shape[1]
+    SX = np.empty(n)
+    SY = np.empty(n)
+    has_load = rhs_head(t, y, L, SX, SY, out)
+    base_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[3 * n + 3 :])
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def base_rhs_locked(t, y, P, S, M, L, out):
+    """y' with the hinges of S held (``deployment.lock_scalars``); O(n m)."""
+    n = P.shape[1]
+    SX = np.empty(n)
+    SY = np.empty(n)
+    has_load = rhs_head(t, y, L, SX, SY, out)
+    locks, _ = _locks(S)
+    lam = np.empty(locks.shape[0])
+    base_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * n + 3 :], lam)
+
+
+@njit(EVENTS_SIGNATURE, cache=True)
+def base_hinge_events(t, y, P, S, M, L, E, out):
+    """Latch and stop events g = D_k - angle, hinge 0 from the body's attitude; O(rows)."""
+    n = P.shape[1]
+    for i in range(E.shape[0]):
+        k = int(E[i, 0])
+        D = y[k] + y[n + k]
+        D -= y[k - 1] + y[2 * n + k - 1] if k > 0 else y[3 * n + 2]
+        out[i] = D - E[i, 1]
+
+
+@njit(cache=True)
+def momentum(V, y):
+    """P = m_b v_c + M_ch v_0 + S' (N s): the whole system's linear momentum; O(n)."""
+    n = V.shape[1]
+    N = 3 * n + 3
+    c = np.cos(y[:n])
+    s = np.sin(y[:n])
+    delta = y[n : 2 * n] - y[2 * n : 3 * n]
+    v = y[N:]
+    jx, jy = _first_moment_rate(V, c, s, delta, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
+    rx, ry = _rho(V, y[3 * n + 2])
+    dth = v[3 * n + 2]
+    v0x = v[3 * n] - dth * ry
+    v0y = v[3 * n + 1] + dth * rx
+    mb, mch = V[V_BM, 0], V[V_MCH, 0]
+    return mb * v[3 * n] + mch * v0x + jx, mb * v[3 * n + 1] + mch * v0y + jy
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def base_mechanics(t, y, P, S, M, L, out):
+    """(T, P_ext, P_diss) into out[:3]: T (J) the whole system's kinetic energy (module
+    docstring), P_ext = Q . phi' + F . v_0 (W), P_diss the dampers' power with hinge 0's rate
+    from the body (W). O(n)."""
+    n = P.shape[1]
+    N = 3 * n + 3
+    full_mechanics(t, _chain_state(y, n), P, S, M, L, out)
+    v = y[N:]
+    c = np.cos(y[:n])
+    s = np.sin(y[:n])
+    delta = y[n : 2 * n] - y[2 * n : 3 * n]
+    jx, jy = _first_moment_rate(P, c, s, delta, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
+    rx, ry = _rho(P, y[3 * n + 2])
+    dth = v[3 * n + 2]
+    v0x = v[3 * n] - dth * ry
+    v0y = v[3 * n + 1] + dth * rx
+    mb, mch = P[V_BM, 0], P[V_MCH, 0]
+    vc2 = v[3 * n] ** 2 + v[3 * n + 1] ** 2
+    out[0] += 0.5 * (mb * vc2 + P[V_BJ, 0] * dth * dth + mch * (v0x * v0x + v0y * v0y))
+    out[0] += v0x * jx + v0y * jy
+    SX = np.empty(n)
+    SY = np.empty(n)
+    if load_sums(L, t, SX, SY):
+        out[1] += SX[0] * v0x + SY[0] * v0y
+    if S[0] != 0.0:
+        r = v[0] + v[n]
+        out[2] += P[V_NU, 0] * ((r - dth) ** 2 - r * r)
