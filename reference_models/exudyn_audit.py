@@ -4,7 +4,7 @@ the node states exudyn recorded at every step.
 
 * W_ext(t) = int P_ext dt, P_ext = sum of the nodal forces . the node velocities (W);
 * D(t) = int P_diss dt, P_diss (W) the power of the scene's dampers on
-  the beam: the hinge dampers nu_k (dD_k/dt)^2, the acting stops' dampers d (dD_k/dt)^2 and
+  the beam: the hinge dampers nu_k (dD_k/dt)^2 (hinge 0's rate from a free base's), the acting stops' dampers d (dD_k/dt)^2 and
   the rods' Kelvin-Voigt bending damping int c (dK/dt)^2 ds (exudyn's ``bendingDamping``: the
   virtual work int c K' delta K ds of its material curvature K; 5 Gauss points per element).
   The powers are integrated by the trapezoidal rule over exudyn's steps: second order, as
@@ -29,7 +29,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference_models.exudyn_beam import _cross, _elements, _energies, _interpolate
+from reference_models.exudyn_beam import (
+    _cross,
+    _elements,
+    _energies,
+    _interpolate,
+    body_attitude,
+)
 from reference_models.exudyn_observe import (
     _chord_angles,
     _ends,
@@ -54,7 +60,7 @@ def step_powers(scene: Scene, E: int, t_rec: np.ndarray, records: dict) -> tuple
             forces = loads.nodal(float(t))
             if forces is not None:
                 p_ext[i] = float(forces[0] @ vR[i, :, 0] + forces[1] @ vR[i, :, 1])
-    dD = hinge_rates(qL, vL, qR, vR)
+    dD = hinge_rates(qL, vL, qR, vR, body_attitude(qv)[1])
     p_diss = np.sum(chain.nu * dD**2, -1)
     D0 = scene.initial_hinge_angles()
     for stop in scene.stops:

@@ -9,9 +9,34 @@ import math
 
 import numpy as np
 
-from rodval.core.scene import Scene
+from rodval.core.base import rotate
+from rodval.core.scene import Scene, hinge_angles
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(5)
+
+#: The records' key of a free base's body node (its states [x_c, y_c, theta] (m, m, rad) and
+#: their rates), beside the beam nodes' (rod, local node) keys.
+BODY = (-1, -1)
+
+
+def root_motion(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """Node 0's initial position (m) and velocity (m/s), (2,) each: the origin at rest on a
+    pinned base; on a free base r_0 = position + R(attitude) h and v_0 = velocity + rate k x
+    R(attitude) h (h = hinge_offset, ``rodval.core.base``)."""
+    b = scene.base
+    if not b.free:
+        return np.zeros(2), np.zeros(2)
+    rho = rotate(b.attitude, np.asarray(b.hinge_offset, float))
+    return np.asarray(b.position) + rho, np.asarray(b.velocity) + b.rate * np.array([-rho[1], rho[0]])
+
+
+def body_attitude(at: dict) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The free base's attitude theta (rad) and rate (rad/s), (nt,) each, from the node states
+    ``at`` (None, None on a pinned base: no body record)."""
+    if BODY not in at:
+        return None, None
+    q, v = at[BODY][:2]
+    return q[:, 2], v[:, 2]
 
 
 def _positive(name: str, value, *, upper: float = math.inf, integer: bool = False):
@@ -159,7 +184,7 @@ def _initial_node_states(scene: Scene, elements: int):
     n, l = chain.n, chain.l
     phi, dphi = ini["phi"], ini["dphi"]
     J = np.array([[0.0, -1.0], [1.0, 0.0]])
-    root, root_vel = np.zeros(2), np.zeros(2)
+    root, root_vel = root_motion(scene)
     s = np.linspace(0.0, 1.0, elements + 1)
     ref = np.empty((n, elements + 1, 4))
     cur = np.empty((n, elements + 1, 4))
@@ -260,10 +285,11 @@ def _elements(chain, E: int, at: dict):
 def _energies(
     scene: Scene, E: int, EA: float, at: dict, phi, alpha, beta
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Kinetic, rod strain and hinge energy (J) per output time: beam and point-mass kinetic;
-    the rods' bending (EI kappa^2/2) and axial (EA eps^2/2, EA of the run) strain; the hinge
-    springs (kappa D^2/2 with the continuous tangent angles phi + alpha, phi + beta) and the
-    acting stops. The potential energy is strain + hinge."""
+    """Kinetic, rod strain and hinge energy (J) per output time: beam and point-mass kinetic
+    (and a free base's body, m |v_c|^2 / 2 + J theta'^2 / 2, from ``at[BODY]``); the rods'
+    bending (EI kappa^2/2) and axial (EA eps^2/2, EA of the run) strain; the hinge springs
+    (kappa D^2/2 with the continuous tangent angles phi + alpha, phi + beta, hinge 0 from the
+    body's attitude) and the acting stops. The potential energy is strain + hinge."""
     chain = scene.chain
     kin = np.zeros(phi.shape[0])
     pot = np.zeros(phi.shape[0])
@@ -279,8 +305,11 @@ def _energies(
     for k in range(chain.n):
         vt = at[(k, E)][1][:, :2]
         kin += 0.5 * chain.mu[k] * np.sum(vt**2, -1)
-    left = np.concatenate([np.zeros((phi.shape[0], 1)), (phi + beta)[:, :-1]], 1)
-    D = (phi + alpha) - left
+    attitude, rate = body_attitude(at)
+    if rate is not None:
+        v_c = at[BODY][1][:, :2]
+        kin += 0.5 * (scene.base.mass * np.sum(v_c**2, -1) + scene.base.inertia * rate**2)
+    D = hinge_angles(phi, alpha, beta, attitude)
     hinge = 0.5 * np.sum(chain.kappa * (D - chain.rest_angle) ** 2, -1)
     for stop in scene.stops:
         pen = D[:, stop.hinge] - stop.angle
@@ -293,12 +322,16 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
-def _angular_momentum(chain, E: int, at: dict) -> np.ndarray:
-    """The ``angular_momentum`` rows (nt, 2) (N m s, counter-clockwise positive) of the beam
-    field (see rodval.core.scene.QUANTITIES): k = 0 about the root node,
-    H_0 = sum int (r - r_0) x r_t dm (the rods' mass on the beam's reference arc length, the
-    node masses at the rod ends; 5 Gauss points per element integrate the degree-6 integrand
-    exactly), k = 1 about the centre of mass, H_0 - (S x P) / M."""
+def _momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The ``angular_momentum`` rows (nt, 2) (N m s, counter-clockwise positive) and the
+    ``momentum`` rows P (nt, 2) (N s) of the whole system (see rodval.core.scene.QUANTITIES):
+    the beam field (the rods' mass on the beam's reference arc length, the node masses at the
+    rod ends; 5 Gauss points per element integrate the degree-6 integrand r x v exactly) and a
+    free base's body (``at[BODY]``: P += m v_c, H += J theta' + m (r_c - r_0) x v_c, first
+    moment += m (r_c - r_0)). k = 0 about node 0, H_0 = sum int (r - r_0) x r_t dm; k = 1
+    about the system's centre of mass, H_0 - (S x P) / M (S the first mass moment about node
+    0, M the total mass)."""
+    chain = scene.chain
     root = at[(0, 0)][0][:, None, :2]  # (nt, 1, 2)
     H0 = np.zeros(root.shape[0])
     P = np.zeros((root.shape[0], 2))
@@ -316,4 +349,12 @@ def _angular_momentum(chain, E: int, at: dict) -> np.ndarray:
         P += chain.mu[k] * v
         first += chain.mu[k] * r
     total = float(np.sum(chain.m * chain.l + chain.mu))
-    return np.stack([H0, H0 - _cross(first, P) / total], -1)
+    if BODY in at:
+        mass, inertia = scene.base.mass, scene.base.inertia
+        q_b, v_b = at[BODY][:2]
+        r_c = q_b[:, :2] - root[:, 0]
+        H0 += inertia * v_b[:, 2] + mass * _cross(r_c, v_b[:, :2])
+        P += mass * v_b[:, :2]
+        first += mass * r_c
+        total += mass
+    return np.stack([H0, H0 - _cross(first, P) / total], -1), P

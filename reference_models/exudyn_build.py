@@ -1,5 +1,6 @@
-"""Building the exudyn beam model of a scene: nodes, ANCF cable elements, hinges (joints,
-spring-dampers, stops, latch joints), point masses, loads and sensors (``build``)."""
+"""Building the exudyn beam model of a scene: nodes, ANCF cable elements, a free base's rigid
+body, hinges (joints, spring-dampers, stops, latch joints), point masses, loads and sensors
+(``build``)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from reference_models.exudyn_beam import (
+    BODY,
     _initial_node_states,
     _load_function,
     _revolutions,
@@ -22,11 +24,13 @@ class _Built:
 
     SC: Any
     mbs: Any
-    node_sensors: dict[tuple[int, int], tuple[int, int, int]]  # (rod, local node) -> (q, v, a)
+    #: (rod, local node) -> sensors (q, v, a); a free base's body node under ``BODY``
+    node_sensors: dict[tuple[int, int], tuple[int, int, int]]
     load_errors: list
     nodes: list  # beam node numbers per rod
     initial: tuple  # _initial_node_states: ref, offsets, velocities
     latch_joints: dict  # hinge -> exudyn object number of its locking joint
+    body: int | None = None  # a free base's NodeRigidBody2D (None: pinned to the ground)
 
 
 def _items():
@@ -41,7 +45,10 @@ def build(scene: Scene, E: int, EA: float) -> _Built:
     stiffness EA (N), assembled: O(n E) items. Hinges are a position joint plus a torsional
     spring-damper on the end tangents (relaxed at the rest angle: exudyn's ``offset``); limit
     stops a second spring-damper with a one-sided user law; latches a rotation-locking
-    ObjectJointGeneric, inactive until the pre-step function (``_Latches``) switches it on."""
+    ObjectJointGeneric, inactive until the pre-step function (``_Latches``) switches it on.
+    A free base is a NodeRigidBody2D (reference coordinates [x_c, y_c, theta] at the initial
+    position and attitude) with an ObjectRigidBody2D of the body's mass and inertia; hinge 0
+    joins it, at the hinge offset, to rod 1 (instead of the ground)."""
     import exudyn as exu
 
     chain = scene.chain
@@ -50,7 +57,8 @@ def build(scene: Scene, E: int, EA: float) -> _Built:
     ground = mbs.AddObject(_items().ObjectGround())
     ref, q0, v0 = _initial_node_states(scene, E)
     nodes, elems = _add_rods(mbs, scene, E, EA, (ref, q0, v0))
-    latch_joints = _add_hinges(mbs, scene, E, ground, nodes, elems)
+    body_node, root_body = _add_body(mbs, scene, ground)
+    latch_joints = _add_hinges(mbs, scene, E, root_body, nodes, elems)
     it = _items()
     for k in range(chain.n):
         if chain.mu[k] > 0:
@@ -65,9 +73,31 @@ def build(scene: Scene, E: int, EA: float) -> _Built:
                 loadVectorUserFunction=_load_function(f, load_errors),
             )
         )
-    node_sensors = _add_sensors(mbs, scene, E, nodes)
+    node_sensors = _add_sensors(mbs, scene, E, nodes, body_node)
     mbs.Assemble()
-    return _Built(SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints)
+    return _Built(
+        SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints, body_node
+    )
+
+
+def _add_body(mbs, scene: Scene, ground: int) -> tuple[int | None, int]:
+    """A free base's rigid body: (its NodeRigidBody2D, its ObjectRigidBody2D), the node's
+    coordinates [x_c, y_c, theta] (m, m, rad) referenced at the initial position and attitude
+    and moving with the initial velocity and rate; (None, ground) on a pinned base."""
+    b = scene.base
+    if not b.free:
+        return None, ground
+    it = _items()
+    node = mbs.AddNode(
+        it.NodeRigidBody2D(
+            referenceCoordinates=[b.position[0], b.position[1], b.attitude],
+            initialVelocities=[b.velocity[0], b.velocity[1], b.rate],
+        )
+    )
+    body = mbs.AddObject(
+        it.ObjectRigidBody2D(physicsMass=b.mass, physicsInertia=b.inertia, nodeNumber=node)
+    )
+    return node, body
 
 
 def _add_rods(mbs, scene: Scene, E: int, EA: float, initial) -> tuple[list, list]:
@@ -109,8 +139,10 @@ def _add_rods(mbs, scene: Scene, E: int, EA: float, initial) -> tuple[list, list
     return nodes, elems
 
 
-def _add_hinges(mbs, scene: Scene, E: int, ground: int, nodes, elems) -> dict[int, int]:
-    """Hinge k's joint, spring-damper, stops and latch joint; returns hinge -> latch joint."""
+def _add_hinges(mbs, scene: Scene, E: int, root_body: int, nodes, elems) -> dict[int, int]:
+    """Hinge k's joint, spring-damper, stops and latch joint; returns hinge -> latch joint.
+    Hinge 0 joins ``root_body`` (the ground, or a free base's body at its hinge offset, the
+    angle measured from the body frame) to rod 1."""
     it = _items()
     chain = scene.chain
     ini = scene.initial.resolve(chain.n)
@@ -122,9 +154,14 @@ def _add_hinges(mbs, scene: Scene, E: int, ground: int, nodes, elems) -> dict[in
         stops_of.setdefault(stop.hinge, []).append(stop)
     latch_joints: dict[int, int] = {}
     for k in range(chain.n):
-        if k == 0:
-            pos0 = mbs.AddMarker(it.MarkerBodyPosition(bodyNumber=ground))
-            rot0 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=ground))
+        if k == 0 and scene.base.free:
+            offset = [*scene.base.hinge_offset, 0.0]
+            pos0 = mbs.AddMarker(it.MarkerBodyPosition(bodyNumber=root_body, localPosition=offset))
+            rot0 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=root_body, localPosition=offset))
+            angle0 = tangent_left[0] - scene.base.attitude
+        elif k == 0:
+            pos0 = mbs.AddMarker(it.MarkerBodyPosition(bodyNumber=root_body))
+            rot0 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=root_body))
             angle0 = tangent_left[0]
         else:
             pos0 = mbs.AddMarker(it.MarkerNodePosition(nodeNumber=nodes[k - 1][-1]))
@@ -185,23 +222,28 @@ def _add_latch_joint(mbs, markers: tuple[int, int], angle: float) -> int:
     )
 
 
-def _add_sensors(mbs, scene: Scene, E: int, nodes) -> dict:
+def _add_sensors(mbs, scene: Scene, E: int, nodes, body_node: int | None = None) -> dict:
     """Sensors (coordinates, velocities, accelerations, stored internally) on the beam nodes
-    the outputs need: (rod, node) -> three sensor numbers."""
+    the outputs need, (rod, node) -> three sensor numbers, and on a free base's body node
+    (``BODY`` -> its three: hinge 0 is measured from it)."""
     import exudyn as exu
 
     n = scene.n
     wanted = set()
-    if scene.wants("phi", "dphi", "alpha", "beta", "x", "y", "hinge_angle", "hinge_moment"):
+    ends = ("phi", "dphi", "alpha", "beta", "x", "y", "hinge_angle", "hinge_moment", "base")
+    if scene.wants(*ends):
         wanted |= {(k, 0) for k in range(n)} | {(k, E) for k in range(n)}
-    if scene.wants("energy", "angular_momentum") or scene.latches:
+    if scene.wants("energy", "angular_momentum", "momentum") or scene.latches:
         wanted |= {(k, j) for k in range(n) for j in range(E + 1)}
+    node_of = {key: nodes[key[0]][key[1]] for key in wanted}
+    if body_node is not None:
+        node_of[BODY] = body_node
     ovt = exu.OutputVariableType
     return {
         key: tuple(
             mbs.AddSensor(
                 _items().SensorNode(
-                    nodeNumber=nodes[key[0]][key[1]],
+                    nodeNumber=node_of[key],
                     storeInternal=True,
                     writeToFile=False,
                     outputVariableType=v,
@@ -209,5 +251,5 @@ def _add_sensors(mbs, scene: Scene, E: int, nodes) -> dict:
             )
             for v in (ovt.CoordinatesTotal, ovt.Coordinates_t, ovt.Coordinates_tt)
         )
-        for key in sorted(wanted)
+        for key in sorted(node_of)
     }

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, _energies, _hermite
+from reference_models.exudyn_beam import BODY, _GAUSS_W, _GAUSS_X, _energies, _hermite
 from reference_models.exudyn_build import _Built
 from rodval.core.scene import Scene
 from rodval.core.status import (
@@ -29,7 +29,7 @@ class _Guard:
 
     * non-finite coordinates or velocities: STATUS_DIVERGED;
     * kinetic energy T = v^T M v / 2 (consistent mass of the cubic elements plus the point
-      masses; the hinge data nodes carry no mass) above ``factor`` x the budget of
+      masses and a free base's body, diag(m, m, J); the hinge data nodes carry no mass) above ``factor`` x the budget of
       ``rodval.solvers.guard`` (``GuardSpec``, ``Monitor``: W+ on the load power at the
       checked states), E(0) the initial T + Pi (``_energies``): STATUS_BLOWUP;
     * max_k |dphi_k| x step above ``max_rotation``: STATUS_FAILED (under-resolved)."""
@@ -79,6 +79,8 @@ class _Guard:
             for k in range(chain.n)
             for j in range(E + 1)
         }
+        if built.body is not None:
+            at0[BODY] = self._add_body(scene, np.asarray(mbs.systemData.GetNodeLTGODE2(built.body)))
         parts = _energies(
             scene, E, EA, at0, ini["phi"][None], ini["alpha"][None], ini["beta"][None]
         )
@@ -86,6 +88,16 @@ class _Guard:
         self.energy = Monitor(self.spec)
         self.verdict: tuple | None = None
         self.min_step, self.max_rotation_seen = math.inf, 0.0
+
+    def _add_body(self, scene: Scene, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A free base's body node (coordinates ``idx``): its reference [x_c, y_c, theta] into
+        ``ref`` and its mass diag(m, m, J) into ``M``; returns its initial state and rates
+        (1, 3) each."""
+        b = scene.base
+        state = np.array([[b.position[0], b.position[1], b.attitude]])
+        self.ref[idx] = state[0]
+        self.M[idx, idx] += np.array([b.mass, b.mass, b.inertia])
+        return state, np.array([[b.velocity[0], b.velocity[1], b.rate]])
 
     def _power(self, t: float, v: np.ndarray) -> float:
         p = 0.0

@@ -6,14 +6,16 @@ from __future__ import annotations
 import numpy as np
 
 from reference_models.exudyn_beam import (
-    _angular_momentum,
+    BODY,
     _energies,
     _hermite,
     _interpolate,
+    _momenta,
     _wrap,
+    body_attitude,
     stop_moment,
 )
-from rodval.core.scene import QUANTITIES, Scene
+from rodval.core.scene import QUANTITIES, Scene, hinge_angles
 
 
 def _observe(
@@ -32,7 +34,9 @@ def _observe(
     and stop laws at the measured D and dD while the hinge is free, and from the state
     where its latch was switched on (``lock_steps``: hinge -> time, s) the beam's own bending
     moment EI kappa_b at the root of rod k+1 (the hinge has no inertia: it transmits that
-    moment), kappa_b the curvature of the cable's field there."""
+    moment), kappa_b the curvature of the cable's field there. Hinge 0 is measured from a free
+    base's attitude (its body node's record, ``BODY``), which also gives "base"; "momentum"
+    and "angular_momentum" are the whole system's (``_momenta``)."""
     n = scene.n
     rods = np.arange(1, n + 1)
     at = {
@@ -65,9 +69,27 @@ def _observe(
         out["kinetic"] = (kin[:, None], zero)
         out["potential"] = ((strain + hinge)[:, None], zero)
         out["energy"] = ((kin + strain + hinge)[:, None], zero)
-    if scene.wants("angular_momentum"):
-        out["angular_momentum"] = (_angular_momentum(scene.chain, E, at), np.arange(2))
+    if scene.wants("angular_momentum", "momentum"):
+        H, P = _momenta(scene, E, at)
+        if scene.wants("angular_momentum"):
+            out["angular_momentum"] = (H, np.arange(2))
+        if scene.wants("momentum"):
+            out["momentum"] = (P, np.arange(2))
+    if scene.wants("base"):
+        _base_quantities(at, out)
     return out
+
+
+def _base_quantities(at: dict, out: dict) -> None:
+    """The free base's "base" quantities into ``out``: base_position, base_velocity (m, m/s;
+    its centre of mass, k = 0, 1), base_attitude, base_rate (rad, rad/s; k = 0), from its body
+    node's record."""
+    q, v = at[BODY]
+    pair, one = np.arange(2), np.zeros(1, dtype=int)
+    out["base_position"] = (q[:, :2], pair)
+    out["base_velocity"] = (v[:, :2], pair)
+    out["base_attitude"] = (q[:, 2:3], one)
+    out["base_rate"] = (v[:, 2:3], one)
 
 
 def _ends(n: int, E: int, at: dict) -> tuple[np.ndarray, ...]:
@@ -109,9 +131,9 @@ def _hinge_quantities(scene: Scene, E: int, times, at: dict, angles, ends, lock_
     phi, alpha, beta = angles
     qL, vL, qR, vR = ends
     hinges = np.arange(scene.n)
-    left = np.concatenate([np.zeros((phi.shape[0], 1)), (phi + beta)[:, :-1]], 1)
-    D = (phi + alpha) - left
-    dD = hinge_rates(qL, vL, qR, vR)
+    attitude, rate = body_attitude(at)
+    D = hinge_angles(phi, alpha, beta, attitude)
+    dD = hinge_rates(qL, vL, qR, vR, rate)
     if scene.wants("hinge_angle"):
         out["hinge_angle"] = (D, hinges)
     if scene.wants("hinge_moment"):
@@ -126,15 +148,19 @@ def _hinge_quantities(scene: Scene, E: int, times, at: dict, angles, ends, lock_
         out["hinge_moment"] = (M, hinges)
 
 
-def hinge_rates(qL, vL, qR, vR) -> np.ndarray:
+def hinge_rates(qL, vL, qR, vR, base_rate=None) -> np.ndarray:
     """dD_k/dt (rad/s, (nt, n)): the rate of rod k+1's left end tangent minus rod k's right
-    one (0 for the root) from the rods' end node states and rates (nt, n, 4)."""
+    one (for the root: minus a free base's rate ``base_rate`` (nt,), 0 on a pinned base) from
+    the rods' end node states and rates (nt, n, 4)."""
 
     def rate(q, v):
         return (q[..., 2] * v[..., 3] - q[..., 3] * v[..., 2]) / (q[..., 2] ** 2 + q[..., 3] ** 2)
 
     right = rate(qR, vR)[:, :-1]
-    return rate(qL, vL) - np.concatenate([np.zeros((right.shape[0], 1)), right], 1)
+    dD = rate(qL, vL) - np.concatenate([np.zeros((right.shape[0], 1)), right], 1)
+    if base_rate is not None:
+        dD[:, 0] -= base_rate
+    return dD
 
 
 def _root_bending_moment(chain, E: int, at: dict, k: int) -> np.ndarray:
@@ -188,10 +214,15 @@ def stop_events(
 
 def recorded_hinge_angle(records: dict, E: int, k: int, D0: float, nt: int) -> np.ndarray:
     """D_k (rad) at the first ``nt`` recorded steps: the difference of the end tangents'
-    angles, unwrapped in time from the initial hinge angle D0 (rad)."""
+    angles (for the root: rod 1's minus a free base's attitude, 0 on a pinned base),
+    unwrapped in time from the initial hinge angle D0 (rad)."""
 
     def tangent(key):  # tangent angle (rad, wrapped) of a rod end at the recorded times
         return np.arctan2(*records[key][0][:nt, [3, 2]].T)
 
-    D = np.unwrap(tangent((k, 0)) - (tangent((k - 1, E)) if k > 0 else 0.0))
+    if k > 0:
+        left = tangent((k - 1, E))
+    else:
+        left = records[BODY][0][:nt, 2] if BODY in records else 0.0
+    D = np.unwrap(tangent((k, 0)) - left)
     return D + 2 * np.pi * np.round((D0 - D[0]) / (2 * np.pi))

@@ -100,6 +100,7 @@ def test_shipped_studies_and_the_readme_example_are_valid():
     sizes = {p.stem: len(load_study(p).cases) for p in sorted(root.glob("*.toml"))}
     assert sizes == {
         "companion_three_panel": 1,
+        "companion_three_panel_free": 2,
         "deployment": 1,
         "deployment_stiff": 1,
         "deployment_sample": 256,

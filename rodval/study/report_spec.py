@@ -98,8 +98,10 @@ def _report_rods(table: dict[str, Any], drawn: list[Case], where: str) -> list[i
 def _report_quantities(table: dict[str, Any], drawn: list[Case], where: str) -> list[str]:
     """``report.quantities``: among the outputs of every report case (default: those of
     ``DEFAULT_REPORT_QUANTITIES`` they output, else all they output)."""
-    outputs = [
-        q for q in QUANTITIES if all(q in trajectory_quantities(c.scene.outputs) for c in drawn)
+    outputs = [  # trajectory quantities: a free base's "base" yields base_attitude, ...
+        q
+        for q in trajectory_quantities(QUANTITIES)
+        if all(q in trajectory_quantities(c.scene.outputs) for c in drawn)
     ]
     quantities = table.get(
         "quantities", [q for q in DEFAULT_REPORT_QUANTITIES if q in outputs] or outputs
