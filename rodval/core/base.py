@@ -99,7 +99,10 @@ class Base:
         """A Base from a scene file's ``[base]`` table (unknown keys refused)."""
         check_keys(d, ("kind", *BODY_FIELDS), where)
         try:
-            return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+            values: dict[str, Any] = {
+                k: tuple(v) if isinstance(v, list) else v for k, v in d.items()
+            }
+            return cls(**values)
         except ValueError as exc:
             raise ValueError(f"{where}: {exc}") from None
 

@@ -36,6 +36,8 @@ class FreeBaseSystem(FullSystem):
         b, i = scene.base, self.initial
         self.N = 3 * self.n + 3
         self.body = b
+        assert b.mass is not None and b.inertia is not None  # a free base has both (Base)
+        self.body_mass, self.body_inertia = b.mass, b.inertia
         self.y0 = np.concatenate(
             [
                 i["phi"],
@@ -55,7 +57,7 @@ class FreeBaseSystem(FullSystem):
     def kernel_constants(self) -> np.ndarray:
         chain, b = self.chain, self.body
         mass = float(np.sum(chain.m * chain.l + chain.mu))
-        rows = [b.mass, b.inertia, b.hinge_offset[0], b.hinge_offset[1], mass]
+        rows = [self.body_mass, self.body_inertia, b.hinge_offset[0], b.hinge_offset[1], mass]
         V = full_constants(self.cc, chain)
         return np.vstack([V, np.outer(rows, np.ones(self.n))])
 
@@ -165,13 +167,13 @@ class FreeBaseSystem(FullSystem):
         X x P for X = node 0 and the centre of mass (docs/quantities.md)."""
         rc, vc = self.body_states(Y)
         r0 = self.root_states(Y)[0]
-        mb = self.body.mass
+        mb = self.body_mass
         out = np.empty((len(Y), 2))
         total = mb + float(np.sum(self.base_chain.m * self.base_chain.l + self.base_chain.mu))
         P = self.momentum_rows(Y)
         for i, y in enumerate(Y):
             _, h, first = self.rod_momenta_at(y)
-            HO = self.body.inertia * self.attitude_rate(Y)[i] + mb * _cross(rc[i], vc[i]) + h.sum()
+            HO = self.body_inertia * self.attitude_rate(Y)[i] + mb * _cross(rc[i], vc[i]) + h.sum()
             X = (mb * rc[i] + first.sum(axis=0)) / total
             out[i] = HO - _cross(r0[i], P[i]), HO - _cross(X, P[i])
         return out

@@ -220,9 +220,10 @@ class PaperSystem(PaperEnergy, OdeSystem):
         phi, dphi = (a[0] for a in self.rigid(y[None, :]))
         Q = self.generalized_force(t, phi)
         p_ext = 0.0 if Q is None else float(Q @ dphi)
-        if Q is not None and self.scene.base.free:  # the loads' resultant on node 0's motion
-            SX, SY = self.loads.suffix_sums(t)
-            p_ext += float(SX[0] * self.root_motion(y)[1][0] + SY[0] * self.root_motion(y)[1][1])
+        sums = self.loads.suffix_sums(t)
+        if sums is not None and self.scene.base.free:  # the loads' resultant on node 0's motion
+            v0 = self.root_motion(y)[1]
+            p_ext += float(sums[0][0] * v0[0] + sums[1][0] * v0[1])
         with self._mode_at(t):
             return p_ext, self.damper_power_at(y) if self.damped else 0.0
 
