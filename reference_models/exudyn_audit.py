@@ -3,10 +3,11 @@ definitions (``rodval.solvers.audit``, ``rodval.core.lock_window.window_energies
 the node states exudyn recorded at every step.
 
 * W_ext(t) = int P_ext dt, P_ext = sum of the nodal forces . the node velocities (W);
-* D(t) = int P_diss dt, P_diss (W) the power of the scene's dampers on
-  the beam: the hinge dampers nu_k (dD_k/dt)^2 (hinge 0's rate from a free base's), the acting stops' dampers d (dD_k/dt)^2 and
-  the rods' Kelvin-Voigt bending damping int c (dK/dt)^2 ds (exudyn's ``bendingDamping``: the
-  virtual work int c K' delta K ds of its material curvature K; 5 Gauss points per element).
+* D(t) = int P_diss dt, P_diss (W) the power of the scene's dampers on the beam: the hinge
+  dampers nu_k (dD_k/dt)^2 (hinge 0's rate from a free base's), the acting stops' dampers
+  d (dD_k/dt)^2 and the rods' Kelvin-Voigt bending damping int c (dK/dt)^2 ds (exudyn's
+  ``bendingDamping``: the virtual work int c K' delta K ds of its material curvature K; 5
+  Gauss points per element).
   The powers are integrated by the trapezoidal rule over exudyn's steps: second order, as
   its generalized-alpha integrator.
 * A lock: exudyn has no instantaneous impact (its latch joint, switched on at the step

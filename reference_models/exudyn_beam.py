@@ -27,7 +27,15 @@ def root_motion(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     if not b.free:
         return np.zeros(2), np.zeros(2)
     rho = rotate(b.attitude, np.asarray(b.hinge_offset, float))
-    return np.asarray(b.position) + rho, np.asarray(b.velocity) + b.rate * np.array([-rho[1], rho[0]])
+    perp = np.array([-rho[1], rho[0]])  # k x rho
+    return np.asarray(b.position) + rho, np.asarray(b.velocity) + b.rate * perp
+
+
+def body_mass(scene: Scene) -> tuple[float, float]:
+    """A free base's mass (kg) and inertia about its centre of mass (kg m^2)."""
+    mass, inertia = scene.base.mass, scene.base.inertia
+    assert mass is not None and inertia is not None  # a free base has both (Base)
+    return mass, inertia
 
 
 def body_attitude(at: dict) -> tuple[np.ndarray | None, np.ndarray | None]:
@@ -308,7 +316,8 @@ def _energies(
     attitude, rate = body_attitude(at)
     if rate is not None:
         v_c = at[BODY][1][:, :2]
-        kin += 0.5 * (scene.base.mass * np.sum(v_c**2, -1) + scene.base.inertia * rate**2)
+        mass, inertia = body_mass(scene)
+        kin += 0.5 * (mass * np.sum(v_c**2, -1) + inertia * rate**2)
     D = hinge_angles(phi, alpha, beta, attitude)
     hinge = 0.5 * np.sum(chain.kappa * (D - chain.rest_angle) ** 2, -1)
     for stop in scene.stops:
@@ -350,7 +359,7 @@ def _momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
         first += chain.mu[k] * r
     total = float(np.sum(chain.m * chain.l + chain.mu))
     if BODY in at:
-        mass, inertia = scene.base.mass, scene.base.inertia
+        mass, inertia = body_mass(scene)
         q_b, v_b = at[BODY][:2]
         r_c = q_b[:, :2] - root[:, 0]
         H0 += inertia * v_b[:, 2] + mass * _cross(r_c, v_b[:, :2])

@@ -75,9 +75,7 @@ def build(scene: Scene, E: int, EA: float) -> _Built:
         )
     node_sensors = _add_sensors(mbs, scene, E, nodes, body_node)
     mbs.Assemble()
-    return _Built(
-        SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints, body_node
-    )
+    return _Built(SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints, body_node)
 
 
 def _add_body(mbs, scene: Scene, ground: int) -> tuple[int | None, int]:
@@ -94,9 +92,7 @@ def _add_body(mbs, scene: Scene, ground: int) -> tuple[int | None, int]:
             initialVelocities=[b.velocity[0], b.velocity[1], b.rate],
         )
     )
-    body = mbs.AddObject(
-        it.ObjectRigidBody2D(physicsMass=b.mass, physicsInertia=b.inertia, nodeNumber=node)
-    )
+    body = mbs.AddObject(it.ObjectRigidBody2D(mass=b.mass, inertia=b.inertia, nodeNumber=node))
     return node, body
 
 

@@ -5,7 +5,11 @@ field, Euler-Bernoulli bending stiffness EI_k, mass per length m_k, axial stiffn
 standing in for inextensibility). Rods are meshed separately; at node k the end node of rod k
 and the start node of rod k+1 are joined by a 2D revolute joint (position constraint) and a
 torsional spring-damper (kappa_k, nu_k) on the relative rotation of the two end tangents.
-Hinge 0 joins the ground frame (the x axis) to rod 1's root tangent. The torsional springs use
+Hinge 0 joins the ground frame (the x axis) to rod 1's root tangent, or on a free base
+(``Scene.base``) a rigid body (NodeRigidBody2D and ObjectRigidBody2D: the body's mass and
+inertia, free in the plane) at its hinge offset, the hinge angle measured from the body's
+attitude; the body's motion is then part of the outputs ("base", "momentum",
+"angular_momentum", the kinetic energy). The torsional springs use
 a NodeGenericData to keep their angle continuous beyond +-pi (hinge 0 turns past pi in the
 paper's example). Point masses mu_k sit on the end node of rod k; the scene's nodal forces act
 there through exudyn load user functions, exactly zero outside each force's support.
@@ -185,6 +189,10 @@ class ExudynModel(Model):
         self.max_rotation_per_step = _positive(
             "max_rotation_per_step", max_rotation_per_step, upper=math.pi
         )
+
+    def check_base(self, scene: Scene) -> None:
+        """Every kind of base is modelled: a pinned base as the ground, a free one as a rigid
+        body (``exudyn_build``); nothing is refused."""
 
     @classmethod
     def check_options(cls, options: dict[str, Any]) -> dict[str, Any]:

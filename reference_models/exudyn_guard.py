@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from reference_models.exudyn_beam import BODY, _GAUSS_W, _GAUSS_X, _energies, _hermite
+from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, BODY, _energies, _hermite, body_mass
 from reference_models.exudyn_build import _Built
 from rodval.core.scene import Scene
 from rodval.core.status import (
@@ -29,9 +29,10 @@ class _Guard:
 
     * non-finite coordinates or velocities: STATUS_DIVERGED;
     * kinetic energy T = v^T M v / 2 (consistent mass of the cubic elements plus the point
-      masses and a free base's body, diag(m, m, J); the hinge data nodes carry no mass) above ``factor`` x the budget of
-      ``rodval.solvers.guard`` (``GuardSpec``, ``Monitor``: W+ on the load power at the
-      checked states), E(0) the initial T + Pi (``_energies``): STATUS_BLOWUP;
+      masses and a free base's body, diag(m, m, J); the hinge data nodes carry no mass)
+      above ``factor`` x the budget of ``rodval.solvers.guard`` (``GuardSpec``, ``Monitor``:
+      W+ on the load power at the checked states), E(0) the initial T + Pi (``_energies``):
+      STATUS_BLOWUP;
     * max_k |dphi_k| x step above ``max_rotation``: STATUS_FAILED (under-resolved)."""
 
     def __init__(
@@ -94,9 +95,10 @@ class _Guard:
         ``ref`` and its mass diag(m, m, J) into ``M``; returns its initial state and rates
         (1, 3) each."""
         b = scene.base
+        mass, inertia = body_mass(scene)
         state = np.array([[b.position[0], b.position[1], b.attitude]])
         self.ref[idx] = state[0]
-        self.M[idx, idx] += np.array([b.mass, b.mass, b.inertia])
+        self.M[idx, idx] += np.array([mass, mass, inertia])
         return state, np.array([[b.velocity[0], b.velocity[1], b.rate]])
 
     def _power(self, t: float, v: np.ndarray) -> float:

@@ -33,11 +33,13 @@ class _Latches:
     extrapolation within the coming step, or of the cubic Hermite interpolant between the last
     two states when D is already past (bracketed between steps either way).
 
-    Measures of each lock, on the beam solution: the kinetic energy v^T M v / 2 of the whole
-    chain (consistent mass) just before the activation step and ``LOCK_SETTLE_STEPS`` steps
-    after it, the angular momentum about the root (node 0) and the angular momentum H_k of the
-    outboard part (rods k+1..n and their node masses) about the hinge node k. The latch's
-    cumulative angular impulse on the outboard part is
+    Hinge 0's left side is a free base's attitude (its body node's coordinate) or the ground's
+    x axis. Measures of each lock, on the beam solution: the kinetic energy v^T M v / 2 of the
+    whole system (consistent mass, a free base's body included) just before the activation
+    step and ``LOCK_SETTLE_STEPS`` steps after it, the chain's angular momentum about the
+    root (node 0) and the angular momentum H_k of the outboard part (rods k+1..n and their
+    node masses) about the hinge node k. The latch's cumulative angular impulse on the
+    outboard part is
     S(tau) = H_k(tau) - H_k(before) - int M_k dt, with M_k the finite moments on the outboard
     part about the moving hinge node (hinge k's spring, damper and stops, the outboard loads,
     and -v_P x p of the moving reference point), integrated by the trapezoid rule (N m s,
@@ -51,6 +53,9 @@ class _Latches:
         sd = built.mbs.systemData
         ltg = [[np.asarray(sd.GetNodeLTGODE2(nd), int) for nd in rod] for rod in built.nodes]
         self.ltg = ltg
+        # a free base's attitude coordinate: hinge 0's left side (None: the ground's x axis)
+        self.free = built.body is not None
+        body = int(sd.GetNodeLTGODE2(built.body)[2]) if built.body is not None else None
         size = guard.ref.size
         D0 = scene.initial_hinge_angles()
         self.items = []
@@ -63,7 +68,7 @@ class _Latches:
                     "k": k,
                     "dir": direction,
                     "joint": built.latch_joints[latch.hinge],
-                    "left": None if k == 0 else ltg[k - 1][E][2:],
+                    "left": body if k == 0 else ltg[k - 1][E][2:],
                     "right": ltg[k][0][2:],
                     "D": float(D0[k]),
                     "state": "armed",
@@ -102,7 +107,7 @@ class _Latches:
         self.stops: dict[int, list] = {}
         for stop in scene.stops:
             self.stops.setdefault(stop.hinge, []).append(stop)
-        self.root = {"left": None, "right": ltg[0][0][2:], "D": float(D0[0])}
+        self.root = {"left": body, "right": ltg[0][0][2:], "D": float(D0[0])}
         self.prev: dict | None = None
         self.pending: list[dict] = []
         self.events: list[dict] = []
@@ -127,9 +132,11 @@ class _Latches:
     @staticmethod
     def _angle(q, v, a, idx):
         """Tangent angle (wrapped), its rate and acceleration of slope dofs ``idx`` (None: the
-        x axis)."""
+        x axis; one index: a free base's attitude coordinate, continuous)."""
         if idx is None:
             return 0.0, 0.0, 0.0
+        if np.ndim(idx) == 0:
+            return float(q[idx]), float(v[idx]), float(a[idx])
         sx, sy = q[idx]
         vx, vy = v[idx]
         ax, ay = a[idx]
@@ -191,15 +198,7 @@ class _Latches:
                 fy = f.fy(t) if f.fy is not None else 0.0
                 r = q[idx] - P
                 finite += r[0] * fy - r[1] * fx
-        # about the origin: hinge 0's spring, damper and stops on rod 1, and all loads
-        D0, dD0, _ = self._hinge(self.root, q, v, a)
-        root_moment = -(chain.kappa[0] * (D0 - chain.rest_angle[0]) + chain.nu[0] * dD0)
-        root_moment -= sum(float(stop_moment(st, D0, dD0)) for st in self.stops.get(0, []))
-        for f, idx, _ in self.loads:
-            if f.active(t):
-                fx = f.fx(t) if f.fx is not None else 0.0
-                fy = f.fy(t) if f.fy is not None else 0.0
-                root_moment += q[idx][0] * fy - q[idx][1] * fx
+        H_root, root_moment = self._root_momentum(t, q, v, a, p, h)
         rel = self._chord_rate(k, q, v) - (self._chord_rate(k - 1, q, v) if k > 0 else 0.0)
         return {
             "t": t,
@@ -207,12 +206,35 @@ class _Latches:
             "M_beam": self._root_moment(k, q),
             "H_out": H_out,
             "finite": finite,
-            "H_root": float(h.sum()),
+            "H_root": H_root,
             "root_moment": root_moment,
             "T": 0.5 * float(v @ self.guard.M @ v),
             "D": D,
             "dD": dD,
         }
+
+    def _root_momentum(self, t: float, q, v, a, p, h) -> tuple[float, float]:
+        """The chain's angular momentum about node 0 (N m s) and its rate's finite moments
+        (N m): hinge 0's spring, damper and stops on rod 1 and all loads, about node 0, and on
+        a free base (node 0 moving) -v_0 x P; ``p``, ``h``: the rods' momenta (``_momenta``).
+        On a pinned base node 0 is the origin."""
+        chain = self.scene.chain
+        D0, dD0, _ = self._hinge(self.root, q, v, a)
+        root_moment = -(chain.kappa[0] * (D0 - chain.rest_angle[0]) + chain.nu[0] * dD0)
+        root_moment -= sum(float(stop_moment(st, D0, dD0)) for st in self.stops.get(0, []))
+        root = q[self.ltg[0][0][:2]] if self.free else np.zeros(2)
+        for f, idx, _ in self.loads:
+            if f.active(t):
+                fx = f.fx(t) if f.fx is not None else 0.0
+                fy = f.fy(t) if f.fy is not None else 0.0
+                r = q[idx] - root
+                root_moment += r[0] * fy - r[1] * fx
+        H_root = float(h.sum())
+        if self.free:
+            v0, P = v[self.ltg[0][0][:2]], p.sum(0)
+            H_root -= float(root[0] * P[1] - root[1] * P[0])
+            root_moment -= float(v0[0] * P[1] - v0[1] * P[0])
+        return H_root, root_moment
 
     # -- per step --------------------------------------------------------------------------
     def pre_step(self, t: float, h: float) -> None:
@@ -317,7 +339,12 @@ class _Latches:
         root_jump = last["H_root"] - before["H_root"] - ev["root_integral"]
         latch = item["latch"]
         chords = before["chords"]
-        rigid = rigid_lock(self.scene.chain, chords[:, 0], chords[:, 1], before["held"], item["k"])
+        # the rigid-panel yardstick is a pinned chain's: none on a free base (as the native)
+        rigid = (
+            {}
+            if self.free
+            else rigid_lock(self.scene.chain, chords[:, 0], chords[:, 1], before["held"], item["k"])
+        )
         self.events.append(
             {
                 "t": float(ev["t_lock"]),

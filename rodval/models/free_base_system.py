@@ -15,16 +15,17 @@ import numpy as np
 from rodval.core.base import rotate
 from rodval.core.scene import Scene
 from rodval.models import free_base as fb
-from rodval.models.full import FullSystem
 from rodval.models.kernels import full_constants
+from rodval.models.lock_records import plastic_jump
 from rodval.models.paper_matrices import hinge_matrix
 from rodval.models.paper_system import PaperSystem
 
 
-class FreeBaseSystem(FullSystem):
+class FreeBaseSystem(PaperSystem):
     """The full model (the paper's rung, printed coefficients, compiled kernel) on a free
     base."""
 
+    full = True
     accel_kernel = staticmethod(fb.base_accel)
     compiled_rhs = staticmethod(fb.base_rhs)
     compiled_mechanics = staticmethod(fb.base_mechanics)
@@ -32,7 +33,7 @@ class FreeBaseSystem(FullSystem):
     compiled_events = staticmethod(fb.base_hinge_events)
 
     def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
-        PaperSystem.__init__(self, scene, coefficients, kernel)
+        super().__init__(scene, coefficients, kernel)
         b, i = scene.base, self.initial
         self.N = 3 * self.n + 3
         self.body = b
@@ -66,6 +67,9 @@ class FreeBaseSystem(FullSystem):
 
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         return self.difference_jacobian(t, y)
+
+    def plastic_jump(self, y, hinges, angles):
+        return plastic_jump(self, y, hinges, angles)
 
     # ------------------------------------------------------------------ coordinates
     def generalized_rates(self, y):

@@ -11,6 +11,7 @@ import numpy as np
 
 from rodval.core.scene import Scene
 from rodval.models import deployment, kernels
+from rodval.models.free_base_system import FreeBaseSystem
 from rodval.models.ladder import PAPER_RUNG, LadderSystem, check_kinematics, check_shapes
 from rodval.models.lock_records import plastic_jump
 from rodval.models.paper_matrices import (
@@ -222,8 +223,6 @@ class FullModel(PaperModel):
     def system(self, scene: Scene) -> PaperSystem:
         if scene.base.free:
             self.check_base(scene)
-            from rodval.models.free_base_system import FreeBaseSystem
-
             return FreeBaseSystem(scene)
         if (self.shapes, self.kinematics) == PAPER_RUNG:
             return FullSystem(scene, self.coefficients, self.kernel)
