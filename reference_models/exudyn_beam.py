@@ -9,7 +9,6 @@ import math
 
 import numpy as np
 
-from rodval.core.base import rotate
 from rodval.core.scene import Scene, hinge_angles
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(5)
@@ -17,25 +16,6 @@ _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(5)
 #: The records' key of a free base's body node (its states [x_c, y_c, theta] (m, m, rad) and
 #: their rates), beside the beam nodes' (rod, local node) keys.
 BODY = (-1, -1)
-
-
-def root_motion(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
-    """Node 0's initial position (m) and velocity (m/s), (2,) each: the origin at rest on a
-    pinned base; on a free base r_0 = position + R(attitude) h and v_0 = velocity + rate k x
-    R(attitude) h (h = hinge_offset, ``rodval.core.base``)."""
-    b = scene.base
-    if not b.free:
-        return np.zeros(2), np.zeros(2)
-    rho = rotate(b.attitude, np.asarray(b.hinge_offset, float))
-    perp = np.array([-rho[1], rho[0]])  # k x rho
-    return np.asarray(b.position) + rho, np.asarray(b.velocity) + b.rate * perp
-
-
-def body_mass(scene: Scene) -> tuple[float, float]:
-    """A free base's mass (kg) and inertia about its centre of mass (kg m^2)."""
-    mass, inertia = scene.base.mass, scene.base.inertia
-    assert mass is not None and inertia is not None  # a free base has both (Base)
-    return mass, inertia
 
 
 def body_attitude(at: dict) -> tuple[np.ndarray | None, np.ndarray | None]:
@@ -192,7 +172,7 @@ def _initial_node_states(scene: Scene, elements: int):
     n, l = chain.n, chain.l
     phi, dphi = ini["phi"], ini["dphi"]
     J = np.array([[0.0, -1.0], [1.0, 0.0]])
-    root, root_vel = root_motion(scene)
+    root, root_vel = scene.base.initial_root()
     s = np.linspace(0.0, 1.0, elements + 1)
     ref = np.empty((n, elements + 1, 4))
     cur = np.empty((n, elements + 1, 4))
@@ -316,7 +296,7 @@ def _energies(
     attitude, rate = body_attitude(at)
     if rate is not None:
         v_c = at[BODY][1][:, :2]
-        mass, inertia = body_mass(scene)
+        mass, inertia = scene.base.inertial()
         kin += 0.5 * (mass * np.sum(v_c**2, -1) + inertia * rate**2)
     D = hinge_angles(phi, alpha, beta, attitude)
     hinge = 0.5 * np.sum(chain.kappa * (D - chain.rest_angle) ** 2, -1)
@@ -359,7 +339,7 @@ def _momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
         first += chain.mu[k] * r
     total = float(np.sum(chain.m * chain.l + chain.mu))
     if BODY in at:
-        mass, inertia = body_mass(scene)
+        mass, inertia = scene.base.inertial()
         q_b, v_b = at[BODY][:2]
         r_c = q_b[:, :2] - root[:, 0]
         H0 += inertia * v_b[:, 2] + mass * _cross(r_c, v_b[:, :2])

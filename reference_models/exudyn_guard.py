@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, BODY, _energies, _hermite, body_mass
+from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, BODY, _energies, _hermite
 from reference_models.exudyn_build import _Built
 from rodval.core.scene import Scene
 from rodval.core.status import (
@@ -95,7 +95,7 @@ class _Guard:
         ``ref`` and its mass diag(m, m, J) into ``M``; returns its initial state and rates
         (1, 3) each."""
         b = scene.base
-        mass, inertia = body_mass(scene)
+        mass, inertia = scene.base.inertial()
         state = np.array([[b.position[0], b.position[1], b.attitude]])
         self.ref[idx] = state[0]
         self.M[idx, idx] += np.array([mass, mass, inertia])

@@ -89,10 +89,18 @@ class Base:
     def free(self) -> bool:
         return self.kind == "free"
 
-    @property
-    def root(self) -> np.ndarray:
-        """Node 0's initial position (m, (2,)): position + R(attitude) hinge_offset."""
-        return np.asarray(self.position) + rotate(self.attitude, np.asarray(self.hinge_offset))
+    def initial_root(self) -> tuple[np.ndarray, np.ndarray]:
+        """Node 0's position (m) and velocity (m/s) at t = 0, (2,) each (``root_state``); the
+        origin at rest on a pinned base."""
+        if not self.free:
+            return np.zeros(2), np.zeros(2)
+        return root_state(self, self.position, self.velocity, self.attitude, self.rate)
+
+    def inertial(self) -> tuple[float, float]:
+        """A free body's mass (kg) and inertia about its centre of mass (kg m^2)."""
+        if self.mass is None or self.inertia is None:
+            raise ValueError("a pinned base has no mass or inertia (kind 'pinned')")
+        return self.mass, self.inertia
 
     @classmethod
     def from_dict(cls, d: Any, where: str = "[base]") -> Base:
@@ -118,6 +126,15 @@ def rotate(theta: Any, v: np.ndarray) -> np.ndarray:
     """R(theta) v for body-frame vectors v (..., 2) (m), counter-clockwise theta (rad)."""
     c, s = np.cos(theta), np.sin(theta)
     return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
+
+
+def root_state(base: Base, position, velocity, attitude, rate) -> tuple[np.ndarray, np.ndarray]:
+    """Node 0's position r_0 = r_c + rho (m) and velocity v_0 = v_c + theta' k x rho (m/s),
+    rho = R(theta) hinge_offset, from the body's centre of mass r_c, v_c (..., 2), attitude
+    theta (rad) and rate theta' (rad/s) (...); each (..., 2)."""
+    rho = rotate(np.asarray(attitude), np.asarray(base.hinge_offset, float))
+    perp = np.stack([-rho[..., 1], rho[..., 0]], axis=-1)  # k x rho
+    return np.asarray(position) + rho, np.asarray(velocity) + np.asarray(rate)[..., None] * perp
 
 
 #: The default base: node 0 pinned at the origin.

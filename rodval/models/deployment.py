@@ -291,16 +291,24 @@ def _locks(S):
     return locks, S[2 + m : 2 + 2 * m]
 
 
-@njit(RHS_SIGNATURE, cache=True)
-def full_rhs_locked(t, y, P, S, M, L, out):
-    """y' of the full model with the hinges of S held (``full_accel_locked``); O(n m)."""
+@njit(cache=True, inline="always")
+def locked_head(t, y, P, S, L, out):
+    """The start of a compiled right-hand side with the hinges of S held (``rhs_head``):
+    (SX, SY, has_load, locks, lam): the load suffix sums at t (N), whether a load acts, the
+    held hinges and room for their multipliers. O(n)."""
     n = P.shape[1]
     SX = np.empty(n)
     SY = np.empty(n)
     has_load = rhs_head(t, y, L, SX, SY, out)
     locks, _ = _locks(S)
-    lam = np.empty(locks.shape[0])
-    full_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * n :], lam)
+    return SX, SY, has_load, locks, np.empty(locks.shape[0])
+
+
+@njit(RHS_SIGNATURE, cache=True)
+def full_rhs_locked(t, y, P, S, M, L, out):
+    """y' of the full model with the hinges of S held (``full_accel_locked``); O(n m)."""
+    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
+    full_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * P.shape[1] :], lam)
 
 
 @njit(RHS_SIGNATURE, cache=True)
@@ -328,14 +336,16 @@ def reduced_rhs_locked(t, y, P, S, M, L, out):
 
 
 @njit(cache=True)
-def _hinge_events(phi, alpha, beta, E, out):
+def hinge_events(phi, alpha, beta, E, out, attitude=0.0):
     """out[i] = D_k - angle for the rows [k, angle] of E, D_k = phi_k + alpha_k - phi_{k-1} -
-    beta_{k-1} (rad); O(rows)."""
+    beta_{k-1} (rad), D_0 from a free base's ``attitude`` (rad; 0 for a pin); O(rows)."""
     for i in range(E.shape[0]):
         k = int(E[i, 0])
         D = phi[k] + alpha[k]
         if k > 0:
             D -= phi[k - 1] + beta[k - 1]
+        else:
+            D -= attitude
         out[i] = D - E[i, 1]
 
 
@@ -343,7 +353,7 @@ def _hinge_events(phi, alpha, beta, E, out):
 def full_hinge_events(t, y, P, S, M, L, E, out):
     """The full model's latch and stop events: g = D_k - angle from the state's q; O(rows)."""
     n = P.shape[1]
-    _hinge_events(y[:n], y[n : 2 * n], y[2 * n : 3 * n], E, out)
+    hinge_events(y[:n], y[n : 2 * n], y[2 * n : 3 * n], E, out)
 
 
 @njit(EVENTS_SIGNATURE, cache=True)
@@ -358,4 +368,4 @@ def reduced_hinge_events(t, y, P, S, M, L, E, out):
     else:
         reduced_rhs(t, y, P, S, M, L, rates)
     gamma = M[0, 0][2 * n : 4 * n]
-    _hinge_events(y[:n], gamma[:n], gamma[n:], E, out)
+    hinge_events(y[:n], gamma[:n], gamma[n:], E, out)

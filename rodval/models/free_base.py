@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from rodval.core.loads import load_sums
-from rodval.models.deployment import _locks, _unit_moment, small_solve, superpose
+from rodval.models.deployment import _unit_moment, hinge_events, locked_head, small_solve, superpose
 from rodval.models.kernels import (
     V_KAPPA,
     V_L,
@@ -266,29 +266,21 @@ def base_rhs(t, y, P, S, M, L, out):
 @njit(RHS_SIGNATURE, cache=True)
 def base_rhs_locked(t, y, P, S, M, L, out):
     """y' with the hinges of S held (``deployment.lock_scalars``); O(n m)."""
-    n = P.shape[1]
-    SX = np.empty(n)
-    SY = np.empty(n)
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    locks, _ = _locks(S)
-    lam = np.empty(locks.shape[0])
-    base_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * n + 3 :], lam)
+    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
+    base_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * P.shape[1] + 3 :], lam)
 
 
 @njit(EVENTS_SIGNATURE, cache=True)
 def base_hinge_events(t, y, P, S, M, L, E, out):
     """Latch and stop events g = D_k - angle, hinge 0 from the body's attitude; O(rows)."""
     n = P.shape[1]
-    for i in range(E.shape[0]):
-        k = int(E[i, 0])
-        D = y[k] + y[n + k]
-        D -= y[k - 1] + y[2 * n + k - 1] if k > 0 else y[3 * n + 2]
-        out[i] = D - E[i, 1]
+    hinge_events(y[:n], y[n : 2 * n], y[2 * n : 3 * n], E, out, y[3 * n + 2])
 
 
 @njit(cache=True)
-def momentum(V, y):
-    """P = m_b v_c + M_ch v_0 + S' (N s): the whole system's linear momentum; O(n)."""
+def _root_rates(V, y):
+    """(v_0 (m/s), S' (kg m/s)) at y = [Q; Q']: node 0's velocity v_c + theta' k x rho and the
+    rate of the chain's first mass moment about it, J_S q'; O(n)."""
     n = V.shape[1]
     N = 3 * n + 3
     c = np.cos(y[:n])
@@ -298,10 +290,16 @@ def momentum(V, y):
     jx, jy = _first_moment_rate(V, c, s, delta, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
     rx, ry = _rho(V, y[3 * n + 2])
     dth = v[3 * n + 2]
-    v0x = v[3 * n] - dth * ry
-    v0y = v[3 * n + 1] + dth * rx
+    return v[3 * n] - dth * ry, v[3 * n + 1] + dth * rx, jx, jy
+
+
+@njit(cache=True)
+def momentum(V, y):
+    """P = m_b v_c + M_ch v_0 + S' (N s): the whole system's linear momentum; O(n)."""
+    vc = y[-3:-1]  # the body's velocity: Q' ends with x_c', y_c', theta'
+    v0x, v0y, jx, jy = _root_rates(V, y)
     mb, mch = V[V_BM, 0], V[V_MCH, 0]
-    return mb * v[3 * n] + mch * v0x + jx, mb * v[3 * n + 1] + mch * v0y + jy
+    return mb * vc[0] + mch * v0x + jx, mb * vc[1] + mch * v0y + jy
 
 
 @njit(RHS_SIGNATURE, cache=True)
@@ -313,14 +311,8 @@ def base_mechanics(t, y, P, S, M, L, out):
     N = 3 * n + 3
     full_mechanics(t, _chain_state(y, n), P, S, M, L, out)
     v = y[N:]
-    c = np.cos(y[:n])
-    s = np.sin(y[:n])
-    delta = y[n : 2 * n] - y[2 * n : 3 * n]
-    jx, jy = _first_moment_rate(P, c, s, delta, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
-    rx, ry = _rho(P, y[3 * n + 2])
     dth = v[3 * n + 2]
-    v0x = v[3 * n] - dth * ry
-    v0y = v[3 * n + 1] + dth * rx
+    v0x, v0y, jx, jy = _root_rates(P, y)
     mb, mch = P[V_BM, 0], P[V_MCH, 0]
     vc2 = v[3 * n] ** 2 + v[3 * n + 1] ** 2
     out[0] += 0.5 * (mb * vc2 + P[V_BJ, 0] * dth * dth + mch * (v0x * v0x + v0y * v0y))

@@ -12,21 +12,22 @@ from __future__ import annotations
 
 import numpy as np
 
-from rodval.core.base import rotate
+from rodval.core.base import root_state
 from rodval.core.scene import Scene
 from rodval.models import free_base as fb
 from rodval.models.kernels import full_constants
-from rodval.models.lock_records import plastic_jump
+from rodval.models.paper_energy import _NO_LOADS, _NO_MATRICES
 from rodval.models.paper_matrices import hinge_matrix
-from rodval.models.paper_system import PaperSystem
+from rodval.models.paper_system import StackedSystem
 
 
-class FreeBaseSystem(PaperSystem):
+class FreeBaseSystem(StackedSystem):
     """The full model (the paper's rung, printed coefficients, compiled kernel) on a free
     base."""
 
-    full = True
     accel_kernel = staticmethod(fb.base_accel)
+    locked_kernel = staticmethod(fb.base_accel_locked)
+    unit_kernel = staticmethod(fb.base_unit_responses)
     compiled_rhs = staticmethod(fb.base_rhs)
     compiled_mechanics = staticmethod(fb.base_mechanics)
     compiled_rhs_locked = staticmethod(fb.base_rhs_locked)
@@ -37,8 +38,9 @@ class FreeBaseSystem(PaperSystem):
         b, i = scene.base, self.initial
         self.N = 3 * self.n + 3
         self.body = b
-        assert b.mass is not None and b.inertia is not None  # a free base has both (Base)
-        self.body_mass, self.body_inertia = b.mass, b.inertia
+        self.body_mass, self.body_inertia = b.inertial()
+        #: each rod's mass with its far node's (kg)
+        self.rod_mass = self.base_chain.m * self.base_chain.l + self.base_chain.mu
         self.y0 = np.concatenate(
             [
                 i["phi"],
@@ -56,37 +58,13 @@ class FreeBaseSystem(PaperSystem):
         self.use_kernel()
 
     def kernel_constants(self) -> np.ndarray:
-        chain, b = self.chain, self.body
-        mass = float(np.sum(chain.m * chain.l + chain.mu))
-        rows = [self.body_mass, self.body_inertia, b.hinge_offset[0], b.hinge_offset[1], mass]
-        V = full_constants(self.cc, chain)
+        h = self.body.hinge_offset
+        rows = [self.body_mass, self.body_inertia, h[0], h[1], float(self.rod_mass.sum())]
+        V = full_constants(self.cc, self.chain)
         return np.vstack([V, np.outer(rows, np.ones(self.n))])
-
-    def numpy_rhs(self, t, y):  # the kernel is the compiled one (FreeBaseModel refuses numpy)
-        raise NotImplementedError
 
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         return self.difference_jacobian(t, y)
-
-    def plastic_jump(self, y, hinges, angles):
-        return plastic_jump(self, y, hinges, angles)
-
-    # ------------------------------------------------------------------ coordinates
-    def generalized_rates(self, y):
-        return y[self.N :]
-
-    def rigid(self, Y):
-        n, N = self.n, self.N
-        return Y[:, :n], Y[:, N : N + n]
-
-    def bending(self, times, Y):
-        n, N = self.n, self.N
-        return (
-            Y[:, n : 2 * n],
-            Y[:, 2 * n : 3 * n],
-            Y[:, N + n : N + 2 * n],
-            Y[:, N + 2 * n : N + 3 * n],
-        )
 
     def attitude(self, Y):
         return Y[:, 3 * self.n + 2]
@@ -101,10 +79,7 @@ class FreeBaseSystem(PaperSystem):
 
     def root_states(self, Y) -> tuple[np.ndarray, np.ndarray]:
         """(r_0 (m), v_0 (m/s)) of node 0, each (nt, 2): r_c + rho, v_c + theta' k x rho."""
-        rc, vc = self.body_states(Y)
-        rho = rotate(self.attitude(Y), np.asarray(self.body.hinge_offset))
-        perp = np.stack([-rho[:, 1], rho[:, 0]], axis=-1)
-        return rc + rho, vc + self.attitude_rate(Y)[:, None] * perp
+        return root_state(self.body, *self.body_states(Y), self.attitude(Y), self.attitude_rate(Y))
 
     def root_motion(self, y):
         r0, v0 = self.root_states(y[None, :])
@@ -119,26 +94,9 @@ class FreeBaseSystem(PaperSystem):
         A[hinges == 0, 3 * self.n + 2] = -1.0
         return A
 
-    def unit_responses(self, q, hinges) -> np.ndarray:
-        U = np.empty((len(hinges), self.N))
-        fb.base_unit_responses(self.V, q, np.asarray(hinges, np.int64), U)
-        return U
-
-    def accel_locked(self, t, y):
-        sums = self.loads.suffix_sums(t)
-        SX, SY = (self._no_load, self._no_load) if sums is None else sums
-        out = np.empty(self.N)
-        lam = np.empty(self._lock_h.size)
-        fb.base_accel_locked(
-            self.V, y, sums is not None, SX, SY, self.damped, self._lock_h, out, lam
-        )
-        return out, lam
-
     # ------------------------------------------------------------------ energies, momenta
     def kinetic_energy(self, t, y):
-        self.compiled_mechanics(
-            0.0, y, self.V, self._flags, np.zeros((0, 0, 0)), np.zeros((0, 6)), self._mech
-        )
+        self.compiled_mechanics(0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech)
         return float(self._mech[0])
 
     def energy_rows(self, times, Y):
@@ -148,8 +106,7 @@ class FreeBaseSystem(PaperSystem):
         return kin, self.potential(phi, alpha, beta, self.attitude(Y))
 
     def energy_budget(self, t, y):
-        kin, pot = self.energy_rows(np.array([t]), y[None, :])
-        return float(kin[0] + pot[0])
+        return self._energy_in_mode(t, y)
 
     def rod_momenta_at(self, y):
         """The pinned chain's rod momenta (``PaperEnergy.rod_momenta_at``) with node 0 moving:
@@ -157,7 +114,7 @@ class FreeBaseSystem(PaperSystem):
         m_k r_0 (m_k: rod k's mass with its far node's)."""
         p, h, first = super().rod_momenta_at(y)
         r0, v0 = self.root_motion(y)
-        mass = self.base_chain.m * self.base_chain.l + self.base_chain.mu
+        mass = self.rod_mass
         h = h + mass * _cross(r0, v0) + _cross(r0, p) + _cross(first, v0)
         return p + mass[:, None] * v0, h, first + mass[:, None] * r0
 
@@ -173,11 +130,12 @@ class FreeBaseSystem(PaperSystem):
         r0 = self.root_states(Y)[0]
         mb = self.body_mass
         out = np.empty((len(Y), 2))
-        total = mb + float(np.sum(self.base_chain.m * self.base_chain.l + self.base_chain.mu))
+        total = mb + float(self.rod_mass.sum())
         P = self.momentum_rows(Y)
+        spin = self.body_inertia * self.attitude_rate(Y)
         for i, y in enumerate(Y):
             _, h, first = self.rod_momenta_at(y)
-            HO = self.body_inertia * self.attitude_rate(Y)[i] + mb * _cross(rc[i], vc[i]) + h.sum()
+            HO = spin[i] + mb * _cross(rc[i], vc[i]) + h.sum()
             X = (mb * rc[i] + first.sum(axis=0)) / total
             out[i] = HO - _cross(r0[i], P[i]), HO - _cross(X, P[i])
         return out

@@ -42,7 +42,6 @@ from rodval.models.ladder_kernels import (
     ladder_rhs_locked,
     ladder_unit_responses,
 )
-from rodval.models.lock_records import plastic_jump
 from rodval.models.paper_matrices import (
     angle_differences,
     chain_constants,
@@ -52,7 +51,7 @@ from rodval.models.paper_matrices import (
 from rodval.models.paper_matrices import (
     angular_momentum_rows as momentum_rows,
 )
-from rodval.models.paper_system import PaperSystem
+from rodval.models.paper_system import StackedSystem
 from rodval.models.shapes import MAX_SHAPES, RodShapes, rod_shapes
 
 #: ``kinematics`` of the full model; the first is the paper's (the default).
@@ -190,13 +189,14 @@ def rod_momenta_exact(
     return np.stack([p.real, p.imag], -1), h, np.stack([first.real, first.imag], -1)
 
 
-class LadderSystem(PaperSystem):
+class LadderSystem(StackedSystem):
     """A rung of the ladder other than the paper's (``shapes`` p, ``kinematics``); the
     compiled kernels only (the dense numpy kernel is the paper model's reference)."""
 
     has_jacobian = False
-    full = True
     accel_kernel = staticmethod(ladder_accel)
+    locked_kernel = staticmethod(ladder_accel_locked)
+    unit_kernel = staticmethod(ladder_unit_responses)
     compiled_rhs = staticmethod(ladder_rhs)
     compiled_mechanics = staticmethod(ladder_mechanics)
     compiled_rhs_locked = staticmethod(ladder_rhs_locked)
@@ -231,47 +231,13 @@ class LadderSystem(PaperSystem):
     def kernel_constants(self):
         return ladder_constants(self.chain, self.p, self.exact)
 
-    def generalized_rates(self, y):
-        return y[self.N :]
-
-    def rigid(self, Y):
-        n, N = self.n, self.N
-        return Y[:, :n], Y[:, N : N + n]
-
-    def bending(self, times, Y):
-        n, N = self.n, self.N
-        return (
-            Y[:, n : 2 * n],
-            Y[:, 2 * n : 3 * n],
-            Y[:, N + n : N + 2 * n],
-            Y[:, N + 2 * n : N + 3 * n],
-        )
-
     def _split(self, y: np.ndarray):
         """(phi, phi', g (p+1, n), g' (p+1, n)) of one state."""
         n, N, P1 = self.n, self.N, self.p + 1
         return y[:n], y[N : N + n], y[n:N].reshape(P1, n), y[N + n :].reshape(P1, n)
 
-    def accel_locked(self, t, y):
-        sums = self.loads.suffix_sums(t)
-        SX, SY = (self._no_load, self._no_load) if sums is None else sums
-        out = np.empty(self.N)
-        lam = np.empty(self._lock_h.size)
-        ladder_accel_locked(
-            self.V, y, sums is not None, SX, SY, self.damped, self._lock_h, out, lam
-        )
-        return out, lam
-
-    def unit_responses(self, q, hinges) -> np.ndarray:
-        U = np.empty((len(hinges), self.N))
-        ladder_unit_responses(self.V, q, np.asarray(hinges, np.int64), U)
-        return U
-
     def hinge_rows(self, hinges) -> np.ndarray:
         return rung_hinge_matrix(self.n, self.p)[hinges]
-
-    def plastic_jump(self, y, hinges, angles):
-        return plastic_jump(self, y, hinges, angles)
 
     def kinetic_energy(self, t, y):
         return float(ladder_kinetic(self.V, y))

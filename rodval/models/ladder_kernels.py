@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.models.deployment import _locks, _unit_moment, superpose
+from rodval.models.deployment import _unit_moment, locked_head, superpose
 from rodval.models.kernels import (
     V_KAPPA,
     V_L,
@@ -279,12 +279,7 @@ def ladder_rhs(t, y, P, S, M, L, out):
 @njit(RHS_SIGNATURE, cache=True)
 def ladder_rhs_locked(t, y, P, S, M, L, out):
     """y' of the ladder with the hinges of S held (``deployment.lock_scalars``)."""
-    n = P.shape[1]
-    SX = np.empty(n)
-    SY = np.empty(n)
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    locks, _ = _locks(S)
-    lam = np.empty(locks.shape[0])
+    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
     half = y.shape[0] // 2
     ladder_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[half:], lam)
 

@@ -15,7 +15,7 @@ from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
 from rodval.models import deployment
-from rodval.models.lock_records import energy_parts, lock_record, window_terms
+from rodval.models.lock_records import energy_parts, lock_record, plastic_jump, window_terms
 from rodval.models.paper_energy import _NO_MATRICES, PaperEnergy
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
@@ -218,9 +218,8 @@ class PaperSystem(PaperEnergy, OdeSystem):
         paper_matrices.generalized_forces); P_diss = q'^T C q' = sum_k nu_k (dD_k/dt)^2 >= 0,
         the power taken out by the hinge dampers (D_k: hinge angles)."""
         phi, dphi = (a[0] for a in self.rigid(y[None, :]))
-        Q = self.generalized_force(t, phi)
-        p_ext = 0.0 if Q is None else float(Q @ dphi)
         sums = self.loads.suffix_sums(t)
+        p_ext = 0.0 if sums is None else float(generalized_forces(self.l, phi, *sums) @ dphi)
         if sums is not None and self.scene.base.free:  # the loads' resultant on node 0's motion
             v0 = self.root_motion(y)[1]
             p_ext += float(sums[0][0] * v0[0] + sums[1][0] * v0[1])
@@ -513,6 +512,50 @@ class PaperSystem(PaperEnergy, OdeSystem):
     def accel_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(accelerations, multipliers lambda (N m)) with the locked hinges held."""
         raise NotImplementedError
+
+
+class StackedSystem(PaperSystem):
+    """A full-model system whose state is [Q; Q'] with N = len(Q) coordinates, the chain's
+    phi, alpha, beta first and more after them (a ladder rung's bubbles, a free base's body),
+    on compiled kernels: ``locked_kernel(V, y, has_load, SX, SY, damped, locks, out, lam)``
+    and ``unit_kernel(V, q, locks, U)`` (U[j] = M^-1 a_{locks[j]})."""
+
+    full = True
+    N: int
+    locked_kernel: Any
+    unit_kernel: Any
+
+    def generalized_rates(self, y):
+        return y[self.N :]
+
+    def rigid(self, Y):
+        n, N = self.n, self.N
+        return Y[:, :n], Y[:, N : N + n]
+
+    def bending(self, times, Y):
+        n, N = self.n, self.N
+        return (
+            Y[:, n : 2 * n],
+            Y[:, 2 * n : 3 * n],
+            Y[:, N + n : N + 2 * n],
+            Y[:, N + 2 * n : N + 3 * n],
+        )
+
+    def accel_locked(self, t, y):
+        sums = self.loads.suffix_sums(t)
+        SX, SY = (self._no_load, self._no_load) if sums is None else sums
+        out = np.empty(self.N)
+        lam = np.empty(self._lock_h.size)
+        self.locked_kernel(self.V, y, sums is not None, SX, SY, self.damped, self._lock_h, out, lam)
+        return out, lam
+
+    def unit_responses(self, q, hinges) -> np.ndarray:
+        U = np.empty((len(hinges), self.N))
+        self.unit_kernel(self.V, q, np.asarray(hinges, np.int64), U)
+        return U
+
+    def plastic_jump(self, y, hinges, angles):
+        return plastic_jump(self, y, hinges, angles)
 
 
 class PaperModel(OdeModel):
