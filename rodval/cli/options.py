@@ -208,6 +208,25 @@ def add_junit_option(p) -> None:
     )
 
 
+def check_junit(junit: Path | None, out: Path, inputs: tuple[Path, ...] = ()) -> Path | None:
+    """The --junit file, checked before any work (``check_output_file``): writable, none of
+    the command's ``inputs``, none of the study's own files in ``out``, and, if it exists, a
+    JUnit report rodval wrote."""
+    if junit is None:
+        return None
+    from rodval.core.out_paths import check_output_file
+    from rodval.report.acceptance import is_junit_report
+    from rodval.study.store import StudyStore
+
+    return check_output_file(
+        junit,
+        "--junit",
+        protected=inputs,
+        reserved=StudyStore(out).reserved,
+        ours=is_junit_report,
+    )
+
+
 def acceptance_exit(out: Path, junit: Path | None) -> int:
     """Print one line per breach of the study's [acceptance] in ``out`` (writing the JUnit
     file when asked); exit code 1 when any bound broke, else 0."""

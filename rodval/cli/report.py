@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rodval.cli.options import acceptance_exit, add_junit_option
+from rodval.cli.options import acceptance_exit, add_junit_option, check_junit
 
 
 def register(sub) -> None:
@@ -22,5 +22,6 @@ def register(sub) -> None:
 def run(args) -> int:
     from rodval.report.study_report import build_report
 
+    check_junit(args.junit, args.dir)
     print(build_report(args.dir))
     return acceptance_exit(args.dir, args.junit)

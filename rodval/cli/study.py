@@ -7,7 +7,13 @@ import signal
 import sys
 from pathlib import Path
 
-from rodval.cli.options import acceptance_exit, add_junit_option, positive_float, positive_int
+from rodval.cli.options import (
+    acceptance_exit,
+    add_junit_option,
+    check_junit,
+    positive_float,
+    positive_int,
+)
 from rodval.study.spec import MAX_CASES
 
 
@@ -88,9 +94,16 @@ def run(args) -> int:
             cases = f"{size} case" + ("s" if size != 1 else "")
             print(f"{args.file}: {cases}; checking them before any runs", flush=True)
 
-    spec = load_study(args.file, max_cases=args.max_cases or MAX_CASES, announce=announce)
     if args.backend == "dask" and not args.scheduler:
         raise ValueError("--backend dask needs --scheduler ADDR")
+    if args.backend == "processes" and args.scheduler:
+        raise ValueError(
+            f"--scheduler {args.scheduler}: the processes backend runs on this machine and "
+            "takes no scheduler; add --backend dask to use it"
+        )
+    check_junit(args.junit, args.out, inputs=(args.file,))
+    StudyStore(args.out).check_folder()
+    spec = load_study(args.file, max_cases=args.max_cases or MAX_CASES, announce=announce)
     signal.signal(signal.SIGTERM, signal.default_int_handler)
     try:
         res = run_study(

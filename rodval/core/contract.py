@@ -43,7 +43,8 @@ class Model(ABC):
         trajectory = self.run(scene, settings)
         trajectory.scene = scene
         stats = trajectory.stats
-        stats.valid, stats.validity = verdict(self.validity_checks(scene, trajectory))
+        checks = self.validity_checks(scene, trajectory)
+        stats.valid, stats.validity = verdict(checks, finished=trajectory.success)
         stats.notes = self.scene_notes(scene)
         return trajectory
 

@@ -94,12 +94,15 @@ def step_resolution(rotation: float | None, bound: float) -> list[Check]:
     return [Check("step resolution", float(rotation), bound, "rad", "largest rotation per step")]
 
 
-def verdict(checks: list[Check]) -> tuple[bool | None, list[dict[str, Any]]]:
+def verdict(checks: list[Check], finished: bool = True) -> tuple[bool | None, list[dict[str, Any]]]:
     """(valid, validity): valid is None when nothing could be checked, else whether every
-    check holds; validity lists every check with its figure, bound and reason."""
+    check holds; validity lists every check with its figure, bound and reason. A run that
+    did not finish (``finished`` False) is never called valid: its checks cover only the part
+    it computed, so where they all hold valid is None (no verdict), and False where one broke."""
     if not checks:
         return None, []
-    return all(c.holds for c in checks), [c.as_dict() for c in checks]
+    holds = all(c.holds for c in checks)
+    return (None if holds and not finished else holds), [c.as_dict() for c in checks]
 
 
 def broken(validity: list[dict[str, Any]]) -> list[str]:
@@ -108,8 +111,11 @@ def broken(validity: list[dict[str, Any]]) -> list[str]:
 
 
 def describe(valid: bool | None, validity: list[dict[str, Any]]) -> str:
-    """The verdict in a few words, for summary lines: 'valid', 'validity not checked' or
-    'INVALID: <reason>; <reason>'."""
+    """The verdict in a few words, for summary lines: 'valid', 'INVALID: <reason>; ...',
+    'validity not checked', or, for a run that stopped early whose checks held up to there,
+    'no verdict (the run stopped early; its checks held up to the time reached)'."""
     if valid is None:
+        if validity:
+            return "no verdict (the run stopped early; its checks held up to the time reached)"
         return "validity not checked"
     return "valid" if valid else "INVALID: " + "; ".join(broken(validity))

@@ -12,7 +12,13 @@ import numpy as np
 from rodval.core.scene import Scene
 from rodval.models import deployment, kernels
 from rodval.models.free_base_system import FreeBaseSystem
-from rodval.models.ladder import PAPER_RUNG, LadderSystem, check_kinematics, check_shapes
+from rodval.models.ladder import (
+    PAPER_RUNG,
+    LadderSystem,
+    check_kinematics,
+    check_rung_options,
+    check_shapes,
+)
 from rodval.models.lock_records import plastic_jump
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
@@ -198,6 +204,8 @@ class FullModel(PaperModel):
         super().__init__(coefficients, kernel)
         self.shapes = check_shapes(shapes)
         self.kinematics = check_kinematics(kinematics)
+        if (self.shapes, self.kinematics) != PAPER_RUNG:
+            check_rung_options(self.coefficients, self.kernel)
 
     def options(self):
         return {**super().options(), "shapes": self.shapes, "kinematics": self.kinematics}

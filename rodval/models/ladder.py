@@ -189,6 +189,22 @@ def rod_momenta_exact(
     return np.stack([p.real, p.imag], -1), h, np.stack([first.real, first.imag], -1)
 
 
+def check_rung_options(coefficients: str, kernel: str) -> None:
+    """ValueError unless a rung other than the paper's has the options it runs with: the
+    printed coefficients and the compiled kernel (checked when the model is made, before
+    any work)."""
+    if coefficients != "printed":
+        raise ValueError(
+            "coefficients must be 'printed' with shapes > 1 or exact kinematics (the "
+            f"published erratum belongs to the paper's model), got {coefficients!r}"
+        )
+    if kernel != "numba":
+        raise ValueError(
+            "kernel must be 'numba' with shapes > 1 or exact kinematics (the numpy "
+            f"kernel is the paper model's dense reference), got {kernel!r}"
+        )
+
+
 class LadderSystem(StackedSystem):
     """A rung of the ladder other than the paper's (``shapes`` p, ``kinematics``); the
     compiled kernels only (the dense numpy kernel is the paper model's reference)."""
@@ -203,16 +219,7 @@ class LadderSystem(StackedSystem):
     compiled_events = staticmethod(deployment.full_hinge_events)  # D from [phi; alpha; beta]
 
     def __init__(self, scene: Scene, coefficients: str, kernel: str, shapes: int, kinematics: str):
-        if coefficients != "printed":
-            raise ValueError(
-                "coefficients must be 'printed' with shapes > 1 or exact kinematics (the "
-                f"published erratum belongs to the paper's model), got {coefficients!r}"
-            )
-        if kernel != "numba":
-            raise ValueError(
-                "kernel must be 'numba' with shapes > 1 or exact kinematics (the numpy "
-                f"kernel is the paper model's dense reference), got {kernel!r}"
-            )
+        check_rung_options(coefficients, kernel)
         self.p = check_shapes(shapes)
         self.exact = check_kinematics(kinematics) == "exact"
         super().__init__(scene, coefficients, kernel)

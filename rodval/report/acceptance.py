@@ -75,11 +75,26 @@ def breach_lines(checks: list[Check]) -> list[str]:
     return [f"acceptance breached: {c.name}: {c.failure}" for c in checks if not c.held]
 
 
+#: The name of the ``<testsuites>`` element of rodval's JUnit reports: how a later run knows
+#: that a file at its --junit path is its own to overwrite (``is_junit_report``).
+JUNIT_NAME = "rodval acceptance"
+
+
+def is_junit_report(path: Path) -> bool:
+    """Whether ``path`` is a JUnit report rodval wrote (its root names ``JUNIT_NAME``)."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(512)
+    except OSError:
+        return False
+    return head.startswith(b"<?xml") and f'<testsuites name="{JUNIT_NAME}"'.encode() in head
+
+
 def write_junit(checks: list[Check], path: Path, suite: str) -> Path:
     """A JUnit XML file of ``checks`` (one ``<testcase>`` each, a ``<failure>`` where one
     broke) in one ``<testsuite>`` named ``suite``."""
     failures = sum(not c.held for c in checks)
-    root = ET.Element("testsuites", tests=str(len(checks)), failures=str(failures))
+    root = ET.Element("testsuites", name=JUNIT_NAME, tests=str(len(checks)), failures=str(failures))
     ts = ET.SubElement(
         root, "testsuite", name=suite, tests=str(len(checks)), failures=str(failures)
     )

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from rodval.core.out_paths import STUDY_SCHEMA, is_stamped
 from rodval.models import get_model
 from rodval.models.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
@@ -356,6 +357,12 @@ def build_report(out: str | Path) -> Path:
     meta: dict[str, Any] = _read_json(
         out / "study.json", ("name", "models", "reference", "labels", "axes", "report")
     )
+    if not is_stamped(meta, STUDY_SCHEMA):
+        raise ValueError(
+            f"{out} is not a study folder of rodval: its study.json carries no rodval schema "
+            "and checksum (another program's file, edited, or from an older rodval), so "
+            "rodval report will not write report.md there"
+        )
     prov = _read_json(out / "provenance.json", ("machine", "packages"))
     tables = read_tables(out)
     params = ["n", "horizon", *axis_columns(meta).values()]

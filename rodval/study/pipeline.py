@@ -82,6 +82,8 @@ def _no_silent_nonfinite(traj: Trajectory) -> None:
             traj.stats.message = (
                 f"diverged: the model reported success with non-finite values of {q!r}"
             )
+            if traj.stats.valid:  # no verdict on a run that failed (rodval.core.validity)
+                traj.stats.valid = None
             return
 
 
@@ -136,7 +138,8 @@ def run_study(
     backend: "processes" or "dask" (then ``scheduler`` is the address of a running
     dask.distributed scheduler).
     fresh: first remove what the study in ``out`` wrote (needed when it holds another
-    study); refused for a folder with files but no study.json (not a study folder).
+    study); a folder that holds files but is not a study folder of rodval (no study.json
+    with rodval's schema and checksum) is refused, with or without ``fresh``.
     Every argument is checked before any work; a second run on the same folder at the same
     time is refused (``FolderBusy``).
     """
@@ -145,14 +148,18 @@ def run_study(
     check_choice("backend", backend, BACKENDS)
     if backend == "dask" and not scheduler:
         raise ValueError("backend 'dask' needs --scheduler ADDRESS of a running dask scheduler")
+    if backend == "processes" and scheduler is not None:
+        raise ValueError(
+            f"scheduler {scheduler!r:.60}: the processes backend runs on this machine and takes "
+            "no scheduler; use backend 'dask'"
+        )
     workers = _check_workers(default_workers() if workers is None else workers)
     _check_case_timeout(case_timeout)
     if out.exists() and not out.is_dir():
         raise ValueError(f"out must be a folder, got the file {str(out)!r}")
     start = time.perf_counter()
     store = StudyStore(out)
-    if fresh:
-        store.check_fresh()
+    store.check_folder()
     warnings: list[str] = []
     with store.lock():
         store.claim(study_meta(spec), fresh=fresh)

@@ -10,9 +10,12 @@ and ``figures/``.
   same folder is refused with a ``FolderBusy`` naming the holder's pid.
 * One study: a folder that holds another study (``study.json`` with a different name or
   source, or a different grid) is refused unless ``fresh=True`` (``--fresh``), which first
-  removes what the study wrote (``study_files``) and nothing else. ``study.json`` is what
-  marks a study folder: ``--fresh`` on a folder with files but no ``study.json`` is refused,
-  and files a user put into a study folder are kept.
+  removes what the study wrote (``study_files``) and nothing else.
+* rodval's folders only: a folder is a study folder when its ``study.json`` carries rodval's
+  schema and checksum (``rodval.core.out_paths.stamp``). Any other folder that holds files
+  (a user's ``report.md``, a foreign ``study.json``) is refused before work, with or without
+  ``--fresh``, naming what it holds (``check_folder``); files a user put into a study folder
+  are kept.
 * Case file names are bounded (``MAX_NAME``) whatever the grid: a readable prefix of the case
   id and a hash of the full id; the full parameters live in the record.
 """
@@ -29,6 +32,15 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from rodval.core.out_paths import (
+    HOUSEKEEPING,
+    STUDY_SCHEMA,
+    inside,
+    is_stamped,
+    read_json,
+    refuse_foreign,
+    stamp,
+)
 from rodval.report.tables import ALL_TABLES, FIGURES, MANIFEST
 
 #: Name of the temporary file of an atomic write (``write_text_atomic``): ``.<name>.<pid>.tmp``.
@@ -36,6 +48,10 @@ TEMPORARY = re.compile(r"\..+\.\d+\.tmp")
 
 #: Longest case file name (characters, with ".json"): well below every file system's 255.
 MAX_NAME = 120
+
+
+#: The files a study writes at the top of its folder besides its tables.
+TOP_FILES = ("study.json", "study.toml", "provenance.json", "report.md", MANIFEST)
 
 
 class FolderBusy(ValueError):
@@ -78,14 +94,26 @@ class StudyStore:
         return self.cases_dir / case_file_name(case_id)
 
     def meta(self) -> dict[str, Any] | None:
-        """The saved study.json, or None when there is none (a new folder)."""
+        """The saved study.json, or None when there is none (a new folder); ValueError when
+        it is not rodval's (no rodval schema and checksum: foreign, edited or damaged)."""
         path = self.out / "study.json"
         if not path.is_file():
             return None
+        doc = read_json(path)
+        if not is_stamped(doc, STUDY_SCHEMA):
+            raise ValueError(
+                f"--out {self.out}: its study.json was not written by rodval (no rodval schema "
+                "and checksum: another program's file, edited, damaged or from an older rodval), "
+                "so rodval will not write there; use a new or empty --out"
+            )
+        return dict(doc)
+
+    def owned(self) -> bool:
+        """Whether the folder is a study folder of rodval (a stamped study.json)."""
         try:
-            return json.loads(path.read_text())
-        except (OSError, json.JSONDecodeError) as exc:
-            raise ValueError(f"{path}: unreadable study description ({exc})") from None
+            return self.meta() is not None
+        except ValueError:
+            return False
 
     @contextmanager
     def lock(self) -> Iterator[None]:
@@ -110,25 +138,30 @@ class StudyStore:
         finally:
             fh.close()
 
-    def check_fresh(self) -> None:
-        """Refuse ``--fresh`` on a folder that holds files but is not a study folder (no
-        study.json): only what a study wrote is ever removed (before the lock or any write)."""
-        if not self.out.is_dir() or self.meta() is not None:
-            return
-        other = sorted(p.name for p in self.out.iterdir() if p.name != ".lock")
-        if other:
-            raise ValueError(
-                f"--out {self.out}: not a study folder (no study.json; it holds {other[0]!r}"
-                f"{f' and {len(other) - 1} more' if len(other) > 1 else ''}), so --fresh "
-                "will not empty it; use a new or empty --out"
-            )
+    def check_folder(self) -> None:
+        """Refuse, before the lock or any write, a folder rodval may not write into: one that
+        holds files but is not a study folder of rodval (``refuse_foreign``), or whose
+        study.json is not rodval's (``meta``)."""
+        self.meta()
+        refuse_foreign(self.out, "--out", lambda f: StudyStore(f).owned(), "study", "study.json")
+
+    def reserved(self, path: Path) -> str | None:
+        """Why ``path`` is not free for another output (a file the study writes, or one in
+        its cases/ or figures/), or None."""
+        rel = inside(path, self.out)
+        if rel is None:
+            return None
+        top = {*TOP_FILES, *HOUSEKEEPING, *(f"{t}.{e}" for t in ALL_TABLES for e in ("csv", "md"))}
+        if str(rel) in top or rel.parts[0] in ("cases", FIGURES):
+            return f"a file of the study in {self.out}"
+        return None
 
     def study_files(self, meta: dict[str, Any]) -> list[Path]:
         """The files the study described by ``meta`` (its study.json) wrote into the folder:
         study.json, study.toml, provenance.json, the tables (``<name>.csv`` and ``.md``) and
         their manifest, report.md, the figures report.md links, the records of its cases and the temporary
         files of interrupted atomic writes. ``--fresh`` removes these and nothing else."""
-        top = ["study.json", "study.toml", "provenance.json", "report.md", MANIFEST]
+        top = list(TOP_FILES)
         top += [f"{name}.{ext}" for name in ALL_TABLES for ext in ("csv", "md")]
         files = [self.out / name for name in top]
         report = self.out / "report.md"
@@ -160,7 +193,7 @@ class StudyStore:
                 if folder.is_dir() and not any(folder.iterdir()):
                     folder.rmdir()
         self.cases_dir.mkdir(parents=True, exist_ok=True)
-        write_json_atomic(self.out / "study.json", meta)
+        write_json_atomic(self.out / "study.json", stamp(meta, STUDY_SCHEMA))
 
 
 def same_study(a: dict[str, Any], b: dict[str, Any]) -> bool:
