@@ -60,6 +60,23 @@ def one_line(exc: BaseException) -> str:
     return text or type(exc).__name__
 
 
+def _run(args: argparse.Namespace) -> int:
+    """Run the subcommand. A command that writes a plain output folder (``out_folder`` set
+    by its parser) is refused one that holds files rodval did not write, before any work,
+    and the folder is marked rodval's once the command has written into it
+    (``rodval.core.out_paths``)."""
+    command = getattr(args, "out_folder", None)
+    if command is None:
+        return int(args.func(args) or 0)
+    from rodval.core.out_paths import claim_output_folder, mark_output_folder
+
+    claim_output_folder(args.out)
+    try:
+        return int(args.func(args) or 0)
+    finally:
+        mark_output_folder(args.out, command)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run a subcommand. A user error (bad option, file, value) is one line on stderr and exit
     status 2; anything unexpected is one line too, exit 2, naming the exception's type and
@@ -71,7 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            return int(args.func(args) or 0)
+            return _run(args)
     except (CliError, ValueError, OSError) as exc:
         print(f"rodval {args.command}: error: {one_line(exc)}", file=sys.stderr)
         return 2

@@ -171,6 +171,7 @@ def register(sub) -> None:
             "--repeats", type=_repeats, default=3, help="timed runs after a warm-up (min is kept)"
         )
         q.add_argument("--out", required=True, type=Path, help="output folder")
+        q.set_defaults(out_folder="bench")
 
 
 def _write(out: Path, stem: str, frame, title: str, body: list[str]) -> None:

@@ -69,7 +69,7 @@ def register(sub) -> None:
         help="also pair the modes of these models (comma-separated, default "
         "full,reduced,exudyn) with --model's and write DIR/compare.csv",
     )
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, out_folder="modes")
 
 
 def run(args) -> int:

@@ -40,7 +40,7 @@ def register(sub) -> None:
         action="store_false",
         help="skip the exudyn cross-check",
     )
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, out_folder="reproduce")
 
 
 def run(args) -> int:

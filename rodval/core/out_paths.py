@@ -146,3 +146,25 @@ def inside(path: Path, folder: Path) -> Path | None:
         return path.resolve().relative_to(folder.resolve())
     except (ValueError, OSError, RuntimeError):
         return None
+
+
+#: The marker of a plain output folder (``rodval compare``, ``modes``, ``reproduce``,
+#: ``bench``): ``rodval.json``, stamped with ``OUTPUT_SCHEMA``, naming the command.
+OUTPUT_MARKER, OUTPUT_SCHEMA = "rodval.json", "rodval-output"
+
+
+def output_folder_owned(folder: Path) -> bool:
+    """Whether ``folder`` carries rodval's output marker (``mark_output_folder``)."""
+    return is_stamped(read_json(folder / OUTPUT_MARKER), OUTPUT_SCHEMA)
+
+
+def claim_output_folder(folder: Path, flag: str = "--out") -> None:
+    """Refuse, before work, an output folder that holds files rodval did not write."""
+    refuse_foreign(folder, flag, output_folder_owned, "output", OUTPUT_MARKER)
+
+
+def mark_output_folder(folder: Path, command: str) -> None:
+    """Mark ``folder`` (when the command made or wrote it) as rodval's output folder."""
+    if folder.is_dir() and not output_folder_owned(folder):
+        record = stamp({"command": command}, OUTPUT_SCHEMA)
+        (folder / OUTPUT_MARKER).write_text(json.dumps(record, indent=1))
