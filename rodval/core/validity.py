@@ -43,17 +43,22 @@ class Check:
     bound: float
     unit: str
     what: str
+    #: The setting that would address a broken check ("" when none is known).
+    fix: str = ""
 
     @property
     def holds(self) -> bool:
         return math.isfinite(self.figure) and self.figure <= self.bound
 
     def reason(self) -> str:
-        """One phrase: '<what> <figure> <unit> > <bound> <unit> (<assumption>)'."""
+        """One phrase: '<what> <figure> <unit> > <bound> <unit> (<assumption>)', and for a
+        broken check the setting that would address it: '; fix: <fix>'."""
         unit = f" {self.unit}" if self.unit else ""
         sign = "<=" if self.holds else ">"
+        fix = f"; fix: {self.fix}" if self.fix and not self.holds else ""
         return (
-            f"{self.what} {self.figure:.3g}{unit} {sign} {self.bound:g}{unit} ({self.assumption})"
+            f"{self.what} {self.figure:.3g}{unit} {sign} {self.bound:g}{unit} "
+            f"({self.assumption}){fix}"
         )
 
     def as_dict(self) -> dict[str, Any]:
@@ -64,6 +69,7 @@ class Check:
             "unit": self.unit,
             "holds": self.holds,
             "reason": self.reason(),
+            "fix": self.fix,
         }
 
 
@@ -74,24 +80,38 @@ def small_bending(max_bending: float | None) -> list[Check]:
         return []
     return [
         Check(
-            "small bending", float(max_bending), SMALL_BENDING_RAD, "rad", "largest bending angle"
+            "small bending",
+            float(max_bending),
+            SMALL_BENDING_RAD,
+            "rad",
+            "largest bending angle",
+            "stiffer rods (EI), or the exudyn beam model, which has no small-bending premise",
         )
     ]
 
 
-def energy_balance(residual: float | None, bound: float = ENERGY_RESIDUAL_BOUND) -> list[Check]:
-    """The energy-balance check of an audited run (relative residual); none when not audited."""
+def energy_balance(
+    residual: float | None, bound: float = ENERGY_RESIDUAL_BOUND, fix: str = ""
+) -> list[Check]:
+    """The energy-balance check of an audited run (relative residual); none when not
+    audited. ``fix``: the model's setting that would close the balance."""
     if residual is None:
         return []
-    return [Check("energy balance", float(residual), bound, "", "energy-audit residual")]
+    return [Check("energy balance", float(residual), bound, "", "energy-audit residual", fix)]
 
 
-def step_resolution(rotation: float | None, bound: float) -> list[Check]:
+def step_resolution(rotation: float | None, bound: float, step: float | None = None) -> list[Check]:
     """The time-step resolution check of a fixed-step run: the largest rotation of a rod in one
-    step (rad) against ``bound``; none when not measured."""
+    step (rad) against ``bound``; none when not measured. With the run's ``step`` (s) the fix
+    names the step that would resolve the fastest rotation seen."""
     if rotation is None:
         return []
-    return [Check("step resolution", float(rotation), bound, "rad", "largest rotation per step")]
+    fix = "a smaller step"
+    if step is not None and rotation > 0 and math.isfinite(rotation):
+        fix = f"step <= {step * bound / rotation:.2g} s"
+    return [
+        Check("step resolution", float(rotation), bound, "rad", "largest rotation per step", fix)
+    ]
 
 
 def verdict(checks: list[Check], finished: bool = True) -> tuple[bool | None, list[dict[str, Any]]]:

@@ -322,6 +322,13 @@ class ReducedModel(PaperModel):
     system_class = ReducedSystem
     MODAL_ANALYSIS = "rodval.models.linear_modes:reduced_modes"
 
+    def energy_fix(self) -> str:
+        """The quasi-static bending has no energy balance of its own (docs/stability.md)."""
+        return (
+            'the full model with kinematics = "exact" (the reduced model\'s quasi-static '
+            "bending keeps no energy balance; docs/stability.md)"
+        )
+
     def scene_notes(self, scene: Scene) -> list[str]:
         """The scene data the quasi-static bending has nowhere to put: the rods' bending
         damping (it acts on bending rates, which the model drops with the bending inertia and
