@@ -218,20 +218,41 @@ def _add_latch_joint(mbs, markers: tuple[int, int], angle: float) -> int:
     )
 
 
-def _add_sensors(mbs, scene: Scene, E: int, nodes, body_node: int | None = None) -> dict:
-    """Sensors (coordinates, velocities, accelerations, stored internally) on the beam nodes
-    the outputs need, (rod, node) -> three sensor numbers, and on a free base's body node
-    (``BODY`` -> its three: hinge 0 is measured from it)."""
-    import exudyn as exu
+#: Sensors per recorded node (coordinates, velocities, accelerations) and the doubles each
+#: stores at every step: the time and the node's coordinates (4 for a cable node, 3 for a free
+#: base's body node).
+SENSORS_PER_NODE = 3
+CABLE_NODE_COORDINATES = 4
+BODY_NODE_COORDINATES = 3
 
+
+def sensor_nodes(scene: Scene, E: int) -> set[tuple[int, int]]:
+    """The beam nodes (rod, local node), 0-based, whose states the scene's outputs need (a
+    free base's body node is recorded besides them)."""
     n = scene.n
-    wanted = set()
+    wanted: set[tuple[int, int]] = set()
     ends = ("phi", "dphi", "alpha", "beta", "x", "y", "hinge_angle", "hinge_moment", "base")
     if scene.wants(*ends):
         wanted |= {(k, 0) for k in range(n)} | {(k, E) for k in range(n)}
     if scene.wants("energy", "angular_momentum", "momentum") or scene.latches:
         wanted |= {(k, j) for k in range(n) for j in range(E + 1)}
-    node_of = {key: nodes[key[0]][key[1]] for key in wanted}
+    return wanted
+
+
+def recorded_doubles(scene: Scene, E: int) -> int:
+    """Doubles the sensors of a run of ``scene`` (E elements per rod) store at every step."""
+    beam = len(sensor_nodes(scene, E)) * (1 + CABLE_NODE_COORDINATES)
+    body = (1 + BODY_NODE_COORDINATES) if scene.base.free else 0
+    return SENSORS_PER_NODE * (beam + body)
+
+
+def _add_sensors(mbs, scene: Scene, E: int, nodes, body_node: int | None = None) -> dict:
+    """Sensors (coordinates, velocities, accelerations, stored internally) on the beam nodes
+    the outputs need (``sensor_nodes``), (rod, node) -> three sensor numbers, and on a free
+    base's body node (``BODY`` -> its three: hinge 0 is measured from it)."""
+    import exudyn as exu
+
+    node_of = {key: nodes[key[0]][key[1]] for key in sensor_nodes(scene, E)}
     if body_node is not None:
         node_of[BODY] = body_node
     ovt = exu.OutputVariableType

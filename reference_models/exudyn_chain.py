@@ -43,9 +43,13 @@ Jacobian kept from before a latch's joint was switched on leaves the joint witho
 until Newton restarts (0.17 ms late on the two-rod scene of tests/test_rigid_lock.py, the
 hinge passing its latch angle by 3.7 mrad).
 rodval's native integrator settings are refused unless at their defaults (``check_settings``;
-``blowup_factor`` applies). Before every step ``_Guard`` checks the state: non-finite
-(STATUS_DIVERGED), kinetic energy above blowup_factor x (E(0) + W+ + 1e-6 J) (STATUS_BLOWUP),
-rotation per step above ``max_rotation_per_step`` (STATUS_FAILED); a verdict stops the run.
+``blowup_factor`` and ``max_wall_s`` apply). Before every step ``_Guard`` checks the state:
+non-finite (STATUS_DIVERGED), kinetic energy above blowup_factor x (E(0) + W+ + 1e-6 J)
+(STATUS_BLOWUP), rotation per step above ``max_rotation_per_step`` (STATUS_FAILED); a verdict
+stops the run. Then ``RunBudget`` (``exudyn_budget``) reads the clock (the run's wall-clock
+budget, set-up included: STATUS_WALL) and counts the recorded steps against the memory bound;
+a run without a wall-clock budget is refused before any work when it plans more than
+``MAX_STEPS_UNBOUNDED`` steps or more than its records fit in memory (``check_plan``).
 """
 
 from __future__ import annotations
@@ -58,7 +62,8 @@ import numpy as np
 
 from reference_models.exudyn_audit import account
 from reference_models.exudyn_beam import _positive
-from reference_models.exudyn_build import _Built, build
+from reference_models.exudyn_budget import EXUDYN_MAX_STEPS, RunBudget, check_plan, planned_steps
+from reference_models.exudyn_build import _Built, build, recorded_doubles
 from reference_models.exudyn_guard import _Guard
 from reference_models.exudyn_latches import _Latches
 from reference_models.exudyn_observe import _observe, stop_events
@@ -92,6 +97,7 @@ DEFAULTS: dict[str, Any] = {
 
 #: IntegratorSettings fields that belong to rodval's ODE integrators: exudyn cannot honour
 #: them (its integrator is set by this model's options), so any non-default value is refused.
+#: (``max_wall_s`` and ``blowup_factor`` are honoured: ``exudyn_budget``, ``exudyn_guard``.)
 NATIVE_INTEGRATOR_FIELDS = (
     "method",
     "rtol",
@@ -99,7 +105,6 @@ NATIVE_INTEGRATOR_FIELDS = (
     "max_step",
     "first_step",
     "max_evaluations",
-    "max_wall_s",
 )
 
 
@@ -138,6 +143,9 @@ class ExudynModel(Model):
     Divergence is detected during the run (``_Guard``): a non-finite state ends it as
     STATUS_DIVERGED, kinetic energy above ``settings.blowup_factor`` x (E(0) + W+(t) + 1e-6 J)
     as STATUS_BLOWUP, both at the time of detection with the output times before it kept.
+    ``settings.max_wall_s`` (s, from the start of the run) ends it as STATUS_WALL with the
+    outputs up to the time reached; without it a run of more than ``MAX_STEPS_UNBOUNDED``
+    steps is refused (``exudyn_budget``).
     """
 
     name = "exudyn"
@@ -223,15 +231,19 @@ class ExudynModel(Model):
         return build(scene, self.elements, self.EA)
 
     def _settings(self, scene: Scene):
+        """exudyn's simulation settings of a run of ``scene``: ``planned_steps`` equal steps
+        over t_end, or only the first ``EXUDYN_MAX_STEPS`` of them (exudyn's largest count; a
+        budgeted run stops before it)."""
         import exudyn as exu
 
         t_end = scene.t_end
         s = exu.SimulationSettings()
         ti = s.timeIntegration
-        nsteps = max(1, math.ceil(t_end / self.step - 1e-9))
-        ti.endTime = t_end
+        planned = planned_steps(t_end, self.step)
+        nsteps = min(planned, EXUDYN_MAX_STEPS)
+        ti.endTime = t_end * nsteps / planned if nsteps < planned else t_end
         ti.numberOfSteps = nsteps
-        ti.initialStepSize = t_end / nsteps
+        ti.initialStepSize = t_end / planned
         ti.automaticStepSize = False
         ti.adaptiveStep = True
         ti.minimumStepSize = ti.initialStepSize / 64.0  # fail fast instead of crawling
@@ -242,7 +254,7 @@ class ExudynModel(Model):
         ti.newton.modifiedNewtonJacUpdatePerStep = bool(scene.latches)
         ti.generalizedAlpha.spectralRadius = self.spectral_radius_for(scene)
         s.solution.file.write = False
-        s.solution.sensors.writePeriod = 0.25 * t_end / nsteps
+        s.solution.sensors.writePeriod = 0.25 * t_end / planned
         s.show.statistics = False
         s.show.computationTime = False
         s.show.globalTimers = False
@@ -306,16 +318,32 @@ class ExudynModel(Model):
                 "the lock"
             )
 
+    def check_plan(self, scene: Scene, settings: IntegratorSettings) -> int:
+        """The run's planned steps, or ValueError before any work when a run without a
+        wall-clock budget plans too many steps or records (``exudyn_budget.check_plan``)."""
+        doubles = recorded_doubles(scene, self.elements)
+        return check_plan(scene.t_end, self.step, doubles, settings.max_wall_s)
+
     def run(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
-        """Run the scene. Of the native integrator ``settings`` only ``blowup_factor`` applies;
-        any other non-default field raises ValueError before any work (``check_settings``): the
-        exudyn integrator is set by this model's options, recorded in ``trajectory.settings``
-        with the steps actually taken."""
+        """Run the scene. Of the native integrator ``settings`` ``blowup_factor`` and
+        ``max_wall_s`` (s, from this call: the set-up counts) apply; any other non-default
+        field raises ValueError before any work (``check_settings``), as does a run without a
+        wall-clock budget that plans too many steps (``check_plan``): the exudyn integrator is
+        set by this model's options, recorded in ``trajectory.settings`` with the steps
+        actually taken."""
+        start = time.perf_counter()
+        settings = settings or IntegratorSettings()
         self.check_settings(settings)
         self.check_scene(scene)
-        factor = (settings or IntegratorSettings()).blowup_factor
+        planned = self.check_plan(scene, settings)
+        budget = RunBudget(settings, start, recorded_doubles(scene, self.elements))
+        factor = settings.blowup_factor
         stats = SolverStats()
-        run_info: dict[str, Any] = {"blowup_factor": factor}
+        run_info: dict[str, Any] = {
+            "blowup_factor": factor,
+            "max_wall_s": settings.max_wall_s,
+            "steps_planned": planned,
+        }
         try:
             built = self._build(scene)
             sim = self._settings(scene)
@@ -327,10 +355,9 @@ class ExudynModel(Model):
             )
             stats.status, stats.message = status, f"build failed: {message}"
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
-        ti = sim.timeIntegration
-        run_info.update(steps_planned=int(ti.numberOfSteps), step_used=float(ti.initialStepSize))
+        run_info.update(step_used=float(sim.timeIntegration.initialStepSize))
         latches = _Latches(built, guard, scene, self.elements) if scene.latches else None
-        self._solve(scene, built, sim, guard, latches, stats)
+        self._solve(scene, built, sim, (guard, latches, budget), stats)
         run_info.update(
             steps=stats.nsteps,
             min_step_used=guard.min_step if math.isfinite(guard.min_step) else None,
@@ -341,7 +368,7 @@ class ExudynModel(Model):
         except Exception as exc:  # noqa: BLE001
             stats.status, stats.message = STATUS_ERROR, f"reading sensors failed: {exc}"
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
-        times = _ended(scene, stats, guard, t_rec, diverged)
+        times = _ended(scene, stats, (guard, budget), t_rec, diverged)
         events, lock_steps = _lock_records(latches)
         reached = t_rec[t_rec <= times[-1]] if times.size else t_rec[:0]
         stops = stop_events(scene, self.elements, reached, records, lock_steps)
@@ -364,11 +391,13 @@ class ExudynModel(Model):
         run_info.update(audit)
         return self._trajectory(scene, times, observed, stats, run_info, events)
 
-    def _solve(self, scene: Scene, built: _Built, sim, guard: _Guard, latches, stats) -> None:
-        """exudyn's implicit solver over the scene, the guard and the latches in its pre-step
-        function; the outcome and counters into ``stats`` (the guard keeps its verdict)."""
+    def _solve(self, scene: Scene, built: _Built, sim, checks: tuple, stats) -> None:
+        """exudyn's implicit solver over the scene, ``checks`` = (guard, latches or None,
+        budget) in its pre-step function; the outcome and counters into ``stats`` (the guard
+        keeps its verdict, the budget its stop)."""
         import exudyn as exu
 
+        guard, latches, budget = checks
         solver: Any = exu.MainSolverImplicitSecondOrder()
         guard.solver = solver
 
@@ -385,7 +414,7 @@ class ExudynModel(Model):
                         True,
                     )
                     return False
-            return go
+            return go and budget.pre_step()
 
         built.mbs.SetPreStepUserFunction(pre_step)
         if self.solver == "trapezoidal":
@@ -402,7 +431,7 @@ class ExudynModel(Model):
                     _solver_message(solver, "solver failed"),
                 )
             elif guard.verdict is None:  # the last step's end state has had no pre-step check
-                guard.check(scene.t_end)
+                guard.check(scene.t_end if budget.stop is None else built.mbs.systemData.GetTime())
         except Exception as exc:  # noqa: BLE001 - exudyn errors come back as data
             stats.status = STATUS_ERROR
             cause = built.load_errors[0] if built.load_errors else exc
@@ -420,8 +449,13 @@ class ExudynModel(Model):
         geometrically exact: no small-bending assumption)."""
         seen = trajectory.settings.get("max_rotation_per_step_seen")
         return super().validity_checks(scene, trajectory) + step_resolution(
-            seen, self.max_rotation_per_step
+            seen, self.max_rotation_per_step, trajectory.settings.get("step_used")
         )
+
+    def energy_fix(self) -> str:
+        """exudyn's residual is generalized-alpha's numerical dissipation, which falls with
+        the step (docs/deployment.md, "Where the lock energy goes")."""
+        return "a smaller step (exudyn option step; its numerical dissipation falls with it)"
 
     def _records(self, built: _Built):
         """Recorded times (s); per (rod, local node), arrays q, v, a (nt, 4) up to the first
@@ -472,15 +506,20 @@ class ExudynModel(Model):
 
 
 def _ended(
-    scene: Scene, stats: SolverStats, guard: _Guard, t_rec: np.ndarray, diverged: bool
+    scene: Scene, stats: SolverStats, checks: tuple[_Guard, RunBudget], t_rec, diverged: bool
 ) -> np.ndarray:
     """How the run ended (status, message, time reached into ``stats``; the guard's verdict
-    explains a solver failure that may follow it) and the output times it kept."""
+    explains a solver failure that may follow it, the budget's stop (``checks`` = (guard,
+    budget)) a run that ended early) and the output times it kept."""
+    guard, budget = checks
     stats.t_reached = float(t_rec[-1]) if t_rec.size else 0.0
     keep_detected = True
     if guard.verdict is not None and stats.status != STATUS_ERROR:
         stats.status, stats.message, t_detected, keep_detected = guard.verdict
         stats.t_reached = min(stats.t_reached, t_detected) if t_rec.size else 0.0
+    stopped = budget.outcome(stats.t_reached)
+    if stats.status == 0 and stopped is not None and stats.t_reached < scene.t_end * (1 - 1e-9):
+        stats.status, stats.message = stopped
     if stats.status == 0 and stats.t_reached < scene.t_end * (1 - 1e-9):
         stats.status, stats.message = STATUS_FAILED, "solver stopped before t_end"
     if stats.status == STATUS_FAILED and diverged and guard.verdict is None:
