@@ -8,6 +8,7 @@ name = "tiny"
 reference = "{reference}"
 
 [scene]
+based_on = "paper"
 n = 2
 t_end = 0.1
 times = {{ num = 11 }}

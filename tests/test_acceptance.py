@@ -19,6 +19,7 @@ name = "gate"
 reference = "full"
 
 [scene]
+based_on = "paper"
 n = 2
 t_end = 0.2
 times = {{ num = 5 }}

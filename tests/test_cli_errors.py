@@ -34,7 +34,7 @@ def bad_files(tmp_path_factory):
     (d / "malformed.toml").write_text("n = [\n")
     (d / "zero_rods.toml").write_text("n = 0\n")
     (d / "unknown_key.toml").write_text("rods = 3\n")
-    (d / "negative_ei.toml").write_text("[chain]\nEI = -1.0\n")
+    (d / "negative_ei.toml").write_text('based_on = "paper"\n[chain]\nEI = -1.0\n')
     return d
 
 

@@ -111,7 +111,7 @@ def test_paper_scene_is_at_rest_and_unchanged():
 
 def test_cli_modes_refuses_an_unbalanced_initial_state_and_takes_the_flag(tmp_path, capsys):
     path = tmp_path / "fold.toml"
-    path.write_text("n = 3\n[chain]\nrest_angle = 1.0\nnu = 0.0\n")
+    path.write_text('based_on = "paper"\nn = 3\n[chain]\nrest_angle = 1.0\nnu = 0.0\n')
     proc = run_main(capsys, "modes", str(path), "--out", str(tmp_path / "m"))
     assert_refused(
         proc, ["not an equilibrium", "100 N m", "--allow-unbalanced", "--about equilibrium"]
@@ -130,7 +130,9 @@ def test_cli_modes_refuses_an_unbalanced_initial_state_and_takes_the_flag(tmp_pa
 
 def test_cli_modes_load_at_holds_a_windowed_load(tmp_path, capsys):
     path = tmp_path / "step.toml"
-    path.write_text('n = 3\n[[loads]]\ntype = "constant"\nnode = 3\nY = 30.0\nt_off = 0.6\n')
+    path.write_text(
+        'based_on = "paper"\nn = 3\n[[loads]]\ntype = "constant"\nnode = 3\nY = 30.0\nt_off = 0.6\n'
+    )
     assert (
         main(
             [

@@ -19,6 +19,7 @@ pytestmark = pytest.mark.exudyn
 WING = {
     "study": {"name": "wing", "reference": "full"},
     "scene": {
+        "based_on": "paper",
         "t_end": 0.1,
         "times": {"num": 6},
         "outputs": ["phi", "dphi", "energy"],
@@ -83,7 +84,7 @@ def test_the_models_table_says_which_settings_apply():
 
     spec = rodval.Study.from_dict(
         {
-            "scene": {"n": 2, "t_end": 0.05},
+            "scene": {"based_on": "paper", "n": 2, "t_end": 0.05},
             "integrator": {"rtol": 1e-9},
             "models": {"full": {}, "exudyn": {"elements": 2}},
         }

@@ -54,6 +54,7 @@ def test_bad_profiles_are_refused_naming_the_array_and_key(spec, words):
 
 def test_a_scene_file_profile_builds_the_chain_and_still_checks_bounds():
     doc = {
+        "based_on": "paper",
         "n": 5,
         "chain": {"EI": {"first": [5e4], "rest": 1e4}, "m": {"at": [0, 1], "values": [4, 2]}},
     }
@@ -61,9 +62,13 @@ def test_a_scene_file_profile_builds_the_chain_and_still_checks_bounds():
     np.testing.assert_array_equal(scene.chain.EI, [5e4, 1e4, 1e4, 1e4, 1e4])
     np.testing.assert_allclose(scene.chain.m, [3.8, 3.4, 3.0, 2.6, 2.2], rtol=1e-14)
     with pytest.raises(ValueError, match=r"^wing\.toml \[chain\]: EI profile: unknown key"):
-        scene_from_dict({"n": 2, "chain": {"EI": {"rst": 1.0}}}, where="wing.toml")
+        scene_from_dict(
+            {"based_on": "paper", "n": 2, "chain": {"EI": {"rst": 1.0}}}, where="wing.toml"
+        )
     with pytest.raises(ValueError, match=r"EI"):  # the chain's own bounds: EI > 0
-        scene_from_dict({"n": 2, "chain": {"EI": {"rest": -1.0}}}, where="wing.toml")
+        scene_from_dict(
+            {"based_on": "paper", "n": 2, "chain": {"EI": {"rest": -1.0}}}, where="wing.toml"
+        )
 
 
 def test_one_grid_sweeps_n_for_a_non_uniform_chain_with_short_ids():
@@ -71,6 +76,7 @@ def test_one_grid_sweeps_n_for_a_non_uniform_chain_with_short_ids():
     (before: one [[grid]] per n with hand-written lists, 200-character case ids)."""
     doc = {
         "scene": {
+            "based_on": "paper",
             "t_end": 0.1,
             "chain": {
                 "EI": {"first": [5e4], "rest": 1e4},

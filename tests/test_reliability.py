@@ -103,7 +103,7 @@ def test_huge_initial_rate_on_the_cli(tmp_path, capsys):
     """`rodval simulate F.toml --model full --method DOP853` with dphi = 1e160: exit 1 and a
     status line, within a time limit."""
     path = tmp_path / "F.toml"
-    path.write_text("n = 4\nt_end = 0.5\n[initial]\ndphi = 1e160\n")
+    path.write_text('based_on = "paper"\nn = 4\nt_end = 0.5\n[initial]\ndphi = 1e160\n')
     for method in ("DOP853", "RK45", "RK23"):
         with TimeLimit(20):
             code = main(
@@ -155,9 +155,9 @@ def test_memory_estimate_is_refused_before_any_work():
         paper_scene(100000, times=np.linspace(0, 2, 5000))
     assert time.perf_counter() - start < 5
     with pytest.raises(ValueError, match=r"num must be an integer >= 1 and <= 1000000"):
-        scene_from_dict({"times": {"num": 1e9}})
+        scene_from_dict({"based_on": "paper", "times": {"num": 1e9}})
     with pytest.raises(ValueError, match=r"num must be >= 1 and <= 1000000, got 1000000000"):
-        scene_from_dict({"times": {"num": 10**9}})
+        scene_from_dict({"based_on": "paper", "times": {"num": 10**9}})
 
 
 def test_memory_limit_is_a_setting(monkeypatch):
@@ -182,7 +182,7 @@ def test_memory_estimate_counts_outputs_and_dense_matrices():
 
 def test_scene_file_too_large_on_the_cli(tmp_path, capsys):
     path = tmp_path / "big.toml"
-    path.write_text("n = 50000\ntimes = {num = 100000}\n")
+    path.write_text('based_on = "paper"\nn = 50000\ntimes = {num = 100000}\n')
     assert main(["simulate", str(path), "--out", str(tmp_path / "o")]) == 2
     line = one_line_error(capsys)
     assert "big.toml" in line and "GB of memory" in line
@@ -223,7 +223,7 @@ def test_absurd_magnitudes_are_refused_with_the_allowed_range(field, value):
     with pytest.raises(ValueError, match=rf"^{field} \(.*must lie in \[.*1e\+12\].*got"):
         SMALL.chain.with_(**{field: value})
     with pytest.raises(ValueError, match=rf"\[chain\].*{field}|{field} \("):
-        scene_from_dict({"chain": {field: value}}, where="F.toml [chain]")
+        scene_from_dict({"based_on": "paper", "chain": {field: value}}, where="F.toml [chain]")
 
 
 def test_huge_initial_rate_of_the_reduced_model_is_a_divergence():
@@ -245,10 +245,16 @@ def test_bounds_keep_the_extremes_in_use():
 @pytest.mark.parametrize(
     "build, words",
     [
-        (lambda: scene_from_dict({"initial": {"phi": "a"}}), "initial phi must be a real"),
-        (lambda: scene_from_dict({"times": {"num": "x"}}), "num must be an integer"),
-        (lambda: scene_from_dict({"times": {"num": 2.7}}), "got 2.7"),
-        (lambda: scene_from_dict({"times": {"start": "0"}}), "times.start"),
+        (
+            lambda: scene_from_dict({"based_on": "paper", "initial": {"phi": "a"}}),
+            "initial phi must be a real",
+        ),
+        (
+            lambda: scene_from_dict({"based_on": "paper", "times": {"num": "x"}}),
+            "num must be an integer",
+        ),
+        (lambda: scene_from_dict({"based_on": "paper", "times": {"num": 2.7}}), "got 2.7"),
+        (lambda: scene_from_dict({"based_on": "paper", "times": {"start": "0"}}), "times.start"),
         (lambda: SMALL.with_(times={"num": 3}), "times (output times) must be a 1-D"),
         (lambda: SMALL.with_(loads=None), "loads must be a sequence of NodalForce"),
         (lambda: SMALL.with_(loads=[1]), "loads must be NodalForce objects"),
@@ -322,7 +328,7 @@ def test_the_default_method_finishes_the_stiff_chain():
 
 def test_budgets_on_the_cli(tmp_path, capsys):
     path = tmp_path / "stiff.toml"
-    path.write_text("n = 4\n[chain]\nm = 1e-6\n")
+    path.write_text('based_on = "paper"\nn = 4\n[chain]\nm = 1e-6\n')
     out = str(tmp_path / "o")
     with TimeLimit(20):
         code = main(
@@ -352,7 +358,7 @@ def test_unexpected_exception_is_one_line_naming_its_type(monkeypatch, tmp_path,
 
 def test_numerical_warnings_are_not_printed(tmp_path, capsys):
     path = tmp_path / "F.toml"
-    path.write_text("n = 4\nt_end = 0.5\n[initial]\ndphi = 1e160\n")
+    path.write_text('based_on = "paper"\nn = 4\nt_end = 0.5\n[initial]\ndphi = 1e160\n')
     main(["simulate", str(path), "--method", "RK45", "--out", str(tmp_path / "o")])
     assert "Warning" not in capsys.readouterr().err
 

@@ -113,6 +113,7 @@ def _deployment(count: int, seed: int) -> dict:
             "loads": [],
             "chain": {
                 "l": 1.0,
+                "m": 3.0,
                 "EI": 5e3,
                 "mu": 0.5,
                 "kappa": {"first": [1e5], "rest": 50.0},

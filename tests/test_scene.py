@@ -91,7 +91,7 @@ def test_chain_broadcasts_and_is_immutable():
 def test_scene_file_round_trip(tmp_path):
     path = tmp_path / "s.toml"
     path.write_text(
-        'n = 3\nt_end = 0.5\ntimes = {num = 11}\noutputs = ["phi", "x"]\n'
+        'based_on = "paper"\nn = 3\nt_end = 0.5\ntimes = {num = 11}\noutputs = ["phi", "x"]\n'
         '[chain]\nEI = [1e4, 2e4, 3e4]\n[[loads]]\ntype = "pulse"\nnode = 3\nYbar = 10.0\n'
     )
     s = load_scene(path)
@@ -103,14 +103,20 @@ def test_scene_file_round_trip(tmp_path):
     "d,match",
     [
         ({"n": 3, "colour": 1}, r"unknown key 'colour'"),
-        ({"chain": {"E": 1}}, r"\[chain\]: unknown key 'E'"),
+        ({"based_on": "paper", "chain": {"E": 1}}, r"\[chain\]: unknown key 'E'"),
         ({"n": 0}, r"key 'n'"),
-        ({"loads": [{"type": "gust", "node": 1}]}, r"load type must be one of"),
-        ({"loads": [{"type": "pulse", "node": 1, "Zbar": 1}]}, r"unexpected keyword"),
-        ({"times": {"num": 0}}, r"num must be >= 1"),
-        ({"chain": {"l": -1.0}}, r"l \(rod length\)"),
+        (
+            {"based_on": "paper", "loads": [{"type": "gust", "node": 1}]},
+            r"load type must be one of",
+        ),
+        (
+            {"based_on": "paper", "loads": [{"type": "pulse", "node": 1, "Zbar": 1}]},
+            r"unexpected keyword",
+        ),
+        ({"based_on": "paper", "times": {"num": 0}}, r"num must be >= 1"),
+        ({"based_on": "paper", "chain": {"l": -1.0}}, r"l \(rod length\)"),
         ({"base": "lab"}, r"key 'base'"),
-        ({"t_end": "long"}, r"key 't_end'"),
+        ({"based_on": "paper", "t_end": "long"}, r"key 't_end'"),
     ],
 )
 def test_scene_file_errors_name_file_and_key(d, match):

@@ -17,6 +17,7 @@ name = "modes-tiny"
 reference = "full"
 
 [scene]
+based_on = "paper"
 t_end = 0.1
 times = {{ num = 3 }}
 

@@ -17,7 +17,13 @@ from rodval.study.toml_text import toml_text
 
 DOC = {
     "study": {"name": "py", "reference": "full"},
-    "scene": {"n": 2, "t_end": 0.05, "times": {"num": 3}, "outputs": ["phi", "beta"]},
+    "scene": {
+        "based_on": "paper",
+        "n": 2,
+        "t_end": 0.05,
+        "times": {"num": 3},
+        "outputs": ["phi", "beta"],
+    },
     "integrator": {"rtol": 1e-8, "atol": 1e-10},
     "models": {"full": {}, "reduced": {}},
     "grid": {"scene.chain.EI": [1e4, 1e5], "scene.n": [2, 3]},
@@ -28,6 +34,7 @@ name = "py"
 reference = "full"
 
 [scene]
+based_on = "paper"
 n = 2
 t_end = 0.05
 times = { num = 3 }

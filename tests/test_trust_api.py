@@ -41,7 +41,7 @@ def test_model_options_of_the_wrong_type_are_named(kwargs, words):
     ],
 )
 def test_study_arguments_of_the_wrong_type_are_named(tmp_path, kwargs, words):
-    doc = {"scene": {"n": 2, "t_end": 0.05}, "models": {"reduced": {}}}
+    doc = {"scene": {"based_on": "paper", "n": 2, "t_end": 0.05}, "models": {"reduced": {}}}
     with pytest.raises(ValueError, match=words):
         rodval.run_study(doc, tmp_path / "out", **kwargs)
     assert not (tmp_path / "out").exists()
@@ -50,7 +50,7 @@ def test_study_arguments_of_the_wrong_type_are_named(tmp_path, kwargs, words):
 def test_a_study_out_that_is_a_file_is_refused(tmp_path):
     junk = tmp_path / "junk.bin"
     junk.write_bytes(b"\x00\x01")
-    doc = {"scene": {"n": 2, "t_end": 0.05}, "models": {"reduced": {}}}
+    doc = {"scene": {"based_on": "paper", "n": 2, "t_end": 0.05}, "models": {"reduced": {}}}
     with pytest.raises(ValueError, match=r"^out must be a folder, got the file"):
         rodval.run_study(doc, junk)
     assert junk.read_bytes() == b"\x00\x01"
@@ -113,7 +113,7 @@ def test_edited_run_json_events_and_binary_tables_are_named(tmp_path, capsys):
 
 
 def test_a_binary_table_is_refused_in_rodvals_words(tmp_path, capsys):
-    doc = {"scene": {"n": 2, "t_end": 0.05}, "models": {"reduced": {}}}
+    doc = {"scene": {"based_on": "paper", "n": 2, "t_end": 0.05}, "models": {"reduced": {}}}
     res = rodval.run_study(doc, tmp_path / "s", workers=1, progress=False)
     (res.out / "cases.csv").write_bytes(b"\x80\x81")
     proc = run_main(capsys, "report", str(res.out))
@@ -147,7 +147,9 @@ def test_unhashable_names_in_files_are_refused_in_one_line(tmp_path):
     from rodval.study.sampling import check_distribution
 
     with pytest.raises(ValueError, match=r"load type must be one of .*got \[\]"):
-        scene_from_dict({"n": 2, "loads": [{"type": [], "node": 1}]}, where="s")
+        scene_from_dict(
+            {"based_on": "paper", "n": 2, "loads": [{"type": [], "node": 1}]}, where="s"
+        )
     with pytest.raises(ValueError, match=r"model must be one of"):
         rodval.Study.from_dict({"models": {"a": {"model": ["full"]}}})
     with pytest.raises(ValueError, match=r"must be a table with dist"):

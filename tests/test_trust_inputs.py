@@ -16,7 +16,10 @@ from rodval.cli import main
 from rodval.core.scene_file import load_scene
 from rodval.core.settings import MIN_RTOL
 
-TINY = 'n = 2\nt_end = 0.05\ntimes = {start = 0.0, stop = 0.05, num = 11}\noutputs = ["phi"]\n'
+TINY = (
+    'based_on = "paper"\nn = 2\nt_end = 0.05\ntimes = {start = 0.0, stop = 0.05, num = 11}\n'
+    'outputs = ["phi"]\n'
+)
 
 
 @pytest.fixture(scope="module")
@@ -130,7 +133,7 @@ def test_unknown_top_level_key_in_an_edited_run_json_is_refused(runs, tmp_path, 
 
 def test_scene_name_must_be_a_string(tmp_path):
     path = tmp_path / "s.toml"
-    path.write_text("name = 123\n")
+    path.write_text('based_on = "paper"\nname = 123\n')
     with pytest.raises(ValueError, match=r"s\.toml: name .*must be a string, got 123$"):
         load_scene(path)
     with pytest.raises(ValueError, match="^name .*must be a string"):
@@ -146,7 +149,9 @@ def test_latch_direction_must_be_the_integer_plus_or_minus_one(direction):
 
 def test_latch_direction_float_in_a_scene_file_is_refused(tmp_path):
     path = tmp_path / "s.toml"
-    path.write_text("n = 2\n[[latches]]\nhinge = 1\nangle = -0.5\ndirection = -1.0\n")
+    path.write_text(
+        'based_on = "paper"\nn = 2\n[[latches]]\nhinge = 1\nangle = -0.5\ndirection = -1.0\n'
+    )
     with pytest.raises(ValueError, match=r"s\.toml.*latch direction.*got -1\.0$"):
         load_scene(path)
 
@@ -275,7 +280,7 @@ def test_api_entry_points_refuse_wrong_types_in_one_line(call, words):
 def test_modes_about_equilibrium_of_a_chain_with_a_free_hinge(tmp_path, capsys):
     scene = tmp_path / "free.toml"
     scene.write_text(
-        "n = 3\n[chain]\nkappa = [100.0, 0.0, 100.0]\n"
+        'based_on = "paper"\nn = 3\n[chain]\nkappa = [100.0, 0.0, 100.0]\n'
         '[[loads]]\ntype = "constant"\nnode = "last"\nY = 50.0\n'
     )
     args = ["modes", str(scene), "--about", "equilibrium", "--out", str(tmp_path / "m")]

@@ -27,6 +27,7 @@ from rodval.core.loads import LoadSet, load_sums, load_table
 from rodval.core.scene_file import scene_from_dict, scene_to_dict
 
 BOOM = """
+based_on = "paper"
 name = "boom"
 n = 5
 t_end = 0.4
@@ -116,6 +117,7 @@ def test_tabulated_history_from_a_csv_file_in_a_scene_file(tmp_path):
     (tmp_path / "force.csv").write_text("t,Y\n0,0\n0.1,20\n0.3,20\n0.35,0\n")
     scene = scene_from_dict(
         {
+            "based_on": "paper",
             "n": 2,
             "t_end": 0.4,
             "loads": [{"type": "tabulated", "node": 2, "file": str(tmp_path / "force.csv")}],
@@ -128,7 +130,11 @@ def test_tabulated_history_from_a_csv_file_in_a_scene_file(tmp_path):
     (tmp_path / "bad.csv").write_text("time,Y\n0,0\n")
     with pytest.raises(ValueError, match="name the columns t, X, Y"):
         scene_from_dict(
-            {"n": 2, "loads": [{"type": "tabulated", "node": 2, "file": str(tmp_path / "bad.csv")}]}
+            {
+                "based_on": "paper",
+                "n": 2,
+                "loads": [{"type": "tabulated", "node": 2, "file": str(tmp_path / "bad.csv")}],
+            }
         )
 
 

@@ -26,6 +26,7 @@ from rodval.study import load_study, run_study
 #: Rods so soft (EI = 1e-3 N m^2, the trust review's case) that the paper load bends them by
 #: hundreds of radians: the run reaches t_end, its results mean nothing.
 ABSURD = """
+based_on = "paper"
 name = "absurd"
 n = 3
 t_end = 0.5

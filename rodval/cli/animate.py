@@ -6,12 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from rodval.cli.options import positive_int
-from rodval.core.scene_file import scene_from_dict
-from rodval.report.animation import MAX_FPS, MAX_FRAMES, animate_runs
-from rodval.report.run_files import read_run, read_run_record
 
 
 def register(sub) -> None:
+    from rodval.report.animation import MAX_FPS, MAX_FRAMES
+
     p = sub.add_parser(
         "animate",
         help="animate runs (GIF or MP4)",
@@ -19,7 +18,11 @@ def register(sub) -> None:
         "FILE (.gif with Pillow, .mp4 with the ffmpeg program), the runs overlaid in one frame "
         "each, the time in the title, each latch marked on its hinge node from its lock on, "
         "stop contacts marked at their times. Nodes from the runs' x, y outputs, else from "
-        "phi and the rod lengths.",
+        "phi and the rod lengths, hung from the pin at the origin or, for a free base, from "
+        "node 0 where the body moved (output 'base'; a free-base run with neither x, y nor "
+        "'base' is refused). Each run is drawn only at output times it has: the frames are "
+        "the output times all runs share (a note says so when the runs' times differ; runs "
+        "sharing fewer than 2 are refused).",
     )
     p.add_argument("runs", metavar="RUN", type=Path, nargs="+", help="run folder(s)")
     p.add_argument("--out", required=True, type=Path, help="FILE.gif or FILE.mp4")
@@ -39,17 +42,33 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    runs, lengths = {}, {}
+    from rodval.core.scene_file import scene_from_dict
+    from rodval.report.animation import animate_runs, shared_times
+    from rodval.report.run_files import read_run, read_run_record
+
+    runs, lengths, bases = {}, {}, {}
     for folder in args.runs:
         traj = read_run(folder)
         label = f"{folder.name} ({traj.model})"
         if label in runs:
             label = f"{folder} ({traj.model})"
         scene = scene_from_dict(read_run_record(folder / "run.json")["scene"], where=str(folder))
-        runs[label], lengths[label] = traj, scene.chain.l
-    done = animate_runs(runs, lengths, args.out, fps=args.fps, frames=args.frames)
+        runs[label], lengths[label], bases[label] = traj, scene.chain.l, scene.base
+    try:
+        done = animate_runs(runs, lengths, args.out, fps=args.fps, frames=args.frames, bases=bases)
+    except ValueError as exc:
+        if str(exc).startswith("--out"):
+            raise
+        raise ValueError(f"{', '.join(map(str, args.runs))}: {exc}") from None
     print(
         f"{done.frames} frames, {len(done.events)} events marked, "
         f"t = {done.times[0]:g}..{done.times[-1]:g} s -> {done.path}"
     )
+    counts = {label: traj.times.size for label, traj in runs.items()}
+    if len(set(counts.values())) > 1:
+        each = ", ".join(f"{label}: {c}" for label, c in counts.items())
+        print(
+            f"note: the runs' output times differ ({each} output times): each run is drawn "
+            f"only at the {shared_times(runs).size} output times they share"
+        )
     return 0

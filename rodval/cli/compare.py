@@ -6,12 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rodval.analysis.metrics import discrepancies
 from rodval.cli import CliError
-from rodval.core.scene_file import scene_differences
-from rodval.report.figures import plot_time_histories
-from rodval.report.markdown import to_markdown
-from rodval.report.run_files import read_run, read_run_record
 
 
 def register(sub) -> None:
@@ -20,7 +15,10 @@ def register(sub) -> None:
         help="compare two runs of the same scene",
         description="Compare run A against the reference run B (output folders of `rodval "
         "simulate`): DIR/discrepancies.csv and .md (per quantity: max_abs, rms, final_abs, "
-        "max_rel, where the maximum is; see rodval.analysis.metrics) and DIR/histories.png.",
+        "max_rel, where the maximum is; see rodval.analysis.metrics) and DIR/histories.png. "
+        "A run whose trajectory is not the one its run.json records (cut, edited) or whose "
+        "run.json records no digest of it is refused. DIR must be new, empty or an output "
+        "folder of rodval (refused before any work otherwise).",
     )
     p.add_argument("a", metavar="A", type=Path, help="run folder to compare")
     p.add_argument("b", metavar="B", type=Path, help="reference run folder")
@@ -31,10 +29,17 @@ def register(sub) -> None:
         help="compare runs whose scenes differ (chain, loads, horizon, ...: refused "
         "otherwise); the table then mixes a model's error with the change of scene",
     )
-    p.set_defaults(func=run)
+    # DIR is claimed before any work and marked rodval's (rodval.cli._run, out_paths)
+    p.set_defaults(func=run, out_folder="compare")
 
 
 def run(args) -> int:
+    from rodval.analysis.metrics import discrepancies
+    from rodval.core.scene_file import scene_differences
+    from rodval.report.figures import plot_time_histories
+    from rodval.report.markdown import to_markdown
+    from rodval.report.run_files import read_run, read_run_record
+
     differ = scene_differences(
         read_run_record(args.a / "run.json")["scene"], read_run_record(args.b / "run.json")["scene"]
     )

@@ -144,7 +144,9 @@ class Chain:
         rest_angle=0.0,
         bending_damping=0.0,
         _n: int | None = None,
+        **unknown: Any,
     ):
+        check_keys(unknown, self.FIELDS, "Chain", noun="field")  # a ValueError, not TypeError
         n = _n
         if n is None:
             given = (l, m, EI, mu, kappa, nu, rest_angle, bending_damping)
@@ -216,9 +218,30 @@ class InitialState:
     dalpha: np.ndarray | None = None
     dbeta: np.ndarray | None = None
 
+    #: The coordinates and rates, in order.
+    KEYS = ("phi", "dphi", "alpha", "beta", "dalpha", "dbeta")
+
+    def __init__(
+        self,
+        phi: Any = None,
+        dphi: Any = None,
+        alpha: Any = None,
+        beta: Any = None,
+        dalpha: Any = None,
+        dbeta: Any = None,
+        **unknown: Any,
+    ) -> None:
+        """Each a scalar (rad, rad/s), a sequence of n, or None (zeros); an unknown keyword
+        is a ValueError naming it and the allowed keys."""
+        check_keys(unknown, self.KEYS, "InitialState")
+        given = (phi, dphi, alpha, beta, dalpha, dbeta)
+        for key, value in zip(self.KEYS, given):
+            object.__setattr__(self, key, value)
+
     def resolve(self, n: int) -> dict[str, np.ndarray]:
+        """Every coordinate and rate as an array of n (zeros where None), checked."""
         out = {}
-        for key in ("phi", "dphi", "alpha", "beta", "dalpha", "dbeta"):
+        for key in self.KEYS:
             v = getattr(self, key)
             if v is None:
                 out[key] = np.zeros(n)

@@ -1,6 +1,9 @@
 """Scenes from TOML files or plain dicts (the format studies reuse for their base scene), and
 the complete resolved scene as a dict (``scene_to_dict``: run records, reruns).
 
+A document holds what it says: an omitted key is physically neutral (no loads, no node
+masses, hinge springs or dampers, straight at rest) or, for ``n``, ``t_end`` and the rods'
+``l``, ``m``, ``EI``, an error naming it; ``based_on = "paper"`` fills in the paper's example.
 Every key, with its unit, meaning, default and allowed range: ``docs/scene_file.md``.
 Every error is a ValueError that names the file and the offending key.
 """
@@ -16,24 +19,44 @@ from typing import Any
 import numpy as np
 
 from rodval.core.base import PINNED, Base
-from rodval.core.checks import check_keys
-from rodval.core.loads import LOAD_FACTORIES
+from rodval.core.checks import check_keys, check_number
+from rodval.core.loads import LOAD_FACTORIES, pulse
 from rodval.core.profiles import resolve_profiles
+from rodval.core.resources import check_rods
 from rodval.core.scene import (
     DEFAULT_NUM_TIMES,
     MAX_TIMES,
     QUANTITIES,
+    UNIFORM_DEFAULTS,
     Chain,
     InitialState,
     Latch,
     Scene,
     Stop,
     output_times,
-    paper_scene,
 )
 
-BASES = ("paper",)
+#: The scenes a file may be ``based_on``: what the file omits takes that scene's values.
+BASED_ON = ("paper",)
+#: The paper example's number of rods and horizon (s) (``paper_scene``'s defaults).
+PAPER_N = 8
+PAPER_T_END = 2.0
+#: Rod data without a neutral value: a file states them (or is ``based_on`` a scene).
+REQUIRED_CHAIN = {
+    "l": "rod length, m",
+    "m": "mass per length, kg/m",
+    "EI": "bending stiffness, N m^2",
+}
+#: The neutral values of the other chain fields: no node masses (kg), hinge springs
+#: (N m/rad) or dampers (N m s/rad), springs relaxed straight (rad), no bending damping
+#: (N m^2 s).
+NEUTRAL_CHAIN: dict[str, float] = dict(
+    mu=0.0, kappa=0.0, nu=0.0, rest_angle=0.0, bending_damping=0.0
+)
+#: The outputs of a file that names none (``Scene``'s default; outputs are not physics).
+DEFAULT_OUTPUTS: tuple[str, ...] = Scene.outputs
 TOP_KEYS = {
+    "based_on",
     "base",
     "name",
     "n",
@@ -49,7 +72,7 @@ TOP_KEYS = {
 LATCH_KEYS = ("hinge", "angle", "direction", "window")
 STOP_KEYS = ("hinge", "angle", "side", "stiffness", "damping")
 CHAIN_KEYS = set(Chain.FIELDS)
-INITIAL_KEYS = {"phi", "dphi", "alpha", "beta", "dalpha", "dbeta"}
+INITIAL_KEYS = set(InitialState.KEYS)
 TIMES_KEYS = {"start", "stop", "num"}
 
 
@@ -123,47 +146,105 @@ def _table_items(d: dict, key: str, cls: type, keys: tuple[str, ...], where: str
     return out
 
 
-def scene_from_dict(d: dict, where: str = "scene") -> Scene:
-    """Build and validate a Scene from the dict form (see module docstring).
+def _missing(key: str, what: str) -> ValueError:
+    """The one-line error of a required key the document omits (``where`` is added by
+    ``scene_from_dict``)."""
+    return ValueError(
+        f"key '{key}' ({what}) is missing; give it, or write based_on = \"paper\" to take "
+        "the paper example's values for every key the file omits"
+    )
 
-    Every error is a ValueError that names ``where`` (a file name) and the offending key.
+
+def _based_on(d: dict, where: str) -> str | None:
+    """The document's ``based_on`` (one of ``BASED_ON``) or None; a string ``base`` (the old
+    spelling of ``based_on``) is refused, so that no file silently changes meaning."""
+    base = d.get("base")
+    if isinstance(base, str):
+        raise ValueError(
+            f"{where} key 'base': base = {base!r} no longer names the scene the file starts "
+            f'from; write based_on = "paper" for the paper\'s example ([base] is a table: '
+            "the body node 0 belongs to)"
+        )
+    if base is not None and not isinstance(base, dict):
+        raise ValueError(
+            f"{where} key 'base': must be a [base] table (the body node 0 belongs to), got {base!r}"
+        )
+    based_on = d.get("based_on")
+    if based_on is not None and (not isinstance(based_on, str) or based_on not in BASED_ON):
+        raise ValueError(
+            f"{where} key 'based_on': must be one of {BASED_ON} (the scene whose values fill "
+            f"in what the file omits), got {based_on!r}"
+        )
+    return based_on
+
+
+def _count(d: dict, based_on: str | None) -> int:
+    """``n``, the number of rods: an integer >= 1 (the paper's 8 with ``based_on``)."""
+    if "n" not in d and based_on is None:
+        raise _missing("n", "number of rods")
+    n = d.get("n", PAPER_N)
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise ValueError(f"key 'n' (number of rods) must be an integer >= 1, got {n!r}")
+    check_rods(n)  # before any n-sized list (a profile) exists
+    return n
+
+
+def _horizon(d: dict, based_on: str | None) -> float:
+    """``t_end``, the horizon (s): a finite number > 0 (the paper's 2 s with ``based_on``)."""
+    if "t_end" not in d and based_on is None:
+        raise _missing("t_end", "horizon, s")
+    t_end = d.get("t_end", PAPER_T_END)
+    if isinstance(t_end, bool) or not isinstance(t_end, (int, float)):
+        raise ValueError(f"key 't_end' (horizon) must be a number > 0 s, got {t_end!r}")
+    return check_number(
+        "t_end (horizon)", t_end, low=0, low_open=True, finite=True, allowed="finite and > 0 s"
+    )
+
+
+def _chain(d: dict, n: int, based_on: str | None, where: str) -> Chain:
+    """The ``[chain]`` table over the paper's values (``based_on``) or the neutral ones; a rod
+    field without a neutral value (``REQUIRED_CHAIN``) must be given."""
+    spec = d.get("chain", {})
+    check_keys(spec, CHAIN_KEYS, f"{where} [chain]")
+    spec = resolve_profiles(spec, n, f"{where} [chain]")
+    defaults = UNIFORM_DEFAULTS if based_on == "paper" else NEUTRAL_CHAIN
+    for key, what in REQUIRED_CHAIN.items():
+        if key not in spec and key not in defaults:
+            raise _missing(f"chain.{key}", what)
+    return Chain(**{**defaults, **spec}, _n=n)
+
+
+def _loads(d: dict, n: int, based_on: str | None, where: str) -> tuple:
+    """The ``[[loads]]`` tables; omitted: none (the paper's pulse at node n with
+    ``based_on``)."""
+    if "loads" not in d:
+        return (pulse(n),) if based_on == "paper" else ()
+    if not isinstance(d["loads"], list):
+        raise ValueError("key 'loads' must be an array of tables [[loads]]")
+    return tuple(_load(s, n, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"]))
+
+
+def scene_from_dict(d: dict, where: str = "scene") -> Scene:
+    """Build and validate a Scene from the dict form (``docs/scene_file.md``).
+
+    The scene holds what ``d`` says: an omitted key is neutral (no loads, no node masses,
+    hinge springs or dampers, straight at rest, pinned, the default output times) or, for
+    ``n``, ``t_end`` and the rods' ``l``, ``m``, ``EI``, an error; with ``based_on = "paper"``
+    every omitted key takes the paper example's value (``paper_scene``). Every error is a
+    ValueError that names ``where`` (a file name) and the offending key.
     """
     check_keys(d, TOP_KEYS, where)
-    base = d.get("base", "paper")
-    body = PINNED
-    if isinstance(base, dict):  # a [base] table: the body node 0 belongs to, on the paper's scene
-        body = Base.from_dict(base, f"{where} [base]")
-    elif base not in BASES:
-        raise ValueError(
-            f"{where} key 'base': must be one of {BASES} or a [base] table, got {base!r}"
-        )
+    based_on = _based_on(d, where)
+    body = Base.from_dict(d["base"], f"{where} [base]") if "base" in d else PINNED
     try:
-        n = d.get("n", 8)
-        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-            raise ValueError(f"key 'n' (number of rods) must be an integer >= 1, got {n!r}")
-        t_end = d.get("t_end", 2.0)
-        if isinstance(t_end, bool) or not isinstance(t_end, (int, float)):
-            raise ValueError(f"key 't_end' (horizon) must be a number > 0 s, got {t_end!r}")
-        # the base's chain, loads and outputs; its output times are the file's (one here, so
-        # that memory is checked once, on the scene's own times)
-        scene = paper_scene(n, t_end=float(t_end), times=[float(t_end)])
-        chain_spec = d.get("chain", {})
-        check_keys(chain_spec, CHAIN_KEYS, f"{where} [chain]")
-        chain_spec = resolve_profiles(chain_spec, n, f"{where} [chain]")
-        chain = (
-            Chain(**{**scene.chain.as_dict(), **chain_spec}, _n=n) if chain_spec else scene.chain
-        )
-        loads = scene.loads
-        if "loads" in d:
-            if not isinstance(d["loads"], list):
-                raise ValueError("key 'loads' must be an array of tables [[loads]]")
-            loads = tuple(
-                _load(s, n, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"])
-            )
+        n = _count(d, based_on)
+        t_end = _horizon(d, based_on)
+        chain = _chain(d, n, based_on, where)
+        loads = _loads(d, n, based_on, where)
         init_spec = d.get("initial", {})
         check_keys(init_spec, INITIAL_KEYS, f"{where} [initial]")
         init_spec = resolve_profiles(init_spec, n, f"{where} [initial]")
-        outputs = d.get("outputs", scene.outputs)
+        outputs = d.get("outputs", DEFAULT_OUTPUTS)
         if isinstance(outputs, str) or not isinstance(outputs, (list, tuple)):
             raise ValueError(f"key 'outputs' must be a list from {QUANTITIES}, got {outputs!r}")
         latches = tuple(_table_items(d, "latches", Latch, LATCH_KEYS, where))
@@ -173,11 +254,11 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
             loads=loads,
             latches=latches,
             stops=stops,
-            t_end=float(t_end),
-            times=_times(d.get("times"), float(t_end), where),
+            t_end=t_end,
+            times=_times(d.get("times"), t_end, where),
             outputs=tuple(outputs),
             initial=InitialState(**init_spec),
-            name=d.get("name", scene.name),
+            name=d.get("name", f"paper-n{n}" if based_on == "paper" else "scene"),
             base=body,
         )
     except ValueError as exc:
@@ -187,8 +268,8 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
 
 def read_scene_document(source: str | Path) -> dict[str, Any]:
     """The scene document (dict form) of ``"paper"`` or a TOML scene file, not yet validated."""
-    if str(source) in BASES:
-        return {"base": str(source)}
+    if str(source) in BASED_ON:
+        return {"based_on": str(source)}
     path = Path(source)
     if not path.is_file():
         raise ValueError(f"SCENE must be 'paper' or an existing TOML file, got {str(source)!r}")
@@ -219,7 +300,8 @@ def anchor_load_files(doc: dict[str, Any], folder: Path) -> dict[str, Any]:
 
 
 def load_scene(source: str | Path) -> Scene:
-    """``"paper"`` (the paper's example) or the path of a TOML scene file."""
+    """``"paper"`` (the paper's example, ``{"based_on": "paper"}``) or the path of a TOML
+    scene file."""
     return scene_from_dict(read_scene_document(source), where=str(source))
 
 
@@ -240,10 +322,11 @@ def with_horizon(doc: dict[str, Any], t_end: float, where: str) -> Scene:
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
-    """The complete resolved scene in the scene-file format (chain arrays, loads with their
-    parameters, initial state, output times, outputs): ``scene_from_dict`` rebuilds the same
-    scene from it, bit for bit. A load that is a plain Python callable has no such form: it
-    is recorded as ``{"type": "callable", "node": k}``, which ``scene_from_dict`` refuses."""
+    """The complete resolved scene in the scene-file format (every key: chain arrays, loads
+    with their parameters, initial state, output times, outputs; a free base): it is based on
+    nothing, and ``scene_from_dict`` rebuilds the same scene from it, bit for bit. A load
+    that is a plain Python callable has no such form: it is recorded as
+    ``{"type": "callable", "node": k}``, which ``scene_from_dict`` refuses."""
     init = scene.initial.resolve(scene.n)
     return {
         "name": scene.name,
