@@ -10,9 +10,28 @@ import re
 import sys
 import traceback
 import warnings
+from collections.abc import Collection, Sequence
 
 #: Subcommand modules, in the order ``rodval --help`` lists them.
 COMMANDS = ("reproduce", "simulate", "compare", "study", "report", "bench", "modes", "animate")
+#: Each subcommand's line in ``rodval --help``, the ``help`` its module's ``register`` gives
+#: (tests/test_startup.py checks they agree): ``rodval --help`` and ``--version`` list the
+#: subcommands without importing their modules, whose options name constants of the heavy
+#: modules (the registry's model names, the study's limits, the animation's).
+SUMMARIES = {
+    "reproduce": "reproduce the paper's example (Table 1, Fig. 3, cross-check)",
+    "simulate": "run one scene with one model",
+    "compare": "compare two runs of the same scene",
+    "study": "run a study (grid of scenes x models) and write tables and a report",
+    "report": "rebuild a study's report from its saved tables",
+    "bench": "performance benchmarks (work-precision, cost vs n, ...)",
+    "modes": "natural frequencies and mode shapes about a configuration",
+    "animate": "animate runs (GIF or MP4)",
+}
+
+
+#: An argument argparse reads as a value, not an option (``OneLineParser``).
+NEGATIVE_NUMBER = re.compile(r"^-[\d.]")
 
 
 class CliError(Exception):
@@ -26,13 +45,16 @@ class OneLineParser(argparse.ArgumentParser):
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        self._negative_number_matcher = re.compile(r"^-[\d.]")
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(full: Collection[str] = COMMANDS) -> argparse.ArgumentParser:
+    """The ``rodval`` parser. The subcommands in ``full`` are registered by their modules
+    (``register``: all their options); the others only by name and summary line, which is
+    all ``rodval --help`` shows, so that their modules are not imported."""
     parser = OneLineParser(
         prog="rodval",
         description="Cross-validate plane rod-chain models: the paper's full and reduced\n"
@@ -50,8 +72,25 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"rodval {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in COMMANDS:
-        importlib.import_module(f"{__name__}.{name}").register(sub)
+        if name in full:
+            importlib.import_module(f"{__name__}.{name}").register(sub)
+        else:
+            sub.add_parser(name, help=SUMMARIES[name])
     return parser
+
+
+def command_of(argv: Sequence[str]) -> str | None:
+    """The subcommand ``argv`` names, as argparse finds it: its first word that is not an
+    option (the top-level options take no value) or the word after ``--``, if it is one of
+    ``COMMANDS``."""
+    words = iter(argv)
+    for word in words:
+        if word == "--":
+            word = next(words, "")
+        elif word.startswith("-") and not NEGATIVE_NUMBER.match(word):
+            continue
+        return word if word in COMMANDS else None
+    return None
 
 
 def one_line(exc: BaseException) -> str:
@@ -83,7 +122,10 @@ def main(argv: list[str] | None = None) -> int:
     message as an internal error (a bug to report, never hidden); no traceback is printed
     (``RODVAL_TRACEBACK=1`` prints it for debugging). Numerical RuntimeWarnings (overflow in
     a diverging run) are not printed: the run's status reports how it ended."""
-    parser = build_parser()
+    if argv is None:
+        argv = sys.argv[1:]
+    command = command_of(argv)
+    parser = build_parser(full=() if command is None else (command,))
     args = parser.parse_args(argv)
     try:
         with warnings.catch_warnings():

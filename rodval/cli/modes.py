@@ -4,18 +4,17 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from rodval.cli.options import add_model_options, positive_int, set_options
-from rodval.core.scene import Scene
-from rodval.core.scene_file import load_scene, scene_from_dict
-from rodval.models.registry import MODEL_NAMES, model_class
-from rodval.report.figures import plot_modes
-from rodval.report.run_files import read_run_record
+
+if TYPE_CHECKING:
+    from rodval.core.scene import Scene
 
 
 def register(sub) -> None:
+    from rodval.models.registry import MODEL_NAMES
+
     p = sub.add_parser(
         "modes",
         help="natural frequencies and mode shapes about a configuration",
@@ -74,6 +73,8 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from rodval.analysis.modes import model_modes
+    from rodval.models.registry import model_class
+    from rodval.report.figures import plot_modes
 
     compare = _compare_list(args.compare)
     scene, model = _scene_and_model(args)
@@ -109,6 +110,8 @@ def run(args) -> int:
 
 def _compare_list(text: str | None) -> tuple[str, ...]:
     """--compare MODELS as a tuple of registered model names (ValueError otherwise)."""
+    from rodval.models.registry import MODEL_NAMES
+
     if not text:
         return ()
     compare = tuple(x.strip() for x in text.split(",") if x.strip())
@@ -119,6 +122,8 @@ def _compare_list(text: str | None) -> tuple[str, ...]:
 
 def _options_for(model: str, pool: dict) -> dict:
     """The options of ``pool`` (the command line's) that ``model``'s modes take."""
+    from rodval.models.registry import model_class
+
     accepted = model_class(model).MODES_OPTIONS
     return {k: v for k, v in pool.items() if k in accepted}
 
@@ -149,6 +154,8 @@ def _record(scene: Scene, m, args) -> dict:
 
 def _summary(scene: Scene, m, args) -> list[str]:
     """The printed lines: what was linearized about what, the equilibrium, the modes."""
+    import numpy as np
+
     lines = [f"{m.model} modes of {scene.name} about the {m.about} state -> {args.out}"]
     if "unbalanced_residual_Nm" in m.info:
         lines.append(
@@ -201,6 +208,10 @@ def _comparison(scene: Scene, m, models: tuple[str, ...], pool: dict, args) -> l
 def _scene_and_model(args) -> tuple[Scene, str]:
     """The scene of SCENE ('paper', a TOML file, or a run.json: its recorded scene) and the
     model: --model, else a run.json's own model (when it has modes), else "full"."""
+    from rodval.core.scene_file import load_scene, scene_from_dict
+    from rodval.models.registry import MODEL_NAMES
+    from rodval.report.run_files import read_run_record
+
     path = Path(args.scene)
     if path.suffix != ".json":
         return load_scene(args.scene), args.model or "full"

@@ -6,7 +6,6 @@ import importlib.util
 from pathlib import Path
 
 from rodval.cli import CliError
-from rodval.report.paper import crosscheck_markdown, reproduce_paper
 
 
 def register(sub) -> None:
@@ -44,6 +43,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from rodval.report.paper import crosscheck_markdown, reproduce_paper
+
     have_exudyn = importlib.util.find_spec("exudyn") is not None
     if args.cross_check and not have_exudyn:
         raise CliError("--cross-check needs exudyn: pip install 'rodval[exudyn]'")

@@ -14,10 +14,11 @@ from rodval.cli.options import (
     positive_float,
     positive_int,
 )
-from rodval.study.spec import MAX_CASES
 
 
 def register(sub) -> None:
+    from rodval.study.spec import MAX_CASES
+
     p = sub.add_parser(
         "study",
         help="run a study (grid of scenes x models) and write tables and a report",
@@ -87,6 +88,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from rodval.study import load_study, run_study
+    from rodval.study.spec import MAX_CASES
     from rodval.study.store import StudyStore
 
     def announce(size: int) -> None:
