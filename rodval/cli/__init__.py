@@ -8,6 +8,7 @@ import importlib
 import os
 import re
 import sys
+import time
 import traceback
 import warnings
 from collections.abc import Collection, Sequence
@@ -121,12 +122,21 @@ def main(argv: list[str] | None = None) -> int:
     status 2; anything unexpected is one line too, exit 2, naming the exception's type and
     message as an internal error (a bug to report, never hidden); no traceback is printed
     (``RODVAL_TRACEBACK=1`` prints it for debugging). Numerical RuntimeWarnings (overflow in
-    a diverging run) are not printed: the run's status reports how it ended."""
+    a diverging run) are not printed: the run's status reports how it ended.
+
+    ``args.started`` (``time.perf_counter`` clock) is when the command started, from which
+    its wall-clock budget counts: the process start for the ``rodval`` command itself (argv
+    None: its interpreter start-up and imports are the command's), the call otherwise (a
+    host process that calls ``main`` has its own age)."""
+    started = time.perf_counter()
     if argv is None:
-        argv = sys.argv[1:]
+        from rodval.core.clock import process_age_s
+
+        argv, started = sys.argv[1:], started - process_age_s()
     command = command_of(argv)
     parser = build_parser(full=() if command is None else (command,))
     args = parser.parse_args(argv)
+    args.started = started
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
