@@ -38,7 +38,10 @@ Solver: exudyn's implicit generalized-alpha (or trapezoidal index-2) integrator 
 step (halved, down to step/64, only if Newton fails), sparse linear solver (EigenSparse), no
 solution files, no graphics and no console output. Newton's absolute tolerance is
 ``newton_atol_per_EA * EA`` (N): the default absolute tolerance lies below the round-off of the
-stiff axial forces. With latches the (modified) Newton Jacobian is renewed every step: a
+stiff axial forces. With latches the (modified) Newton Jacobian is renewed every step
+(``JAC_PER_STEP``; renewing it only in the step a latch switches on, through exudyn's
+``solver.conv.jacobianUpdateRequested``, keeps the lock times to 1e-7 ms but moves phi by
+1.3e-6 rad on the 6-panel wing and is not faster: docs/reference_model.md, "Speed"): a
 Jacobian kept from before a latch's joint was switched on leaves the joint without effect
 until Newton restarts (0.17 ms late on the two-rod scene of tests/test_rigid_lock.py, the
 hinge passing its latch angle by 3.7 mrad).
@@ -80,6 +83,9 @@ from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.core.validity import Check, step_resolution
 
 ELEMENTS = ("cable2d",)
+#: renew the Newton Jacobian every step of a scene with latches (True: the old way) instead of
+#: only in the step a latch's joint is switched on (``_Latches.pre_step``)
+JAC_PER_STEP = True
 SOLVERS = ("generalized-alpha", "trapezoidal")
 
 #: Converged defaults, chosen by benchmarks/exudyn_convergence.py (docs/reference_model.md).
@@ -251,7 +257,7 @@ class ExudynModel(Model):
         ti.verboseModeFile = 0
         ti.newton.relativeTolerance = self.newton_rtol
         ti.newton.absoluteTolerance = self.newton_atol_per_EA * self.EA
-        ti.newton.modifiedNewtonJacUpdatePerStep = bool(scene.latches)
+        ti.newton.modifiedNewtonJacUpdatePerStep = bool(scene.latches) and JAC_PER_STEP
         ti.generalizedAlpha.spectralRadius = self.spectral_radius_for(scene)
         s.solution.file.write = False
         s.solution.sensors.writePeriod = 0.25 * t_end / planned
@@ -355,7 +361,10 @@ class ExudynModel(Model):
             )
             stats.status, stats.message = status, f"build failed: {message}"
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
-        run_info.update(step_used=float(sim.timeIntegration.initialStepSize))
+        run_info.update(
+            step_used=float(sim.timeIntegration.initialStepSize),
+            **_newton_record(sim, bool(scene.latches)),
+        )
         latches = _Latches(built, guard, scene, self.elements) if scene.latches else None
         self._solve(scene, built, sim, (guard, latches, budget), stats)
         run_info.update(
@@ -400,12 +409,13 @@ class ExudynModel(Model):
         guard, latches, budget = checks
         solver: Any = exu.MainSolverImplicitSecondOrder()
         guard.solver = solver
+        jac_on_switch = not sim.timeIntegration.newton.modifiedNewtonJacUpdatePerStep
 
         def pre_step(mbs, t):
             go = guard.pre_step(mbs, t)
             if latches is not None and go:
                 try:
-                    latches.pre_step(t, float(solver.it.currentStepSize))
+                    latches.pre_step(t, guard.h, solver if jac_on_switch else None)
                 except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
                     guard.verdict = (
                         STATUS_ERROR,
@@ -546,6 +556,25 @@ def _lock_records(latches: _Latches | None) -> tuple[list[dict], dict[int, float
         pass
     events = sorted(latches.events, key=lambda ev: ev["t"])
     return events, dict(latches.lock_times.items())
+
+
+def _newton_record(sim, latches: bool) -> dict[str, Any]:
+    """The Newton and linear-solver choices of a run, for ``trajectory.settings`` (chosen by
+    benchmarks/exudyn_speed.py and the measurements in docs/reference_model.md, "Speed")."""
+    newton = sim.timeIntegration.newton
+    per_step = bool(newton.modifiedNewtonJacUpdatePerStep)
+    return {
+        "linear_solver": str(sim.linearSolver.solverType).split(".")[-1],
+        "newton": "modified" if newton.useModifiedNewton else "full",
+        "newton_atol": float(newton.absoluteTolerance),
+        "newton_rtol": float(newton.relativeTolerance),
+        "jacobian_update": (
+            "every step"
+            if per_step
+            else f"when the contraction exceeds {newton.modifiedNewtonContractivity:g}"
+            + (" and in the step a latch switches on" if latches else "")
+        ),
+    }
 
 
 def _unknown_options_message(unknown: dict) -> str:

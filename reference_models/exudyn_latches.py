@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, _hermite, _wrap, stop_moment
 from reference_models.exudyn_build import _Built
@@ -108,24 +109,40 @@ class _Latches:
         for stop in scene.stops:
             self.stops.setdefault(stop.hinge, []).append(stop)
         self.root = {"left": body, "right": ltg[0][0][2:], "D": float(D0[0])}
+        # the per-step hinge angles, vectorized: row 0 hinge 0 (root), rows 1.. the latches
+        self._sides = _Sides(
+            [self.root["left"]] + [it["left"] for it in self.items],
+            [self.root["right"]] + [it["right"] for it in self.items],
+        )
+        self._D = np.array([self.root["D"]] + [it["D"] for it in self.items])
+        self._angle_of = np.array([it["latch"].angle for it in self.items], float)
+        self._dir = np.array([it["dir"] for it in self.items], float)
+        self._armed = np.ones(len(self.items), bool)
         self.prev: dict | None = None
         self.pending: list[dict] = []
         self.events: list[dict] = []
         self.lock_times: dict[int, float] = {}
         self.step_count = 0
         self._cfg = None  # exudyn's configuration of the last accepted state (StartOfStep)
+        self._root_shapes: dict[int, tuple] = {}  # rod -> Hermite slopes at its root
 
     # -- measures --------------------------------------------------------------------------
-    def _state(self):
+    def _state(self, known=None):
+        """q (absolute: the reference added), v, a of the last accepted state (exudyn's
+        StartOfStep configuration, which at the pre-step equals the current one); ``known``:
+        (q - reference, v) the guard read in this pre-step (one read of each a step)."""
         import exudyn as exu
 
         sd, cfg = self.mbs.systemData, self._cfg
         if cfg is None:
             cfg = exu.ConfigurationType.StartOfStep
-        q = np.asarray(sd.GetODE2Coordinates(cfg)) + self.guard.ref
+        if known is not None:
+            q, v = known
+        else:
+            q, v = sd.GetODE2Coordinates(cfg), sd.GetODE2Coordinates_t(cfg)
         return (
-            q,
-            np.asarray(sd.GetODE2Coordinates_t(cfg)),
+            np.asarray(q) + self.guard.ref,
+            np.asarray(v),
             np.asarray(sd.GetODE2Coordinates_tt(cfg)),
         )
 
@@ -175,7 +192,9 @@ class _Latches:
         """EI kappa_b (N m) at the root of rod j (0-based): the moment the hinge there
         transmits, in the sense of its spring's kappa (D - rest)."""
         E, le = self.E, self.scene.chain.l[j] / self.E
-        _, dS, ddS = _hermite(np.zeros(1), le)
+        if j not in self._root_shapes:
+            self._root_shapes[j] = _hermite(np.zeros(1), le)[1:]
+        dS, ddS = self._root_shapes[j]
         a, b = self.ltg[j][0], self.ltg[j][1 if E >= 1 else 0]
         Q = np.stack([q[a[:2]], q[a[2:]], q[b[:2]], q[b[2:]]])  # (4, 2)
         r1, r2 = dS[0] @ Q, ddS[0] @ Q
@@ -237,66 +256,96 @@ class _Latches:
         return H_root, root_moment
 
     # -- per step --------------------------------------------------------------------------
-    def pre_step(self, t: float, h: float) -> None:
-        """Called before the step to t, on the state at t - h (the last accepted step)."""
+    def pre_step(self, t: float, h: float, solver=None) -> None:
+        """Called before the step to t, on the state at t - h (the last accepted step). The
+        hinge angles of hinge 0 and of every armed latch and the bound that a crossing needs
+        are one compiled call a step (``_latch_step``); the closed-form roots
+        (``_taylor_roots``, vectorized over the latches) run only when a latch passes it, and
+        Python loops only over the latches that switch or are being measured. ``solver``: exudyn's
+        solver, whose Newton Jacobian is renewed in the step a joint is switched on
+        (``conv.jacobianUpdateRequested``)."""
         if h <= 0:
             return
         t0 = t - h
-        q, v, a = self._state()
-        self.root["D"] = self._hinge(self.root, q, v, a)[0]
-        now = {}
-        for item in self.items:
-            if item["state"] != "armed":
-                continue
-            D, dD, ddD = self._hinge(item, q, v, a)
-            item["D"] = D
-            now[item["k"]] = (D, dD, ddD)
+        q, v, a = self._state(self.guard.state)
+        armed = self._armed
+        sides = self._sides
+        Dl, dDl, ddDl, maybe = _latch_step(
+            q,
+            v,
+            a,
+            sides.kind,
+            sides.i0,
+            sides.i1,
+            self._D,
+            self._angle_of,
+            self._dir,
+            armed,
+            h,
+        )
+        self.root["D"] = float(self._D[0])
         for ev in list(self.pending):
             self._advance(ev, self._measures(t0, ev["item"], q, v, a))
-        for item in self.items:
-            if item["state"] != "armed":
-                continue
-            D, dD, ddD = now[item["k"]]
-            angle, s = item["latch"].angle, item["dir"]
-            t_lock = None
-            if s * (D - angle) >= 0:  # already at or past: Hermite root in the last step
-                if self.prev is not None and item["k"] in self.prev["D"]:
-                    Dp, dDp, _ = self.prev["D"][item["k"]]
-                    t_lock = _hermite_root(self.prev["t"], t0, Dp - angle, dDp, D - angle, dD)
+        prev = self.prev
+        self.prev = {"t": t0, "D": Dl, "dD": dDl, "armed": armed.copy()}
+        if not maybe:
+            return
+        g = Dl - self._angle_of
+        past = self._dir * g >= 0
+        tau = _taylor_roots(g, dDl, ddDl, h)
+        switch = armed & (past | np.isfinite(tau))
+        if not switch.any():
+            return
+        for i in np.flatnonzero(switch):
+            item = self.items[i]
+            item["D"] = float(Dl[i])
+            if past[i]:  # already at or past: Hermite root in the last step
+                if prev is not None and prev["armed"][i]:
+                    t_lock = _hermite_root(
+                        prev["t"],
+                        t0,
+                        prev["D"][i] - item["latch"].angle,
+                        prev["dD"][i],
+                        float(g[i]),
+                        float(dDl[i]),
+                    )
                 else:
                     t_lock = t0
             else:
-                tau = _taylor_root(D - angle, dD, ddD, h)
-                if tau is not None:
-                    t_lock = t0 + tau
-            if t_lock is None:
-                continue
-            self.mbs.SetObjectParameter(item["joint"], "activeConnector", True)
-            item["state"] = "locking"
-            self.lock_times[item["k"]] = t0
-            before = self._measures(t0, item, q, v, a)
-            # the chords just before the lock and the hinges held after it: the rigid-panel
-            # lock's data (rodval.core.rigid)
-            before["chords"] = np.array([self._chord(j, q, v) for j in range(self.scene.n)])
-            before["held"] = [it["k"] for it in self.items if it["state"] != "armed"]
-            self.pending.append(
-                {
-                    "item": item,
-                    "t_lock": t_lock,
-                    "window": lock_window(self.scene.chain, item["latch"], before["held"]),
-                    "steps": 0,
-                    "before": before,
-                    "last": before,
-                    "settled": None,
-                    "integral": 0.0,
-                    "root_integral": 0.0,
-                    "S": 0.0,
-                    "mean": 0.0,
-                    "peak": abs(before["M_beam"]),
-                    "step": h,
-                }
-            )
-        self.prev = {"t": t0, "D": now}
+                t_lock = t0 + float(tau[i])
+            self._switch(item, int(i), t0, t_lock, h, q, v, a)
+        if solver is not None:
+            solver.conv.jacobianUpdateRequested = True
+
+    def _switch(self, item, i: int, t0: float, t_lock: float, h: float, q, v, a) -> None:
+        """Switch latch ``item`` (row ``i``) on before the step from t0 and open its lock
+        record."""
+        self.mbs.SetObjectParameter(item["joint"], "activeConnector", True)
+        item["state"] = "locking"
+        self._armed[i] = False
+        self.lock_times[item["k"]] = t0
+        before = self._measures(t0, item, q, v, a)
+        # the chords just before the lock and the hinges held after it: the rigid-panel
+        # lock's data (rodval.core.rigid)
+        before["chords"] = np.array([self._chord(j, q, v) for j in range(self.scene.n)])
+        before["held"] = [it["k"] for it in self.items if it["state"] != "armed"]
+        self.pending.append(
+            {
+                "item": item,
+                "t_lock": t_lock,
+                "window": lock_window(self.scene.chain, item["latch"], before["held"]),
+                "steps": 0,
+                "before": before,
+                "last": before,
+                "settled": None,
+                "integral": 0.0,
+                "root_integral": 0.0,
+                "S": 0.0,
+                "mean": 0.0,
+                "peak": abs(before["M_beam"]),
+                "step": h,
+            }
+        )
 
     def _advance(self, ev: dict, now: dict) -> None:
         """One accepted step of a lock's window: the trapezoid integrals of the finite moments
@@ -371,16 +420,104 @@ class _Latches:
         self.pending.remove(ev)
 
 
+class _Sides:
+    """The hinge angles D = (right tangent angle) - (left tangent angle) of a set of hinges
+    (rows), with their rates and accelerations, in one compiled call a step (``_hinge_rows``).
+    Each side is None (the ground's x axis), one coordinate index (a free base's attitude,
+    continuous) or the two slope coordinates of a beam node (tangent angle atan2(s_y, s_x))."""
+
+    def __init__(self, left: list, right: list):
+        sides = list(left) + list(right)
+        self.rows = len(left)
+        self.kind = np.array(
+            [0 if s is None else (1 if np.ndim(s) == 0 else 2) for s in sides], np.int64
+        )
+        self.i0 = np.array(
+            [0 if s is None else (int(s) if np.ndim(s) == 0 else int(s[0])) for s in sides],
+            np.int64,
+        )
+        self.i1 = np.array([int(s[1]) if np.ndim(s) == 1 else 0 for s in sides], np.int64)
+
+    def hinges(self, q, v, a, D_prev: np.ndarray):
+        """D (continuous from ``D_prev``), dD, ddD of every row."""
+        out = np.empty((3, self.rows))
+        _hinge_rows(q, v, a, self.kind, self.i0, self.i1, np.asarray(D_prev, float), out)
+        return out[0], out[1], out[2]
+
+
+@njit(cache=True, error_model="numpy")
+def _hinge_rows(q, v, a, kind, i0, i1, D_prev, out):  # pragma: no cover - compiled
+    """``_Sides.hinges`` compiled: rows 0..R-1 of ``out`` (3, R) <- D, dD, ddD, the sides
+    0..R-1 left and R..2R-1 right (kind 0 ground, 1 body coordinate i0, 2 slope (i0, i1))."""
+    R = out.shape[1]
+    for r in range(R):
+        ang = np.zeros(2)
+        rate = np.zeros(2)
+        acc = np.zeros(2)
+        for side in range(2):
+            j = r + side * R
+            if kind[j] == 1:
+                ang[side], rate[side], acc[side] = q[i0[j]], v[i0[j]], a[i0[j]]
+            elif kind[j] == 2:
+                sx, sy = q[i0[j]], q[i1[j]]
+                vx, vy = v[i0[j]], v[i1[j]]
+                ax, ay = a[i0[j]], a[i1[j]]
+                r2 = sx * sx + sy * sy
+                rt = (sx * vy - sy * vx) / r2
+                ang[side] = np.arctan2(sy, sx)
+                rate[side] = rt
+                acc[side] = (sx * ay - sy * ax - 2.0 * (sx * vx + sy * vy) * rt) / r2
+        x = (ang[1] - ang[0]) - D_prev[r]
+        out[0, r] = D_prev[r] + (np.pi - (np.pi - x) % (2.0 * np.pi))
+        out[1, r] = rate[1] - rate[0]
+        out[2, r] = acc[1] - acc[0]
+
+
+@njit(cache=True, error_model="numpy")
+def _latch_step(q, v, a, kind, i0, i1, D, angle, direction, armed, h):  # pragma: no cover
+    """One pre-step of the latches compiled: row 0 hinge 0, rows 1.. the latches. ``D``
+    (continued in place for row 0 and the armed rows); returns D, dD, ddD of the latch rows
+    and whether an armed latch is at or past its angle or may cross it within the step h
+    (|g| <= |dD| h + |ddD| h^2 / 2, g = D - angle): only then the closed-form roots run."""
+    out = np.empty((3, D.size))
+    _hinge_rows(q, v, a, kind, i0, i1, D, out)
+    D[0] = out[0, 0]
+    maybe = False
+    for r in range(1, D.size):
+        if armed[r - 1]:
+            D[r] = out[0, r]
+            g = out[0, r] - angle[r - 1]
+            if direction[r - 1] * g >= 0.0 or abs(g) <= abs(out[1, r]) * h + abs(out[2, r]) * (
+                0.5 * h * h
+            ):
+                maybe = True
+    return out[0, 1:].copy(), out[1, 1:].copy(), out[2, 1:].copy(), maybe
+
+
+def _taylor_roots(g: np.ndarray, dg: np.ndarray, ddg: np.ndarray, h: float) -> np.ndarray:
+    """Per row, the smallest tau in (0, h] where g + dg tau + ddg tau^2 / 2 changes sign from
+    that of g, in closed form (NaN where it does not within the step): the stable quadratic
+    formula (roots q / c2 and g / q with q = -(dg + sign(dg) sqrt(disc)) / 2, c2 = ddg / 2,
+    disc = dg^2 - 2 ddg g), the linear root -g / dg where ddg = 0. A double root (disc = 0)
+    counts; complex roots (disc < 0) do not."""
+    g, dg, ddg = (np.asarray(x, float) for x in (g, dg, ddg))
+    c2 = 0.5 * ddg
+    disc = dg * dg - 4.0 * c2 * g
+    with np.errstate(all="ignore"):
+        sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        qq = -0.5 * (dg + np.where(dg >= 0, sq, -sq))
+        r1 = np.where(c2 != 0, qq / c2, np.where(dg != 0, -g / dg, np.nan))
+        r2 = np.where((c2 != 0) & (qq != 0), g / qq, np.nan)
+    r1 = np.where((r1 > 0) & (r1 <= h), r1, np.nan)
+    r2 = np.where((r2 > 0) & (r2 <= h), r2, np.nan)
+    return np.fmin(r1, r2)
+
+
 def _taylor_root(g: float, dg: float, ddg: float, h: float) -> float | None:
     """Smallest tau in (0, h] where g + dg tau + ddg tau^2 / 2 changes sign from that of g
-    (None if it does not within the step)."""
-    tau = np.array([h])
-    coeffs = [0.5 * ddg, dg, g]
-    roots = np.roots(coeffs) if abs(ddg) > 0 or abs(dg) > 0 else np.array([])
-    real = sorted(
-        float(r.real) for r in np.atleast_1d(roots) if abs(r.imag) < 1e-12 and 0 < r.real <= tau[0]
-    )
-    return real[0] if real else None
+    (None if it does not within the step); the scalar form of ``_taylor_roots``."""
+    tau = float(_taylor_roots(np.array([g]), np.array([dg]), np.array([ddg]), h)[0])
+    return tau if math.isfinite(tau) else None
 
 
 def _hermite_root(t0: float, t1: float, g0: float, dg0: float, g1: float, dg1: float) -> float:
