@@ -11,19 +11,12 @@ import sys
 
 import pytest
 from study_helpers import write_study
+from test_trust_study import one_line
 
 from rodval.cli import main
 
 ONE_MODEL = "[models.reduced]\n"
 QUICK = ["--no-progress", "--workers", "1", "--no-report"]
-
-
-def one_line(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = [line for line in err.splitlines() if line.strip()]
-    assert len(lines) == 1, err
-    assert "Traceback" not in err and "internal error" not in err, err
-    return lines[0]
 
 
 def snapshot(folder) -> dict[str, bytes]:
