@@ -6,6 +6,7 @@ hung after the kernels' module changed). Here a two-module package is compiled a
 one process, the callee's module is edited, and a second process must run the new callee.
 """
 
+import json
 import subprocess
 import sys
 import textwrap
@@ -69,6 +70,72 @@ def test_a_cached_kernel_runs_the_new_code_of_a_callee_in_another_module(tmp_pat
 
 def test_rodval_installs_it_for_its_own_kernels():
     assert jit_cache.INSTALLED
-    root = str(jit_cache.PACKAGE_ROOT) + "/"
-    assert root in jit_cache._DIGESTS
-    assert jit_cache._DIGESTS[root] == jit_cache.source_digest()
+    assert str(jit_cache.PACKAGE_ROOT) + "/" in jit_cache._ROOTS
+    kernels = jit_cache.PACKAGE_ROOT / "models" / "kernels.py"
+    closure = {
+        p.relative_to(jit_cache.PACKAGE_ROOT).as_posix() for p in jit_cache.import_closure(kernels)
+    }
+    # the full model's kernels reach the load kernels and the first-class signatures, not the CLI
+    assert {"models/kernels.py", "core/loads.py", "solvers/signature.py"} <= closure
+    assert not any(p.startswith(("cli/", "report/", "study/")) for p in closure)
+
+
+MODULES = {
+    "a.py": "from numba import njit\n\n\n@njit(cache=True)\ndef value():\n    return {a}\n",
+    "b.py": "from numba import njit\n\n\n@njit(cache=True)\ndef value():\n    return 3\n",
+    "use_a.py": "from numba import njit\n\nfrom kernels import a\n\n\n"
+    "@njit(cache=True)\ndef twice():\n    return 2 * a.value()\n",
+    "use_b.py": "from numba import njit\n\nfrom kernels.b import value\n\n\n"
+    "@njit(cache=True)\ndef twice():\n    return 2 * value()\n",
+    "loop.py": "from numba import njit\n\n\n@njit(cache=True)\ndef call(f):\n    return f() + 1\n",
+}
+COUNT = textwrap.dedent(
+    """
+    import json, sys
+    from pathlib import Path
+
+    from rodval.core import jit_cache
+
+    assert jit_cache.install(Path(sys.argv[1]) / "kernels")
+    from kernels import a, b, loop, use_a, use_b
+
+    values = [use_a.twice(), use_b.twice(), loop.call(use_a.twice), loop.call(use_b.twice)]
+    counts = {}
+    for name, mod in (("a", a), ("b", b), ("use_a", use_a), ("use_b", use_b)):
+        f = mod.value if name in "ab" else mod.twice
+        counts[name] = sum(f.stats.cache_misses.values())
+    print(json.dumps({"values": values, "compiled": counts}))
+    """
+)
+
+
+def test_an_edit_recompiles_only_the_kernels_that_reach_the_edited_file(tmp_path):
+    """Per-kernel keys: after ``a.py`` changes, a second process compiles again only what
+    reaches it by imports (``a``, ``use_a``); ``b`` and ``use_b`` load from the cache. ``loop``
+    takes a kernel as an argument: numba compiles such a specialization in every process, and
+    it runs the new ``a`` (11)."""
+    pkg = tmp_path / "kernels"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    for name, text in MODULES.items():
+        (pkg / name).write_text(text.format(a=1) if name == "a.py" else text)
+
+    def run() -> dict:
+        env_path = f"{tmp_path}:{Path(rodval.__file__).resolve().parents[1]}"
+        out = subprocess.run(
+            [sys.executable, "-c", COUNT, str(tmp_path)],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env={"PYTHONPATH": env_path, "OMP_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"},
+            check=True,
+        )
+        return json.loads(out.stdout)
+
+    first = run()
+    assert first["values"] == [2, 6, 3, 7]
+    assert all(n == 1 for n in first["compiled"].values()), first
+    (pkg / "a.py").write_text(MODULES["a.py"].format(a=5))
+    second = run()
+    assert second["values"] == [10, 6, 11, 7]
+    assert second["compiled"] == {"a": 1, "b": 0, "use_a": 1, "use_b": 0}, second
