@@ -20,6 +20,7 @@ import numpy as np
 
 from rodval.core.base import PINNED, Base
 from rodval.core.checks import check_keys, check_number
+from rodval.core.damping import bending_damping_for_ratio
 from rodval.core.loads import LOAD_FACTORIES, pulse
 from rodval.core.profiles import resolve_profiles
 from rodval.core.resources import check_rods
@@ -204,14 +205,35 @@ def _horizon(d: dict, based_on: str | None) -> float:
 def _chain(d: dict, n: int, based_on: str | None, where: str) -> Chain:
     """The ``[chain]`` table over the paper's values (``based_on``) or the neutral ones; a rod
     field without a neutral value (``REQUIRED_CHAIN``) must be given."""
-    spec = d.get("chain", {})
+    spec = dict(d.get("chain", {}))
     check_keys(spec, CHAIN_KEYS, f"{where} [chain]")
+    ratio = _damping_ratio(spec, where)
     spec = resolve_profiles(spec, n, f"{where} [chain]")
     defaults = UNIFORM_DEFAULTS if based_on == "paper" else NEUTRAL_CHAIN
     for key, what in REQUIRED_CHAIN.items():
         if key not in spec and key not in defaults:
             raise _missing(f"chain.{key}", what)
-    return Chain(**{**defaults, **spec}, _n=n)
+    chain = Chain(**{**defaults, **spec}, _n=n)
+    if ratio is None:
+        return chain
+    c = bending_damping_for_ratio(ratio, chain.l, chain.m, chain.EI)
+    return chain.with_(bending_damping=c)
+
+
+def _damping_ratio(spec: dict, where: str) -> Any:
+    """The ratio of ``[chain] bending_damping = { ratio = ... }`` (removed from ``spec``; the
+    chain gets the converted N m^2 s, ``rodval.core.damping``), or None when the damping is
+    given in N m^2 s (a number, a list or a profile)."""
+    value = spec.get("bending_damping")
+    if not isinstance(value, dict) or "ratio" not in value:
+        return None
+    if set(value) != {"ratio"}:
+        raise ValueError(
+            f"{where} [chain] bending_damping: a table with 'ratio' takes no other key "
+            f"(got {sorted(value)}); give {{ ratio = 0.01 }} for 1 % of critical damping"
+        )
+    del spec["bending_damping"]
+    return value["ratio"]
 
 
 def _loads(d: dict, n: int, based_on: str | None, where: str) -> tuple:
