@@ -311,39 +311,62 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
-def _momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
-    """The ``angular_momentum`` rows (nt, 2) (N m s, counter-clockwise positive) and the
-    ``momentum`` rows P (nt, 2) (N s) of the whole system (see rodval.core.scene.QUANTITIES):
-    the beam field (the rods' mass on the beam's reference arc length, the node masses at the
-    rod ends; 5 Gauss points per element integrate the degree-6 integrand r x v exactly) and a
-    free base's body (``at[BODY]``: P += m v_c, H += J theta' + m (r_c - r_0) x v_c, first
-    moment += m (r_c - r_0)). k = 0 about node 0, H_0 = sum int (r - r_0) x r_t dm; k = 1
-    about the system's centre of mass, H_0 - (S x P) / M (S the first mass moment about node
-    0, M the total mass)."""
+def _momentum_parts(
+    scene: Scene, E: int, at: dict
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per part of the system, about node 0 (the root, moving with a free base): the angular
+    momenta h (nt, parts) (N m s), linear momenta p (nt, parts, 2) (N s), first mass moments
+    (nt, parts, 2) (kg m) and masses (parts,) (kg). The parts are each rod's beam field with
+    its far node's point mass (the rods' mass on the beam's reference arc length; 5 Gauss
+    points per element integrate the degree-6 integrand r x v exactly) and a free base's body
+    (``at[BODY]``: J theta' + m (r_c - r_0) x v_c, m v_c, m (r_c - r_0)), the last part."""
     chain = scene.chain
     root = at[(0, 0)][0][:, None, :2]  # (nt, 1, 2)
-    H0 = np.zeros(root.shape[0])
-    P = np.zeros((root.shape[0], 2))
-    first = np.zeros((root.shape[0], 2))
+    parts = chain.n + (1 if BODY in at else 0)
+    h = np.zeros((root.shape[0], parts))
+    p = np.zeros((root.shape[0], parts, 2))
+    first = np.zeros((root.shape[0], parts, 2))
+    mass = np.append(chain.m * chain.l + chain.mu, scene.base.inertial()[0] if BODY in at else [])
     for k, w, S, _, _, Q, V in _elements(chain, E, at):
         r = np.einsum("gi,tic->tgc", S, Q) - root
         v = np.einsum("gi,tic->tgc", S, V)
-        H0 += chain.m[k] * np.sum(w * _cross(r, v), -1)
-        P += chain.m[k] * np.einsum("g,tgc->tc", w, v)
-        first += chain.m[k] * np.einsum("g,tgc->tc", w, r)
+        h[:, k] += chain.m[k] * np.sum(w * _cross(r, v), -1)
+        p[:, k] += chain.m[k] * np.einsum("g,tgc->tc", w, v)
+        first[:, k] += chain.m[k] * np.einsum("g,tgc->tc", w, r)
     for k in range(chain.n):
         r = at[(k, E)][0][:, :2] - root[:, 0]
         v = at[(k, E)][1][:, :2]
-        H0 += chain.mu[k] * _cross(r, v)
-        P += chain.mu[k] * v
-        first += chain.mu[k] * r
-    total = float(np.sum(chain.m * chain.l + chain.mu))
+        h[:, k] += chain.mu[k] * _cross(r, v)
+        p[:, k] += chain.mu[k] * v
+        first[:, k] += chain.mu[k] * r
     if BODY in at:
-        mass, inertia = scene.base.inertial()
+        body_mass, inertia = scene.base.inertial()
         q_b, v_b = at[BODY][:2]
         r_c = q_b[:, :2] - root[:, 0]
-        H0 += inertia * v_b[:, 2] + mass * _cross(r_c, v_b[:, :2])
-        P += mass * v_b[:, :2]
-        first += mass * r_c
-        total += mass
-    return np.stack([H0, H0 - _cross(first, P) / total], -1), P
+        h[:, -1] = inertia * v_b[:, 2] + body_mass * _cross(r_c, v_b[:, :2])
+        p[:, -1] = body_mass * v_b[:, :2]
+        first[:, -1] = body_mass * r_c
+    return h, p, first, mass
+
+
+def _momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The ``angular_momentum`` rows (nt, 2) (N m s, counter-clockwise positive) and the
+    ``momentum`` rows P (nt, 2) (N s) of the whole system (see rodval.core.scene.QUANTITIES),
+    summed over ``_momentum_parts``: k = 0 about node 0, H_0 = sum int (r - r_0) x r_t dm;
+    k = 1 about the system's centre of mass, H_0 - (S x P) / M (S the first mass moment about
+    node 0, M the total mass)."""
+    h, p, first, mass = _momentum_parts(scene, E, at)
+    H0, P, S = h.sum(-1), p.sum(-2), first.sum(-2)
+    return np.stack([H0, H0 - _cross(S, P) / mass.sum()], -1), P
+
+
+def momentum_audit_rows(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(H, G) (N m s, (nt,)) for the angular-momentum audit (``rodval.core.validity``,
+    ``momentum_balance``), the same parts as the native models' (each rod with its far node,
+    the body): about the system's centre of mass on a free base, about node 0 on a pinned
+    chain; H the parts' sum, G the sum of their magnitudes."""
+    h, p, first, mass = _momentum_parts(scene, E, at)
+    if BODY in at:  # about the centre of mass X: h_X = h_0 - (X - r_0) x p
+        X = first.sum(-2) / mass.sum()
+        h = h - _cross(X[:, None, :], p)
+    return h.sum(-1), np.abs(h).sum(-1)

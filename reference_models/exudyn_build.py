@@ -16,6 +16,7 @@ from reference_models.exudyn_beam import (
     _stop_law,
 )
 from rodval.core.scene import Scene
+from rodval.core.validity import momentum_point
 
 
 @dataclass
@@ -234,7 +235,8 @@ def sensor_nodes(scene: Scene, E: int) -> set[tuple[int, int]]:
     ends = ("phi", "dphi", "alpha", "beta", "x", "y", "hinge_angle", "hinge_moment", "base")
     if scene.wants(*ends):
         wanted |= {(k, 0) for k in range(n)} | {(k, E) for k in range(n)}
-    if scene.wants("energy", "angular_momentum", "momentum") or scene.latches:
+    audit = momentum_point(scene) is not None  # the momentum audit needs every node
+    if scene.wants("energy", "angular_momentum", "momentum") or scene.latches or audit:
         wanted |= {(k, j) for k in range(n) for j in range(E + 1)}
     return wanted
 

@@ -69,7 +69,7 @@ from reference_models.exudyn_budget import EXUDYN_MAX_STEPS, RunBudget, check_pl
 from reference_models.exudyn_build import _Built, build, recorded_doubles
 from reference_models.exudyn_guard import _Guard
 from reference_models.exudyn_latches import _Latches
-from reference_models.exudyn_observe import _observe, stop_events
+from reference_models.exudyn_observe import _observe, momentum_audit, stop_events
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
@@ -80,7 +80,8 @@ from rodval.core.status import (
     numerical_failure,
 )
 from rodval.core.trajectory import SolverStats, Trajectory
-from rodval.core.validity import Check, step_resolution
+from rodval.core.validity import Check, momentum_point, step_resolution
+from rodval.solvers.audit import momentum_residual
 
 ELEMENTS = ("cable2d",)
 #: renew the Newton Jacobian every step of a scene with latches (True: the old way) instead of
@@ -391,6 +392,10 @@ class ExudynModel(Model):
             stats.energy_residual, audit = account(
                 scene, self.elements, self.EA, times, t_rec, records, events, observed
             )
+            if times.size and momentum_point(scene) is not None:
+                stats.momentum_residual = momentum_residual(
+                    *momentum_audit(scene, self.elements, times, t_rec, records)
+                )
         except Exception as exc:  # noqa: BLE001
             stats.status, stats.message = (
                 STATUS_ERROR,

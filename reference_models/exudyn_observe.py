@@ -13,9 +13,25 @@ from reference_models.exudyn_beam import (
     _momenta,
     _wrap,
     body_attitude,
+    momentum_audit_rows,
     stop_moment,
 )
 from rodval.core.scene import QUANTITIES, Scene, hinge_angles
+
+
+def _states_at(times: np.ndarray, t_rec: np.ndarray, records: dict) -> dict:
+    """Each recorded node's (state, rate) at ``times`` (cubic Hermite on the records)."""
+    return {
+        key: (_interpolate(times, t_rec, q, v), _interpolate(times, t_rec, v, a))
+        for key, (q, v, a) in records.items()
+    }
+
+
+def momentum_audit(
+    scene: Scene, E: int, times: np.ndarray, t_rec: np.ndarray, records: dict
+) -> tuple[np.ndarray, np.ndarray]:
+    """(H, G) (N m s) at ``times`` for the angular-momentum audit (``momentum_audit_rows``)."""
+    return momentum_audit_rows(scene, E, _states_at(times, t_rec, records))
 
 
 def _observe(
@@ -39,10 +55,7 @@ def _observe(
     and "angular_momentum" are the whole system's (``_momenta``)."""
     n = scene.n
     rods = np.arange(1, n + 1)
-    at = {
-        key: (_interpolate(times, t_rec, q, v), _interpolate(times, t_rec, v, a))
-        for key, (q, v, a) in records.items()
-    }
+    at = _states_at(times, t_rec, records)
     out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     if not scene.wants(*QUANTITIES):
         return out

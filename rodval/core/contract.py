@@ -18,7 +18,13 @@ from rodval.core.modal import Modes
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.trajectory import Trajectory
-from rodval.core.validity import ENERGY_RESIDUAL_BOUND, Check, energy_balance, verdict
+from rodval.core.validity import (
+    ENERGY_RESIDUAL_BOUND,
+    Check,
+    energy_balance,
+    momentum_balance,
+    verdict,
+)
 
 
 class Model(ABC):
@@ -63,15 +69,22 @@ class Model(ABC):
 
     def validity_checks(self, scene: Scene, trajectory: Trajectory) -> list[Check]:
         """The checks of this model's assumptions on a run of ``scene`` (over the output times
-        it reached). By default the energy balance where the run was audited."""
+        it reached). By default the energy balance and the angular-momentum balance where the
+        run was audited."""
+        stats = trajectory.stats
         return energy_balance(
-            trajectory.stats.energy_residual, self.energy_residual_bound, self.energy_fix()
-        )
+            stats.energy_residual, self.energy_residual_bound, self.energy_fix()
+        ) + momentum_balance(stats.momentum_residual, fix=self.momentum_fix(scene))
 
     def energy_fix(self) -> str:
         """The setting that would close a broken energy balance of this model's run (named
         in the verdict); by default the integration's tolerance."""
         return "a tighter rtol (integration error)"
+
+    def momentum_fix(self, scene: Scene) -> str:
+        """The setting that would keep a drifting angular momentum of this model's run of
+        ``scene`` (named in the verdict); by default the energy balance's."""
+        return self.energy_fix()
 
     def scene_notes(self, scene: Scene) -> list[str]:
         """What this model leaves out of ``scene`` by its premise, one sentence each with the

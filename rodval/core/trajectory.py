@@ -28,6 +28,10 @@ class SolverStats:
     #: max |E - E(0) - W_ext + D| / max(max E, max |W_ext|) over the output times, when the
     #: scene asks for "energy" (see rodval.solvers.audit); None otherwise.
     energy_residual: float | None = None
+    #: max |H - H(0)| / max G over the output times, where angular momentum is conserved
+    #: (``rodval.core.validity.momentum_point``: a free base or a free root, no loads); None
+    #: otherwise.
+    momentum_residual: float | None = None
     #: Largest |alpha|, |beta| (rad) over the output times reached, for models with bending
     #: angles; None otherwise.
     max_bending: float | None = None
@@ -70,6 +74,7 @@ class SolverStats:
             "nsteps": self.nsteps,
             "wall_s": self.wall_s,
             "energy_residual": self.energy_residual,
+            "momentum_residual": self.momentum_residual,
             "max_bending": self.max_bending,
             "small_bending": self.small_bending,
             "valid": self.valid,

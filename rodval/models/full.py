@@ -220,6 +220,17 @@ class FullModel(PaperModel):
             )
         return "a tighter rtol (integration error)"
 
+    def momentum_fix(self, scene: Scene) -> str:
+        """As the energy balance's; on a free base, where the exact kinematics is not built
+        yet (docs/base.md), the exudyn model as well."""
+        if scene.base.free and self.kinematics == "first-order":
+            return (
+                'kinematics = "exact" once it is built on a free base (docs/base.md); today the '
+                "exudyn model (the first-order kinematics drops O(bending) terms of the kinetic "
+                "energy, and its angular momentum drifts)"
+            )
+        return self.energy_fix()
+
     def check_base(self, scene: Scene) -> None:
         """A free base runs on the paper's rung with the printed coefficients and the compiled
         kernel (``free_base``); other options are refused for it, naming the option."""

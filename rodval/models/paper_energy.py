@@ -134,6 +134,14 @@ class PaperEnergy:
         the model's velocity field (``rod_momenta_at``)."""
         return np.array([self.rod_momenta_at(y)[0].sum(axis=0) for y in Y])
 
+    def momentum_audit_rows(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(H, G) (N m s, (nt,) each) for the angular-momentum audit of a pinned chain
+        (``rodval.core.validity.momentum_balance``): the angular momentum about node 0 and the
+        gross, sum_k |h_k| of the rods with their far nodes (``rod_momenta_at``). O(n) per
+        state."""
+        h = np.array([self.rod_momenta_at(y)[1] for y in Y]).reshape(len(Y), -1)
+        return h.sum(axis=1), np.abs(h).sum(axis=1)
+
     def angular_momentum_rows(self, times: np.ndarray, Y: np.ndarray) -> np.ndarray:
         """The ``angular_momentum`` rows (nt, 2) (``paper_matrices.angular_momentum``)."""
         phi, dphi = self.rigid(Y)

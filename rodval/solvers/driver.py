@@ -41,8 +41,8 @@ from rodval.core.status import (
     numerical_failure,
 )
 from rodval.core.trajectory import SolverStats, Trajectory
-from rodval.core.validity import SMALL_BENDING_RAD
-from rodval.solvers.audit import PowerLedger, audit_quantities
+from rodval.core.validity import SMALL_BENDING_RAD, momentum_point
+from rodval.solvers.audit import PowerLedger, audit_quantities, momentum_residual
 from rodval.solvers.events import EventMonitor, apply_hit
 from rodval.solvers.guard import DivergenceGuard
 from rodval.solvers.limits import MAX_IMPLICIT_SIZE
@@ -345,6 +345,18 @@ def _bending_validity(
         stats.small_bending = bool(largest <= SMALL_BENDING_RAD)
 
 
+def _momentum_audit(system: OdeSystem, scene: Scene, Y: np.ndarray, stats: SolverStats) -> None:
+    """``stats.momentum_residual`` where the scene conserves angular momentum
+    (``momentum_point``) and the system measures it (``momentum_audit_rows``)."""
+    rows = getattr(system, "momentum_audit_rows", None)
+    if rows is None or not len(Y) or momentum_point(scene) is None:
+        return
+    try:
+        stats.momentum_residual = momentum_residual(*rows(Y))
+    except Exception:  # noqa: BLE001 - a measure of validity must not fail the run
+        stats.momentum_residual = None
+
+
 def integrate(
     system: OdeSystem,
     scene: Scene,
@@ -410,6 +422,7 @@ def integrate(
         stats.status, stats.message = status, f"observation failed: {message}"
     reached, observed = _finite_prefix(reached, observed, stats)
     _bending_validity(system, reached, out.Y[: reached.size], observed, stats)
+    _momentum_audit(system, scene, out.Y[: reached.size], stats)
     stats.wall_s = time.perf_counter() - start
     return Trajectory(
         model=model,
