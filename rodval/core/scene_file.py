@@ -366,6 +366,31 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     }
 
 
+def scene_to_file_table(scene: Scene, where: str = "scene") -> dict[str, Any]:
+    """The scene as a scene file's table (a study's ``[scene]``): ``scene_to_dict`` with every
+    None left out, since None means the default (a latch's ``direction``: towards its angle;
+    its ``window``: the first bending period, s) and TOML has no null; ``scene_from_dict``
+    rebuilds the same scene from it. A load that is a plain Python callable has no file form:
+    a one-line ValueError naming ``where.loads[i]``."""
+    for i, load in enumerate(scene.loads):
+        if load.name not in LOAD_FACTORIES:
+            raise ValueError(
+                f"{where}.loads[{i}]: the load on node {load.node} is a plain Python callable, "
+                "which a scene or study file cannot hold; build it with a load law of "
+                f"rodval.core.loads ({', '.join(LOAD_FACTORIES)})"
+            )
+    return _without_none(scene_to_dict(scene))
+
+
+def _without_none(value: Any) -> Any:
+    """``value`` with the None entries of its tables left out, at every depth."""
+    if isinstance(value, dict):
+        return {k: _without_none(v) for k, v in value.items() if v is not None}
+    if isinstance(value, list):
+        return [_without_none(v) for v in value]
+    return value
+
+
 #: Keys of a scene dict that label or observe a scene without changing what is simulated:
 #: runs that differ only there are runs of the same scene (compared on their common
 #: quantities and output times).

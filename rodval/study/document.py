@@ -11,7 +11,7 @@ import copy
 from typing import Any
 
 from rodval.core.scene import Scene
-from rodval.core.scene_file import scene_to_dict
+from rodval.core.scene_file import scene_to_file_table
 
 
 def key_error(where: str, key: str, msg: str) -> ValueError:
@@ -21,12 +21,13 @@ def key_error(where: str, key: str, msg: str) -> ValueError:
 
 def plain_document(doc: Any, where: str) -> dict[str, Any]:
     """A deep copy of a study document (never changing the caller's dict), with a
-    ``rodval.Scene`` given as [scene] turned into its scene-file table (``scene_to_dict``)."""
+    ``rodval.Scene`` given as [scene] turned into its scene-file table
+    (``scene_to_file_table``: ValueError naming ``scene.loads[i]`` for a callable load)."""
     if not isinstance(doc, dict):
         raise ValueError(f"{where}: a study document must be a dict, got {type(doc).__name__}")
     doc = copy.deepcopy(doc)
     if isinstance(doc.get("scene"), Scene):
-        doc["scene"] = scene_to_dict(doc["scene"])
+        doc["scene"] = scene_to_file_table(doc["scene"], where="scene")
     return doc
 
 

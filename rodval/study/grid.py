@@ -47,6 +47,13 @@ def check_axis_path(path: str, key: str, doc: dict[str, Any], where: str) -> Non
             f"must be a path into {', '.join(GRID_ROOTS)} "
             "(e.g. scene.n, scene.chain.EI, integrator.rtol, models.full.method)",
         )
+    if path == "scene.file":
+        raise key_error(
+            where,
+            key,
+            "the scene file is read once for the whole study; vary its keys "
+            "(scene.t_end, scene.chain.EI, ...) or write one study per file",
+        )
     if root == "integrator" and (len(rest) != 1 or rest[0] not in INTEGRATOR_KEYS):
         raise key_error(where, key, f"integrator keys are {', '.join(sorted(INTEGRATOR_KEYS))}")
     if root == "models" and (len(rest) != 2 or rest[0] not in doc.get("models", {})):

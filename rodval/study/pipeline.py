@@ -46,6 +46,7 @@ def study_meta(spec: StudySpec) -> dict[str, Any]:
         "report": spec.report.as_dict(),
         **({"sample": spec.sample} if spec.sample else {}),
         **({"acceptance": spec.acceptance} if spec.acceptance else {}),
+        **({"scene_file": spec.scene_file} if spec.scene_file else {}),
         "cases": [
             {"id": c.id, "params": c.params, "fingerprint": c.fingerprint} for c in spec.cases
         ],

@@ -12,7 +12,8 @@ axis values (``n=8,t_end=2``), so it stays the same when other axes or values ar
 This module reads the file and assembles the study; its parts are checked by
 ``rodval.study.model_specs`` ([integrator], [models]), ``rodval.study.grid`` ([grid],
 [sample]), ``rodval.study.case`` (each case, [modes]), ``rodval.study.report_spec``
-([report]) and ``rodval.study.acceptance`` ([acceptance]).
+([report]) and ``rodval.study.acceptance`` ([acceptance]); a [scene] that names a scene file
+(``file = "wing.toml"`` and overrides) is resolved by ``rodval.study.scene_source``.
 
 Every error is a ValueError naming the file and the key, raised before any work.
 """
@@ -45,6 +46,7 @@ from rodval.study.document import key_error, plain_document
 from rodval.study.grid import Design, grid_design, sample_design, sample_meta
 from rodval.study.model_specs import ModelSpec, model_specs
 from rodval.study.report_spec import ReportSpec, report_spec
+from rodval.study.scene_source import resolve_scene, resolved_text
 from rodval.study.store import MAX_NAME, case_file_name
 from rodval.study.toml_text import toml_text
 
@@ -86,6 +88,9 @@ class StudySpec:
     sample: dict[str, Any] | None = None
     #: The checked [acceptance] table (``rodval.study.acceptance``), or None.
     acceptance: dict[str, Any] | None = None
+    #: The scene file [scene] names (``rodval.study.scene_source``): its path, SHA-256 and
+    #: the [scene] table it resolved to; None for a scene written in the study.
+    scene_file: dict[str, Any] | None = None
 
     @classmethod
     def from_dict(
@@ -166,6 +171,7 @@ def study_from_dict(
     *,
     max_cases: int = MAX_CASES,
     announce: Callable[[int], None] | None = None,
+    folder: str | Path | None = None,
 ) -> StudySpec:
     """Parse and validate a study document (the TOML as a dict); see the module docstring.
 
@@ -173,6 +179,9 @@ def study_from_dict(
     before it is expanded, and a larger grid is refused at once.
     announce: called with the number of cases once it is known, before the cases are built
     and checked (which takes about 1-3 ms per case).
+    folder: where a relative ``[scene] file`` is (the study file's folder; default: the
+    current folder); the resolved [scene] replaces it (``rodval.study.scene_source``), and
+    ``text`` becomes the resolved document's TOML.
     """
     doc = plain_document(doc, where)
     max_cases = _check_max_cases(max_cases)
@@ -182,8 +191,7 @@ def study_from_dict(
     models = model_specs(doc, where)
     reference = _reference(study, models, where)
     study["reference"] = reference
-    if "scene" in doc and not isinstance(doc["scene"], dict):
-        raise key_error(where, "scene", "must be a table")
+    scene_file, text = _resolve_scene(doc, Path(folder or "."), where, text)
     expand = sample_design if "sample" in doc else grid_design
     design = expand(doc, where, max_cases, announce)
     cases = _build_cases(doc, design, where)
@@ -208,7 +216,26 @@ def study_from_dict(
             {q for c in cases for q in trajectory_quantities(c.scene.outputs)},
             where,
         ),
+        scene_file=scene_file,
     )
+
+
+def _resolve_scene(
+    doc: dict[str, Any], folder: Path, where: str, text: str
+) -> tuple[dict[str, Any] | None, str]:
+    """Check that [scene] is a table and, when it names a scene file (relative to
+    ``folder``), replace it in ``doc`` by the table it resolves to (``resolve_scene``).
+    Returns the file's record for study.json (path, SHA-256, the resolved table; None
+    without a file) and the study's text: ``text``, or the resolved document's TOML."""
+    if "scene" not in doc:
+        return None, text
+    if not isinstance(doc["scene"], dict):
+        raise key_error(where, "scene", "must be a table")
+    doc["scene"], scene_file = resolve_scene(doc["scene"], folder, where)
+    if scene_file is None:
+        return None, text
+    named = {**doc, "study": {"name": Path(where).stem, **doc["study"]}}
+    return {**scene_file.as_dict(), "scene": doc["scene"]}, resolved_text(named, where, scene_file)
 
 
 def _reference(study: dict[str, Any], models: tuple[ModelSpec, ...], where: str) -> str:
@@ -310,4 +337,11 @@ def load_study(
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
     if isinstance(doc.get("scene"), dict):
         doc["scene"] = anchor_load_files(doc["scene"], path.parent)
-    return study_from_dict(doc, where=str(path), text=text, max_cases=max_cases, announce=announce)
+    return study_from_dict(
+        doc,
+        where=str(path),
+        text=text,
+        max_cases=max_cases,
+        announce=announce,
+        folder=path.parent,
+    )

@@ -9,7 +9,8 @@ and ``figures/``.
   kernel when the process dies, so a killed run never leaves it stuck); a second run on the
   same folder is refused with a ``FolderBusy`` naming the holder's pid.
 * One study: a folder that holds another study (``study.json`` with a different name or
-  source, or a different grid) is refused unless ``fresh=True`` (``--fresh``), which first
+  source, or a different grid), or this study when the scene file its [scene] names has
+  changed (``scene_file_change``), is refused unless ``fresh=True`` (``--fresh``), which first
   removes what the study wrote (``study_files``) and nothing else.
 * rodval's folders only: a folder is a study folder when its ``study.json`` carries rodval's
   schema and checksum (``rodval.core.out_paths.stamp``). Any other folder that holds files
@@ -178,9 +179,13 @@ class StudyStore:
         return files
 
     def claim(self, meta: dict[str, Any], *, fresh: bool) -> None:
-        """Make the folder this study's: refuse a folder holding another study unless
-        ``fresh`` (then remove what that study wrote, ``study_files``); write study.json."""
+        """Make the folder this study's: refuse a folder holding another study, or this
+        study with a changed scene file (``scene_file_change``), unless ``fresh`` (then
+        remove what that study wrote, ``study_files``); write study.json."""
         old = self.meta()
+        changed = None if old is None or fresh else scene_file_change(old, meta)
+        if changed:
+            raise ValueError(f"{self.out}: {changed}; use --fresh to run the study again there")
         if old is not None and not fresh and not same_study(old, meta):
             raise ValueError(
                 f"{self.out} holds another study ({old.get('name')!r} from "
@@ -202,4 +207,16 @@ def same_study(a: dict[str, Any], b: dict[str, Any]) -> bool:
     keys = ("name", "reference", "models")
     return all(
         json.dumps(a.get(k), sort_keys=True) == json.dumps(b.get(k), sort_keys=True) for k in keys
+    )
+
+
+def scene_file_change(old: dict[str, Any], new: dict[str, Any]) -> str | None:
+    """Why two study descriptions are not of the same study because the scene file their
+    [scene] names changed (its SHA-256 differs), or None (same file content, or no file)."""
+    a, b = old.get("scene_file"), new.get("scene_file")
+    if not isinstance(a, dict) or not isinstance(b, dict) or a.get("sha256") == b.get("sha256"):
+        return None
+    return (
+        f"the scene file {b.get('path')!r} of study {new.get('name')!r} changed since the "
+        "study last ran in this folder (its records are of the old scene)"
     )

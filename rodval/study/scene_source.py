@@ -1,0 +1,105 @@
+"""A study's ``[scene]`` that names a scene file: ``[scene] file = "wing.toml"`` and overrides.
+
+The file (a path relative to the study file's folder, or absolute) is read with
+``read_scene_document``, so its tabulated loads' CSV files are found relative to the scene
+file. The other keys of ``[scene]`` override the file's: a top-level key replaces the file's,
+the ``chain`` and ``initial`` tables are merged key by key (``MERGED_TABLES``), and a list
+(``latches``, ``stops``, ``loads``, ``times``) replaces the file's whole. The resolved table,
+not the path, is what the cases build, run and record; the file's SHA-256 goes into study.json
+so that a later run in the same folder notices that the file changed
+(``rodval.study.store``). Every error is one line naming ``scene.file``, before any case runs.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rodval.core.scene_file import read_scene_document
+from rodval.study.document import key_error
+from rodval.study.toml_text import toml_text
+
+#: Tables of [scene] that override the file's key by key (the others replace it whole).
+MERGED_TABLES = ("chain", "initial")
+
+
+@dataclass(frozen=True)
+class SceneFile:
+    """The scene file a study's [scene] names: its path as read and its SHA-256 (hex) at
+    that time."""
+
+    path: str
+    sha256: str
+
+    def as_dict(self) -> dict[str, str]:
+        """The form study.json holds."""
+        return {"path": self.path, "sha256": self.sha256}
+
+
+def resolve_scene(table: Any, folder: Path, where: str) -> tuple[Any, SceneFile | None]:
+    """The [scene] ``table`` of the study ``where`` with its ``file`` (relative to
+    ``folder``) read and the table's other keys laid over it (``merge_scene``), and the file
+    read; ``table`` itself and None when it names no file."""
+    if not isinstance(table, dict) or "file" not in table:
+        return table, None
+    path = _scene_path(table, folder, where)
+    document, digest = _read(path, where)
+    overrides = {k: v for k, v in table.items() if k != "file"}
+    return merge_scene(document, overrides), SceneFile(str(path), digest)
+
+
+def merge_scene(document: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
+    """``document`` (a scene file's table) with ``overrides`` laid over it: top-level keys
+    replace, the ``MERGED_TABLES`` merge key by key. Neither argument is changed."""
+    merged = {**document, **overrides}
+    for key in MERGED_TABLES:
+        if isinstance(document.get(key), dict) and isinstance(overrides.get(key), dict):
+            merged[key] = {**document[key], **overrides[key]}
+    return merged
+
+
+def _scene_path(table: dict[str, Any], folder: Path, where: str) -> Path:
+    """The path of the scene file ``table["file"]`` names (``folder`` / a relative one),
+    checked: a string, no ``based_on`` beside it, an existing file."""
+    file = table["file"]
+    if not isinstance(file, str) or not file:
+        raise key_error(
+            where, "scene.file", f"must be the path of a scene file (a string), got {file!r:.60}"
+        )
+    if "based_on" in table:
+        raise key_error(
+            where,
+            "scene.file",
+            "cannot be combined with based_on in [scene]; write based_on in the scene file",
+        )
+    path = folder / file
+    if not path.exists():
+        raise key_error(
+            where,
+            "scene.file",
+            f"{str(path)!r} does not exist (a relative path is taken from the study file's folder)",
+        )
+    if not path.is_file():
+        raise key_error(where, "scene.file", f"{str(path)!r} is not a file")
+    return path
+
+
+def _read(path: Path, where: str) -> tuple[dict[str, Any], str]:
+    """The scene document of the file ``path`` (``read_scene_document``: its load files
+    anchored at its folder) and the SHA-256 (hex) of its bytes."""
+    try:
+        digest = hashlib.sha256(path.read_bytes()).hexdigest()
+        document = read_scene_document(path.absolute())
+    except OSError as exc:
+        raise key_error(where, "scene.file", f"cannot read {str(path)!r}: {exc.strerror}") from None
+    except ValueError as exc:
+        raise key_error(where, "scene.file", str(exc)) from None
+    return document, digest
+
+
+def resolved_text(doc: dict[str, Any], where: str, scene_file: SceneFile) -> str:
+    """The study document ``doc`` (its [scene] resolved) as TOML, the text copied beside the
+    results as study.toml: it reruns the same study without the scene file."""
+    return f"# {where}, its [scene] file {scene_file.path} resolved\n{toml_text(doc)}"
