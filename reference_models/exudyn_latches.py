@@ -13,6 +13,7 @@ from reference_models.exudyn_build import _Built
 from reference_models.exudyn_guard import _Guard
 from rodval.core.lock_window import lock_window
 from rodval.core.rigid import rigid_lock
+from rodval.core.root_momentum import root_momentum_fields
 from rodval.core.scene import Scene
 
 #: Steps after the activation step at which a lock's "after" state is taken (the index-3
@@ -382,7 +383,10 @@ class _Latches:
     def _finish(self, ev: dict, closed: bool) -> None:
         """Record a lock: the impulse is the window mean of S(tau) (``lock_window``); the
         kinetic energy after it is taken ``LOCK_SETTLE_STEPS`` steps after the activation,
-        the root's angular momentum jump over the whole window."""
+        the root's angular momentum jump over the whole window (None, as its before and
+        after, once hinge 0 is held: ``rodval.core.root_momentum``);
+        ``window_steps``: the window's length in steps of the run's step, impulse_window / h
+        (``rodval.analysis.events.MIN_WINDOW_STEPS``)."""
         item, before, last = ev["item"], ev["before"], ev["last"]
         settled = ev["settled"] or last
         root_jump = last["H_root"] - before["H_root"] - ev["root_integral"]
@@ -394,6 +398,9 @@ class _Latches:
             if self.free
             else rigid_lock(self.scene.chain, chords[:, 0], chords[:, 1], before["held"], item["k"])
         )
+        # the root's angular momentum means nothing once hinge 0 is held (now, earlier, or
+        # by the window's end): the ground's (the base's) holding moment is external
+        root_held = any(it["k"] == 0 and it["state"] != "armed" for it in self.items)
         self.events.append(
             {
                 "t": float(ev["t_lock"]),
@@ -407,12 +414,13 @@ class _Latches:
                 "kinetic_after": float(settled["T"]),
                 "rate_before": float(before["dD"]),
                 "chord_rate_before": float(before["rel"]),
-                "angular_momentum_root_before": float(before["H_root"]),
-                "angular_momentum_root_after": float(last["H_root"]),
-                "angular_momentum_root_jump": float(root_jump),
+                **root_momentum_fields(
+                    float(before["H_root"]), float(last["H_root"]), root_held, float(root_jump)
+                ),
                 "peak_moment": float(ev["peak"]),
                 "t_activated": float(before["t"]),
                 "step": float(ev["step"]),
+                "window_steps": float(ev["window"] / ev["step"]),
                 **rigid,
             }
         )

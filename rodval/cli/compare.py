@@ -16,6 +16,11 @@ def register(sub) -> None:
         description="Compare run A against the reference run B (output folders of `rodval "
         "simulate`): DIR/discrepancies.csv and .md (per quantity: max_abs, rms, final_abs, "
         "max_rel, where the maximum is; see rodval.analysis.metrics) and DIR/histories.png. "
+        "When either run recorded lock events (latches), also the lock table: per lock "
+        "label both lock times, dt = t_A - t_B (s), both lock impulses and impulse_rel, both "
+        "impulse_to_rigid and why a lock is not comparable pointwise (locks only one run "
+        "has included), printed and written to DIR/events.csv and DIR/events.md (see "
+        "rodval.analysis.events). "
         "A run whose trajectory is not the one its run.json records (cut, edited) or whose "
         "run.json records no digest of it is refused. DIR must be new, empty or an output "
         "folder of rodval (refused before any work otherwise).",
@@ -67,4 +72,47 @@ def run(args) -> int:
         )
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3e}"))
     print(f"-> {args.out / 'discrepancies.md'}")
+    locks = lock_table(a.events, b.events)
+    if not locks.empty:
+        locks.to_csv(args.out / "events.csv", index=False)
+        (args.out / "events.md").write_text(
+            f"# Locks of {args.a} ({a.model}) against {args.b} ({b.model})\n\n"
+            + to_markdown(locks, ".6g")
+        )
+        print(f"\nLocks: A = {args.a} ({a.model}) against B = {args.b} ({b.model}):")
+        print(locks.to_string(index=False, na_rep="", float_format=lambda v: f"{v:.6g}"))
+        print(f"-> {args.out / 'events.md'}")
     return 0
+
+
+#: Columns of compare's lock table (A: the run compared, B: the reference run).
+LOCK_TABLE_COLUMNS = {
+    "label": "label",
+    "t_m": "t_A",
+    "t_ref": "t_B",
+    "dt": "dt",
+    "impulse_m": "impulse_A",
+    "impulse_ref": "impulse_B",
+    "impulse_rel": "impulse_rel",
+    "impulse_to_rigid_m": "impulse_to_rigid_A",
+    "impulse_to_rigid_ref": "impulse_to_rigid_B",
+    "not_comparable": "not_comparable",
+}
+
+
+def lock_table(events_a: list, events_b: list):
+    """The locks of run A against the reference run B side by side (one row per lock label,
+    ``rodval.analysis.events.lock_comparison``, columns LOCK_TABLE_COLUMNS); empty when
+    neither run recorded a lock."""
+    from rodval.analysis.events import events_frame, lock_comparison
+
+    events = events_frame(
+        [({"case": "", "model": "A"}, events_a), ({"case": "", "model": "B"}, events_b)]
+    )
+    if events.empty:
+        return events
+    table = lock_comparison(events, "A", "B")
+    table["not_comparable"] = table["not_comparable"].str.replace(
+        r"^only in (A|B)$", r"only in \1 (the other run did not lock)", regex=True
+    )
+    return table[list(LOCK_TABLE_COLUMNS)].rename(columns=LOCK_TABLE_COLUMNS)

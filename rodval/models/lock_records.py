@@ -26,6 +26,7 @@ import numpy as np
 
 from rodval.core.lock_window import lock_window
 from rodval.core.rigid import node_velocities, rigid_lock
+from rodval.core.root_momentum import root_momentum_fields
 from rodval.models.paper_matrices import node_positions
 
 #: The systems these functions read: ``rodval.models.paper_system.PaperSystem`` (which imports
@@ -92,7 +93,15 @@ def lock_record(
     rigid-panel lock of the chords before it (``rodval.core.rigid.rigid_lock``), the angular
     momentum about the root just before and after (N m s; the impact is internal, so it is
     kept while hinge 0 is free) and what the lock window needs (its length, the
-    instantaneous impulse, H_out just before)."""
+    instantaneous impulse, H_out just before).
+
+    The root's angular momentum (``angular_momentum_root_before``, ``_after``, ``_jump``) is
+    None when hinge 0 is held after the lock (locked now or earlier), on a pinned chain and on
+    a free base alike: the held root hinge passes an impulsive moment from the ground (or the
+    base's body) onto rod 1, so the chain's angular momentum about node 0 is no longer kept
+    and its jump measures nothing. While hinge 0 is free its spring, damper and stops are
+    finite moments, which take no part in the instantaneous jump: the jump is meaningful
+    whatever kappa[0] and nu[0] are (docs/deployment.md)."""
     latches = system.latches
     hinges = np.array([latches[j].hinge for j in locked], dtype=np.int64)
     angles = np.array([latches[j].angle for j in locked])
@@ -127,9 +136,7 @@ def lock_record(
         "hinge_before": hinge0,
         "bending_before": bending0,
         "kinetic_after": T1,
-        "angular_momentum_root_before": root0,
-        "angular_momentum_root_after": root1,
-        "angular_momentum_root_jump": root1 - root0,
+        **root_momentum_fields(root0, root1, 0 in hinges.tolist()),
         **rigid,
     }
 

@@ -1,11 +1,14 @@
 """A study's acceptance criteria (``rodval.study.acceptance``) evaluated on its saved tables:
 one check per case, bounded pair and quantity (and per model run when every run must be
-valid), the breaches as one line each, and a JUnit XML report that CI systems display (one
+valid), per case and event bound (the locks against the reference's,
+``rodval.analysis.events.lock_comparison``), per model for ``all_latched``, per run for the
+residuals; the breaches as one line each, and a JUnit XML report that CI systems display (one
 test case per check, a ``<failure>`` exactly where a bound broke).
 """
 
 from __future__ import annotations
 
+import json
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -17,6 +20,20 @@ import pandas as pd
 #: The metrics an acceptance bound may limit (columns of discrepancies.csv); the study file's
 #: [[acceptance.bound]] tables are checked in ``rodval.study.acceptance``.
 BOUND_METRICS = ("max_abs", "rms")
+#: The figures an [[acceptance.event]] table may bound: ``lock_time`` (s, max |dt| of the
+#: model's locks against the reference's), ``impulse`` (max impulse_rel).
+EVENT_METRICS = ("lock_time", "impulse")
+#: The [acceptance] table's scalar keys: ``all_latched`` (the fraction of cases in which every
+#: latch of the scene locked, per model), ``energy_residual`` and ``momentum_residual`` (the
+#: largest |residual| of runtime.csv's column of that name, per run).
+SCALAR_KEYS = ("all_latched", "energy_residual", "momentum_residual")
+#: Why a run has no energy residual: it was not audited.
+NO_ENERGY_RESIDUAL = (
+    'no energy residual recorded (a run audits its energy only with "energy" among the '
+    "scene's outputs)"
+)
+#: Why a run has no momentum residual (runtime.csv's blank): the audit does not apply.
+NOT_AUDITED = "momentum is audited on a free base or a free, unloaded root only"
 
 
 @dataclass(frozen=True)
@@ -37,16 +54,24 @@ def _figure(row: pd.Series, metric: str) -> float:
     return math.nan if value is None else float(value)
 
 
-def acceptance_checks(meta: dict[str, Any], tables: dict[str, pd.DataFrame]) -> list[Check]:
+def acceptance_checks(
+    meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame | None = None
+) -> list[Check]:
     """The checks of the study's ``[acceptance]`` (none without it), in case order. A bound
     breaks when its comparison was not made (status other than "ok") or a bounded metric
-    exceeds it; a run breaks ``valid = true`` when its verdict is invalid."""
+    exceeds it; a run breaks ``valid = true`` when its verdict is invalid. ``events``: the
+    study's events.csv (``rodval.report.tables.read_events``; none: no run locked), for the
+    event bounds (``_event_checks``) and ``all_latched`` (``_latched_checks``); the residual
+    keys are checked per run (``_residual_checks``)."""
     spec = meta.get("acceptance")
     if not spec:
         return []
+    if events is None:
+        events = pd.DataFrame(columns=["case", "model", "t", "label"])
     ref = meta["reference"]
     disc, runtime = tables["discrepancies"], tables["runtime"]
     index = {(str(r["case"]), r["model"], r["quantity"]): r for _, r in disc.iterrows()}
+    comparisons = _lock_comparisons(spec.get("events", []), ref, events)
     checks = []
     for case in tables["cases"]["case"].astype(str):
         for b in spec["bounds"]:
@@ -67,6 +92,127 @@ def acceptance_checks(meta: dict[str, Any], tables: dict[str, pd.DataFrame]) -> 
                 invalid = str(run.get("valid")) == "False"
                 why = f"invalid run: {run.get('invalid_because', '')}" if invalid else ""
                 checks.append(Check("acceptance.valid", f"{case}: {run['model']} valid", why))
+        checks += _event_checks(spec.get("events", []), ref, case, comparisons)
+        checks += _residual_checks(spec, case, runtime)
+    if "all_latched" in spec:
+        labels = [m["label"] for m in meta["models"]]
+        checks += _latched_checks(spec["all_latched"], labels, tables["cases"], events)
+    return checks
+
+
+def _lock_comparisons(
+    bounds: list[dict[str, Any]], ref: str, events: pd.DataFrame
+) -> dict[str, pd.DataFrame]:
+    """Per bounded model, its locks against the reference's (``lock_comparison``), case as
+    text."""
+    from rodval.analysis.events import lock_comparison
+
+    events = events.assign(case=events["case"].astype(str))
+    return {m: lock_comparison(events, m, ref) for m in dict.fromkeys(b["model"] for b in bounds)}
+
+
+def _event_checks(
+    bounds: list[dict[str, Any]], ref: str, case: str, comparisons: dict[str, pd.DataFrame]
+) -> list[Check]:
+    """One check per event bound in ``case``: a lock only one of the pair has breaks it; a
+    lock that is not comparable pointwise is skipped (counted in the check's name); every
+    other lock must keep each bound: |dt| <= lock_time (s), impulse_rel <= impulse."""
+    checks = []
+    for b in bounds:
+        comp = comparisons[b["model"]]
+        locks = comp[comp["case"] == case]
+        why = locks["not_comparable"].fillna("").astype(str)
+        missing = locks[why.str.startswith("only in ")]
+        skipped = locks[(why != "") & ~why.str.startswith("only in ")]
+        kept = locks[why == ""]
+        name = f"{case}: {b['model']} vs {ref}"
+        if locks.empty:
+            name += " (no locks)"
+        elif len(skipped) == len(locks):
+            name += f" (all {len(skipped)} locks not comparable pointwise: skipped)"
+        elif len(skipped):
+            s = "s" if len(skipped) > 1 else ""
+            name += f" ({len(skipped)} lock{s} not comparable pointwise: skipped)"
+        broken = []
+        for _, lock in missing.iterrows():
+            lacks = ref if str(lock["not_comparable"]) == f"only in {b['model']}" else b["model"]
+            broken.append(f"{lock['label']}: no lock in {lacks}")
+        for _, lock in kept.iterrows():
+            dt, rel = abs(float(lock["dt"])), float(lock["impulse_rel"])
+            if "lock_time" in b and not dt <= b["lock_time"]:
+                broken.append(f"{lock['label']} lock time |dt| = {dt:.3g} s > {b['lock_time']:g} s")
+            if "impulse" in b and not rel <= b["impulse"]:
+                broken.append(f"{lock['label']} impulse_rel = {rel:.3g} > {b['impulse']:g}")
+        checks.append(Check("acceptance.events", name, "; ".join(broken)))
+    return checks
+
+
+def _residual_checks(spec: dict[str, Any], case: str, runtime: pd.DataFrame) -> list[Check]:
+    """One check per run of ``case`` and residual key: |residual| <= the bound. A run without
+    an energy residual breaks the bound; a blank momentum residual (or no such column) is
+    a run the momentum audit does not apply to: named, not broken."""
+    checks = []
+    runs = runtime[runtime["case"].astype(str) == case]
+    for key in ("energy_residual", "momentum_residual"):
+        if key not in spec:
+            continue
+        bound = spec[key]
+        for _, run in runs.iterrows():
+            name = f"{case}: {run['model']} {key}"
+            value = pd.to_numeric(pd.Series([run.get(key)]), errors="coerce").iloc[0]
+            if pd.isna(value):
+                if key == "momentum_residual":
+                    checks.append(
+                        Check("acceptance.residuals", f"{name} (not audited: {NOT_AUDITED})")
+                    )
+                else:
+                    checks.append(Check("acceptance.residuals", name, NO_ENERGY_RESIDUAL))
+                continue
+            fail = "" if abs(value) <= bound else f"|{key}| = {abs(value):.3g} > {bound:g}"
+            checks.append(Check("acceptance.residuals", name, fail))
+    return checks
+
+
+def _latched_checks(
+    fraction: float, labels: list[str], cases: pd.DataFrame, events: pd.DataFrame
+) -> list[Check]:
+    """One check per model: in at least ``fraction`` of the cases whose scene has latches
+    (cases.csv's latch_hinges) every latch locked in that model (its "latch hinge ..."
+    events); the failure names the cases where some did not."""
+    from rodval.report.sample_stats import locked_hinges
+
+    if "latch_hinges" not in cases:
+        return [
+            Check("acceptance.events", f"{m}: all latched", "cases.csv has no latch_hinges column")
+            for m in labels
+        ]
+    latched = {
+        str(c): set(json.loads(str(h))) if pd.notna(h) else set()
+        for c, h in zip(cases["case"], cases["latch_hinges"])
+    }
+    latched = {c: h for c, h in latched.items() if h}
+    ev = events.assign(case=events["case"].astype(str))
+    checks = []
+    for model in labels:
+        name = f"{model}: all latched in >= {fraction:.4g} of the cases"
+        if not latched:
+            checks.append(Check("acceptance.events", f"{name} (no case has latches)"))
+            continue
+        own = ev[ev["model"] == model]
+        short = []
+        for case, hinges in latched.items():
+            done = {h for lab in own[own["case"] == case]["label"] for h in locked_hinges(lab)}
+            if not hinges <= done:
+                short.append(f"{case} (hinge {', '.join(map(str, sorted(hinges - done)))})")
+        k = len(latched) - len(short)
+        share = k / len(latched)
+        fail = (
+            ""
+            if share >= fraction
+            else f"every latch locked in {k} of {len(latched)} cases ({share:.1%}) < {fraction:g}; "
+            f"not in case {', '.join(short)}"
+        )
+        checks.append(Check("acceptance.events", name, fail))
     return checks
 
 
@@ -112,21 +258,21 @@ def gate(out: Path, junit: Path | None = None) -> list[str]:
     """Evaluate the acceptance of the study in ``out`` (its study.json and checked tables);
     write ``junit`` when given (also without an [acceptance] table: then it has no test
     cases). Returns the breach lines (empty: the study passes)."""
-    import json
-
-    from rodval.report.tables import read_tables
+    from rodval.report.tables import read_events, read_tables
 
     meta = json.loads((Path(out) / "study.json").read_text())
-    checks = acceptance_checks(meta, read_tables(out))
+    checks = acceptance_checks(meta, read_tables(out), read_events(Path(out)))
     if junit is not None:
         write_junit(checks, junit, str(meta.get("name", "study")))
     return breach_lines(checks)
 
 
-def acceptance_section(meta: dict[str, Any], tables: dict[str, pd.DataFrame]) -> list[str]:
+def acceptance_section(
+    meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame | None = None
+) -> list[str]:
     """The report's "Acceptance" section: the number of checks, how many broke, and each
-    breach (nothing without an [acceptance] table)."""
-    checks = acceptance_checks(meta, tables)
+    breach (nothing without an [acceptance] table); ``events``: the study's events.csv."""
+    checks = acceptance_checks(meta, tables, events)
     if not meta.get("acceptance"):
         return []
     broken = breach_lines(checks)

@@ -6,13 +6,17 @@ import pandas as pd
 
 
 def to_markdown(df: pd.DataFrame, floatfmt: str = ".3g") -> str:
-    """A GitHub pipe table ("|" inside cells escaped); ``_(no rows)_`` for an empty frame."""
+    """A GitHub pipe table ("|" inside cells escaped, None blank); ``_(no rows)_`` for an
+    empty frame."""
     if df.empty:
         return "_(no rows)_\n"
     safe = df.copy()
     for col in safe.columns:
-        if safe[col].dtype == object:
-            safe[col] = safe[col].map(
-                lambda v: str(v).replace("|", "\\|") if isinstance(v, str) else v
+        if safe[col].dtype == object or pd.api.types.is_string_dtype(safe[col]):
+            safe[col] = pd.Series(
+                [str(v).replace("|", "\\|") if isinstance(v, str) else v for v in safe[col]],
+                index=safe.index,
+                dtype=object,
             )
-    return safe.to_markdown(index=False, tablefmt="pipe", floatfmt=floatfmt) + "\n"
+    # None (a value that does not apply) is shown blank
+    return safe.to_markdown(index=False, tablefmt="pipe", floatfmt=floatfmt, missingval="") + "\n"

@@ -16,9 +16,15 @@ import json
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
+from rodval.analysis.events import (
+    COMPARABLE_DT_S,
+    COMPARABLE_ENERGY,
+    GRAZING_LOSS,
+    MIN_WINDOW_STEPS,
+    event_discrepancies,
+)
 from rodval.core.out_paths import STUDY_SCHEMA, is_stamped
 from rodval.models import get_model
 from rodval.models.registry import uses_integrator
@@ -28,7 +34,7 @@ from rodval.report.sample_stats import sample_section
 from rodval.report.study_figures import case_figures, deployment_figures, param_figures
 from rodval.report.study_modes import modes_section
 from rodval.report.study_summary import summary_sections
-from rodval.report.tables import FIGURES, axis_columns, read_tables
+from rodval.report.tables import FIGURES, axis_columns, read_events, read_tables
 
 #: Columns of the events table shown in the report, when present.
 EVENT_REPORT_COLUMNS = (
@@ -48,133 +54,6 @@ EVENT_REPORT_COLUMNS = (
     "window_closed",
     "angular_momentum_root_jump",
 )
-
-
-def read_events(out: Path) -> pd.DataFrame:
-    """``out/events.csv`` (empty frame if the study recorded no events)."""
-    path = out / "events.csv"
-    if not path.is_file():
-        return pd.DataFrame(columns=["case", "model", "t", "label"])
-    try:
-        events = pd.read_csv(path)
-    except (OSError, ValueError, pd.errors.ParserError) as exc:
-        raise ValueError(f"{path}: unreadable ({type(exc).__name__}: {exc})") from None
-    missing = [c for c in ("case", "model", "t", "label") if c not in events]
-    if missing:
-        raise ValueError(f"{path}: column {missing[0]!r} is missing")
-    return events
-
-
-#: A lock is compared pointwise with the reference's when every earlier lock of the case came
-#: within this time (s) of the reference's and its kinetic energy before the lock is within
-#: this fraction of the reference's: otherwise the models reach it in different states.
-COMPARABLE_DT_S = 1e-3
-COMPARABLE_ENERGY = 0.05
-#: A lock is grazing when the rigid-panel lock of the chords just before it would take less
-#: than this fraction of the rigid chain's kinetic energy (``rodval.core.rigid``): its hinge
-#: approaches the latch angle so slowly that its time and impulse hang on small differences
-#: of state, and a model may not lock at all.
-GRAZING_LOSS = 0.01
-
-
-def rigid_loss_fraction(ev: pd.Series) -> float:
-    """The fraction of the rigid chain's kinetic energy the rigid-panel lock takes out (nan
-    where the record lacks the rigid-panel energies, e.g. a stop event)."""
-    before, after = ev.get("rigid_kinetic_before"), ev.get("rigid_kinetic_after")
-    if before is None or after is None or not float(before) > 0:
-        return float("nan")
-    return (float(before) - float(after)) / float(before)
-
-
-def _comparability(ev: pd.Series, r: pd.Series, earlier: list[tuple[str, float]]) -> str:
-    """Why the lock ``ev`` is not comparable pointwise with the reference's ``r`` ("" when it
-    is); ``earlier``: (label, |dt| s) of the case's earlier locks (nan: the model lacks it)."""
-    for who, record in (("its", ev), ("the reference's", r)):
-        loss = rigid_loss_fraction(record)
-        if loss < GRAZING_LOSS:
-            return (
-                f"grazing: {who} rigid-panel lock takes {loss:.2%} of the kinetic energy "
-                f"(< {GRAZING_LOSS:.0%})"
-            )
-    for label, dt in earlier:
-        if not dt <= COMPARABLE_DT_S:
-            return f"after {label}, whose lock time differs by {dt * 1e3:.3g} ms"
-    if "kinetic_before" in r and float(r["kinetic_before"]) > 0:
-        gap = abs(float(ev["kinetic_before"]) / float(r["kinetic_before"]) - 1.0)
-        if not gap <= COMPARABLE_ENERGY:
-            return f"kinetic energy before it differs by {gap:.0%}: different vibration"
-    return ""
-
-
-def event_discrepancies(events: pd.DataFrame, reference: str) -> pd.DataFrame:
-    """Each model's events against the reference's event of the same case and label (the
-    k-th of a repeated label, e.g. a stop's k-th contact, against the reference's k-th;
-    labelled "#k" from the second on): time difference dt (s, model - reference), lock
-    impulse difference and its ratio to the reference's |impulse| (impulse_rel), the same
-    ratio of the rigid-panel impulses (rigid_rel, where recorded), energy_lost difference
-    (J), and ``not_comparable``: why the lock cannot be compared pointwise
-    (``_comparability``, grazing locks included; blank when it can). Events the reference
-    lacks (or the model lacks) are listed with blanks."""
-    cols = [
-        "case",
-        "label",
-        "model",
-        "reference",
-        "dt",
-        "impulse_abs",
-        "impulse_rel",
-        "rigid_rel",
-        "dE_lost",
-        "not_comparable",
-    ]
-    if events.empty:
-        return pd.DataFrame(columns=cols)
-    # the k-th event of a label (a stop's contacts repeat) is compared with the reference's k-th
-    nth = events.sort_values("t", kind="stable").groupby(["case", "model", "label"]).cumcount()
-    events = events.assign(nth=nth)  # aligned on the index
-    ref = events[events["model"] == reference].set_index(["case", "label", "nth"])
-    rows = []
-    for _, ev in events[events["model"] != reference].iterrows():
-        key = (ev["case"], ev["label"], ev["nth"])
-        row = {
-            "case": ev["case"],
-            "label": ev["label"] + (f" #{ev['nth'] + 1}" if ev["nth"] else ""),
-            "model": ev["model"],
-            "reference": reference,
-        }
-        if key in ref.index:
-            r = ref.loc[key]
-            r = r.iloc[0] if isinstance(r, pd.DataFrame) else r
-            row["dt"] = float(ev["t"]) - float(r["t"])
-            if "impulse" in events:
-                d = float(ev["impulse"]) - float(r["impulse"])
-                row["impulse_abs"] = d
-                row["impulse_rel"] = abs(d) / abs(float(r["impulse"]))
-            if "rigid_impulse" in events:
-                d = float(ev["rigid_impulse"]) - float(r["rigid_impulse"])
-                row["rigid_rel"] = abs(d) / abs(float(r["rigid_impulse"]))
-            if "energy_lost" in events:
-                row["dE_lost"] = float(ev["energy_lost"]) - float(r["energy_lost"])
-            row["not_comparable"] = _comparability(
-                ev, r, _earlier_gaps(events, ev, reference, float(r["t"]))
-            )
-        rows.append(row)
-    return pd.DataFrame(rows).reindex(columns=cols)
-
-
-def _earlier_gaps(
-    events: pd.DataFrame, ev: pd.Series, reference: str, t_ref: float
-) -> list[tuple[str, float]]:
-    """(label, |dt| s) of the reference's locks of ev's case before t_ref against the same
-    model's (nan where the model lacks one)."""
-    case = events[(events["case"] == ev["case"]) & events["label"].str.startswith("latch")]
-    own = case[case["model"] == ev["model"]].set_index("label")["t"]
-    out = []
-    for _, r in case[(case["model"] == reference) & (case["t"] < t_ref)].iterrows():
-        t = own.get(r["label"])
-        t = float(t.iloc[0]) if isinstance(t, pd.Series) else t
-        out.append((str(r["label"]), abs(float(t) - float(r["t"])) if t is not None else np.nan))
-    return out
 
 
 def residual_vibration(
@@ -230,6 +109,17 @@ def peak_hinge_moments(traj: pd.DataFrame, events: pd.DataFrame) -> pd.DataFrame
     return pd.DataFrame()
 
 
+def _blanks(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` with its missing float values as None, which the markdown table shows blank (a
+    record's None, e.g. the root's angular momentum jump once hinge 0 is held, is read back
+    from events.csv as nan)."""
+    out = df.copy()
+    for col in out.columns:
+        if pd.api.types.is_float_dtype(out[col]) and out[col].isna().any():
+            out[col] = out[col].astype(object).where(out[col].notna(), None)
+    return out
+
+
 def _deployment_section(
     fig_dir: Path, meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
 ) -> list[str]:
@@ -257,9 +147,10 @@ def _deployment_section(
         "residual of that window's energy balance (J: exudyn's is its integrator's numerical "
         "dissipation; the kinetic, hinge and bending parts are in `events.csv`); the jump of "
         "the angular momentum about the root through the lock (N m s; an internal impulse "
-        "leaves it "
-        "unchanged while hinge 0 is free). docs/deployment.md defines each.\n",
-        to_markdown(events[[c for c in EVENT_REPORT_COLUMNS if c in events]], ".5g"),
+        "leaves it unchanged while hinge 0 is free; blank once hinge 0 is held, where the "
+        "ground's or the base's holding moment makes it meaningless). docs/deployment.md "
+        "defines each.\n",
+        to_markdown(_blanks(events[[c for c in EVENT_REPORT_COLUMNS if c in events]]), ".5g"),
     ]
     silent = [lab for lab in labels if not (events["model"] == lab).any()]
     if silent:
@@ -277,7 +168,10 @@ def _deployment_section(
             f"{COMPARABLE_DT_S * 1e3:g} ms of the reference's and the kinetic energy before it "
             f"within {COMPARABLE_ENERGY:.0%}, and neither lock grazing (its rigid-panel lock "
             f"taking less than {GRAZING_LOSS:.0%} of the kinetic energy: the hinge creeps onto "
-            "the latch angle, and its time hangs on small differences of state); "
+            "the latch angle, and its time hangs on small differences of state), neither "
+            "lock's window overlapping another lock of its run (the windowed impulses are not "
+            "separable) and neither an exudyn window of fewer than "
+            f"{MIN_WINDOW_STEPS} steps of its fixed step; "
             "`not_comparable` says why otherwise. After the "
             "first lock each model carries its own vibration (the full model keeps the lock's "
             "energy as bending vibration unless the rods are damped, the reduced model has no "
@@ -368,13 +262,13 @@ def build_report(out: str | Path) -> Path:
     params = ["n", "horizon", *axis_columns(meta).values()]
     fig_dir = out / FIGURES
     fig_dir.mkdir(exist_ok=True)
+    events = read_events(out)
     lines = _header(meta, prov)
-    lines += acceptance_section(meta, tables)
+    lines += acceptance_section(meta, tables, events)
     lines += summary_sections(meta, tables, params)
     figs = param_figures(fig_dir, meta, tables, params)
     if figs:
         lines += ["## Discrepancy, run time and speed-up against the grid parameters\n", *figs]
-    events = read_events(out)
     lines += sample_section(meta, tables, events)
     lines += _deployment_section(fig_dir, meta, tables, events)
     lines += modes_section(out, fig_dir, meta)

@@ -295,3 +295,18 @@ def trajectory_samples(
         wide.insert(0, "case", cid)
         parts.append(wide)
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
+
+
+def read_events(out: Path) -> pd.DataFrame:
+    """``out/events.csv`` (empty frame if the study recorded no events)."""
+    path = out / "events.csv"
+    if not path.is_file():
+        return pd.DataFrame(columns=["case", "model", "t", "label"])
+    try:
+        events = pd.read_csv(path)
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise ValueError(f"{path}: unreadable ({type(exc).__name__}: {exc})") from None
+    missing = [c for c in ("case", "model", "t", "label") if c not in events]
+    if missing:
+        raise ValueError(f"{path}: column {missing[0]!r} is missing")
+    return events

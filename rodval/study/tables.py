@@ -31,6 +31,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+# EVENT_COLUMNS: the events table's leading columns, named here for the table's readers
+from rodval.analysis.events import EVENT_COLUMNS as EVENT_COLUMNS
+from rodval.analysis.events import events_frame
 from rodval.analysis.metrics import METRICS
 from rodval.analysis.modes import pair_modes
 from rodval.core.modal import Modes
@@ -120,6 +123,7 @@ def runtime_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFra
                     "nsteps": st.nsteps,
                     "t_reached": st.t_reached,
                     "energy_residual": st.energy_residual,
+                    "momentum_residual": st.momentum_residual,
                     "max_bending": st.max_bending,
                     "small_bending": st.small_bending,
                     "valid": st.valid,
@@ -131,48 +135,19 @@ def runtime_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFra
     return pd.DataFrame(rows)
 
 
-#: The leading columns of the events table (after the case columns and model); the keys the
-#: native and exudyn latch records share.
-EVENT_COLUMNS = (
-    "t",
-    "label",
-    "hinge",
-    "impulse",
-    "impulse_window",
-    "rigid_impulse",
-    "impulse_to_rigid",
-    "kinetic_before",
-    "kinetic_after",
-    "energy_lost",
-    "instant_energy_loss",
-    "hinge_before",
-    "bending_before",
-    "kinetic_window_end",
-    "hinge_window_end",
-    "bending_window_end",
-    "work_window_end",
-    "dissipated_window_end",
-    "energy_residual_window_end",
-)
-
-
 def events_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFrame:
-    """One row per event of every run (see module docstring); columns beyond EVENT_COLUMNS are
-    the union of the models' own keys, in first-seen order (blank where a model lacks one)."""
-    rows = []
-    for rec in records:
-        for run in rec.runs:
-            for ev in run.trajectory.events:
-                row = {**_case_columns(rec, axes), "model": run.label, **ev}
-                before, after = ev.get("kinetic_before"), ev.get("kinetic_after")
-                if isinstance(before, (int, float)) and isinstance(after, (int, float)):
-                    row["energy_lost"] = before - after
-                if ev.get("rigid_impulse") and ev.get("impulse") is not None:
-                    row["impulse_to_rigid"] = ev["impulse"] / ev["rigid_impulse"]
-                rows.append(row)
-    lead = [*(_case_columns(records[0], axes) if records else {}), "model", *EVENT_COLUMNS]
-    extra = [c for c in dict.fromkeys(k for row in rows for k in row) if c not in lead]
-    return pd.DataFrame(rows).reindex(columns=[*lead, *extra])
+    """One row per event of every run (see module docstring; ``events_frame``): columns beyond
+    EVENT_COLUMNS are the union of the models' own keys, in first-seen order (blank where a
+    model lacks one)."""
+    lead = [*(_case_columns(records[0], axes) if records else {}), "model"]
+    return events_frame(
+        (
+            ({**_case_columns(rec, axes), "model": run.label}, run.trajectory.events)
+            for rec in records
+            for run in rec.runs
+        ),
+        lead,
+    )
 
 
 def load_records(out: Path, case_ids: list[str], labels: list[str]) -> list[CaseRecord]:
