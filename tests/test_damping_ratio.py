@@ -1,0 +1,89 @@
+"""Bending damping stated as a modal damping ratio (issue 37, ``rodval.core.damping``):
+``[chain] bending_damping = { ratio = 0.01 }`` becomes, per rod, the Kelvin-Voigt c (N m^2 s)
+that gives the rod's first free-free bending mode that ratio, and that c is what the scene,
+run.json and every model hold."""
+
+import json
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+from rodval.cli import main
+from rodval.core.damping import bending_damping_for_ratio, first_free_free_frequency
+from rodval.core.lock_window import _element
+from rodval.core.scene_file import scene_from_dict
+
+WING = {
+    "n": 3,
+    "t_end": 0.02,
+    "chain": {"l": [1.2, 1.0, 0.8], "m": 8.0 / 1.2, "EI": [1e8, 2e4, 5e5]},
+}
+
+
+def _free_free_fe(l: float, m: float, EI: float, elements: int = 32) -> float:
+    """The first flexible eigenfrequency (rad/s) of a free-free beam of cubic Hermite
+    elements (consistent mass): independent of the closed form's beta_1 l."""
+    size = 2 * (elements + 1)
+    K, M = np.zeros((size, size)), np.zeros((size, size))
+    for e in range(elements):
+        k, me = _element(EI, m, l / elements)
+        K[2 * e : 2 * e + 4, 2 * e : 2 * e + 4] += k
+        M[2 * e : 2 * e + 4, 2 * e : 2 * e + 4] += me
+    lam = scipy.linalg.eigh(K, M, eigvals_only=True, subset_by_index=[0, 2])
+    return float(np.sqrt(lam[2]))  # two rigid modes (translation, rotation) first
+
+
+@pytest.mark.parametrize("l, m, EI", [(1.2, 8.0 / 1.2, 2e4), (2.0, 3.0, 1e5), (0.5, 10.0, 1e9)])
+def test_the_first_free_free_frequency_is_the_beams(l, m, EI):
+    """The Hermite element's frequency error falls as h^4 (from above): 32 elements give it
+    to ~1e-7 relative; bound 1e-6."""
+    fe = _free_free_fe(l, m, EI)
+    closed = float(first_free_free_frequency(l, m, EI))
+    assert abs(fe / closed - 1.0) < 1e-6
+
+
+def test_the_ratio_gives_that_mode_the_stated_damping_ratio():
+    """A Kelvin-Voigt rod's modes have zeta = c omega / (2 EI) (docs/model.md): converted
+    back, each rod's first mode has exactly the ratio asked for."""
+    scene = scene_from_dict(
+        {**WING, "chain": {**WING["chain"], "bending_damping": {"ratio": 0.01}}}
+    )
+    ch = scene.chain
+    zeta = ch.bending_damping * first_free_free_frequency(ch.l, ch.m, ch.EI) / (2.0 * ch.EI)
+    np.testing.assert_allclose(zeta, 0.01, rtol=1e-14)
+    per_rod = scene_from_dict(
+        {**WING, "chain": {**WING["chain"], "bending_damping": {"ratio": [0.0, 0.01, 0.02]}}}
+    ).chain.bending_damping
+    np.testing.assert_allclose(per_rod, [0.0, ch.bending_damping[1], 2 * ch.bending_damping[2]])
+
+
+@pytest.mark.parametrize(
+    "value, words",
+    [
+        ({"ratio": 1.0}, ">= 0 and < 1"),
+        ({"ratio": -0.01}, ">= 0 and < 1"),
+        ({"ratio": True}, "damping ratio"),
+        ({"ratio": [0.01, 0.02]}, "one per rod (3), got 2"),
+        ({"ratio": 0.01, "c": 3.0}, "takes no other key"),
+    ],
+)
+def test_a_bad_ratio_is_refused_naming_it(value, words):
+    with pytest.raises(ValueError, match="bending_damping") as err:
+        scene_from_dict({**WING, "chain": {**WING["chain"], "bending_damping": value}})
+    assert words in str(err.value)
+
+
+def test_run_json_records_the_converted_damping_in_n_m2_s(tmp_path):
+    text = (
+        "n = 3\nt_end = 0.02\ntimes = [0.0, 0.01, 0.02]\n[chain]\nl = [1.2, 1.0, 0.8]\nm = 6.0\n"
+        "EI = [1e8, 2e4, 5e5]\nbending_damping = { ratio = 0.01 }\n"
+    )
+    (tmp_path / "wing.toml").write_text(text)
+    out = tmp_path / "run"
+    assert (
+        main(["simulate", str(tmp_path / "wing.toml"), "--model", "full", "--out", str(out)]) == 0
+    )
+    recorded = json.loads((out / "run.json").read_text())["scene"]["chain"]["bending_damping"]
+    expected = bending_damping_for_ratio(0.01, [1.2, 1.0, 0.8], 6.0, [1e8, 2e4, 5e5])
+    np.testing.assert_allclose(recorded, expected, rtol=1e-15)
