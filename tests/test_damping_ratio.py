@@ -87,3 +87,20 @@ def test_run_json_records_the_converted_damping_in_n_m2_s(tmp_path):
     recorded = json.loads((out / "run.json").read_text())["scene"]["chain"]["bending_damping"]
     expected = bending_damping_for_ratio(0.01, [1.2, 1.0, 0.8], 6.0, [1e8, 2e4, 5e5])
     np.testing.assert_allclose(recorded, expected, rtol=1e-15)
+
+
+def test_a_budget_spent_on_a_stiff_vibration_names_it_and_the_fixes():
+    """The rigid two-rod latch with EI 1e9 undamped: DOP853's steps are held by the rods'
+    bending modes; the run that runs out of evaluations says at which frequency, what the rest
+    would cost and which settings would let it finish (issue 37)."""
+    from rodval.bench.stiffness import rigid_latch
+    from rodval.core.status import STATUS_BUDGET
+    from rodval.models import simulate
+
+    stats = simulate(rigid_latch(1e9), "full", max_evaluations=100_000).stats
+    assert stats.status == STATUS_BUDGET
+    rho = stats.switch["spectral_radius"]
+    assert f"held by a vibration of {rho:.4g} rad/s" in stats.message
+    assert "more evaluations to t_end" in stats.message
+    assert "fix: damp the rods' bending ([chain] bending_damping = { ratio" in stats.message
+    assert "the reduced model" in stats.message

@@ -17,6 +17,7 @@ from rodval.core.checks import check_keys
 from rodval.core.modal import Modes
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
+from rodval.core.status import STATUS_BUDGET
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import (
     ENERGY_RESIDUAL_BOUND,
@@ -49,6 +50,8 @@ class Model(ABC):
         trajectory = self.run(scene, settings)
         trajectory.scene = scene
         stats = trajectory.stats
+        if stats.status == STATUS_BUDGET and stats.switch is not None:
+            stats.message += f"; fix: {self.stiffness_fix(scene)}"
         checks = self.validity_checks(scene, trajectory)
         stats.valid, stats.validity = verdict(checks, finished=trajectory.success)
         stats.notes = self.scene_notes(scene)
@@ -80,6 +83,11 @@ class Model(ABC):
         """The setting that would close a broken energy balance of this model's run (named
         in the verdict); by default the integration's tolerance."""
         return "a tighter rtol (integration error)"
+
+    def stiffness_fix(self, scene: Scene) -> str:
+        """The settings that would let a run whose budget went on a stiff vibration finish
+        (appended to its message); by default a larger budget or looser tolerances."""
+        return "a larger max_evaluations, or a looser rtol and atol"
 
     def momentum_fix(self, scene: Scene) -> str:
         """The setting that would keep a drifting angular momentum of this model's run of

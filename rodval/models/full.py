@@ -220,6 +220,15 @@ class FullModel(PaperModel):
             )
         return "a tighter rtol (integration error)"
 
+    def stiffness_fix(self, scene: Scene) -> str:
+        """Stiff vibrations of the full model are its rods' bending modes."""
+        return (
+            "damp the rods' bending ([chain] bending_damping = { ratio = ... }; a ratio of each "
+            "rod's first mode damps a locked segment's slower modes less, docs/model.md), the "
+            "reduced model (quasi-static bending, no bending vibrations), or a looser rtol and "
+            "atol"
+        )
+
     def momentum_fix(self, scene: Scene) -> str:
         """As the energy balance's; on a free base, where the exact kinematics is not built
         yet (docs/base.md), the exudyn model as well."""

@@ -329,6 +329,15 @@ class ReducedModel(PaperModel):
             "bending keeps no energy balance; docs/stability.md)"
         )
 
+    def stiffness_fix(self, scene: Scene) -> str:
+        """The reduced model's stiff vibration is a held hinge's locked pair ringing against
+        the quasi-static bending (undamped: the bending damping has nothing to act on)."""
+        return (
+            "the full model with damped bending ([chain] bending_damping = { ratio = ... }: a "
+            "held hinge's pair rings against the quasi-static bending here, undamped), or a "
+            "looser rtol and atol"
+        )
+
     def scene_notes(self, scene: Scene) -> list[str]:
         """The scene data the quasi-static bending has nowhere to put: the rods' bending
         damping (it acts on bending rates, which the model drops with the bending inertia and

@@ -90,6 +90,22 @@ def switch_record(sw: np.ndarray) -> dict[str, Any] | None:
     }
 
 
+def held_by(switch: dict[str, Any] | None, remaining: float) -> str:
+    """ "; its steps were held by a vibration of ... rad/s (... Hz) ..." for a run whose steps
+    the stiffness test found limited by its fastest mode (``switch``: ``switch_record``), with
+    the evaluations the ``remaining`` horizon (s) would take at the cheaper method's rate;
+    "" otherwise."""
+    if switch is None:
+        return ""
+    rho = switch["spectral_radius"]
+    rates = [r for r in (switch["explicit_cost_per_s"], switch["implicit_cost_per_s"]) if r]
+    return (
+        f"; its steps were held by a vibration of {rho:.4g} rad/s ({rho / (2 * np.pi):.4g} Hz, "
+        f"the spectral radius at t = {switch['t']:.6g} s): about {min(rates) * remaining:.2g} "
+        f"more evaluations to t_end at {min(rates):.3g} per simulated second"
+    )
+
+
 def run_compiled(
     system: OdeSystem,
     y0: np.ndarray,
@@ -163,7 +179,7 @@ def run_compiled(
         switch = res.switch  # a restart goes on with the stepper the run ended with
         stats.switch = switch_record(switch)
         if res.code != budget.EVENT:
-            _ending(res, settings, guard, stats)
+            _ending(res, settings, guard, stats, float(edges[-1]))
             break
         y = _event(system, res, total, events, out)
     if ledger is not None:
@@ -183,10 +199,16 @@ def _event(system: OdeSystem, res, total: np.ndarray, events, out: Outputs) -> n
     return y
 
 
-def _ending(res: dop853.CompiledRun, settings: IntegratorSettings, guard, stats) -> None:
-    """Status and message of a compiled run that ended with ``res.code`` (not an event)."""
+def _ending(
+    res: dop853.CompiledRun, settings: IntegratorSettings, guard, stats, t_end: float
+) -> None:
+    """Status and message of a compiled run that ended with ``res.code`` (not an event). A
+    budget spent on a stiff vibration (``stats.switch``) says which and what the rest of the
+    horizon would cost (``held_by``)."""
     if res.code in _BUDGETS:
         stats.status, setting = _BUDGETS[res.code]
-        stats.message = settings.budget_message(setting, res.t)
+        stats.message = settings.budget_message(setting, res.t) + held_by(
+            stats.switch, t_end - res.t
+        )
     elif res.code != budget.OK:
         stats.status, stats.message = verdict_message(res.code, res.monitor, res.t, guard)
