@@ -47,7 +47,7 @@ from rodval.core.eigen import (
 )
 from rodval.core.loads import constant
 from rodval.core.modal import ABOUT, Equilibrium, Modes, normalize_shapes, static_loads
-from rodval.core.scene import Scene
+from rodval.core.scene import InitialState, Scene, hinge_angles
 
 #: Elongation/displacement ratio above which an exudyn mode counts as axial.
 AXIAL_TOL = 1e-3
@@ -140,7 +140,9 @@ def exudyn_modes(
     n = scene.n
     loads = static_loads(scene, load_at) if about == "equilibrium" else None
     held = _held_forces(loads)
-    prestressed = bool(np.any(scene.chain.kappa * scene.chain.rest_angle != 0))
+    prestressed = _springs_loaded(scene)
+    if about == "equilibrium" and prestressed:
+        scene = _at_rest_angles(scene)  # the static solve starts where the springs relax
     _, mbs, nodes = model.assembled(scene.with_(loads=held))
     for row in nodes:
         for nd in row:
@@ -192,6 +194,35 @@ def exudyn_modes(
             "options": model.options(),
         },
     )
+
+
+def _springs_loaded(scene: Scene) -> bool:
+    """Whether the initial state loads the structure without any load: a hinge spring away
+    from its rest angle (a stowed wing, a rest angle), an acting stop, or bent rods. Such a
+    state is no equilibrium, so modes "about equilibrium" need the static solve (before, only
+    rest angles counted, and a folded wing relaxed at 0 was reported balanced as it was)."""
+    ini = scene.initial.resolve(scene.n)
+    theta = scene.base.attitude if scene.base.free else None
+    D = hinge_angles(ini["phi"], ini["alpha"], ini["beta"], theta)
+    chain = scene.chain
+    stops = [
+        st
+        for st in scene.stops
+        if (D[st.hinge] - st.angle > 0 if st.side == "upper" else D[st.hinge] - st.angle < 0)
+    ]
+    bent = np.any(ini["alpha"] != 0) or np.any(ini["beta"] != 0)
+    return bool(np.any(chain.kappa * (D - chain.rest_angle) != 0) or stops or bent)
+
+
+def _at_rest_angles(scene: Scene) -> Scene:
+    """``scene`` started from straight rods with every hinge at its rest angle (chord angles
+    phi_k = theta + rest_0 + ... + rest_{k-1}, at rest): without loads or acting stops the
+    equilibrium itself, otherwise the start of the static solve. From a stowed wing exudyn's
+    Newton does not reach it (its load steps scale loads, not the springs' pre-stress)."""
+    theta = scene.base.attitude if scene.base.free else 0.0
+    phi = theta + np.cumsum(scene.chain.rest_angle)
+    # latches play no part in modes (in every model); one at its angle would refuse the start
+    return scene.with_(initial=InitialState(phi=phi), latches=())
 
 
 def _held_forces(loads) -> tuple:
