@@ -9,11 +9,14 @@ Units: frequencies in rad/s (``omega``) and Hz (``f_hz``); mode shapes as node d
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from rodval.core.scene import Scene
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: What a model is linearised about: its initial state at rest (free vibration, loads
 #: ignored; it must be an equilibrium, see ``rodval.models.statics.check_at_rest``) or the
@@ -177,6 +180,8 @@ class Modes:
         )
 
     def frequencies_frame(self) -> pd.DataFrame:
+        import pandas as pd
+
         return pd.DataFrame(
             {
                 "mode": np.arange(1, self.count + 1),
@@ -188,6 +193,8 @@ class Modes:
 
     def modes_frame(self) -> pd.DataFrame:
         """Tidy: mode, kind (node_dx, node_dy, hinge), k (node 0..n or hinge 0..n-1), value."""
+        import pandas as pd
+
         rows = []
         for kind, arr in (("node_dx", self.dx), ("node_dy", self.dy), ("hinge", self.hinge)):
             m, k = np.meshgrid(np.arange(1, self.count + 1), np.arange(arr.shape[1]), indexing="ij")

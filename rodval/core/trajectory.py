@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from rodval.core.status import STATUS_SUCCESS, Status
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass
@@ -244,6 +246,8 @@ class Trajectory:
         trajectory's order (units: ``rodval.core.scene.UNITS``)."""
         if not isinstance(wide, bool):
             raise ValueError(f"wide must be True or False, got {wide!r}")
+        import pandas as pd  # imported by the tables that need it, not by every run
+
         if wide:
             columns = {"t": self.times}
             for q, arr in self.values.items():

@@ -11,14 +11,6 @@ import numpy as np
 
 from rodval.core.scene import Scene
 from rodval.models import deployment, kernels
-from rodval.models.free_base_system import FreeBaseSystem
-from rodval.models.ladder import (
-    PAPER_RUNG,
-    LadderSystem,
-    check_kinematics,
-    check_rung_options,
-    check_shapes,
-)
 from rodval.models.lock_records import plastic_jump
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
@@ -29,6 +21,7 @@ from rodval.models.paper_matrices import (
     hinge_matrix,
 )
 from rodval.models.paper_system import PaperModel, PaperSystem
+from rodval.models.rungs import PAPER_RUNG, check_kinematics, check_rung_options, check_shapes
 
 
 class FullSystem(PaperSystem):
@@ -259,9 +252,15 @@ class FullModel(PaperModel):
                 )
 
     def system(self, scene: Scene) -> PaperSystem:
+        """The system of ``scene`` on this model's rung; the free base's and the ladder's
+        modules (and their compiled kernels) are imported only by a scene that uses them."""
         if scene.base.free:
             self.check_base(scene)
+            from rodval.models.free_base_system import FreeBaseSystem
+
             return FreeBaseSystem(scene)
         if (self.shapes, self.kinematics) == PAPER_RUNG:
             return FullSystem(scene, self.coefficients, self.kernel)
+        from rodval.models.ladder import LadderSystem
+
         return LadderSystem(scene, self.coefficients, self.kernel, self.shapes, self.kinematics)

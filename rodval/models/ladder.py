@@ -17,7 +17,6 @@ from functools import cached_property
 
 import numpy as np
 
-from rodval.core.checks import check_choice, check_number
 from rodval.core.scene import Chain, Scene
 from rodval.models import deployment
 from rodval.models.kernels import V_CB, V_EPS, V_KB, V_PI, V_RHO, V_TAU, V_W, _rows
@@ -52,25 +51,8 @@ from rodval.models.paper_matrices import (
     angular_momentum_rows as momentum_rows,
 )
 from rodval.models.paper_system import StackedSystem
-from rodval.models.shapes import MAX_SHAPES, RodShapes, rod_shapes
-
-#: ``kinematics`` of the full model; the first is the paper's (the default).
-KINEMATICS = ("first-order", "exact")
-#: The paper's rung: one cubic shape per rod, first-order kinematics.
-PAPER_RUNG = (1, KINEMATICS[0])
-
-
-def check_shapes(shapes) -> int:
-    """``shapes`` (p, the bending shapes per rod beyond the rigid rotation: p + 1 shape
-    coordinates) as an int in 1..MAX_SHAPES, else a ValueError naming the range."""
-    allowed = f"an integer in 1..{MAX_SHAPES}"
-    return int(
-        check_number("shapes", shapes, low=1, high=MAX_SHAPES, integer=True, allowed=allowed)
-    )
-
-
-def check_kinematics(kinematics) -> str:
-    return check_choice("kinematics", kinematics, KINEMATICS)
+from rodval.models.rungs import check_kinematics, check_rung_options, check_shapes
+from rodval.models.shapes import RodShapes, rod_shapes
 
 
 def shapes_of(chain: Chain, p: int) -> RodShapes:
@@ -187,22 +169,6 @@ def rod_momenta_exact(
         + chain.mu * np.imag(np.conj(r_nodes) * v_nodes)
     )
     return np.stack([p.real, p.imag], -1), h, np.stack([first.real, first.imag], -1)
-
-
-def check_rung_options(coefficients: str, kernel: str) -> None:
-    """ValueError unless a rung other than the paper's has the options it runs with: the
-    printed coefficients and the compiled kernel (checked when the model is made, before
-    any work)."""
-    if coefficients != "printed":
-        raise ValueError(
-            "coefficients must be 'printed' with shapes > 1 or exact kinematics (the "
-            f"published erratum belongs to the paper's model), got {coefficients!r}"
-        )
-    if kernel != "numba":
-        raise ValueError(
-            "kernel must be 'numba' with shapes > 1 or exact kinematics (the numpy "
-            f"kernel is the paper model's dense reference), got {kernel!r}"
-        )
 
 
 class LadderSystem(StackedSystem):

@@ -94,9 +94,6 @@ from rodval.core.modal import (
 from rodval.core.scene import Chain, InitialState, Scene
 from rodval.models.full import FullModel
 from rodval.models.ladder import (
-    PAPER_RUNG,
-    check_kinematics,
-    check_shapes,
     ladder_mass_matrix,
     ladder_stiffness,
 )
@@ -109,6 +106,7 @@ from rodval.models.paper_matrices import (
     stiffness_matrix,
 )
 from rodval.models.reduced import ReducedModel, ReducedSystem
+from rodval.models.rungs import PAPER_RUNG, check_kinematics, check_shapes
 from rodval.models.statics import (
     check_at_rest,
     load_stiffness,

@@ -38,7 +38,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from rodval.core.checks import check_keys
 from rodval.core.out_paths import (
@@ -488,6 +487,8 @@ def _no_digest(folder: Path) -> ValueError:
 
 
 def _read_csv(path: Path, rec: dict[str, Any]) -> Trajectory:
+    import pandas as pd
+
     try:
         frame = pd.read_csv(path)
         return Trajectory.from_frame(frame, rec["model"], rec["scene"].get("name", "scene"))
