@@ -7,7 +7,14 @@ the node states exudyn recorded at every step.
   dampers nu_k (dD_k/dt)^2 (hinge 0's rate from a free base's), the acting stops' dampers
   d (dD_k/dt)^2 and the rods' Kelvin-Voigt bending damping int c (dK/dt)^2 ds (exudyn's
   ``bendingDamping``: the virtual work int c K' delta K ds of its material curvature K; 5
-  Gauss points per element).
+  Gauss points per element; exudyn's C++ ``ComputeODE2LHS`` adds ``bendingDamping *
+  curvature_t`` to the bending moment, with curvature_t = (f_t g - f g_t) / g^2, f = r' x r'',
+  g = |r'|^2: the rate used here, normalisation included).
+  A residual at start-up with bending damping is not this law's: with generalized-alpha's
+  computed initial accelerations at spectral radius 0, the first steps kick the overdamped
+  element-scale bending modes (E rises by tens of J with no load) and the damping takes that
+  energy out again, which D books (issue 37; docs/deployment.md, "exudyn's start-up with
+  bending damping"; tests/test_exudyn_kv_audit.py).
   The powers are integrated by the trapezoidal rule over exudyn's steps: second order, as
   its generalized-alpha integrator.
 * A lock: exudyn has no instantaneous impact (its latch joint, switched on at the step

@@ -260,6 +260,10 @@ class ExudynModel(Model):
         ti.newton.absoluteTolerance = self.newton_atol_per_EA * self.EA
         ti.newton.modifiedNewtonJacUpdatePerStep = bool(scene.latches) and JAC_PER_STEP
         ti.generalizedAlpha.spectralRadius = self.spectral_radius_for(scene)
+        # with bending damping, generalized-alpha's step from computed initial accelerations
+        # kicks the overdamped element-scale modes by 5-45 J on a stowed wing (docs/deployment.md,
+        # "exudyn's start-up with bending damping"); it starts from a = 0 there instead
+        ti.generalizedAlpha.computeInitialAccelerations = not initial_kick(scene)
         s.solution.file.write = False
         s.solution.sensors.writePeriod = 0.25 * t_end / planned
         s.show.statistics = False
@@ -563,12 +567,21 @@ def _lock_records(latches: _Latches | None) -> tuple[list[dict], dict[int, float
     return events, dict(latches.lock_times.items())
 
 
+def initial_kick(scene: Scene) -> bool:
+    """Whether generalized-alpha's first step from computed initial accelerations would kick
+    the element-scale modes (any rod with bending damping): such a run starts from a = 0."""
+    return bool(scene.chain.bending_damping.any())
+
+
 def _newton_record(sim, latches: bool) -> dict[str, Any]:
     """The Newton and linear-solver choices of a run, for ``trajectory.settings`` (chosen by
     benchmarks/exudyn_speed.py and the measurements in docs/reference_model.md, "Speed")."""
     newton = sim.timeIntegration.newton
     per_step = bool(newton.modifiedNewtonJacUpdatePerStep)
     return {
+        "initial_accelerations": bool(
+            sim.timeIntegration.generalizedAlpha.computeInitialAccelerations
+        ),
         "linear_solver": str(sim.linearSolver.solverType).split(".")[-1],
         "newton": "modified" if newton.useModifiedNewton else "full",
         "newton_atol": float(newton.absoluteTolerance),
