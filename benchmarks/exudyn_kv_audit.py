@@ -23,7 +23,7 @@ from tabulate import tabulate
 
 import reference_models.exudyn_chain as chain_module
 from reference_models.exudyn_audit import energy_parts
-from reference_models.exudyn_beam import _cross, _elements
+from reference_models.exudyn_beam import beam_elements, cross2d
 from reference_models.exudyn_chain import ExudynModel
 from rodval import simulate
 from rodval.core.scene_file import scene_from_dict
@@ -46,13 +46,13 @@ def kv_bookings(sc, E: int, t_rec: np.ndarray, records: dict) -> tuple[float, fl
     qv = {key: (q, v) for key, (q, v, _) in records.items()}
     h = np.diff(t_rec)
     audit = squared = mean = 0.0
-    for k, w, _, dS, ddS, Q, V in _elements(sc.chain, E, qv):
+    for k, w, _, dS, ddS, Q, V in beam_elements(sc.chain, E, qv):
         c = sc.chain.bending_damping[k]
         r1, r2 = np.einsum("gi,tic->tgc", dS, Q), np.einsum("gi,tic->tgc", ddS, Q)
         v1, v2 = np.einsum("gi,tic->tgc", dS, V), np.einsum("gi,tic->tgc", ddS, V)
         n2 = np.sum(r1**2, -1)
-        K = _cross(r1, r2) / n2
-        Kt = (_cross(v1, r2) + _cross(r1, v2)) / n2 - 2 * _cross(r1, r2) * np.sum(
+        K = cross2d(r1, r2) / n2
+        Kt = (cross2d(v1, r2) + cross2d(r1, v2)) / n2 - 2 * cross2d(r1, r2) * np.sum(
             r1 * v1, -1
         ) / n2**2
         dK = np.diff(K, axis=0)

@@ -268,11 +268,11 @@ def timed_run(scene: Scene, **options) -> dict:
         return lambda *args, **kwargs: timed(factory(*args, **kwargs))
 
     patches = [
-        (exudyn_guard._Guard, "pre_step", timed),
-        (exudyn_latches._Latches, "pre_step", timed),
+        (exudyn_guard.Guard, "pre_step", timed),
+        (exudyn_latches.Latches, "pre_step", timed),
         (exudyn_budget.RunBudget, "pre_step", timed),
-        (exudyn_build, "_load_function", timed_factory),
-        (exudyn_build, "_stop_law", timed_factory),
+        (exudyn_build, "load_function", timed_factory),
+        (exudyn_build, "stop_law", timed_factory),
     ]
     saved = [(owner, name, getattr(owner, name)) for owner, name, _ in patches]
     try:

@@ -38,17 +38,17 @@ from __future__ import annotations
 import numpy as np
 
 from reference_models.exudyn_beam import (
-    _cross,
-    _elements,
-    _energies,
-    _interpolate,
+    beam_elements,
     body_attitude,
+    cross2d,
+    hermite_interpolate,
+    system_energies,
 )
 from reference_models.exudyn_observe import (
-    _chord_angles,
-    _ends,
+    chord_angles,
     hinge_rates,
     recorded_hinge_angle,
+    rod_ends,
 )
 from rodval.core.loads import LoadSet
 from rodval.core.lock_window import window_energies
@@ -60,7 +60,7 @@ def step_powers(scene: Scene, E: int, t_rec: np.ndarray, records: dict) -> tuple
     """(P_ext, P_diss) (W, (steps,)) at the recorded steps (see the module docstring)."""
     chain = scene.chain
     qv = {key: (q, v) for key, (q, v, _) in records.items()}
-    qL, vL, qR, vR = _ends(scene.n, E, qv)
+    qL, vL, qR, vR = rod_ends(scene.n, E, qv)
     p_ext = np.zeros(t_rec.size)
     if scene.loads:
         loads = LoadSet(scene.loads, scene.n)
@@ -76,14 +76,14 @@ def step_powers(scene: Scene, E: int, t_rec: np.ndarray, records: dict) -> tuple
         pen = recorded_hinge_angle(records, E, k, D0[k], t_rec.size) - stop.angle
         inside = pen > 0 if stop.side == "upper" else pen < 0
         p_diss += np.where(inside, stop.damping * dD[:, k] ** 2, 0.0)
-    for k, w, _, dS, ddS, Q, V in _elements(chain, E, qv):
+    for k, w, _, dS, ddS, Q, V in beam_elements(chain, E, qv):
         c = chain.bending_damping[k]
         if c == 0:
             continue
         r1, r2 = np.einsum("gi,tic->tgc", dS, Q), np.einsum("gi,tic->tgc", ddS, Q)
         v1, v2 = np.einsum("gi,tic->tgc", dS, V), np.einsum("gi,tic->tgc", ddS, V)
         n2 = np.sum(r1**2, -1)
-        curv_rate = (_cross(v1, r2) + _cross(r1, v2)) / n2 - 2 * _cross(r1, r2) * np.sum(
+        curv_rate = (cross2d(v1, r2) + cross2d(r1, v2)) / n2 - 2 * cross2d(r1, r2) * np.sum(
             r1 * v1, -1
         ) / n2**2
         p_diss += c * np.sum(w * curv_rate**2, -1)
@@ -97,15 +97,15 @@ def _cumulative(t: np.ndarray, p: np.ndarray) -> np.ndarray:
 
 def energy_parts(scene: Scene, E: int, EA: float, times, t_rec, records) -> np.ndarray:
     """(kinetic, hinge, rod strain) energy (J), (3, len(times)), at any times (s) inside the
-    recorded steps (``_energies`` on the node states interpolated there); the rod strain is
+    recorded steps (``system_energies`` on the node states interpolated there); the rod strain is
     the bending and the (small) axial strain energy."""
     times = np.asarray(times, float)
     at = {
-        key: (_interpolate(times, t_rec, q, v), _interpolate(times, t_rec, v, a))
+        key: (hermite_interpolate(times, t_rec, q, v), hermite_interpolate(times, t_rec, v, a))
         for key, (q, v, a) in records.items()
     }
-    phi, _, alpha, beta = _chord_angles(scene, E, times, t_rec, records, at)
-    kin, strain, hinge = _energies(scene, E, EA, at, phi, alpha, beta)
+    phi, _, alpha, beta = chord_angles(scene, E, times, t_rec, records, at)
+    kin, strain, hinge = system_energies(scene, E, EA, at, phi, alpha, beta)
     return np.array([kin, hinge, strain])
 
 

@@ -11,7 +11,8 @@ import numpy as np
 
 from rodval.core.scene import Scene, hinge_angles
 
-_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(5)
+#: 5-point Gauss-Legendre points on [-1, 1] and their weights, (5,) each (exact to degree 9).
+GAUSS_X, GAUSS_W = np.polynomial.legendre.leggauss(5)
 
 #: The records' key of a free base's body node (its states [x_c, y_c, theta] (m, m, rad) and
 #: their rates), beside the beam nodes' (rod, local node) keys.
@@ -27,7 +28,9 @@ def body_attitude(at: dict) -> tuple[np.ndarray | None, np.ndarray | None]:
     return q[:, 2], v[:, 2]
 
 
-def _positive(name: str, value, *, upper: float = math.inf, integer: bool = False):
+def positive(name: str, value, *, upper: float = math.inf, integer: bool = False):
+    """``value`` as a float in (0, upper] (an int >= 1 if ``integer``); ValueError naming
+    ``name`` otherwise (bools, non-numbers, non-finite values)."""
     ok_type = (
         isinstance(value, (int, np.integer))
         if integer
@@ -44,12 +47,12 @@ def _positive(name: str, value, *, upper: float = math.inf, integer: bool = Fals
     return int(value) if integer else float(value)
 
 
-def _wrap(a: np.ndarray) -> np.ndarray:
+def wrap_angle(a: np.ndarray) -> np.ndarray:
     """Angle(s) wrapped to (-pi, pi]."""
     return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
 
 
-def _hermite(s: np.ndarray, le: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def hermite_shapes(s: np.ndarray, le: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cubic Hermite shape functions of an element of length le at local s (m):
     values, first and second s-derivatives, each (len(s), 4) for [r0, r0', r1, r1']."""
     x = s / le
@@ -156,7 +159,7 @@ def _bent_rod(alpha: float, beta: float, l: float, elements: int):
     return p, t, dp, dt
 
 
-def _initial_node_states(scene: Scene, elements: int):
+def initial_node_states(scene: Scene, elements: int):
     """Reference coordinates (straight rods along the initial chords) and initial coordinate
     offsets and velocities of every beam node, per rod: arrays (n, elements+1, 4) with
     [x, y, slope_x, slope_y] (m, m, -, -) and their rates.
@@ -196,12 +199,12 @@ def _initial_node_states(scene: Scene, elements: int):
     return ref, cur - ref, vel
 
 
-def _revolutions(angle: float) -> float:
+def revolutions(angle: float) -> float:
     """Initial value of a torsional spring's revolution counter for a relative angle (rad)."""
     return float(round(angle / (2.0 * math.pi)))
 
 
-def _stop_law(side: str):
+def stop_law(side: str):
     """springTorqueUserFunction of a one-sided limit stop (exudyn's sign: the returned torque
     is the spring's restoring torque, k (rotation - offset) for a plain spring): stiffness x
     penetration + damping x rate beyond the stop angle (``offset``), zero on the free side."""
@@ -224,7 +227,7 @@ def stop_moment(stop, D, dD):
     return np.where(inside, stop.stiffness * pen + stop.damping * np.asarray(dD, float), 0.0)
 
 
-def _load_function(f, errors: list):
+def load_function(f, errors: list):
     """exudyn load user function of a NodalForce: [X, Y, 0] (N) inside its support, zero
     (and not evaluated) outside; exceptions are recorded and re-raised."""
     fx, fy = f.fx, f.fy
@@ -241,7 +244,9 @@ def _load_function(f, errors: list):
     return user_function
 
 
-def _interpolate(times: np.ndarray, t_rec: np.ndarray, y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+def hermite_interpolate(
+    times: np.ndarray, t_rec: np.ndarray, y: np.ndarray, dy: np.ndarray
+) -> np.ndarray:
     """Cubic Hermite interpolation of records y (nt, m) with derivatives dy at ``times``;
     exact at recorded times."""
     i = np.clip(np.searchsorted(t_rec, times, side="right") - 1, 0, max(t_rec.size - 2, 0))
@@ -254,14 +259,14 @@ def _interpolate(times: np.ndarray, t_rec: np.ndarray, y: np.ndarray, dy: np.nda
     return h00 * y[i] + h10 * h * dy[i] + h01 * y[i + 1] + h11 * h * dy[i + 1]
 
 
-def _elements(chain, E: int, at: dict):
-    """Per element j of every rod k, with the Gauss points of ``_GAUSS_X`` on it: (k, weights
+def beam_elements(chain, E: int, at: dict):
+    """Per element j of every rod k, with the Gauss points of ``GAUSS_X`` on it: (k, weights
     (g,) (m), shape functions S, dS, ddS (g, 4), nodal positions/slopes Q and their rates V
     (nt, 4, 2)) from the node states ``at`` at the output times."""
     for k in range(chain.n):
         le = chain.l[k] / E
-        w = 0.5 * le * _GAUSS_W
-        S, dS, ddS = _hermite(0.5 * le * (_GAUSS_X + 1.0), le)
+        w = 0.5 * le * GAUSS_W
+        S, dS, ddS = hermite_shapes(0.5 * le * (GAUSS_X + 1.0), le)
         for j in range(E):
             qa, va = at[(k, j)]
             qb, vb = at[(k, j + 1)]
@@ -270,7 +275,7 @@ def _elements(chain, E: int, at: dict):
             yield k, w, S, dS, ddS, Q, V
 
 
-def _energies(
+def system_energies(
     scene: Scene, E: int, EA: float, at: dict, phi, alpha, beta
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Kinetic, rod strain and hinge energy (J) per output time: beam and point-mass kinetic
@@ -281,7 +286,7 @@ def _energies(
     chain = scene.chain
     kin = np.zeros(phi.shape[0])
     pot = np.zeros(phi.shape[0])
-    for k, w, S, dS, ddS, Q, V in _elements(chain, E, at):
+    for k, w, S, dS, ddS, Q, V in beam_elements(chain, E, at):
         r_t = np.einsum("gi,tic->tgc", S, V)
         r1 = np.einsum("gi,tic->tgc", dS, Q)
         r2 = np.einsum("gi,tic->tgc", ddS, Q)
@@ -307,7 +312,9 @@ def _energies(
     return kin, pot, hinge
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def cross2d(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The planar cross product a_x b_y - a_y b_x of 2-vectors along the last axis: shape
+    a.shape[:-1] (broadcast), units the product of a's and b's."""
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
@@ -327,29 +334,29 @@ def _momentum_parts(
     p = np.zeros((root.shape[0], parts, 2))
     first = np.zeros((root.shape[0], parts, 2))
     mass = np.append(chain.m * chain.l + chain.mu, scene.base.inertial()[0] if BODY in at else [])
-    for k, w, S, _, _, Q, V in _elements(chain, E, at):
+    for k, w, S, _, _, Q, V in beam_elements(chain, E, at):
         r = np.einsum("gi,tic->tgc", S, Q) - root
         v = np.einsum("gi,tic->tgc", S, V)
-        h[:, k] += chain.m[k] * np.sum(w * _cross(r, v), -1)
+        h[:, k] += chain.m[k] * np.sum(w * cross2d(r, v), -1)
         p[:, k] += chain.m[k] * np.einsum("g,tgc->tc", w, v)
         first[:, k] += chain.m[k] * np.einsum("g,tgc->tc", w, r)
     for k in range(chain.n):
         r = at[(k, E)][0][:, :2] - root[:, 0]
         v = at[(k, E)][1][:, :2]
-        h[:, k] += chain.mu[k] * _cross(r, v)
+        h[:, k] += chain.mu[k] * cross2d(r, v)
         p[:, k] += chain.mu[k] * v
         first[:, k] += chain.mu[k] * r
     if BODY in at:
         body_mass, inertia = scene.base.inertial()
         q_b, v_b = at[BODY][:2]
         r_c = q_b[:, :2] - root[:, 0]
-        h[:, -1] = inertia * v_b[:, 2] + body_mass * _cross(r_c, v_b[:, :2])
+        h[:, -1] = inertia * v_b[:, 2] + body_mass * cross2d(r_c, v_b[:, :2])
         p[:, -1] = body_mass * v_b[:, :2]
         first[:, -1] = body_mass * r_c
     return h, p, first, mass
 
 
-def _momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
+def system_momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
     """The ``angular_momentum`` rows (nt, 2) (N m s, counter-clockwise positive) and the
     ``momentum`` rows P (nt, 2) (N s) of the whole system (see rodval.core.scene.QUANTITIES),
     summed over ``_momentum_parts``: k = 0 about node 0, H_0 = sum int (r - r_0) x r_t dm;
@@ -357,7 +364,7 @@ def _momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
     node 0, M the total mass)."""
     h, p, first, mass = _momentum_parts(scene, E, at)
     H0, P, S = h.sum(-1), p.sum(-2), first.sum(-2)
-    return np.stack([H0, H0 - _cross(S, P) / mass.sum()], -1), P
+    return np.stack([H0, H0 - cross2d(S, P) / mass.sum()], -1), P
 
 
 def momentum_audit_rows(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -368,5 +375,5 @@ def momentum_audit_rows(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.
     h, p, first, mass = _momentum_parts(scene, E, at)
     if BODY in at:  # about the centre of mass X: h_X = h_0 - (X - r_0) x p
         X = first.sum(-2) / mass.sum()
-        h = h - _cross(X[:, None, :], p)
+        h = h - cross2d(X[:, None, :], p)
     return h.sum(-1), np.abs(h).sum(-1)

@@ -10,17 +10,17 @@ from typing import Any
 
 from reference_models.exudyn_beam import (
     BODY,
-    _initial_node_states,
-    _load_function,
-    _revolutions,
-    _stop_law,
+    initial_node_states,
+    load_function,
+    revolutions,
+    stop_law,
 )
 from rodval.core.scene import Scene
 from rodval.core.validity import momentum_point
 
 
 @dataclass
-class _Built:
+class BuiltSystem:
     """An assembled exudyn system and the sensor ids needed for the scene's outputs."""
 
     SC: Any
@@ -29,7 +29,7 @@ class _Built:
     node_sensors: dict[tuple[int, int], tuple[int, int, int]]
     load_errors: list
     nodes: list  # beam node numbers per rod
-    initial: tuple  # _initial_node_states: ref, offsets, velocities
+    initial: tuple  # initial_node_states: ref, offsets, velocities
     latch_joints: dict  # hinge -> exudyn object number of its locking joint
     body: int | None = None  # a free base's NodeRigidBody2D (None: pinned to the ground)
 
@@ -41,12 +41,12 @@ def _items():
     return itemInterface
 
 
-def build(scene: Scene, E: int, EA: float) -> _Built:
+def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     """The exudyn beam model of ``scene``, each rod meshed into E ANCF cable elements of axial
     stiffness EA (N), assembled: O(n E) items. Hinges are a position joint plus a torsional
     spring-damper on the end tangents (relaxed at the rest angle: exudyn's ``offset``); limit
     stops a second spring-damper with a one-sided user law; latches a rotation-locking
-    ObjectJointGeneric, inactive until the pre-step function (``_Latches``) switches it on.
+    ObjectJointGeneric, inactive until the pre-step function (``Latches``) switches it on.
     A free base is a NodeRigidBody2D (reference coordinates [x_c, y_c, theta] at the initial
     position and attitude) with an ObjectRigidBody2D of the body's mass and inertia; hinge 0
     joins it, at the hinge offset, to rod 1 (instead of the ground)."""
@@ -56,7 +56,7 @@ def build(scene: Scene, E: int, EA: float) -> _Built:
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
     ground = mbs.AddObject(_items().ObjectGround())
-    ref, q0, v0 = _initial_node_states(scene, E)
+    ref, q0, v0 = initial_node_states(scene, E)
     nodes, elems = _add_rods(mbs, scene, E, EA, (ref, q0, v0))
     body_node, root_body = _add_body(mbs, scene, ground)
     latch_joints = _add_hinges(mbs, scene, E, root_body, nodes, elems)
@@ -71,12 +71,14 @@ def build(scene: Scene, E: int, EA: float) -> _Built:
             it.LoadForceVector(
                 markerNumber=marker,
                 loadVector=[0, 0, 0],
-                loadVectorUserFunction=_load_function(f, load_errors),
+                loadVectorUserFunction=load_function(f, load_errors),
             )
         )
     node_sensors = _add_sensors(mbs, scene, E, nodes, body_node)
     mbs.Assemble()
-    return _Built(SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints, body_node)
+    return BuiltSystem(
+        SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints, body_node
+    )
 
 
 def _add_body(mbs, scene: Scene, ground: int) -> tuple[int | None, int]:
@@ -173,7 +175,7 @@ def _add_hinges(mbs, scene: Scene, E: int, root_body: int, nodes, elems) -> dict
         rot1 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=elems[k][0], localPosition=[0, 0, 0]))
         springs = [(float(chain.kappa[k]), float(chain.nu[k]), float(chain.rest_angle[k]), 0)]
         springs += [
-            (stop.stiffness, stop.damping, stop.angle, _stop_law(stop.side))
+            (stop.stiffness, stop.damping, stop.angle, stop_law(stop.side))
             for stop in stops_of.get(k, [])
         ]
         _add_springs(mbs, (rot0, rot1), angle0, springs)
@@ -190,7 +192,7 @@ def _add_springs(mbs, markers: tuple[int, int], angle0: float, springs: list) ->
         if stiffness == 0 and damping == 0:
             continue
         turns = mbs.AddNode(
-            it.NodeGenericData(numberOfDataCoordinates=1, initialCoordinates=[_revolutions(angle0)])
+            it.NodeGenericData(numberOfDataCoordinates=1, initialCoordinates=[revolutions(angle0)])
         )
         mbs.AddObject(
             it.ObjectConnectorTorsionalSpringDamper(

@@ -46,7 +46,7 @@ Jacobian kept from before a latch's joint was switched on leaves the joint witho
 until Newton restarts (0.17 ms late on the two-rod scene of tests/test_rigid_lock.py, the
 hinge passing its latch angle by 3.7 mrad).
 rodval's native integrator settings are refused unless at their defaults (``check_settings``;
-``blowup_factor`` and ``max_wall_s`` apply). Before every step ``_Guard`` checks the state:
+``blowup_factor`` and ``max_wall_s`` apply). Before every step ``Guard`` checks the state:
 non-finite (STATUS_DIVERGED), kinetic energy above blowup_factor x (E(0) + W+ + 1e-6 J)
 (STATUS_BLOWUP), rotation per step above ``max_rotation_per_step`` (STATUS_FAILED); a verdict
 stops the run. Then ``RunBudget`` (``exudyn_budget``) reads the clock (the run's wall-clock
@@ -64,12 +64,12 @@ from typing import Any
 import numpy as np
 
 from reference_models.exudyn_audit import account
-from reference_models.exudyn_beam import _positive
+from reference_models.exudyn_beam import positive
 from reference_models.exudyn_budget import EXUDYN_MAX_STEPS, RunBudget, check_plan, planned_steps
-from reference_models.exudyn_build import _Built, build, recorded_doubles
-from reference_models.exudyn_guard import _Guard
-from reference_models.exudyn_latches import _Latches
-from reference_models.exudyn_observe import _observe, momentum_audit, stop_events
+from reference_models.exudyn_build import BuiltSystem, build, recorded_doubles
+from reference_models.exudyn_guard import Guard
+from reference_models.exudyn_latches import Latches
+from reference_models.exudyn_observe import momentum_audit, observe, stop_events
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
@@ -85,7 +85,7 @@ from rodval.solvers.audit import momentum_residual
 
 ELEMENTS = ("cable2d",)
 #: renew the Newton Jacobian every step of a scene with latches (True: the old way) instead of
-#: only in the step a latch's joint is switched on (``_Latches.pre_step``)
+#: only in the step a latch's joint is switched on (``Latches.pre_step``)
 JAC_PER_STEP = True
 SOLVERS = ("generalized-alpha", "trapezoidal")
 
@@ -147,7 +147,7 @@ class ExudynModel(Model):
         step. Beyond it the trajectory is not a resolved solution.
 
     Any other keyword is refused with a ValueError listing these (``check_options``).
-    Divergence is detected during the run (``_Guard``): a non-finite state ends it as
+    Divergence is detected during the run (``Guard``): a non-finite state ends it as
     STATUS_DIVERGED, kinetic energy above ``settings.blowup_factor`` x (E(0) + W+(t) + 1e-6 J)
     as STATUS_BLOWUP, both at the time of detection with the output times before it kept.
     ``settings.max_wall_s`` (s, from the start of the run) ends it as STATUS_WALL with the
@@ -179,9 +179,9 @@ class ExudynModel(Model):
     ):
         if unknown:
             raise ValueError(_unknown_options_message(unknown))
-        self.elements = _positive("elements", elements, integer=True)
-        self.step = _positive("step", step, upper=0.1)
-        self.EA = _positive("EA", EA, upper=1e14)
+        self.elements = positive("elements", elements, integer=True)
+        self.step = positive("step", step, upper=0.1)
+        self.EA = positive("EA", EA, upper=1e14)
         if element not in ELEMENTS:
             raise ValueError(f"element must be one of {ELEMENTS}, got {element!r}")
         self.element = element
@@ -199,9 +199,9 @@ class ExudynModel(Model):
         self.spectral_radius: float | str = (
             "auto" if spectral_radius == "auto" else float(spectral_radius)
         )
-        self.newton_rtol = _positive("newton_rtol", newton_rtol, upper=1e-2)
-        self.newton_atol_per_EA = _positive("newton_atol_per_EA", newton_atol_per_EA, upper=1e-6)
-        self.max_rotation_per_step = _positive(
+        self.newton_rtol = positive("newton_rtol", newton_rtol, upper=1e-2)
+        self.newton_atol_per_EA = positive("newton_atol_per_EA", newton_atol_per_EA, upper=1e-6)
+        self.max_rotation_per_step = positive(
             "max_rotation_per_step", max_rotation_per_step, upper=math.pi
         )
 
@@ -233,7 +233,7 @@ class ExudynModel(Model):
         return built.SC, built.mbs, nodes
 
     # -- system ------------------------------------------------------------------------------
-    def _build(self, scene: Scene) -> _Built:
+    def _build(self, scene: Scene) -> BuiltSystem:
         """The beam model of ``scene`` with this model's discretization (``build``)."""
         return build(scene, self.elements, self.EA)
 
@@ -358,7 +358,7 @@ class ExudynModel(Model):
         try:
             built = self._build(scene)
             sim = self._settings(scene)
-            guard = _Guard(built, scene, self.elements, self.EA, factor, self.max_rotation_per_step)
+            guard = Guard(built, scene, self.elements, self.EA, factor, self.max_rotation_per_step)
         except Exception as exc:  # noqa: BLE001 - a failed build is data
             status, message = numerical_failure(exc, 0.0) or (
                 STATUS_ERROR,
@@ -370,7 +370,7 @@ class ExudynModel(Model):
             step_used=float(sim.timeIntegration.initialStepSize),
             **_newton_record(sim, bool(scene.latches)),
         )
-        latches = _Latches(built, guard, scene, self.elements) if scene.latches else None
+        latches = Latches(built, guard, scene, self.elements) if scene.latches else None
         self._solve(scene, built, sim, (guard, latches, budget), stats)
         run_info.update(
             steps=stats.nsteps,
@@ -389,7 +389,7 @@ class ExudynModel(Model):
         events = sorted(events + stops, key=lambda ev: ev["t"])
         try:
             observed = (
-                _observe(scene, self.elements, self.EA, times, t_rec, records, lock_steps)
+                observe(scene, self.elements, self.EA, times, t_rec, records, lock_steps)
                 if times.size
                 else {}
             )
@@ -409,7 +409,7 @@ class ExudynModel(Model):
         run_info.update(audit)
         return self._trajectory(scene, times, observed, stats, run_info, events)
 
-    def _solve(self, scene: Scene, built: _Built, sim, checks: tuple, stats) -> None:
+    def _solve(self, scene: Scene, built: BuiltSystem, sim, checks: tuple, stats) -> None:
         """exudyn's implicit solver over the scene, ``checks`` = (guard, latches or None,
         budget) in its pre-step function; the outcome and counters into ``stats`` (the guard
         keeps its verdict, the budget its stop)."""
@@ -476,7 +476,7 @@ class ExudynModel(Model):
         the step (docs/deployment.md, "Where the lock energy goes")."""
         return "a smaller step (exudyn option step; its numerical dissipation falls with it)"
 
-    def _records(self, built: _Built):
+    def _records(self, built: BuiltSystem):
         """Recorded times (s); per (rod, local node), arrays q, v, a (nt, 4) up to the first
         non-finite record; whether a non-finite record was cut off."""
         mbs = built.mbs
@@ -525,7 +525,7 @@ class ExudynModel(Model):
 
 
 def _ended(
-    scene: Scene, stats: SolverStats, checks: tuple[_Guard, RunBudget], t_rec, diverged: bool
+    scene: Scene, stats: SolverStats, checks: tuple[Guard, RunBudget], t_rec, diverged: bool
 ) -> np.ndarray:
     """How the run ended (status, message, time reached into ``stats``; the guard's verdict
     explains a solver failure that may follow it, the budget's stop (``checks`` = (guard,
@@ -555,7 +555,7 @@ def _ended(
     return times[times < stats.t_reached - tol]  # the state at the detection time is bad
 
 
-def _lock_records(latches: _Latches | None) -> tuple[list[dict], dict[int, float]]:
+def _lock_records(latches: Latches | None) -> tuple[list[dict], dict[int, float]]:
     """The lock events in time order and hinge -> lock time (s), pending locks closed."""
     if latches is None:
         return [], {}

@@ -1,4 +1,4 @@
-"""The exudyn model's per-step divergence and resolution check (``_Guard``), on the guard
+"""The exudyn model's per-step divergence and resolution check (``Guard``), on the guard
 spec, energy budget and messages of ``rodval.solvers.guard``."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, BODY, _energies, _hermite
-from reference_models.exudyn_build import _Built
+from reference_models.exudyn_beam import BODY, GAUSS_W, GAUSS_X, hermite_shapes, system_energies
+from reference_models.exudyn_build import BuiltSystem
 from rodval.core.scene import Scene
 from rodval.core.status import (
     STATUS_DIVERGED,
@@ -55,7 +55,7 @@ def _state_kernel(q, v, M, end, root, d_ref):  # pragma: no cover - compiled
     return True, 0.5 * kinetic, rate_max, k_max
 
 
-class _Guard:
+class Guard:
     """Divergence and resolution checks of one run, on every accepted step (exudyn's
     PreStepUserFunction: called before each step with t = the end of the coming step, on the
     state of the last accepted step, at t - step). A verdict stops the solver after the coming
@@ -66,12 +66,18 @@ class _Guard:
     * kinetic energy T = v^T M v / 2 (consistent mass of the cubic elements plus the point
       masses and a free base's body, diag(m, m, J); the hinge data nodes carry no mass)
       above ``factor`` x the budget of ``rodval.solvers.guard`` (``GuardSpec``, ``Monitor``:
-      W+ on the load power at the checked states), E(0) the initial T + Pi (``_energies``):
+      W+ on the load power at the checked states), E(0) the initial T + Pi (``system_energies``):
       STATUS_BLOWUP;
     * max_k |dphi_k| x step above ``max_rotation``: STATUS_FAILED (under-resolved)."""
 
     def __init__(
-        self, built: _Built, scene: Scene, E: int, EA: float, factor: float, max_rotation: float
+        self,
+        built: BuiltSystem,
+        scene: Scene,
+        E: int,
+        EA: float,
+        factor: float,
+        max_rotation: float,
     ):
         mbs, chain = built.mbs, scene.chain
         ref, q0, v0 = built.initial
@@ -90,9 +96,9 @@ class _Guard:
         self.M = np.zeros((size, size))  # dense: a 4 us product at n = 8, 2 elements/rod
         for k in range(chain.n):
             le = chain.l[k] / E
-            s = 0.5 * le * (_GAUSS_X + 1.0)
-            S = _hermite(s, le)[0]
-            Me = chain.m[k] * np.einsum("g,gi,gj->ij", 0.5 * le * _GAUSS_W, S, S)  # (4, 4)
+            s = 0.5 * le * (GAUSS_X + 1.0)
+            S = hermite_shapes(s, le)[0]
+            Me = chain.m[k] * np.einsum("g,gi,gj->ij", 0.5 * le * GAUSS_W, S, S)  # (4, 4)
             for j in range(E):
                 a, b = ltg[k][j], ltg[k][j + 1]
                 dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
@@ -121,7 +127,7 @@ class _Guard:
         }
         if built.body is not None:
             at0[BODY] = self._add_body(scene, np.asarray(mbs.systemData.GetNodeLTGODE2(built.body)))
-        parts = _energies(
+        parts = system_energies(
             scene, E, EA, at0, ini["phi"][None], ini["alpha"][None], ini["beta"][None]
         )
         self.spec = GuardSpec(blowup_factor=float(factor), energy0_J=float(np.sum(parts)))

@@ -1,5 +1,5 @@
 """Latches in the exudyn model: the rotation-locking joints switched on in the pre-step
-function when a hinge angle crosses its latch angle, and the lock records (``_Latches``)."""
+function when a hinge angle crosses its latch angle, and the lock records (``Latches``)."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ import math
 import numpy as np
 from numba import njit
 
-from reference_models.exudyn_beam import _GAUSS_W, _GAUSS_X, _hermite, _wrap, stop_moment
-from reference_models.exudyn_build import _Built
-from reference_models.exudyn_guard import _Guard
+from reference_models.exudyn_beam import GAUSS_W, GAUSS_X, hermite_shapes, stop_moment, wrap_angle
+from reference_models.exudyn_build import BuiltSystem
+from reference_models.exudyn_guard import Guard
 from rodval.core.lock_window import lock_window
 from rodval.core.rigid import rigid_lock
 from rodval.core.root_momentum import root_momentum_fields
@@ -22,7 +22,7 @@ from rodval.core.scene import Scene
 LOCK_SETTLE_STEPS = 2
 
 
-class _Latches:
+class Latches:
     """The latches of one run, driven from exudyn's PreStepUserFunction (state of the last
     accepted step, at t - h, before the step to t).
 
@@ -49,7 +49,7 @@ class _Latches:
     window [t_lock, t_lock + w] (``rodval.core.lock_window``, the same window and measure as
     the native models'), by the trapezoid rule on the steps."""
 
-    def __init__(self, built: _Built, guard: _Guard, scene: Scene, E: int):
+    def __init__(self, built: BuiltSystem, guard: Guard, scene: Scene, E: int):
         self.mbs, self.guard, self.scene, self.E = built.mbs, guard, scene, E
         chain, n = scene.chain, scene.n
         sd = built.mbs.systemData
@@ -84,8 +84,8 @@ class _Latches:
         rod_of: list[int] = []
         for k in range(n):
             le = chain.l[k] / E
-            sg = 0.5 * le * (_GAUSS_X + 1.0)
-            S = _hermite(sg, le)[0]
+            sg = 0.5 * le * (GAUSS_X + 1.0)
+            S = hermite_shapes(sg, le)[0]
             for j in range(E):
                 a, b = ltg[k][j], ltg[k][j + 1]
                 dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
@@ -94,7 +94,7 @@ class _Latches:
                         r = np.zeros(size)
                         r[dofs[:, c]] = S[g]
                         rows.append(r)
-                    wts.append(chain.m[k] * 0.5 * le * _GAUSS_W[g])
+                    wts.append(chain.m[k] * 0.5 * le * GAUSS_W[g])
                     rod_of.append(k)
             if chain.mu[k] > 0:
                 for rows, c in ((rows_x, 0), (rows_y, 1)):
@@ -167,7 +167,7 @@ class _Latches:
     def _hinge(self, item, q, v, a):
         tl, rl, al = self._angle(q, v, a, item["left"])
         tr, rr, ar = self._angle(q, v, a, item["right"])
-        D = item["D"] + float(_wrap(np.array((tr - tl) - item["D"])))
+        D = item["D"] + float(wrap_angle(np.array((tr - tl) - item["D"])))
         return D, rr - rl, ar - al
 
     def _momenta(self, q, v):
@@ -194,7 +194,7 @@ class _Latches:
         transmits, in the sense of its spring's kappa (D - rest)."""
         E, le = self.E, self.scene.chain.l[j] / self.E
         if j not in self._root_shapes:
-            self._root_shapes[j] = _hermite(np.zeros(1), le)[1:]
+            self._root_shapes[j] = hermite_shapes(np.zeros(1), le)[1:]
         dS, ddS = self._root_shapes[j]
         a, b = self.ltg[j][0], self.ltg[j][1 if E >= 1 else 0]
         Q = np.stack([q[a[:2]], q[a[2:]], q[b[:2]], q[b[2:]]])  # (4, 2)

@@ -7,14 +7,14 @@ import numpy as np
 
 from reference_models.exudyn_beam import (
     BODY,
-    _energies,
-    _hermite,
-    _interpolate,
-    _momenta,
-    _wrap,
     body_attitude,
+    hermite_interpolate,
+    hermite_shapes,
     momentum_audit_rows,
     stop_moment,
+    system_energies,
+    system_momenta,
+    wrap_angle,
 )
 from rodval.core.scene import QUANTITIES, Scene, hinge_angles
 
@@ -22,7 +22,7 @@ from rodval.core.scene import QUANTITIES, Scene, hinge_angles
 def _states_at(times: np.ndarray, t_rec: np.ndarray, records: dict) -> dict:
     """Each recorded node's (state, rate) at ``times`` (cubic Hermite on the records)."""
     return {
-        key: (_interpolate(times, t_rec, q, v), _interpolate(times, t_rec, v, a))
+        key: (hermite_interpolate(times, t_rec, q, v), hermite_interpolate(times, t_rec, v, a))
         for key, (q, v, a) in records.items()
     }
 
@@ -34,7 +34,7 @@ def momentum_audit(
     return momentum_audit_rows(scene, E, _states_at(times, t_rec, records))
 
 
-def _observe(
+def observe(
     scene: Scene,
     E: int,
     EA: float,
@@ -52,15 +52,15 @@ def _observe(
     moment EI kappa_b at the root of rod k+1 (the hinge has no inertia: it transmits that
     moment), kappa_b the curvature of the cable's field there. Hinge 0 is measured from a free
     base's attitude (its body node's record, ``BODY``), which also gives "base"; "momentum"
-    and "angular_momentum" are the whole system's (``_momenta``)."""
+    and "angular_momentum" are the whole system's (``system_momenta``)."""
     n = scene.n
     rods = np.arange(1, n + 1)
     at = _states_at(times, t_rec, records)
     out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     if not scene.wants(*QUANTITIES):
         return out
-    phi, dphi, alpha, beta = _chord_angles(scene, E, times, t_rec, records, at)
-    qL, vL, qR, vR = _ends(n, E, at)
+    phi, dphi, alpha, beta = chord_angles(scene, E, times, t_rec, records, at)
+    qL, vL, qR, vR = rod_ends(n, E, at)
     for name, val in (("phi", phi), ("dphi", dphi), ("alpha", alpha), ("beta", beta)):
         if scene.wants(name):
             out[name] = (val, rods)
@@ -77,13 +77,13 @@ def _observe(
             scene, E, times, at, (phi, alpha, beta), (qL, vL, qR, vR), lock_steps, out
         )
     if scene.wants("energy"):
-        kin, strain, hinge = _energies(scene, E, EA, at, phi, alpha, beta)
+        kin, strain, hinge = system_energies(scene, E, EA, at, phi, alpha, beta)
         zero = np.zeros(1, dtype=int)
         out["kinetic"] = (kin[:, None], zero)
         out["potential"] = ((strain + hinge)[:, None], zero)
         out["energy"] = ((kin + strain + hinge)[:, None], zero)
     if scene.wants("angular_momentum", "momentum"):
-        H, P = _momenta(scene, E, at)
+        H, P = system_momenta(scene, E, at)
         if scene.wants("angular_momentum"):
             out["angular_momentum"] = (H, np.arange(2))
         if scene.wants("momentum"):
@@ -105,7 +105,7 @@ def _base_quantities(at: dict, out: dict) -> None:
     out["base_rate"] = (v[:, 2:3], one)
 
 
-def _ends(n: int, E: int, at: dict) -> tuple[np.ndarray, ...]:
+def rod_ends(n: int, E: int, at: dict) -> tuple[np.ndarray, ...]:
     """The rods' left and right node states and rates (qL, vL, qR, vR), (nt, n, 4)."""
     qL = np.stack([at[(k, 0)][0] for k in range(n)], 1)
     qR = np.stack([at[(k, E)][0] for k in range(n)], 1)
@@ -114,7 +114,7 @@ def _ends(n: int, E: int, at: dict) -> tuple[np.ndarray, ...]:
     return qL, vL, qR, vR
 
 
-def _chord_angles(scene: Scene, E: int, times, t_rec, records: dict, at: dict):
+def chord_angles(scene: Scene, E: int, times, t_rec, records: dict, at: dict):
     """(phi, dphi, alpha, beta) (rad, rad/s; (nt, n)) at ``times`` from the node states ``at``
     there: the chord angles continuous in time (unwrapped along every recorded step from the
     initial phi) and the end tangents' angles to the chord."""
@@ -128,17 +128,17 @@ def _chord_angles(scene: Scene, E: int, times, t_rec, records: dict, at: dict):
     phi0 = scene.initial.resolve(n)["phi"]
     phi_rec += 2 * np.pi * np.round((phi0 - phi_rec[0]) / (2 * np.pi))
     i = np.clip(np.searchsorted(t_rec, times, side="right") - 1, 0, t_rec.size - 1)
-    qL, vL, qR, vR = _ends(n, E, at)
+    qL, vL, qR, vR = rod_ends(n, E, at)
     d, dd = qR[..., :2] - qL[..., :2], vR[..., :2] - vL[..., :2]
-    phi = phi_rec[i] + _wrap(np.arctan2(d[..., 1], d[..., 0]) - phi_rec[i])
+    phi = phi_rec[i] + wrap_angle(np.arctan2(d[..., 1], d[..., 0]) - phi_rec[i])
     dphi = (d[..., 0] * dd[..., 1] - d[..., 1] * dd[..., 0]) / np.sum(d**2, -1)
-    alpha = _wrap(np.arctan2(qL[..., 3], qL[..., 2]) - phi)
-    beta = _wrap(np.arctan2(qR[..., 3], qR[..., 2]) - phi)
+    alpha = wrap_angle(np.arctan2(qL[..., 3], qL[..., 2]) - phi)
+    beta = wrap_angle(np.arctan2(qR[..., 3], qR[..., 2]) - phi)
     return phi, dphi, alpha, beta
 
 
 def _hinge_quantities(scene: Scene, E: int, times, at: dict, angles, ends, lock_steps, out):
-    """ "hinge_angle" D_k (rad) and "hinge_moment" (N m) into ``out`` (see ``_observe``):
+    """ "hinge_angle" D_k (rad) and "hinge_moment" (N m) into ``out`` (see ``observe``):
     ``angles`` = (phi, alpha, beta) (nt, n); ``ends`` = the rods' left and right node states
     and rates (qL, vL, qR, vR), (nt, n, 4)."""
     phi, alpha, beta = angles
@@ -180,8 +180,8 @@ def _root_bending_moment(chain, E: int, at: dict, k: int) -> np.ndarray:
     """The beam's bending moment EI kappa_b (N m) at the root of rod k+1 at every output time,
     kappa_b the curvature of its first cable element's field at s = 0."""
     le = chain.l[k] / E
-    ddS = _hermite(np.zeros(1), le)[2][0]  # (4,) at s = 0
-    dS = _hermite(np.zeros(1), le)[1][0]
+    ddS = hermite_shapes(np.zeros(1), le)[2][0]  # (4,) at s = 0
+    dS = hermite_shapes(np.zeros(1), le)[1][0]
     qa, qb = at[(k, 0)][0], at[(k, 1)][0]
     Q = np.stack([qa[:, :2], qa[:, 2:], qb[:, :2], qb[:, 2:]], 1)  # (nt, 4, 2)
     r1 = np.einsum("i,tic->tc", dS, Q)

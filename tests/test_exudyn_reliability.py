@@ -231,7 +231,7 @@ def test_guard_verdicts_on_a_set_state():
     """The per-step check on states set by hand: a NaN velocity is STATUS_DIVERGED (exudyn's
     Newton usually gives up before a state turns non-finite, so no run reaches this), a huge
     one STATUS_BLOWUP, and its kinetic energy agrees with the measured one."""
-    from reference_models.exudyn_guard import _Guard
+    from reference_models.exudyn_guard import Guard
     from rodval.core.status import STATUS_DIVERGED
 
     scene = Scene(
@@ -241,7 +241,7 @@ def test_guard_verdicts_on_a_set_state():
         initial=InitialState(dphi=[0.5, -0.3], dalpha=[2.0, 1.0]),
     )
     built = ExudynModel()._build(scene)
-    guard = _Guard(built, scene, 2, 1e10, 100.0, 0.1)
+    guard = Guard(built, scene, 2, 1e10, 100.0, 0.1)
     sd = built.mbs.systemData
     v0 = sd.GetODE2Coordinates_t()
     assert 0.5 * v0 @ guard.M @ v0 == pytest.approx(

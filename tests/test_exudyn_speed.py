@@ -94,7 +94,7 @@ def test_closed_form_crossing_equals_numpy_roots():
 
 
 def test_vectorized_hinge_angles_equal_the_per_hinge_ones():
-    """``_Sides.hinges`` (ground, body and slope sides mixed) equals ``_Latches._angle`` per
+    """``_Sides.hinges`` (ground, body and slope sides mixed) equals ``Latches._angle`` per
     hinge, D continued from a previous value past +-pi."""
     lat = _latches_module()
     rng = np.random.default_rng(3)
@@ -104,8 +104,8 @@ def test_vectorized_hinge_angles_equal_the_per_hinge_ones():
     D_prev = np.array([0.1, 3.0, -3.1, 7.0])
     D, dD, ddD = lat._Sides(left, right).hinges(q, v, a, D_prev)
     for i in range(4):
-        tl, rl, al = lat._Latches._angle(q, v, a, left[i])
-        tr, rr, ar = lat._Latches._angle(q, v, a, right[i])
+        tl, rl, al = lat.Latches._angle(q, v, a, left[i])
+        tr, rr, ar = lat.Latches._angle(q, v, a, right[i])
         wrapped = math.remainder((tr - tl) - D_prev[i], 2 * math.pi)
         assert D[i] == pytest.approx(D_prev[i] + wrapped, abs=1e-12)
         assert dD[i] == pytest.approx(rr - rl, rel=1e-12, abs=1e-12)

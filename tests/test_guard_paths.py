@@ -56,10 +56,10 @@ def test_scipy_and_compiled_guards_give_one_verdict(model):
 def test_exudyn_guard_gives_the_native_verdict():
     pytest.importorskip("exudyn")
     from reference_models.exudyn_chain import ExudynModel
-    from reference_models.exudyn_guard import _Guard
+    from reference_models.exudyn_guard import Guard
 
     built = ExudynModel()._build(SCENE)
-    guard = _Guard(built, SCENE, 2, 1e10, IntegratorSettings().blowup_factor, 0.1)
+    guard = Guard(built, SCENE, 2, 1e10, IntegratorSettings().blowup_factor, 0.1)
     sd = built.mbs.systemData
     sd.SetODE2Coordinates_t(SCALE * sd.GetODE2Coordinates_t())
     assert not guard.check(T_CHECK, H)

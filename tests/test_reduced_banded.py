@@ -197,7 +197,7 @@ def test_accel_wrapper_and_band_structure():
     assert_close(out, ref.numpy_rhs(0.3, np.concatenate([phi, dphi]))[n:])
     scales = Cst[lu.C_RSCALE :]
     np.testing.assert_array_equal(np.exp2(np.round(np.log2(scales))), scales)
-    T = lu._magnitudes(Cst)  # (7n, W), row i holds columns i-KL .. i+KL+KU
+    T = lu.band_magnitudes(Cst)  # (7n, W), row i holds columns i-KL .. i+KL+KU
     assert not np.any(T[:, lu.KL + lu.KU + 1 :]), "the pivoting fill columns must start empty"
     for i in range(lu.NB * n):
         cols = i - lu.KL + np.flatnonzero(T[i])
@@ -263,7 +263,7 @@ def band_residual(Cst, phi, dphi, SX, SY, ddphi, gamma):
     N = lu.NB * n
     c, s = np.cos(phi), np.sin(phi)
     vec = np.empty(5 * n)
-    rb._forces(Cst, phi, dphi, c, s, True, SX, SY, True, vec)
+    rb.reduced_forces(Cst, phi, dphi, c, s, True, SX, SY, True, vec)
     unscaled = Cst.copy()
     unscaled[lu.C_RSCALE :] = 1.0
     A = np.empty((N, lu.W))

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from rodval.core.bounds import _check_bounds
+from rodval.core.bounds import check_bounds
 from rodval.core.checks import check_choice, check_keys, check_number
 
 #: The kinds of base: a fixed pin at the origin, or a free rigid body.
@@ -33,7 +33,7 @@ def _vector(name: str, value: Any, unit: str) -> tuple[float, float]:
             f"base {name} must be a pair [x, y] of real numbers ({unit}), got {value!r}"
         )
     x, y = (check_number(f"base {name} ({unit})", v, finite=True) for v in value)
-    _check_bounds(f"base {name} ({unit})", np.array([x, y]), None)
+    check_bounds(f"base {name} ({unit})", np.array([x, y]), None)
     return (x, y)
 
 
@@ -72,13 +72,13 @@ class Base:
                 raise ValueError(f"a free base needs its {name} (base.{name})")
             unit = "kg" if name == "mass" else "kg m^2"
             v = check_number(f"base {name} ({unit})", value, low=0.0, low_open=True, finite=True)
-            _check_bounds(f"base {name} ({unit})", np.array([v]), True)
+            check_bounds(f"base {name} ({unit})", np.array([v]), True)
             set_(self, name, v)
         for name, unit in (("hinge_offset", "m"), ("position", "m"), ("velocity", "m/s")):
             set_(self, name, _vector(name, getattr(self, name), unit))
         for name, unit in (("attitude", "rad"), ("rate", "rad/s")):
             v = check_number(f"base {name} ({unit})", getattr(self, name), finite=True)
-            _check_bounds(f"base {name} ({unit})", np.array([v]), None)
+            check_bounds(f"base {name} ({unit})", np.array([v]), None)
             set_(self, name, v)
 
     def _given(self, name: str) -> bool:

@@ -20,7 +20,7 @@ MAX_MAGNITUDE = 1e12
 MIN_POSITIVE = 1e-12
 
 
-def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndarray:
+def as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndarray:
     """A length-n float array from a scalar or sequence of real numbers; ``positive``: True
     for > 0, False for >= 0 (both with bounded magnitudes: ``MAX_MAGNITUDE``,
     ``MIN_POSITIVE``), None for any finite value (angles, initial state)."""
@@ -38,12 +38,12 @@ def _as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndar
         arr = np.full(n, float(arr))
     if arr.shape != (n,):
         raise ValueError(f"{name} must be a scalar or have length n = {n}, got shape {arr.shape}")
-    _check_bounds(name, arr, positive)
+    check_bounds(name, arr, positive)
     arr.setflags(write=False)
     return arr
 
 
-def _check_bounds(name: str, arr: np.ndarray, positive: bool | None) -> None:
+def check_bounds(name: str, arr: np.ndarray, positive: bool | None) -> None:
     """The bounds of the chain's data on a float array: finite; ``positive`` True: in
     [MIN_POSITIVE, MAX_MAGNITUDE], False: in [0, MAX_MAGNITUDE], None: any finite value.
     ValueError naming ``name`` and the allowed range."""
@@ -65,10 +65,10 @@ def _check_bounds(name: str, arr: np.ndarray, positive: bool | None) -> None:
         )
 
 
-def _bounded_number(name: str, value: Any, *, positive: bool | None) -> float:
-    """A real number within the chain's bounds (``_check_bounds``); ``name`` with its unit."""
+def bounded_number(name: str, value: Any, *, positive: bool | None) -> float:
+    """A real number within the chain's bounds (``check_bounds``); ``name`` with its unit."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(f"{name} must be a real number, got {value!r}")
     v = float(value)
-    _check_bounds(name, np.array([v]), positive)
+    check_bounds(name, np.array([v]), positive)
     return v

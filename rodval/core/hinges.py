@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from rodval.core.bounds import _bounded_number, _check_bounds
+from rodval.core.bounds import bounded_number, check_bounds
 from rodval.core.checks import check_number
 
 
@@ -85,11 +85,11 @@ class Stop:
         if self.side not in ("upper", "lower"):
             raise ValueError(f"stop side must be 'upper' or 'lower', got {self.side!r}")
         # an acting stop adds its stiffness to kappa and its damping to nu: the same bounds
-        _bounded_number("stop stiffness (N m/rad)", self.stiffness, positive=True)
-        _bounded_number("stop damping (N m s/rad)", self.damping, positive=False)
+        bounded_number("stop stiffness (N m/rad)", self.stiffness, positive=True)
+        bounded_number("stop damping (N m s/rad)", self.damping, positive=False)
 
 
-def _check_acting_stops(chain: Any, stops: tuple[Stop, ...]) -> None:
+def check_acting_stops(chain: Any, stops: tuple[Stop, ...]) -> None:
     """An acting stop adds its stiffness to its hinge's kappa and its damping to nu: the sums
     (all of a hinge's stops acting at once) must stay within the chain's bounds."""
     for field_name, attr, unit in (
@@ -100,14 +100,14 @@ def _check_acting_stops(chain: Any, stops: tuple[Stop, ...]) -> None:
         for st in stops:
             total[st.hinge] += getattr(st, attr)
         for st in stops:
-            _check_bounds(
+            check_bounds(
                 f"stop {attr} + {field_name} of hinge {st.hinge} ({unit})",
                 total[st.hinge : st.hinge + 1],
                 positive=False,
             )
 
 
-def _hinge_items(label: str, cls: type[Latch] | type[Stop], items: Any, n: int) -> tuple[Any, ...]:
+def hinge_items(label: str, cls: type[Latch] | type[Stop], items: Any, n: int) -> tuple[Any, ...]:
     """The scene's latches or stops (``label``) as a tuple of ``cls`` on hinges 0..n-1."""
     if isinstance(items, (str, bytes, dict)) or not isinstance(items, Iterable):
         raise ValueError(f"{label} must be a sequence of rodval.{cls.__name__}")
@@ -121,7 +121,7 @@ def _hinge_items(label: str, cls: type[Latch] | type[Stop], items: Any, n: int) 
     return out
 
 
-def _check_latches(latches: tuple[Latch, ...], D0: np.ndarray) -> None:
+def check_latches(latches: tuple[Latch, ...], D0: np.ndarray) -> None:
     """At most one latch per hinge, each ahead of its hinge's initial angle D0 (rad) in its
     direction."""
     hinges = [latch.hinge for latch in latches]

@@ -27,11 +27,11 @@ from typing import Any
 import numpy as np
 
 from rodval.core.base import PINNED, Base
-from rodval.core.bounds import _as_rod_array
+from rodval.core.bounds import as_rod_array
 from rodval.core.checks import check_keys, check_number
 from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
 from rodval.core.hinges import Stop as Stop
-from rodval.core.hinges import _check_acting_stops, _check_latches, _hinge_items
+from rodval.core.hinges import check_acting_stops, check_latches, hinge_items
 from rodval.core.loads import NodalForce
 from rodval.core.resources import check_rods, check_run_memory
 
@@ -156,21 +156,21 @@ class Chain:
             raise ValueError(f"n (number of rods) must be >= 1, got {n}")
         check_rods(n)  # before any n-sized array
         set_ = object.__setattr__
-        set_(self, "l", _as_rod_array("l (rod length)", l, n, positive=True))
-        set_(self, "m", _as_rod_array("m (mass per length)", m, n, positive=True))
-        set_(self, "EI", _as_rod_array("EI (bending stiffness)", EI, n, positive=True))
-        set_(self, "mu", _as_rod_array("mu (node mass)", mu, n, positive=False))
-        set_(self, "kappa", _as_rod_array("kappa (hinge stiffness)", kappa, n, positive=False))
-        set_(self, "nu", _as_rod_array("nu (hinge damping)", nu, n, positive=False))
+        set_(self, "l", as_rod_array("l (rod length)", l, n, positive=True))
+        set_(self, "m", as_rod_array("m (mass per length)", m, n, positive=True))
+        set_(self, "EI", as_rod_array("EI (bending stiffness)", EI, n, positive=True))
+        set_(self, "mu", as_rod_array("mu (node mass)", mu, n, positive=False))
+        set_(self, "kappa", as_rod_array("kappa (hinge stiffness)", kappa, n, positive=False))
+        set_(self, "nu", as_rod_array("nu (hinge damping)", nu, n, positive=False))
         set_(
             self,
             "rest_angle",
-            _as_rod_array("rest_angle (hinge rest angle, rad)", rest_angle, n, positive=None),
+            as_rod_array("rest_angle (hinge rest angle, rad)", rest_angle, n, positive=None),
         )
         set_(
             self,
             "bending_damping",
-            _as_rod_array(
+            as_rod_array(
                 "bending_damping (rod bending damping, N m^2 s)", bending_damping, n, positive=False
             ),
         )
@@ -246,7 +246,7 @@ class InitialState:
             if v is None:
                 out[key] = np.zeros(n)
                 continue
-            out[key] = _as_rod_array(f"initial {key}", v, n, positive=None)
+            out[key] = as_rod_array(f"initial {key}", v, n, positive=None)
         return out
 
 
@@ -403,14 +403,14 @@ class Scene:
         if not isinstance(self.initial, InitialState):
             raise ValueError("initial must be a rodval.InitialState")
         self.initial.resolve(n)  # validate now, before any work
-        object.__setattr__(self, "latches", _hinge_items("latches", Latch, self.latches, n))
-        object.__setattr__(self, "stops", _hinge_items("stops", Stop, self.stops, n))
-        _check_acting_stops(self.chain, self.stops)
+        object.__setattr__(self, "latches", hinge_items("latches", Latch, self.latches, n))
+        object.__setattr__(self, "stops", hinge_items("stops", Stop, self.stops, n))
+        check_acting_stops(self.chain, self.stops)
         if not isinstance(self.base, Base):
             raise ValueError(f"base must be a rodval.Base, got {type(self.base).__name__}")
         if not self.base.free and self.wants("base"):
             raise ValueError("output 'base' needs a free base (Base(kind='free', ...))")
-        _check_latches(self.latches, self.initial_hinge_angles())
+        check_latches(self.latches, self.initial_hinge_angles())
 
     @property
     def n(self) -> int:

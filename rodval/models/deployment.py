@@ -30,16 +30,16 @@ from rodval.models.kernels import (
     V_L,
     V_OUTER,
     V_PPDIAG,
-    _full_solve,
-    _generator_solve,
     full_accel,
+    full_solve,
+    generator_solve,
     rhs_head,
 )
-from rodval.models.reduced_band_lu import _band_size, _solve_band
+from rodval.models.reduced_band_lu import band_size, solve_band
 from rodval.models.reduced_banded import (
-    _forces,
-    _solve_sweep,
+    reduced_forces,
     reduced_rhs,
+    solve_sweep,
     track_bending,
 )
 from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE
@@ -50,7 +50,7 @@ SIMULTANEOUS_RAD = 1e-8
 
 
 @njit(cache=True)
-def _unit_moment(k, fp, fa, fb):
+def unit_moment(k, fp, fa, fb):
     """fp, fa, fb += a_k (generalized force of a unit moment at hinge k)."""
     fp[k] += 1.0
     fa[k] += 1.0
@@ -116,8 +116,8 @@ def full_unit_responses(V, phi, locks, U):
         fp[:] = 0.0
         fa[:] = 0.0
         fb[:] = 0.0
-        _unit_moment(locks[j], fp, fa, fb)
-        _full_solve(V, c, s, fp, fa, fb, U[j])
+        unit_moment(locks[j], fp, fa, fb)
+        full_solve(V, c, s, fp, fa, fb, U[j])
 
 
 @njit(cache=True)
@@ -157,16 +157,16 @@ def superpose(out, U, locks, n, lam, theta=-1):
 def _reduced_linear(Cst, c, s, fp, fa, fb, T, ddphi, gamma):
     """The reduced model's unreduced linear solve for given right-hand sides (the sweep, the
     banded LU as fallback)."""
-    if _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi, gamma):
+    if solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi, gamma):
         return True
     n = c.shape[0]
     N = 7 * n
-    rest = np.empty(_band_size(n))
+    rest = np.empty(band_size(n))
     o1 = N * 11
     o2 = o1 + N + 10
     U = rest[:o1].reshape((N, 11))
     A = rest[o2 : o2 + 16 * 15].reshape((16, 15))
-    return _solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi, gamma)
+    return solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi, gamma)
 
 
 @njit(cache=True)
@@ -181,7 +181,7 @@ def reduced_solve_locked(
     c = np.cos(phi)
     s = np.sin(phi)
     vec = np.empty(5 * n)
-    _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
+    reduced_forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
     T = np.empty((n, 3, 4))
     fp = vec[:n].copy()
     fa = vec[n : 2 * n].copy()
@@ -196,7 +196,7 @@ def reduced_solve_locked(
         fp[:] = 0.0
         fa[:] = 0.0
         fb[:] = 0.0
-        _unit_moment(locks[j], fp, fa, fb)
+        unit_moment(locks[j], fp, fa, fb)
         if not _reduced_linear(Cst, c, s, fp, fa, fb, T, X[j], Gm[j]):
             return False
     G = np.empty((m, m))
@@ -235,7 +235,7 @@ def mpp_solve(V, phi, r, x):
         b[k, 1] = V[V_L, k] * sk
         a[k, 0] = V[V_OUTER, k] * b[k, 0]
         a[k, 1] = V[V_OUTER, k] * b[k, 1]
-    _generator_solve(V[V_PPDIAG], a, b, a, r, x)
+    generator_solve(V[V_PPDIAG], a, b, a, r, x)
 
 
 def reduced_hinge_gradient(chain, k: int) -> np.ndarray:

@@ -19,7 +19,7 @@ vectors), J_S = dS/dq, and T_chain the pinned chain's kinetic energy. Lagrange's
 The translation equation is d P / dt = F for P = m_b v_c + M_ch v_0 + S', whatever the chain's
 kinematics: the linear momentum is kept exactly. The total mass matrix is bordered,
 [[M_c, J_S^T E], [E^T J_S, D]] with E = [I_2, rho_perp]; it is solved by eliminating the chain
-(``_full_solve``, O(n)): q'' = u - G E x_b with u = M_c^-1 r_c, G = M_c^-1 J_S^T (two more
+(``full_solve``, O(n)): q'' = u - G E x_b with u = M_c^-1 r_c, G = M_c^-1 J_S^T (two more
 O(n) solves) and the 3 x 3 Schur complement D - E^T (J_S G) E for the body's x_b. O(n) per
 evaluation, three chain solves.
 """
@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from rodval.core.loads import load_sums
-from rodval.models.deployment import _unit_moment, hinge_events, locked_head, small_solve, superpose
+from rodval.models.deployment import hinge_events, locked_head, small_solve, superpose, unit_moment
 from rodval.models.kernels import (
     V_KAPPA,
     V_L,
@@ -38,9 +38,9 @@ from rodval.models.kernels import (
     V_OUTER,
     V_REST,
     V_W,
-    _full_forces,
-    _full_solve,
+    full_forces,
     full_mechanics,
+    full_solve,
     rhs_head,
 )
 from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE
@@ -116,7 +116,7 @@ def field_responses(V, c, s, delta, G):
         fa[:] = 0.0
         fb[:] = 0.0
         _field_forces(V, c, s, delta, 1.0 - j, float(j), fp, fa, fb)
-        _full_solve(V, c, s, fp, fa, fb, G[j])
+        full_solve(V, c, s, fp, fa, fb, G[j])
         kx, ky = _first_moment_rate(V, c, s, delta, G[j, :n], G[j, n : 2 * n], G[j, 2 * n :])
         K[0, j] = kx
         K[1, j] = ky
@@ -129,7 +129,7 @@ def base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out):
     ``out`` (3n + 3): q'' then (a_c (m/s^2), theta'' (rad/s^2)). O(n)."""
     n = c.shape[0]
     u = out[: 3 * n]
-    _full_solve(V, c, s, fp, fa, fb, u)
+    full_solve(V, c, s, fp, fa, fb, u)
     jx, jy = _first_moment_rate(V, c, s, delta, u[:n], u[n : 2 * n], u[2 * n :])
     rx, ry = _rho(V, th)
     px, py = -ry, rx  # rho_perp
@@ -197,7 +197,7 @@ def base_accel(V, y, has_load, SX, SY, damped, out):
     fp = np.empty(n)
     fa = np.empty(n)
     fb = np.empty(n)
-    _full_forces(V, _chain_state(y, n), c, s, has_load, SX, SY, damped, fp, fa, fb)
+    full_forces(V, _chain_state(y, n), c, s, has_load, SX, SY, damped, fp, fa, fb)
     shift = V[V_KAPPA, 0] * th + (V[V_NU, 0] * dth if damped else 0.0)
     fp[0] += shift  # hinge 0 measured from the body: D_0 - theta
     fa[0] += shift
@@ -235,7 +235,7 @@ def base_unit_responses(V, y, locks, U):
         fp[:] = 0.0
         fa[:] = 0.0
         fb[:] = 0.0
-        _unit_moment(locks[j], fp, fa, fb)
+        unit_moment(locks[j], fp, fa, fb)
         rb[2] = -1.0 if locks[j] == 0 else 0.0
         base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, U[j])
 

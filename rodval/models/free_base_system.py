@@ -16,7 +16,7 @@ from rodval.core.base import root_state
 from rodval.core.scene import Scene
 from rodval.models import free_base as fb
 from rodval.models.kernels import full_constants
-from rodval.models.paper_energy import _NO_LOADS, _NO_MATRICES
+from rodval.models.paper_energy import NO_LOADS, NO_MATRICES
 from rodval.models.paper_matrices import hinge_matrix
 from rodval.models.paper_system import StackedSystem
 
@@ -96,7 +96,7 @@ class FreeBaseSystem(StackedSystem):
 
     # ------------------------------------------------------------------ energies, momenta
     def kinetic_energy(self, t, y):
-        self.compiled_mechanics(0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech)
+        self.compiled_mechanics(0.0, y, self.V, self._flags, NO_MATRICES, NO_LOADS, self._mech)
         return float(self._mech[0])
 
     def energy_rows(self, times, Y):

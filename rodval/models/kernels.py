@@ -38,7 +38,7 @@ V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB = range(9)
 V_PA, V_PB, V_AP, V_BP, V_AA, V_AB, V_EPS, V_PI, V_RHO, V_TAU = range(9, 19)
 
 
-def _rows(cc, chain) -> list[np.ndarray]:
+def constant_rows(cc, chain) -> list[np.ndarray]:
     """The rows V_L .. V_CB shared by every kernel (and by reduced_banded's constants); V_KB
     = 4 EI/l (N m) and V_CB = 4 bending_damping/l (N m s), see paper_matrices.bending_blocks."""
     return [
@@ -67,7 +67,7 @@ def full_constants(cc, chain) -> np.ndarray:
         cc.pa_diag * (aa * cc.ap_diag - ab * cc.bp_diag)
         + cc.pb_diag * (aa * cc.bp_diag - ab * cc.ap_diag)
     ) / det
-    rows = _rows(cc, chain) + [
+    rows = constant_rows(cc, chain) + [
         cc.pa_diag,
         cc.pb_diag,
         cc.ap_diag,
@@ -83,7 +83,7 @@ def full_constants(cc, chain) -> np.ndarray:
 
 
 @njit(cache=True)
-def _hinge_forces(V, phi, alpha, beta, row, out_p, out_a, out_b):
+def hinge_forces(V, phi, alpha, beta, row, out_p, out_a, out_b):
     """out += A^T diag(V[row]) (A [phi; alpha; beta] - rest), O(n): hinge springs about
     their rest angles (row V_KAPPA) or dampers (row V_NU: no rest rate)."""
     n = phi.shape[0]
@@ -102,7 +102,7 @@ def _hinge_forces(V, phi, alpha, beta, row, out_p, out_a, out_b):
 
 
 @njit(cache=True)
-def _gpp_times(V, c, s, x, out):
+def gpp_times(V, c, s, x, out):
     """out -= G_pp x, G_pp[k,j] = l_k l_j M_max(k,j) s_kj, O(n)."""
     n = c.shape[0]
     l, outer = V[V_L], V[V_OUTER]
@@ -121,7 +121,7 @@ def _gpp_times(V, c, s, x, out):
 
 
 @njit(cache=True)
-def _upper_times(V, c, s, x, cos_part, out, sign):
+def upper_times(V, c, s, x, cos_part, out, sign):
     """out += sign * X x with X[k,j] = l_k w_j (c_kj if cos_part else s_kj) for k < j, O(n)."""
     n = c.shape[0]
     l, w = V[V_L], V[V_W]
@@ -137,8 +137,8 @@ def _upper_times(V, c, s, x, cos_part, out, sign):
 
 
 @njit(cache=True)
-def _upper_t_times(V, c, s, x, cos_part, out, sign):
-    """out += sign * X^T x for the X of ``_upper_times``, O(n)."""
+def upper_t_times(V, c, s, x, cos_part, out, sign):
+    """out += sign * X^T x for the X of ``upper_times``, O(n)."""
     n = c.shape[0]
     l, w = V[V_L], V[V_W]
     lc = 0.0
@@ -153,7 +153,7 @@ def _upper_t_times(V, c, s, x, cos_part, out, sign):
 
 
 @njit(cache=True)
-def _generator_solve(d, a, b, e, r, x):
+def generator_solve(d, a, b, e, r, x):
     """Solve S x = r for S = diag(d) + tril(a b^T, -1) + triu(b e^T, 1) (2-vectors a_k, b_k,
     e_k per row, (n, 2) arrays): S[k,j] = a_k . b_j (k > j), b_k . e_j (k < j); O(n)."""
     n = d.shape[0]
@@ -196,13 +196,13 @@ def _schur_solve(V, c, s, r, x):
     """Solve S x = r for the full model's Schur complement S = M_pp - M_pg M_gg^-1 M_gp in
     O(n): S = diag(d) + tril(a b^T) + triu(b e^T) with 2-vectors a_k, b_k, e_k per rod."""
     d, a, b, e = schur_generators(V, c, s)
-    _generator_solve(d, a, b, e, r, x)
+    generator_solve(d, a, b, e, r, x)
 
 
 @njit(cache=True)
 def schur_generators(V, c, s):
     """(d, a, b, e) of the Schur complement S = diag(d) + tril(a b^T) + triu(b e^T) (see
-    ``_generator_solve``) from the rows V_L, V_OUTER, V_W, V_PPDIAG, V_EPS .. V_TAU; O(n)."""
+    ``generator_solve``) from the rows V_L, V_OUTER, V_W, V_PPDIAG, V_EPS .. V_TAU; O(n)."""
     n = c.shape[0]
     l, outer, w = V[V_L], V[V_OUTER], V[V_W]
     eps, pi, rho, tau = V[V_EPS], V[V_PI], V[V_RHO], V[V_TAU]
@@ -233,7 +233,7 @@ def schur_generators(V, c, s):
 
 
 @njit(cache=True)
-def _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
+def full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
     """f = [Q; 0; 0] - h - C q' - K q + A^T kappa rest of the full model (N m) into fp, fa, fb
     (zeroed here), O(n). C q' (hinge dampers and the rods' bending damping) only when
     ``damped``."""
@@ -244,9 +244,9 @@ def _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
     fp[:] = 0.0
     fa[:] = 0.0
     fb[:] = 0.0
-    _hinge_forces(V, phi, alpha, beta, V_KAPPA, fp, fa, fb)
+    hinge_forces(V, phi, alpha, beta, V_KAPPA, fp, fa, fb)
     if damped:
-        _hinge_forces(V, dphi, dalpha, dbeta, V_NU, fp, fa, fb)
+        hinge_forces(V, dphi, dalpha, dbeta, V_NU, fp, fa, fb)
     kb, cb = V[V_KB], V[V_CB]
     for k in range(n):
         fa[k] += kb[k] * (alpha[k] + 0.5 * beta[k])
@@ -258,10 +258,10 @@ def _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
         fa[k] = -fa[k]
         fb[k] = -fb[k]
     w2 = dphi * dphi
-    _gpp_times(V, c, s, w2, fp)  # - G_pp phi'^2
-    _upper_times(V, c, s, dphi * (dalpha - dbeta), False, fp, -2.0)  # - 2 G_pa (...)
-    _upper_t_times(V, c, s, w2, False, fa, 1.0)  # - h_alpha = + G_pa^T w2
-    _upper_t_times(V, c, s, w2, False, fb, -1.0)
+    gpp_times(V, c, s, w2, fp)  # - G_pp phi'^2
+    upper_times(V, c, s, dphi * (dalpha - dbeta), False, fp, -2.0)  # - 2 G_pa (...)
+    upper_t_times(V, c, s, w2, False, fa, 1.0)  # - h_alpha = + G_pa^T w2
+    upper_t_times(V, c, s, w2, False, fb, -1.0)
     if has_load:
         load_moments(V, c, s, SX, SY, fp)
 
@@ -276,7 +276,7 @@ def load_moments(V, c, s, SX, SY, fp):
 
 
 @njit(cache=True)
-def _full_solve(V, c, s, fp, fa, fb, out):
+def full_solve(V, c, s, fp, fa, fb, out):
     """q'' = M(phi)^-1 [fp; fa; fb] (3n) into ``out``, O(n): the bending coordinates are
     eliminated per rod, the Schur complement is solved by ``_schur_solve``."""
     n = V.shape[1]
@@ -289,11 +289,11 @@ def _full_solve(V, c, s, fp, fa, fb, out):
         ga[k] = (aa[k] * fa[k] - ab[k] * fb[k]) / det
         gb[k] = (aa[k] * fb[k] - ab[k] * fa[k]) / det
     r = fp - V[V_PA] * ga - V[V_PB] * gb
-    _upper_times(V, c, s, ga - gb, True, r, -1.0)
+    upper_times(V, c, s, ga - gb, True, r, -1.0)
     xp = out[:n]
     _schur_solve(V, c, s, r, xp)
     ut = np.zeros(n)
-    _upper_t_times(V, c, s, xp, True, ut, 1.0)
+    upper_t_times(V, c, s, xp, True, ut, 1.0)
     for k in range(n):
         ra = fa[k] - ut[k] - V[V_AP, k] * xp[k]
         rb = fb[k] + ut[k] - V[V_BP, k] * xp[k]
@@ -313,8 +313,8 @@ def full_accel(V, y, has_load, SX, SY, damped, out):
     fp = np.empty(n)
     fa = np.empty(n)
     fb = np.empty(n)
-    _full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb)
-    _full_solve(V, c, s, fp, fa, fb, out)
+    full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb)
+    full_solve(V, c, s, fp, fa, fb, out)
 
 
 @njit(cache=True, inline="always")
@@ -354,7 +354,7 @@ def _mpp_quadratic(V, c, s, x):
 
 
 @njit(cache=True)
-def _load_power(V, c, s, dphi, L, t):
+def load_power(V, c, s, dphi, L, t):
     """P_ext = Q . phi' (W) with Q_k = l_k (c_k SY_k - s_k SX_k); 0 when no load acts."""
     n = c.shape[0]
     SX = np.empty(n)
@@ -369,7 +369,7 @@ def _load_power(V, c, s, dphi, L, t):
 
 
 @njit(cache=True)
-def _damper_power(V, S, dphi, dalpha, dbeta):
+def compiled_damper_power(V, S, dphi, dalpha, dbeta):
     """q'^T C q' = sum_k nu_k (dD_k/dt)^2 + sum_k cb_k (a'^2 + a' b' + b'^2) (W), dD_k/dt =
     phi'_k + alpha'_k - phi'_{k-1} - beta'_{k-1} (the hinge rates,
     ``rodval.core.scene.hinge_angles`` of the rates), cb = 4 bending_damping/l on the bending
@@ -399,15 +399,15 @@ def full_mechanics(t, y, P, S, M, L, out):
     c = np.cos(phi)
     s = np.sin(phi)
     u = np.zeros(n)
-    _upper_times(P, c, s, va - vb, True, u, 1.0)  # U (alpha' - beta')
+    upper_times(P, c, s, va - vb, True, u, 1.0)  # U (alpha' - beta')
     aa, ab = P[V_AA], P[V_AB]
     T = _mpp_quadratic(P, c, s, dphi)
     for k in range(n):
         T += 2.0 * dphi[k] * (u[k] + P[V_PA, k] * va[k] + P[V_PB, k] * vb[k])
         T += aa[k] * (va[k] * va[k] + vb[k] * vb[k]) + 2.0 * ab[k] * va[k] * vb[k]
     out[0] = 0.5 * T
-    out[1] = _load_power(P, c, s, dphi, L, t)
-    out[2] = _damper_power(P, S, dphi, va, vb)
+    out[1] = load_power(P, c, s, dphi, L, t)
+    out[2] = compiled_damper_power(P, S, dphi, va, vb)
 
 
 @njit(RHS_SIGNATURE, cache=True)
@@ -420,6 +420,6 @@ def reduced_mechanics(t, y, P, S, M, L, out):
     c = np.cos(phi)
     s = np.sin(phi)
     out[0] = 0.5 * _mpp_quadratic(P, c, s, dphi)
-    out[1] = _load_power(P, c, s, dphi, L, t)
+    out[1] = load_power(P, c, s, dphi, L, t)
     zero = np.zeros(n)
-    out[2] = _damper_power(P, S, dphi, zero, zero)
+    out[2] = compiled_damper_power(P, S, dphi, zero, zero)

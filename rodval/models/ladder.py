@@ -19,7 +19,7 @@ import numpy as np
 
 from rodval.core.scene import Chain, Scene
 from rodval.models import deployment
-from rodval.models.kernels import V_CB, V_EPS, V_KB, V_PI, V_RHO, V_TAU, V_W, _rows
+from rodval.models.kernels import V_CB, V_EPS, V_KB, V_PI, V_RHO, V_TAU, V_W, constant_rows
 from rodval.models.ladder_kernels import (
     BLOCK_A,
     BLOCK_B,
@@ -68,7 +68,7 @@ def ladder_constants(chain: Chain, p: int, exact: bool) -> np.ndarray:
     sh = shapes_of(chain, p)
     Pinv = np.linalg.inv(sh.P)
     Pinv = 0.5 * (Pinv + np.swapaxes(Pinv, 1, 2))
-    rows = _rows(chain_constants(chain), chain)
+    rows = constant_rows(chain_constants(chain), chain)
     rows[V_W] = np.ones(n)
     rows[V_KB] = np.zeros(n)
     rows[V_CB] = np.zeros(n)

@@ -13,7 +13,7 @@ N = n (p + 2) coordinates. docs/model.md ("The model ladder") derives every term
   eliminated, leaving the Schur complement of the paper's model with per-rod constants
   a^T P^-1 a, b^T P^-1 a, b^T P^-1 b and, with exact kinematics, its diagonal raised by
   g^T P g and its generators by the rods' bending first moments a . g (the rank-2
-  semiseparable form is kept): ``kernels._generator_solve``, O(n p^2).
+  semiseparable form is kept): ``kernels.generator_solve``, O(n p^2).
 
 The rows of V: the paper model's rows V_L .. V_TAU (``kernels``; V_W = 1, V_KB = V_CB = 0:
 the shapes' own blocks carry the bending), then the ``LV_*`` rows below and the per-rod shape
@@ -25,20 +25,20 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.models.deployment import _unit_moment, locked_head, superpose
+from rodval.models.deployment import locked_head, superpose, unit_moment
 from rodval.models.kernels import (
     V_KAPPA,
     V_L,
     V_NU,
-    _damper_power,
-    _generator_solve,
-    _hinge_forces,
-    _load_power,
-    _upper_t_times,
-    _upper_times,
+    compiled_damper_power,
+    generator_solve,
+    hinge_forces,
     load_moments,
+    load_power,
     rhs_head,
     schur_generators,
+    upper_t_times,
+    upper_times,
 )
 from rodval.solvers.signature import RHS_SIGNATURE
 
@@ -154,9 +154,9 @@ def ladder_forces(V, y, c, s, A, Pg, has_load, SX, SY, damped, fp, fg):
     dg = v[n:].reshape((P1, n))
     fp[:] = 0.0
     fg[:] = 0.0
-    _hinge_forces(V, q[:n], g[0], g[1], V_KAPPA, fp, fg[0], fg[1])
+    hinge_forces(V, q[:n], g[0], g[1], V_KAPPA, fp, fg[0], fg[1])
     if damped:
-        _hinge_forces(V, v[:n], dg[0], dg[1], V_NU, fp, fg[0], fg[1])
+        hinge_forces(V, v[:n], dg[0], dg[1], V_NU, fp, fg[0], fg[1])
     for k in range(n):
         _block_times(V, P1, BLOCK_K, k, g, fg, 1.0)
         if damped:
@@ -184,7 +184,7 @@ def ladder_solve(V, A, Pg, g, c, s, fp, fg, out):
         _block_times(V, P1, BLOCK_PINV, k, fg, G, 1.0)
         aG[k] = _dot(V, P1, BLOCK_A, k, G)
         r[k] -= _dot(V, P1, BLOCK_B, k, G)
-    _upper_times(V, c, s, aG, True, r, -1.0)  # V_W = 1: sum_{j>k} l_k c_kj a_j . G_j
+    upper_times(V, c, s, aG, True, r, -1.0)  # V_W = 1: sum_{j>k} l_k c_kj a_j . G_j
     d, a, b, e = schur_generators(V, c, s)
     if V[LV_EXACT, 0] != 0.0:
         for k in range(n):
@@ -195,9 +195,9 @@ def ladder_solve(V, A, Pg, g, c, s, fp, fg, out):
             e[k, 0] -= A[k] * s[k]
             e[k, 1] += A[k] * c[k]
     xp = out[:n]
-    _generator_solve(d, a, b, e, r, xp)
+    generator_solve(d, a, b, e, r, xp)
     ut = np.zeros(n)
-    _upper_t_times(V, c, s, xp, True, ut, 1.0)  # sum_{j<k} l_j c_kj x_j
+    upper_t_times(V, c, s, xp, True, ut, 1.0)  # sum_{j<k} l_j c_kj x_j
     rg = np.empty((P1, n))
     for k in range(n):
         for i in range(P1):
@@ -247,7 +247,7 @@ def ladder_unit_responses(V, q, locks, U):
     for j in range(locks.shape[0]):
         fp[:] = 0.0
         fg[:] = 0.0
-        _unit_moment(locks[j], fp, fg[0], fg[1])
+        unit_moment(locks[j], fp, fg[0], fg[1])
         ladder_solve(V, A, Pg, g, c, s, fp, fg, U[j])
 
 
@@ -325,7 +325,7 @@ def ladder_damper_power(V, S, y):
     P1 = _shape_count(V)
     v = y[y.shape[0] // 2 :]
     dg = v[n:].reshape((P1, n))
-    power = _damper_power(V, S, v[:n], dg[0], dg[1])  # V_CB = 0: the hinges only
+    power = compiled_damper_power(V, S, v[:n], dg[0], dg[1])  # V_CB = 0: the hinges only
     if S[0] != 0.0:
         for k in range(n):
             power += _quadratic(V, P1, BLOCK_C, k, dg, dg)
@@ -340,5 +340,5 @@ def ladder_mechanics(t, y, P, S, M, L, out):
     n = P.shape[1]
     phi, v = y[:n], y[y.shape[0] // 2 :]
     out[0] = ladder_kinetic(P, y)
-    out[1] = _load_power(P, np.cos(phi), np.sin(phi), v[:n], L, t)
+    out[1] = load_power(P, np.cos(phi), np.sin(phi), v[:n], L, t)
     out[2] = ladder_damper_power(P, S, y)

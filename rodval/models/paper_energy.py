@@ -21,8 +21,8 @@ from rodval.models.paper_matrices import (
 )
 
 #: Placeholders for the compiled forms' unused arrays (no dense matrices, no loads).
-_NO_MATRICES = np.zeros((0, 0, 0))
-_NO_LOADS = np.zeros((0, len(LOAD_COLUMNS)))
+NO_MATRICES = np.zeros((0, 0, 0))
+NO_LOADS = np.zeros((0, len(LOAD_COLUMNS)))
 
 
 class PaperEnergy:
@@ -76,9 +76,7 @@ class PaperEnergy:
                 if self.full
                 else np.concatenate([phi, v[:n]])
             )
-            self.compiled_mechanics(
-                0.0, y, self.V, self._flags, _NO_MATRICES, _NO_LOADS, self._mech
-            )
+            self.compiled_mechanics(0.0, y, self.V, self._flags, NO_MATRICES, NO_LOADS, self._mech)
             return float(self._mech[0])
         return 0.5 * float(v @ assemble_mass(self.cc_kinetic, angle_differences(phi)[0]) @ v)
 

@@ -16,7 +16,7 @@ from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
 from rodval.models import deployment
 from rodval.models.lock_records import energy_parts, lock_record, plastic_jump, window_terms
-from rodval.models.paper_energy import _NO_MATRICES, PaperEnergy
+from rodval.models.paper_energy import NO_MATRICES, PaperEnergy
 from rodval.models.paper_matrices import (
     DEFAULT_VARIANT,
     VARIANTS,
@@ -186,7 +186,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
 
     def compiled_scratch(self) -> np.ndarray:
         """The compiled form's M: work space its right-hand side reuses (none by default)."""
-        return _NO_MATRICES
+        return NO_MATRICES
 
     def generalized_force(self, t: float, phi: np.ndarray) -> np.ndarray | None:
         """Q(phi, t) (N m) on the phi coordinates, or None when no load acts at t."""

@@ -39,10 +39,11 @@ from rodval.models.kernels import (
 
 # Rows of Cst: the first rows are laid out like kernels.V (so that the kernels' O(n) helpers
 # read them), then the bending-row diagonals and the equilibration scales.
-_BASE = max(V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB) + 1
-C_AP, C_BP = _BASE, _BASE + 1
+#: number of Cst's leading rows laid out like kernels.V (rows 0 .. N_V_ROWS - 1)
+N_V_ROWS = max(V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB) + 1
+C_AP, C_BP = N_V_ROWS, N_V_ROWS + 1
 #: first of 7 rows of row scales (one per local equation) and of 7 rows of column scales
-C_RSCALE = _BASE + 2
+C_RSCALE = N_V_ROWS + 2
 C_CSCALE = C_RSCALE + 7
 N_CST = C_CSCALE + 7
 
@@ -186,7 +187,7 @@ def _eliminate(A, b, j, U):
 
 
 @njit(cache=True)
-def _solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
+def solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
     """The banded LU with partial pivoting (module docstring) of the 7n x 7n system. U (7n x
     11), b (7n + 10), A (RING x W): work storage. False if a pivot column is exactly zero."""
     n = c.shape[0]
@@ -231,12 +232,14 @@ def _solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
 #: operation takes a ~100-cycle microcode assist (5x slower runs at n = 8192,
 #: benchmarks/subnormal_cost.py).
 @njit(cache=True)
-def _band_size(n):
+def band_size(n):
+    """Length (float64 entries) of the banded LU's work storage for n rods: U (7n x (KL + KU +
+    1)), b (7n + KL + KU) and the ring A (RING x W), as ``solve_band`` takes them."""
     return NB * n * (KL + KU + 1) + NB * n + KL + KU + RING * W
 
 
 @njit(cache=True)
-def _magnitudes(Cst):
+def band_magnitudes(Cst):
     """Angle-independent coefficient magnitudes |A| of the banded matrix (c = s = 1,
     unit scales), in band storage."""
     n = Cst.shape[1]
@@ -248,7 +251,7 @@ def _magnitudes(Cst):
 
 
 @njit(cache=True)
-def _ruiz(T, rs, cs, sweeps):
+def ruiz_equilibrate(T, rs, cs, sweeps):
     """Ruiz equilibration of the band magnitudes T (modified in place): after the sweeps
     every row and column of diag(rs) |A| diag(cs) has its largest entry close to 1."""
     N = T.shape[0]

@@ -67,15 +67,14 @@ from rodval.models.kernels import (
     V_OUTER,
     V_PPDIAG,
     V_W,
-    _gpp_times,
-    _hinge_forces,
-    _rows,
-    _upper_t_times,
+    constant_rows,
+    gpp_times,
+    hinge_forces,
     rhs_head,
+    upper_t_times,
 )
 from rodval.models.paper_matrices import DEFAULT_VARIANT, chain_constants
 from rodval.models.reduced_band_lu import (
-    _BASE,
     C_AP,
     C_BP,
     C_CSCALE,
@@ -83,19 +82,20 @@ from rodval.models.reduced_band_lu import (
     KL,
     KU,
     N_CST,
+    N_V_ROWS,
     NB,
     RING,
     W,
-    _band_size,
-    _magnitudes,
-    _ruiz,
-    _solve_band,
+    band_magnitudes,
+    band_size,
+    ruiz_equilibrate,
+    solve_band,
 )
 from rodval.solvers.signature import RHS_SIGNATURE
 
 
 @njit(cache=True)
-def _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec):
+def reduced_forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec):
     """Right-hand sides (N m) into vec (scratch of 5n): vec[:n] = r_p = Q - G_pp phi'^2
     - C_pp phi' - K_pp phi, vec[n:2n] = r_alpha, vec[2n:3n] = r_beta, with
     r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi) (C only when ``damped``)."""
@@ -108,16 +108,16 @@ def _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec):
     w2 = vec[4 * n : 5 * n]
     for k in range(n):
         w2[k] = dphi[k] * dphi[k]
-    _hinge_forces(Cst, phi, zero, zero, V_KAPPA, fp, fa, fb)  # K_qp phi
+    hinge_forces(Cst, phi, zero, zero, V_KAPPA, fp, fa, fb)  # K_qp phi
     if damped:
-        _hinge_forces(Cst, dphi, zero, zero, V_NU, fp, fa, fb)  # C_qp phi'
+        hinge_forces(Cst, dphi, zero, zero, V_NU, fp, fa, fb)  # C_qp phi'
     for k in range(n):
         fp[k] = -fp[k]
         fa[k] = -fa[k]
         fb[k] = -fb[k]
-    _gpp_times(Cst, c, s, w2, fp)  # - G_pp phi'^2
-    _upper_t_times(Cst, c, s, w2, False, fa, 1.0)  # - G_ap phi'^2 = + G_pa^T phi'^2
-    _upper_t_times(Cst, c, s, w2, False, fb, -1.0)  # - G_bp phi'^2 = - G_pa^T phi'^2
+    gpp_times(Cst, c, s, w2, fp)  # - G_pp phi'^2
+    upper_t_times(Cst, c, s, w2, False, fa, 1.0)  # - G_ap phi'^2 = + G_pa^T phi'^2
+    upper_t_times(Cst, c, s, w2, False, fb, -1.0)  # - G_bp phi'^2 = - G_pa^T phi'^2
     if has_load:
         l = Cst[V_L]
         for k in range(n):
@@ -252,7 +252,7 @@ def _root_to_tip(Cst, c, s, T, ddphi_out, gamma_out):
 
 
 @njit(cache=True)
-def _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
+def solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
     """The tip-to-root elimination (module docstring, "sweep"), then root to tip. T (n x 3 x
     4): work storage for u_k = T_k[:, :3] z_k + T_k[:, 3]. False if a local pivot is zero or
     a result is not finite. O(n): ~250 flops per rod."""
@@ -292,7 +292,7 @@ def work_size(n):
     """Length of a float64 work array of ``reduced_solve_work`` that serves every method for
     n rods: 7n scratch, then the larger of the sweep's T (12n) and the banded LU's U
     (7n x 11), right-hand side (7n + 10) and ring of active rows."""
-    return 7 * n + max(12 * n, _band_size(n))
+    return 7 * n + max(12 * n, band_size(n))
 
 
 @njit(cache=True)
@@ -319,24 +319,24 @@ def reduced_solve_work(
         c[k] = np.cos(phi[k])
         s[k] = np.sin(phi[k])
     vec = work[2 * n : 7 * n]
-    _forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
+    reduced_forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
     fp, fa, fb = vec[:n], vec[n : 2 * n], vec[2 * n : 3 * n]
     rest = work[7 * n :]
     if method != METHOD_BAND:
         T = rest[: 12 * n].reshape((n, 3, 4))
-        if _solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
+        if solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
             return True
         if method == METHOD_SWEEP:
             ddphi_out[:] = np.nan
             gamma_out[:] = np.nan
             return False
-    if rest.shape[0] < _band_size(n):
-        rest = np.empty(_band_size(n))
+    if rest.shape[0] < band_size(n):
+        rest = np.empty(band_size(n))
     o1 = N * (KL + KU + 1)
     o2 = o1 + N + KL + KU
     U = rest[:o1].reshape((N, KL + KU + 1))
     A = rest[o2 : o2 + RING * W].reshape((RING, W))
-    if _solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi_out, gamma_out):
+    if solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi_out, gamma_out):
         return True
     ddphi_out[:] = np.nan
     gamma_out[:] = np.nan
@@ -364,13 +364,13 @@ def banded_constants(cc, chain, variant: str = DEFAULT_VARIANT) -> np.ndarray:
     if cc is None:
         cc = chain_constants(chain, variant)
     Cst = np.zeros((N_CST, n))
-    Cst[:_BASE] = np.vstack(_rows(cc, chain))
+    Cst[:N_V_ROWS] = np.vstack(constant_rows(cc, chain))
     Cst[C_AP] = cc.ap_diag
     Cst[C_BP] = cc.bp_diag
     Cst[C_RSCALE:] = 1.0
     rs = np.ones(NB * n)
     cs = np.ones(NB * n)
-    _ruiz(_magnitudes(Cst), rs, cs, 20)
+    ruiz_equilibrate(band_magnitudes(Cst), rs, cs, 20)
 
     def pow2(v):
         return np.exp2(np.round(np.log2(v)))  # exact scaling: no rounding
