@@ -65,11 +65,15 @@ import numpy as np
 
 from reference_models.exudyn_audit import account
 from reference_models.exudyn_beam import positive
-from reference_models.exudyn_budget import EXUDYN_MAX_STEPS, RunBudget, check_plan, planned_steps
+from reference_models.exudyn_budget import RunBudget, check_plan
 from reference_models.exudyn_build import BuiltSystem, build, recorded_doubles
 from reference_models.exudyn_guard import Guard
 from reference_models.exudyn_latches import Latches
 from reference_models.exudyn_observe import momentum_audit, observe, stop_events
+from reference_models.exudyn_settings import (
+    newton_record,
+    simulation_settings,
+)
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
@@ -84,9 +88,6 @@ from rodval.core.validity import Check, momentum_point, step_resolution
 from rodval.solvers.audit import momentum_residual
 
 ELEMENTS = ("cable2d",)
-#: renew the Newton Jacobian every step of a scene with latches (True: the old way) instead of
-#: only in the step a latch's joint is switched on (``Latches.pre_step``)
-JAC_PER_STEP = True
 SOLVERS = ("generalized-alpha", "trapezoidal")
 
 #: Converged defaults, chosen by benchmarks/exudyn_convergence.py (docs/reference_model.md).
@@ -238,39 +239,13 @@ class ExudynModel(Model):
         return build(scene, self.elements, self.EA)
 
     def _settings(self, scene: Scene):
-        """exudyn's simulation settings of a run of ``scene``: ``planned_steps`` equal steps
-        over t_end, or only the first ``EXUDYN_MAX_STEPS`` of them (exudyn's largest count; a
-        budgeted run stops before it)."""
-        import exudyn as exu
-
-        t_end = scene.t_end
-        s = exu.SimulationSettings()
-        ti = s.timeIntegration
-        planned = planned_steps(t_end, self.step)
-        nsteps = min(planned, EXUDYN_MAX_STEPS)
-        ti.endTime = t_end * nsteps / planned if nsteps < planned else t_end
-        ti.numberOfSteps = nsteps
-        ti.initialStepSize = t_end / planned
-        ti.automaticStepSize = False
-        ti.adaptiveStep = True
-        ti.minimumStepSize = ti.initialStepSize / 64.0  # fail fast instead of crawling
-        ti.verboseMode = 0
-        ti.verboseModeFile = 0
-        ti.newton.relativeTolerance = self.newton_rtol
-        ti.newton.absoluteTolerance = self.newton_atol_per_EA * self.EA
-        ti.newton.modifiedNewtonJacUpdatePerStep = bool(scene.latches) and JAC_PER_STEP
-        ti.generalizedAlpha.spectralRadius = self.spectral_radius_for(scene)
-        # with bending damping, generalized-alpha's step from computed initial accelerations
-        # kicks the overdamped element-scale modes by 5-45 J on a stowed wing (docs/deployment.md,
-        # "exudyn's start-up with bending damping"); it starts from a = 0 there instead
-        ti.generalizedAlpha.computeInitialAccelerations = not initial_kick(scene)
-        s.solution.file.write = False
-        s.solution.sensors.writePeriod = 0.25 * t_end / planned
-        s.show.statistics = False
-        s.show.computationTime = False
-        s.show.globalTimers = False
-        s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-        return s
+        """exudyn's simulation settings of a run of ``scene`` (``simulation_settings``)."""
+        return simulation_settings(
+            scene,
+            self.step,
+            (self.newton_rtol, self.newton_atol_per_EA * self.EA),
+            self.spectral_radius_for(scene),
+        )
 
     # -- run -----------------------------------------------------------------------------------
     @staticmethod
@@ -368,7 +343,7 @@ class ExudynModel(Model):
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         run_info.update(
             step_used=float(sim.timeIntegration.initialStepSize),
-            **_newton_record(sim, bool(scene.latches)),
+            **newton_record(sim, bool(scene.latches)),
         )
         latches = Latches(built, guard, scene, self.elements) if scene.latches else None
         self._solve(scene, built, sim, (guard, latches, budget), stats)
@@ -565,34 +540,6 @@ def _lock_records(latches: Latches | None) -> tuple[list[dict], dict[int, float]
         pass
     events = sorted(latches.events, key=lambda ev: ev["t"])
     return events, dict(latches.lock_times.items())
-
-
-def initial_kick(scene: Scene) -> bool:
-    """Whether generalized-alpha's first step from computed initial accelerations would kick
-    the element-scale modes (any rod with bending damping): such a run starts from a = 0."""
-    return bool(scene.chain.bending_damping.any())
-
-
-def _newton_record(sim, latches: bool) -> dict[str, Any]:
-    """The Newton and linear-solver choices of a run, for ``trajectory.settings`` (chosen by
-    benchmarks/exudyn_speed.py and the measurements in docs/reference_model.md, "Speed")."""
-    newton = sim.timeIntegration.newton
-    per_step = bool(newton.modifiedNewtonJacUpdatePerStep)
-    return {
-        "initial_accelerations": bool(
-            sim.timeIntegration.generalizedAlpha.computeInitialAccelerations
-        ),
-        "linear_solver": str(sim.linearSolver.solverType).split(".")[-1],
-        "newton": "modified" if newton.useModifiedNewton else "full",
-        "newton_atol": float(newton.absoluteTolerance),
-        "newton_rtol": float(newton.relativeTolerance),
-        "jacobian_update": (
-            "every step"
-            if per_step
-            else f"when the contraction exceeds {newton.modifiedNewtonContractivity:g}"
-            + (" and in the step a latch switches on" if latches else "")
-        ),
-    }
 
 
 def _unknown_options_message(unknown: dict) -> str:
