@@ -43,10 +43,12 @@ RUN = textwrap.dedent(
 )
 
 
-def _run(root: Path) -> str:
+def _run(root: Path, code: str = RUN) -> str:
+    """``code`` run by a fresh Python with ``root`` (holding the package ``kernels``) and
+    rodval importable; its stdout."""
     env_path = f"{root}:{Path(rodval.__file__).resolve().parents[1]}"
     out = subprocess.run(
-        [sys.executable, "-c", RUN, str(root)],
+        [sys.executable, "-c", code, str(root)],
         capture_output=True,
         text=True,
         timeout=120,
@@ -75,8 +77,8 @@ def test_rodval_installs_it_for_its_own_kernels():
     closure = {
         p.relative_to(jit_cache.PACKAGE_ROOT).as_posix() for p in jit_cache.import_closure(kernels)
     }
-    # the full model's kernels reach the load kernels and the first-class signatures, not the CLI
-    assert {"models/kernels.py", "core/loads.py", "solvers/signature.py"} <= closure
+    # the full model's kernels reach the load kernels they call, not the CLI
+    assert {"models/kernels.py", "core/loads.py"} <= closure
     assert not any(p.startswith(("cli/", "report/", "study/")) for p in closure)
 
 
@@ -121,16 +123,7 @@ def test_an_edit_recompiles_only_the_kernels_that_reach_the_edited_file(tmp_path
         (pkg / name).write_text(text.format(a=1) if name == "a.py" else text)
 
     def run() -> dict:
-        env_path = f"{tmp_path}:{Path(rodval.__file__).resolve().parents[1]}"
-        out = subprocess.run(
-            [sys.executable, "-c", COUNT, str(tmp_path)],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            env={"PYTHONPATH": env_path, "OMP_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"},
-            check=True,
-        )
-        return json.loads(out.stdout)
+        return json.loads(_run(tmp_path, COUNT))
 
     first = run()
     assert first["values"] == [2, 6, 3, 7]

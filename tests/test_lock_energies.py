@@ -67,11 +67,13 @@ def test_the_reduced_lock_takes_the_rigid_loss_at_once_the_full_one_rings_it_dow
 def test_exudyn_lock_window_accounts_and_its_numerical_dissipation():
     """exudyn (2 elements per rod, spectral radius 0) on the same lock: it has no
     instantaneous loss; with h = 2.5e-5 s its window balance closes within 1 % of E
-    (measured +0.19 %: what the switched-on joint and generalized-alpha add or take, O(h^2))
+    (measured +0.37 %: what the switched-on joint and generalized-alpha add or take, O(h^2))
     and the ring left at the window's end is the damping law's within 5 % (measured 0.290);
-    with h = 1e-4 s (7 steps per ring period) the integrator itself takes out more than 5 %
-    of E in the window (measured 7.8 %), which the run reports as its numerical dissipation
-    and the validity verdict flags."""
+    with h = 2e-4 s (3.5 steps per ring period) the integrator itself takes out more than 5 %
+    of E in the window (measured 22 %), which the run reports as its numerical dissipation
+    and the validity verdict flags. (At 1e-4 s it took 7.8 % when exudyn started from
+    computed initial accelerations, the start-up kick leaving through this window; from
+    a = 0, the rule with bending damping, 0.7 %.)"""
     pytest.importorskip("exudyn")
     scene = stiff_damped_latch()
     fine = simulate(scene, "exudyn", elements=2, step=2.5e-5).events[0]
@@ -80,7 +82,7 @@ def test_exudyn_lock_window_accounts_and_its_numerical_dissipation():
     assert abs(fine["energy_residual_window_end"]) <= 1e-2 * E0
     assert vibration_left(fine) == pytest.approx(RING_LEFT, rel=0.05)
     audited = dataclasses.replace(scene, outputs=(*scene.outputs, "energy"))
-    coarse = simulate(audited, "exudyn", elements=2, step=1e-4)
+    coarse = simulate(audited, "exudyn", elements=2, step=2e-4)
     assert coarse.events[0]["energy_residual_window_end"] < -0.05 * E0
     assert coarse.settings["numerical_dissipation"] > 0.05 * E0
     broken = {c["assumption"] for c in coarse.stats.validity if not c["holds"]}

@@ -42,7 +42,6 @@ from rodval.models.reduced_banded import (
     solve_sweep,
     track_bending,
 )
-from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE
 
 #: Another armed latch locks together with the one whose crossing was located when its
 #: angle is within this distance (rad) of its latch angle at that time.
@@ -304,14 +303,14 @@ def locked_head(t, y, P, S, L, out):
     return SX, SY, has_load, locks, np.empty(locks.shape[0])
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def full_rhs_locked(t, y, P, S, M, L, out):
     """y' of the full model with the hinges of S held (``full_accel_locked``); O(n m)."""
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
     full_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * P.shape[1] :], lam)
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def reduced_rhs_locked(t, y, P, S, M, L, out):
     """y' of the reduced model with the hinges of S held at their angles
     (``reduced_solve_locked``); gamma and the largest |gamma| kept in the work space M[0, 0]
@@ -349,14 +348,14 @@ def hinge_events(phi, alpha, beta, E, out, attitude=0.0):
         out[i] = D - E[i, 1]
 
 
-@njit(EVENTS_SIGNATURE, cache=True)
+@njit(cache=True)
 def full_hinge_events(t, y, P, S, M, L, E, out):
     """The full model's latch and stop events: g = D_k - angle from the state's q; O(rows)."""
     n = P.shape[1]
     hinge_events(y[:n], y[n : 2 * n], y[2 * n : 3 * n], E, out)
 
 
-@njit(EVENTS_SIGNATURE, cache=True)
+@njit(cache=True)
 def reduced_hinge_events(t, y, P, S, M, L, E, out):
     """The reduced model's latch and stop events: g = D_k - angle with the quasi-static
     bending gamma of the current mode (one solve of the mode's right-hand side, which leaves

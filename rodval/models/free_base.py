@@ -43,7 +43,6 @@ from rodval.models.kernels import (
     full_solve,
     rhs_head,
 )
-from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE
 
 # Rows of V after the full model's (``kernels.full_constants``, rows 0..18), each the same
 # value in every column: the body's mass (kg), inertia (kg m^2), hinge offset (m, body frame)
@@ -253,7 +252,7 @@ def base_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
     superpose(out, U, locks, n, lam, 3 * n + 2)
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def base_rhs(t, y, P, S, M, L, out):
     """y' of the full model on a free base (compiled integrators' right-hand side)."""
     n = P.shape[1]
@@ -263,14 +262,14 @@ def base_rhs(t, y, P, S, M, L, out):
     base_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[3 * n + 3 :])
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def base_rhs_locked(t, y, P, S, M, L, out):
     """y' with the hinges of S held (``deployment.lock_scalars``); O(n m)."""
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
     base_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * P.shape[1] + 3 :], lam)
 
 
-@njit(EVENTS_SIGNATURE, cache=True)
+@njit(cache=True)
 def base_hinge_events(t, y, P, S, M, L, E, out):
     """Latch and stop events g = D_k - angle, hinge 0 from the body's attitude; O(rows)."""
     n = P.shape[1]
@@ -302,7 +301,7 @@ def momentum(V, y):
     return mb * vc[0] + mch * v0x + jx, mb * vc[1] + mch * v0y + jy
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def base_mechanics(t, y, P, S, M, L, out):
     """(T, P_ext, P_diss) into out[:3]: T (J) the whole system's kinetic energy (module
     docstring), P_ext = Q . phi' + F . v_0 (W), P_diss the dampers' power with hinge 0's rate

@@ -30,7 +30,6 @@ import numpy as np
 from numba import njit
 
 from rodval.core.loads import load_sums
-from rodval.solvers.signature import RHS_SIGNATURE
 
 # Rows of V (per-rod vectors). Shared by both models.
 V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB = range(9)
@@ -327,7 +326,7 @@ def rhs_head(t, y, L, SX, SY, out):
     return load_sums(L, t, SX, SY)
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def full_rhs(t, y, P, S, M, L, out):
     """y' of the full model (compiled integrators' right-hand side, loads from table L)."""
     n = P.shape[1]
@@ -388,7 +387,7 @@ def compiled_damper_power(V, S, dphi, dalpha, dbeta):
     return p
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def full_mechanics(t, y, P, S, M, L, out):
     """(T, P_ext, P_diss) of the full model into out[:3]: T = 1/2 q'^T M q' (J) with the
     kinematic (printed, symmetric) mass matrix, the load power (W) and the damper power
@@ -410,7 +409,7 @@ def full_mechanics(t, y, P, S, M, L, out):
     out[2] = compiled_damper_power(P, S, dphi, va, vb)
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def reduced_mechanics(t, y, P, S, M, L, out):
     """(T, P_ext, P_diss) of the reduced model into out[:3]: T = 1/2 phi'^T M_pp phi' (J; its
     bending rates are dropped, in its dampers too: P_diss = sum_k nu_k (phi'_k -

@@ -40,7 +40,6 @@ from rodval.models.kernels import (
     upper_t_times,
     upper_times,
 )
-from rodval.solvers.signature import RHS_SIGNATURE
 
 #: Rows after the paper model's 19: rod mass m l (kg), node mass mu (kg), the number of
 #: shapes p + 1 and the exact-kinematics flag (the same in every column).
@@ -265,7 +264,7 @@ def ladder_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
     superpose(out, U, locks, n, lam)
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def ladder_rhs(t, y, P, S, M, L, out):
     """y' of the ladder (compiled integrators' right-hand side, loads from table L)."""
     n = P.shape[1]
@@ -276,7 +275,7 @@ def ladder_rhs(t, y, P, S, M, L, out):
     ladder_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[half:])
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def ladder_rhs_locked(t, y, P, S, M, L, out):
     """y' of the ladder with the hinges of S held (``deployment.lock_scalars``)."""
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
@@ -332,7 +331,7 @@ def ladder_damper_power(V, S, y):
     return power
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def ladder_mechanics(t, y, P, S, M, L, out):
     """(T, P_ext, P_diss) of the ladder into out[:3]: ``ladder_kinetic`` (J), the load power
     (W) and the dampers' power: hinges sum nu (dD/dt)^2 plus the rods' g'^T C g' (W; 0 unless

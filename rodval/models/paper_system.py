@@ -30,6 +30,7 @@ from rodval.models.paper_matrices import (
     stiffness_matrix,
 )
 from rodval.solvers.ode_model import OdeModel
+from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE, first_class
 from rodval.solvers.system import CompiledForm, EventRecord, EventSpec, OdeSystem
 
 #: Right-hand-side implementations: "numba" (compiled, structured; default) or "numpy"
@@ -164,17 +165,19 @@ class PaperSystem(PaperEnergy, OdeSystem):
             return None
         rows = self.event_rows()
         locked = bool(self.locked)
+        rhs = self.compiled_rhs_locked if locked else self.compiled_rhs
         return CompiledForm(
-            self.compiled_rhs_locked if locked else self.compiled_rhs,
+            first_class(rhs, RHS_SIGNATURE),
             self.V,
             deployment.lock_scalars(self._flags[0], self._lock_h, self._lock_a)
             if locked
             else self._flags,
             self.compiled_scratch(),
             table,
-            mechanics=self.compiled_mechanics,
+            mechanics=first_class(self.compiled_mechanics, RHS_SIGNATURE),
             name=type(self).__name__,
-            events=self.compiled_events,
+            # no event rows: the integrators' own no_events, and this kernel is not compiled
+            events=first_class(self.compiled_events, EVENTS_SIGNATURE) if rows else None,
             E=np.array([[r.hinge, r.angle] for r in rows], float).reshape(-1, 2),
             directions=np.array([r.direction for r in rows], float),
         )

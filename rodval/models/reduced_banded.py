@@ -91,7 +91,6 @@ from rodval.models.reduced_band_lu import (
     ruiz_equilibrate,
     solve_band,
 )
-from rodval.solvers.signature import RHS_SIGNATURE
 
 
 @njit(cache=True)
@@ -429,7 +428,7 @@ def track_bending(gamma, seen):
     return seen
 
 
-@njit(RHS_SIGNATURE, cache=True)
+@njit(cache=True)
 def reduced_rhs(t, y, P, S, M, L, out):
     """y' of the reduced model (compiled integrators' right-hand side, loads from table L);
     O(n) time and memory per evaluation, no allocation: ``M[0, 0]`` is its work space

@@ -91,24 +91,14 @@ def acceptance_spec(
     for i, b in enumerate(raw):
         key = f".bound[{i}]"
         check_keys(b, BOUND_KEYS, where, path=f"acceptance{key}")
-        if b.get("model") not in others:
-            raise err(
-                f"{key}.model",
-                f"must be a model label other than the reference {reference!r} "
-                f"(one of {others}), got {b.get('model')!r}",
-            )
+        _check_model(b, key, others, reference, err)
         if b.get("quantity") not in quantities:
             raise err(
                 f"{key}.quantity",
                 f"must be a quantity the cases output ({', '.join(sorted(quantities))}), "
                 f"got {b.get('quantity')!r}",
             )
-        limits = {m: b[m] for m in BOUND_METRICS if m in b}
-        if not limits:
-            raise err(key, f"needs at least one of {', '.join(BOUND_METRICS)}")
-        for m, v in limits.items():
-            if isinstance(v, bool) or not isinstance(v, numbers.Real) or v <= 0 or not v < math.inf:
-                raise err(f"{key}.{m}", f"must be a finite number > 0, got {v!r}")
+        limits = _limits(b, key, BOUND_METRICS, err)
         bounds.append({"model": b["model"], "quantity": b["quantity"], **limits})
     events = _event_bounds(raw_events, others, reference, where, err)
     return {"valid": valid, "bounds": bounds, "events": events, **scalars}
@@ -123,17 +113,28 @@ def _event_bounds(
     for i, b in enumerate(raw):
         key = f".event[{i}]"
         check_keys(b, EVENT_KEYS, where, path=f"acceptance{key}")
-        if b.get("model") not in others:
-            raise err(
-                f"{key}.model",
-                f"must be a model label other than the reference {reference!r} "
-                f"(one of {others}), got {b.get('model')!r}",
-            )
-        limits = {m: b[m] for m in EVENT_METRICS if m in b}
-        if not limits:
-            raise err(key, f"needs at least one of {', '.join(EVENT_METRICS)}")
-        for m, v in limits.items():
-            if isinstance(v, bool) or not isinstance(v, numbers.Real) or v <= 0 or not v < math.inf:
-                raise err(f"{key}.{m}", f"must be a finite number > 0, got {v!r}")
+        _check_model(b, key, others, reference, err)
+        limits = _limits(b, key, EVENT_METRICS, err)
         events.append({"model": b["model"], **{m: float(v) for m, v in limits.items()}})
     return events
+
+
+def _check_model(b: dict[str, Any], key: str, others: list[str], reference: str, err: Any) -> None:
+    """The table's ``model`` must be a label other than the reference's."""
+    if b.get("model") not in others:
+        raise err(
+            f"{key}.model",
+            f"must be a model label other than the reference {reference!r} "
+            f"(one of {others}), got {b.get('model')!r}",
+        )
+
+
+def _limits(b: dict[str, Any], key: str, metrics: tuple[str, ...], err: Any) -> dict[str, Any]:
+    """The table's bounds among ``metrics``: at least one, each a finite number > 0."""
+    limits = {m: b[m] for m in metrics if m in b}
+    if not limits:
+        raise err(key, f"needs at least one of {', '.join(metrics)}")
+    for m, v in limits.items():
+        if isinstance(v, bool) or not isinstance(v, numbers.Real) or v <= 0 or not v < math.inf:
+            raise err(f"{key}.{m}", f"must be a finite number > 0, got {v!r}")
+    return limits
