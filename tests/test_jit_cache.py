@@ -132,3 +132,48 @@ def test_an_edit_recompiles_only_the_kernels_that_reach_the_edited_file(tmp_path
     second = run()
     assert second["values"] == [10, 6, 11, 7]
     assert second["compiled"] == {"a": 1, "b": 0, "use_a": 1, "use_b": 0}, second
+
+
+def _ast_imports(path: Path, root: Path) -> set[Path]:
+    """An independent reading of the rodval modules ``path`` imports: Python's own parser."""
+    import ast
+
+    here = path.relative_to(root).parts[:-1]
+    found = set()
+
+    def add(parts):
+        base = root.joinpath(*parts)
+        for cand in (base.with_suffix(".py"), base / "__init__.py") if parts else ():
+            if cand.is_file():
+                found.add(cand)
+                break
+
+    for node in ast.walk(ast.parse(path.read_bytes())):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name.split(".")[0] == root.name:
+                    add(tuple(a.name.split(".")[1:]))
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                target = here[: len(here) - node.level + 1] + tuple(filter(None, [node.module]))
+            elif (node.module or "").split(".")[0] == root.name:
+                target = tuple(node.module.split(".")[1:])
+            else:
+                continue
+            add(target)
+            for a in node.names:
+                add((*target, a.name))
+    found.discard(path)
+    return found
+
+
+def test_the_import_scanner_reads_every_module_as_pythons_parser_does():
+    """The cache key's dependencies come from a regular expression (fast at start-up); on
+    every rodval module it must find each rodval module Python's parser finds (a missed one
+    would let a kernel run a stale callee) and may only add ones named in strings."""
+    root = jit_cache.PACKAGE_ROOT
+    for path in sorted(root.rglob("*.py")):
+        path = path.resolve()
+        expected = _ast_imports(path, root)
+        found = set(jit_cache._imports(path, root))
+        assert expected <= found, (path, expected - found)
