@@ -81,3 +81,18 @@ def test_the_registry_is_the_only_list_of_model_names():
 )
 def test_the_name_list_check_finds_literals(source, count):
     assert len(_name_lists(ast.parse(source))) == count
+
+
+def test_no_private_name_is_imported_from_another_module():
+    """A module's private names stay in it (issue 41): a name another module imports is part
+    of its module's interface and has a public name. Names every import of a private name."""
+    private = [
+        f"{p.relative_to(ROOT)}: {node.module or '.'}.{alias.name}"
+        for p, tree in _trees()
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ImportFrom)
+        and (node.level or (node.module or "").split(".")[0] in PACKAGES)
+        for alias in node.names
+        if alias.name.startswith("_") and not alias.name.startswith("__")
+    ]
+    assert not private, f"private names imported from another module: {private}"
