@@ -73,8 +73,7 @@ def step_powers(scene: Scene, E: int, t_rec: np.ndarray, records: dict) -> tuple
     D0 = scene.initial_hinge_angles()
     for stop in scene.stops:
         k = stop.hinge
-        pen = recorded_hinge_angle(records, E, k, D0[k], t_rec.size) - stop.angle
-        inside = pen > 0 if stop.side == "upper" else pen < 0
+        inside = stop.acts(recorded_hinge_angle(records, E, k, D0[k], t_rec.size))
         p_diss += np.where(inside, stop.damping * dD[:, k] ** 2, 0.0)
     for k, w, _, dS, ddS, Q, V in beam_elements(chain, E, qv):
         c = chain.bending_damping[k]

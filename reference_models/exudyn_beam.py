@@ -222,8 +222,8 @@ def stop_law(side: str):
 def stop_moment(stop, D, dD):
     """The moment (N m, same sign as a hinge spring's kappa (D - rest)) of a limit stop at
     hinge angle(s) D (rad) and rate(s) dD (rad/s): zero on the free side."""
-    pen = np.asarray(D, float) - stop.angle
-    inside = pen > 0 if stop.side == "upper" else pen < 0
+    D = np.asarray(D, float)
+    pen, inside = D - stop.angle, stop.acts(D)
     return np.where(inside, stop.stiffness * pen + stop.damping * np.asarray(dD, float), 0.0)
 
 
@@ -307,8 +307,7 @@ def system_energies(
     hinge = 0.5 * np.sum(chain.kappa * (D - chain.rest_angle) ** 2, -1)
     for stop in scene.stops:
         pen = D[:, stop.hinge] - stop.angle
-        inside = pen > 0 if stop.side == "upper" else pen < 0
-        hinge += np.where(inside, 0.5 * stop.stiffness * pen**2, 0.0)
+        hinge += np.where(stop.acts(D[:, stop.hinge]), 0.5 * stop.stiffness * pen**2, 0.0)
     return kin, pot, hinge
 
 

@@ -47,7 +47,7 @@ from rodval.core.eigen import (
 )
 from rodval.core.loads import constant
 from rodval.core.modal import ABOUT, Equilibrium, Modes, normalize_shapes, static_loads
-from rodval.core.scene import InitialState, Scene, hinge_angles
+from rodval.core.scene import InitialState, Scene
 
 #: Elongation/displacement ratio above which an exudyn mode counts as axial.
 AXIAL_TOL = 1e-3
@@ -202,14 +202,9 @@ def _springs_loaded(scene: Scene) -> bool:
     state is no equilibrium, so modes "about equilibrium" need the static solve (before, only
     rest angles counted, and a folded wing relaxed at 0 was reported balanced as it was)."""
     ini = scene.initial.resolve(scene.n)
-    theta = scene.base.attitude if scene.base.free else None
-    D = hinge_angles(ini["phi"], ini["alpha"], ini["beta"], theta)
+    D = scene.initial_hinge_angles()
     chain = scene.chain
-    stops = [
-        st
-        for st in scene.stops
-        if (D[st.hinge] - st.angle > 0 if st.side == "upper" else D[st.hinge] - st.angle < 0)
-    ]
+    stops = any(st.acts(D[st.hinge]) for st in scene.stops)
     bent = np.any(ini["alpha"] != 0) or np.any(ini["beta"] != 0)
     return bool(np.any(chain.kappa * (D - chain.rest_angle) != 0) or stops or bent)
 

@@ -206,8 +206,8 @@ def stop_events(
     events = []
     for stop in scene.stops:
         k = stop.hinge
-        g = recorded_hinge_angle(records, E, k, D0[k], t_rec.size) - stop.angle
-        inside = g > 0 if stop.side == "upper" else g < 0
+        D = recorded_hinge_angle(records, E, k, D0[k], t_rec.size)
+        g, inside = D - stop.angle, stop.acts(D)
         for i in np.flatnonzero(inside[1:] != inside[:-1]):
             t = t_rec[i] + (t_rec[i + 1] - t_rec[i]) * g[i] / (g[i] - g[i + 1])
             if t >= lock_times.get(k, np.inf):

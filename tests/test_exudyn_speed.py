@@ -14,12 +14,16 @@ issue 39, the latch crossing test by numpy.roots per latch per step), by
 2e-4 s)."""
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from rodval import Chain, InitialState, Scene, paper_scene, simulate
-from rodval.core.hinges import Latch
+from rodval import paper_scene, simulate
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from exudyn_speed import latch3_scene  # noqa: E402
 
 pytestmark = pytest.mark.exudyn
 
@@ -34,23 +38,6 @@ PAPER_PHI_BEFORE = np.array(
 )
 #: lock times (s) of the latched 3-rod scene (benchmarks/exudyn_speed.latch3_scene), before
 LATCH3_LOCKS_BEFORE = {"latch hinge 2": 0.3178366319430856, "latch hinge 1": 0.6982280523396831}
-
-
-def latch3_scene() -> Scene:
-    """benchmarks/exudyn_speed.latch3_scene: 3 rods (l = 1.5 m, m = 3 kg/m, EI = 1e5 N m^2,
-    mu = 0.5 kg), hinge 0 free, hinges 1, 2 stowed at +-(pi - 0.05) unfolding on 50 N m/rad
-    springs, latches at 0 on hinges 1 and 2, 0.8 s."""
-    fold = math.pi - 0.05
-    chain = Chain.uniform(3, l=1.5, m=3.0, EI=1e5, mu=0.5, kappa=[0.0, 50.0, 50.0], nu=0.0)
-    return Scene(
-        chain=chain,
-        t_end=0.8,
-        times=np.linspace(0.0, 0.8, 81),
-        outputs=("phi",),
-        initial=InitialState(phi=[0.0, fold, 0.0]),
-        latches=(Latch(1, 0.0), Latch(2, 0.0)),
-        name="latch3",
-    )
 
 
 def _latches_module():

@@ -88,6 +88,11 @@ class Stop:
         bounded_number("stop stiffness (N m/rad)", self.stiffness, positive=True)
         bounded_number("stop damping (N m s/rad)", self.damping, positive=False)
 
+    def acts(self, D: Any) -> Any:
+        """Whether the stop acts at hinge angle(s) ``D`` (rad, a number or an array): D
+        beyond ``angle`` on its ``side``, strictly (the one definition every model uses)."""
+        return D > self.angle if self.side == "upper" else D < self.angle
+
 
 def check_acting_stops(chain: Any, stops: tuple[Stop, ...]) -> None:
     """An acting stop adds its stiffness to its hinge's kappa and its damping to nu: the sums

@@ -89,7 +89,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
             int(np.sign(la.angle - D0[la.hinge])) if la.direction is None else la.direction
             for la in self.latches
         )
-        self._initial_stops = tuple(self._beyond(st, D0[st.hinge]) for st in self.stops)
+        self._initial_stops = tuple(bool(st.acts(D0[st.hinge])) for st in self.stops)
         #: mode: which stops act, which latches are locked (in lock order)
         self.stop_active: tuple[bool, ...] = self._initial_stops
         self.locked: tuple[int, ...] = ()
@@ -298,10 +298,6 @@ class PaperSystem(PaperEnergy, OdeSystem):
         return out
 
     # ----------------------------------------------------------------- deployment: modes
-    @staticmethod
-    def _beyond(stop, D: float) -> bool:
-        return bool(D > stop.angle) if stop.side == "upper" else bool(D < stop.angle)
-
     def _apply_stops(self) -> None:
         """Rebuild the effective chain (and every constant derived from it) for the current
         stop activity: an acting stop adds its stiffness and damping to its hinge, the rest
