@@ -1,5 +1,7 @@
-"""The body the chain hangs from (``Scene.base``): a fixed pin (``"pinned"``, the default) or
-a free-floating rigid body (``"free"``: a spacecraft), docs/base.md.
+"""The body the chain hangs from (``Scene.base``): a fixed pin (``"pinned"``, the default), a
+free-floating rigid body (``"free"``: a spacecraft) or a body whose motion is prescribed
+(``"prescribed"``: a hub spun up by a motor; its position and attitude are laws of time,
+``Motion``), docs/base.md.
 
 Conventions (with ``rodval.core.scene``'s): the body's centre of mass is at ``position`` (m,
 global frame), its attitude theta (rad) is the angle of its body frame from the global x
@@ -19,11 +21,99 @@ import numpy as np
 
 from rodval.core.bounds import check_bounds
 from rodval.core.checks import check_choice, check_keys, check_number
+from rodval.core.loads import LAW_CONSTANT, LAW_HARMONIC, LAW_LINEAR, LAW_SPIN_UP, motion_at
 
-#: The kinds of base: a fixed pin at the origin, or a free rigid body.
-BASE_KINDS = ("pinned", "free")
+#: The kinds of base: a fixed pin at the origin, a free rigid body, a prescribed motion.
+BASE_KINDS = ("pinned", "free", "prescribed")
 #: Fields that describe a free body (a pinned base takes none of them).
 BODY_FIELDS = ("mass", "inertia", "hinge_offset", "position", "velocity", "attitude", "rate")
+#: The prescribed coordinates of a base's motion: its centre's x, y (m) and attitude (rad).
+MOTION_AXES = ("x", "y", "attitude")
+#: Motion laws -> (their parameters, law code): f(t) on t >= 0, twice differentiable.
+MOTION_LAWS: dict[str, tuple[tuple[str, ...], int]] = {
+    "constant": (("value",), LAW_CONSTANT),
+    "linear": (("value", "rate"), LAW_LINEAR),
+    "harmonic": (("amplitude", "omega", "phase"), LAW_HARMONIC),
+    "spin_up": (("rate", "time"), LAW_SPIN_UP),
+}
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A prescribed coordinate history f(t) of a base (m for x, y; rad for the attitude), twice
+    differentiable, with f' and f'' in closed form (``loads.law_motion``, the load laws'
+    formulas). ``law`` and its parameters (``MOTION_LAWS``):
+
+    * ``constant``: f = value;
+    * ``linear``: f = value + rate t;
+    * ``harmonic``: f = amplitude sin(omega t + phase) (omega > 0 in rad/s);
+    * ``spin_up``: Kane, Ryan and Banerjee's smooth spin-up to ``rate`` (per s) over ``time``
+      T (s): f = rate/T (t^2/2 + (T/2 pi)^2 (cos(2 pi t/T) - 1)) for t < T, rate (t - T/2)
+      after; f' and f'' are continuous (f'' = 0 at t = 0 and at T)."""
+
+    law: str = "constant"
+    params: tuple[float, ...] = (0.0,)
+
+    def __post_init__(self) -> None:
+        check_choice("motion law", self.law, tuple(MOTION_LAWS))
+        names = MOTION_LAWS[self.law][0]
+        if len(self.params) != len(names):
+            raise ValueError(
+                f"motion law {self.law!r} takes {len(names)} parameters "
+                f"({', '.join(names)}), got {len(self.params)}"
+            )
+        values = tuple(
+            check_number(f"motion {self.law} {name}", v, finite=True)
+            for name, v in zip(names, self.params)
+        )
+        for name in ("omega", "time"):
+            if name in names:
+                check_number(
+                    f"motion {self.law} {name}", values[names.index(name)], low=0.0, low_open=True
+                )
+        object.__setattr__(self, "params", values)
+
+    @classmethod
+    def from_dict(cls, d: Any, where: str) -> Motion:
+        """A Motion from a scene file's table ``{law = "spin_up", rate = 4.0, time = 15.0}``."""
+        if not isinstance(d, dict) or "law" not in d:
+            raise ValueError(f"{where}: a motion needs a 'law' (one of {', '.join(MOTION_LAWS)})")
+        law = d["law"]
+        check_choice(f"{where} law", law, tuple(MOTION_LAWS))
+        names = MOTION_LAWS[law][0]
+        check_keys(d, ("law", *names), where)
+        missing = [k for k in names if k not in d]
+        if missing:
+            raise ValueError(f"{where}: motion law {law!r} needs {', '.join(missing)}")
+        return cls(law, tuple(d[k] for k in names))
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"law": self.law, **dict(zip(MOTION_LAWS[self.law][0], self.params))}
+
+    def rows(self, axis: int) -> list[tuple[float, ...]]:
+        """The law's rows of a base-motion table (``loads.LOAD_COLUMNS``; component = the
+        axis 0, 1, 2 = x, y, attitude)."""
+        code = MOTION_LAWS[self.law][1]
+        p = self.params
+        if self.law == "spin_up":
+            rate, T = p
+            return [
+                (0, axis, code, 0.0, T, 0, rate, T, 0.0, 0),
+                (0, axis, LAW_LINEAR, T, np.inf, 1, 0.5 * rate * T, rate, 0.0, 0),
+            ]
+        padded = (*p, 0.0, 0.0, 0.0)[:3]
+        return [(0, axis, code, 0.0, np.inf, 1, *padded, 0)]
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        """Times (s) where f'' has a kink (the spin-up's end)."""
+        return (self.params[1],) if self.law == "spin_up" else ()
+
+
+def motion_table(motion: tuple[Motion, ...]) -> np.ndarray:
+    """The base-motion table (rows x ``LOAD_COLUMNS``) of the three axes' laws."""
+    rows = [r for axis, m in enumerate(motion) for r in m.rows(axis)]
+    return np.ascontiguousarray(np.array(rows, dtype=np.float64))
 
 
 def _vector(name: str, value: Any, unit: str) -> tuple[float, float]:
@@ -54,6 +144,8 @@ class Base:
     velocity: tuple[float, float] = (0.0, 0.0)
     attitude: float = 0.0
     rate: float = 0.0
+    #: a prescribed base's laws (x, y, attitude), ``Motion`` each (a dict of some on input)
+    motion: Any = None
 
     def __post_init__(self) -> None:
         check_choice("base kind", self.kind, BASE_KINDS)
@@ -66,6 +158,14 @@ class Base:
                     "node 0 fixed at the origin) takes none of " + ", ".join(BODY_FIELDS)
                 )
             return
+        if self.kind == "prescribed":
+            self._prescribe()
+            return
+        if self.motion is not None:
+            raise ValueError(
+                "base motion prescribes a body's motion; a free base (kind 'free') moves by "
+                "its equations (use kind 'prescribed')"
+            )
         for name in ("mass", "inertia"):
             value = getattr(self, name)
             if value is None:
@@ -81,6 +181,66 @@ class Base:
             check_bounds(f"base {name} ({unit})", np.array([v]), None)
             set_(self, name, v)
 
+    def _prescribe(self) -> None:
+        """Check a prescribed base: its motion laws (``Motion``, by axis) and hinge offset
+        only; the body's state at t = 0 comes from the laws."""
+        given = [n for n in BODY_FIELDS if n != "hinge_offset" and self._given(n)]
+        if given:
+            raise ValueError(
+                f"base {given[0]}: a prescribed base (kind 'prescribed') takes its position "
+                "and attitude from its motion laws (base.motion: x, y, attitude) and its "
+                "hinge_offset, none of " + ", ".join(b for b in BODY_FIELDS if b != "hinge_offset")
+            )
+        object.__setattr__(self, "hinge_offset", _vector("hinge_offset", self.hinge_offset, "m"))
+        laws = {} if self.motion is None else self.motion
+        if isinstance(laws, tuple) and len(laws) == 3 and all(isinstance(m, Motion) for m in laws):
+            return
+        if not isinstance(laws, dict):
+            raise ValueError(
+                f"base motion must map x, y, attitude to Motion laws, got {type(laws).__name__}"
+            )
+        check_keys(laws, MOTION_AXES, "base motion")
+        motion = []
+        for axis in MOTION_AXES:
+            law = laws.get(axis, Motion())
+            if isinstance(law, dict):
+                law = Motion.from_dict(law, f"base motion {axis}")
+            if not isinstance(law, Motion):
+                raise ValueError(
+                    f"base motion {axis} must be a rodval Motion, got {type(law).__name__}"
+                )
+            motion.append(law)
+        object.__setattr__(self, "motion", tuple(motion))
+
+    @property
+    def prescribed(self) -> bool:
+        return self.kind == "prescribed"
+
+    @property
+    def moving(self) -> bool:
+        """Whether node 0 moves (a free or a prescribed base)."""
+        return self.kind != "pinned"
+
+    def motion_table(self) -> np.ndarray:
+        """A prescribed base's law table (``motion_table``)."""
+        return motion_table(self.motion)
+
+    def state_at(self, t: float) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """A prescribed base's (r_c (m), v_c (m/s), theta (rad), theta' (rad/s)) at t."""
+        m = motion_at(self.motion_table(), t)
+        return m[:2, 0], m[:2, 1], float(m[2, 0]), float(m[2, 1])
+
+    def initial_attitude(self) -> float | None:
+        """The body's attitude at t = 0 (rad; None for a pin): hinge 0 is measured from it."""
+        if self.prescribed:
+            return self.state_at(0.0)[2]
+        return self.attitude if self.free else None
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        """Kinks of a prescribed motion's acceleration (s)."""
+        return tuple(b for m in (self.motion or ()) for b in m.breakpoints)
+
     def _given(self, name: str) -> bool:
         default = next(f.default for f in fields(self) if f.name == name)
         return getattr(self, name) != default
@@ -92,6 +252,8 @@ class Base:
     def initial_root(self) -> tuple[np.ndarray, np.ndarray]:
         """Node 0's position (m) and velocity (m/s) at t = 0, (2,) each (``root_state``); the
         origin at rest on a pinned base."""
+        if self.prescribed:
+            return root_state(self, *self.state_at(0.0))
         if not self.free:
             return np.zeros(2), np.zeros(2)
         return root_state(self, self.position, self.velocity, self.attitude, self.rate)
@@ -105,7 +267,7 @@ class Base:
     @classmethod
     def from_dict(cls, d: Any, where: str = "[base]") -> Base:
         """A Base from a scene file's ``[base]`` table (unknown keys refused)."""
-        check_keys(d, ("kind", *BODY_FIELDS), where)
+        check_keys(d, ("kind", *BODY_FIELDS, "motion"), where)
         try:
             values: dict[str, Any] = {
                 k: tuple(v) if isinstance(v, list) else v for k, v in d.items()
@@ -116,9 +278,16 @@ class Base:
 
     def as_dict(self) -> dict[str, Any]:
         """The scene-file form (``from_dict`` rebuilds the same base)."""
+        if self.prescribed:
+            return {
+                "kind": self.kind,
+                "hinge_offset": list(self.hinge_offset),
+                "motion": {a: m.as_dict() for a, m in zip(MOTION_AXES, self.motion)},
+            }
         return {
             f.name: list(v) if isinstance(v := getattr(self, f.name), tuple) else v
             for f in fields(self)
+            if f.name != "motion"
         }
 
 

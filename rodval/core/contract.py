@@ -64,10 +64,10 @@ class Model(ABC):
     def check_base(self, scene: Scene) -> None:
         """ValueError (before any work) unless this model, with its options, has the scene's
         kind of base (``rodval.core.base``); by default a pinned base only."""
-        if scene.base.free:
+        if scene.base.moving:
             raise ValueError(
-                f"model {self.name!r} has no free base (base kind 'free'); docs/base.md lists "
-                "the models that do"
+                f"model {self.name!r} has no {scene.base.kind} base (base kind "
+                f"{scene.base.kind!r}); docs/base.md lists the models that do"
             )
 
     def validity_checks(self, scene: Scene, trajectory: Trajectory) -> list[Check]:
@@ -127,9 +127,9 @@ class Model(ABC):
         )
         if cls.MODAL_ANALYSIS is None:
             raise ValueError(f"model {cls.name!r} has no modal analysis")
-        if scene.base.free:
+        if scene.base.moving:
             raise ValueError(
-                f"model {cls.name!r}: modes of a chain on a free base (the free spacecraft) are "
+                f"model {cls.name!r}: modes of a chain on a {scene.base.kind} base (the free spacecraft) are "
                 "not built yet (docs/base.md)"
             )
         module, function = cls.MODAL_ANALYSIS.split(":")

@@ -408,8 +408,11 @@ class Scene:
         check_acting_stops(self.chain, self.stops)
         if not isinstance(self.base, Base):
             raise ValueError(f"base must be a rodval.Base, got {type(self.base).__name__}")
-        if not self.base.free and self.wants("base"):
-            raise ValueError("output 'base' needs a free base (Base(kind='free', ...))")
+        if not self.base.moving and self.wants("base"):
+            raise ValueError(
+                "output 'base' needs a free or prescribed base (Base(kind='free', ...) or "
+                "Base(kind='prescribed', ...))"
+            )
         check_latches(self.latches, self.initial_hinge_angles())
 
     @property
@@ -419,13 +422,14 @@ class Scene:
     def initial_hinge_angles(self) -> np.ndarray:
         """D_k at t = 0 (rad), k = 0..n-1 (hinge 0 from the base's attitude)."""
         init = self.initial.resolve(self.n)
-        attitude = self.base.attitude if self.base.free else None
+        attitude = self.base.initial_attitude()
         return hinge_angles(init["phi"], init["alpha"], init["beta"], attitude)
 
     @property
     def breakpoints(self) -> np.ndarray:
         """Sorted load kinks strictly inside (0, t_end), where integration restarts."""
         bps = {b for f in self.loads for b in f.breakpoints if 0 < b < self.t_end}
+        bps |= {b for b in self.base.breakpoints if 0 < b < self.t_end}
         return np.array(sorted(bps))
 
     def with_(self, **changes) -> Scene:

@@ -362,7 +362,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "latches": [dataclasses.asdict(latch) for latch in scene.latches],
         "stops": [dataclasses.asdict(stop) for stop in scene.stops],
         # a free body only: a pinned scene's dict (and every record made of it) is unchanged
-        **({"base": scene.base.as_dict()} if scene.base.free else {}),
+        **({"base": scene.base.as_dict()} if scene.base.moving else {}),
     }
 
 

@@ -114,9 +114,10 @@ def energy_balance(
 def momentum_point(scene: Any) -> str | None:
     """The point about which the angular momentum of ``scene`` is conserved, or None: "centre
     of mass" on a free base, "root" (node 0) on a pinned chain whose hinge 0 has no spring,
-    damper, stop or latch; None with any load (their moments would have to be booked).
+    damper, stop or latch; None with any load (their moments would have to be booked) and on
+    a prescribed base.
     Latches and stops elsewhere are internal: the momentum is kept through their events."""
-    if scene.loads:
+    if scene.loads or scene.base.prescribed:  # a prescribed base drives the chain
         return None
     if scene.base.free:
         return MOMENTUM_POINTS[0]

@@ -10,6 +10,8 @@ outputs, which add the body's motion (``base``) and the whole system's momenta.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from rodval.core.base import root_state
@@ -17,65 +19,67 @@ from rodval.core.scene import Scene
 from rodval.models import free_base as fb
 from rodval.models.kernels import full_constants
 from rodval.models.paper_energy import NO_LOADS, NO_MATRICES
-from rodval.models.paper_matrices import hinge_matrix
 from rodval.models.paper_system import StackedSystem
 
 
-class FreeBaseSystem(StackedSystem):
-    """The full model (the paper's rung, printed coefficients, compiled kernel) on a free
-    base."""
+class FreeBody:
+    """What a free body adds to a stacked chain system (``StackedSystem``) whose chain has
+    ``Nc`` coordinates: the body's x_c, y_c, theta after them (N = Nc + 3), its initial state,
+    hinge 0 measured from theta, the whole system's energies and momenta, and the outputs.
+    Mixed in before the chain's system class (``FreeBaseSystem``: the paper's rung;
+    ``moving_base.LadderFreeSystem``: every ladder rung); ``momentum_kernel(V, y)`` gives P."""
 
-    accel_kernel = staticmethod(fb.base_accel)
-    locked_kernel = staticmethod(fb.base_accel_locked)
-    unit_kernel = staticmethod(fb.base_unit_responses)
-    compiled_rhs = staticmethod(fb.base_rhs)
-    compiled_mechanics = staticmethod(fb.base_mechanics)
-    compiled_rhs_locked = staticmethod(fb.base_rhs_locked)
-    compiled_events = staticmethod(fb.base_hinge_events)
+    Nc: int
+    N: int
+    momentum_kernel: Any
+    #: the chain system's (``StackedSystem``) attributes and methods used here
+    n: int
+    V: np.ndarray
+    scene: Scene
+    base_chain: Any
+    initial: dict
+    compiled_mechanics: Any
+    _flags: np.ndarray
+    _mech: np.ndarray
 
-    def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
-        super().__init__(scene, coefficients, kernel)
-        b, i = scene.base, self.initial
-        self.N = 3 * self.n + 3
-        self.body = b
-        self.body_mass, self.body_inertia = b.inertial()
+    def body_setup(self, scene: Scene) -> None:
+        """The body's constants (call before the chain system's kernel set-up); a prescribed
+        base is a massless body following its laws."""
+        b = self.body = scene.base
+        if b.prescribed:
+            self.body_mass, self.body_inertia = 0.0, 0.0
+            self.body_start = b.state_at(0.0)
+        else:
+            self.body_mass, self.body_inertia = b.inertial()
+            self.body_start = (np.array(b.position), np.array(b.velocity), b.attitude, b.rate)
         #: each rod's mass with its far node's (kg)
         self.rod_mass = self.base_chain.m * self.base_chain.l + self.base_chain.mu
-        self.y0 = np.concatenate(
-            [
-                i["phi"],
-                i["alpha"],
-                i["beta"],
-                b.position,
-                [b.attitude],
-                i["dphi"],
-                i["dalpha"],
-                i["dbeta"],
-                b.velocity,
-                [b.rate],
-            ]
-        )
-        self.use_kernel()
 
-    def kernel_constants(self) -> np.ndarray:
+    def body_rows(self) -> np.ndarray:
+        """The kernels' body rows (appended to the chain's V): body mass, inertia, hinge
+        offset, chain mass, each the same in every column."""
         h = self.body.hinge_offset
         rows = [self.body_mass, self.body_inertia, h[0], h[1], float(self.rod_mass.sum())]
-        V = full_constants(self.cc, self.chain)
-        return np.vstack([V, np.outer(rows, np.ones(self.n))])
+        return np.outer(rows, np.ones(self.n))
+
+    def with_body(self, y0: np.ndarray) -> np.ndarray:
+        """The state [q; x_c, y_c, theta; q'; rates] from the chain's [q; q']."""
+        (r, v, th, w), Nc = self.body_start, self.Nc
+        return np.concatenate([y0[:Nc], r, [th], y0[Nc:], v, [w]])
 
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
-        return self.difference_jacobian(t, y)
+        return self.difference_jacobian(t, y)  # type: ignore[attr-defined]
 
     def attitude(self, Y):
-        return Y[:, 3 * self.n + 2]
+        return Y[:, self.Nc + 2]
 
     def attitude_rate(self, Y):
-        return Y[:, self.N + 3 * self.n + 2]
+        return Y[:, self.N + self.Nc + 2]
 
     def body_states(self, Y) -> tuple[np.ndarray, np.ndarray]:
         """(r_c (m), v_c (m/s)) of the body's centre of mass, each (nt, 2)."""
-        n, N = self.n, self.N
-        return Y[:, 3 * n : 3 * n + 2], Y[:, N + 3 * n : N + 3 * n + 2]
+        Nc, N = self.Nc, self.N
+        return Y[:, Nc : Nc + 2], Y[:, N + Nc : N + Nc + 2]
 
     def root_states(self, Y) -> tuple[np.ndarray, np.ndarray]:
         """(r_0 (m), v_0 (m/s)) of node 0, each (nt, 2): r_c + rho, v_c + theta' k x rho."""
@@ -87,11 +91,11 @@ class FreeBaseSystem(StackedSystem):
 
     # ------------------------------------------------------------------ locks
     def hinge_rows(self, hinges) -> np.ndarray:
-        """Rows of D = A Q (3n + 3 columns): hinge 0 is measured from the body (-1 at theta)."""
+        """Rows of D = A Q (N columns): hinge 0 is measured from the body (-1 at theta)."""
         hinges = np.asarray(hinges, dtype=np.int64)
         A = np.zeros((hinges.size, self.N))
-        A[:, : 3 * self.n] = hinge_matrix(self.n)[hinges]
-        A[hinges == 0, 3 * self.n + 2] = -1.0
+        A[:, : self.Nc] = super().hinge_rows(hinges)  # type: ignore[misc]
+        A[hinges == 0, self.Nc + 2] = -1.0
         return A
 
     # ------------------------------------------------------------------ energies, momenta
@@ -101,26 +105,27 @@ class FreeBaseSystem(StackedSystem):
 
     def energy_rows(self, times, Y):
         kin = np.array([self.kinetic_energy(t, y) for t, y in zip(times, Y)])
-        phi = self.rigid(Y)[0]
-        alpha, beta = self.bending(times, Y)[:2]
-        return kin, self.potential(phi, alpha, beta, self.attitude(Y))
+        phi = self.rigid(Y)[0]  # type: ignore[attr-defined]
+        alpha, beta = self.bending(times, Y)[:2]  # type: ignore[attr-defined]
+        pot = self.potential(phi, alpha, beta, self.attitude(Y))  # type: ignore[attr-defined]
+        return kin, pot + self.bubble_energies(Y)  # type: ignore[attr-defined]
 
     def energy_budget(self, t, y):
-        return self._energy_in_mode(t, y)
+        return self._energy_in_mode(t, y)  # type: ignore[attr-defined]
 
     def rod_momenta_at(self, y):
         """The pinned chain's rod momenta (``PaperEnergy.rod_momenta_at``) with node 0 moving:
         p += m_k v_0, h (about the origin) += m_k r_0 x v_0 + r_0 x p + first x v_0, first +=
         m_k r_0 (m_k: rod k's mass with its far node's)."""
-        p, h, first = super().rod_momenta_at(y)
+        p, h, first = super().rod_momenta_at(y)  # type: ignore[misc]
         r0, v0 = self.root_motion(y)
         mass = self.rod_mass
-        h = h + mass * _cross(r0, v0) + _cross(r0, p) + _cross(first, v0)
+        h = h + mass * cross(r0, v0) + cross(r0, p) + cross(first, v0)
         return p + mass[:, None] * v0, h, first + mass[:, None] * r0
 
     def momentum_rows(self, Y) -> np.ndarray:
-        """The whole system's P (N s, (nt, 2)), ``free_base.momentum`` (kept exactly)."""
-        return np.array([fb.momentum(self.V, y) for y in Y])
+        """The whole system's P (N s, (nt, 2)), ``momentum_kernel`` (kept exactly)."""
+        return np.array([self.momentum_kernel(self.V, y) for y in Y])
 
     def angular_momentum_rows(self, times, Y):
         """[H about node 0, H about the system's centre of mass] (N m s, (nt, 2)), body
@@ -135,9 +140,9 @@ class FreeBaseSystem(StackedSystem):
         spin = self.body_inertia * self.attitude_rate(Y)
         for i, y in enumerate(Y):
             _, h, first = self.rod_momenta_at(y)
-            HO = spin[i] + mb * _cross(rc[i], vc[i]) + h.sum()
+            HO = spin[i] + mb * cross(rc[i], vc[i]) + h.sum()
             X = (mb * rc[i] + first.sum(axis=0)) / total
-            out[i] = HO - _cross(r0[i], P[i]), HO - _cross(X, P[i])
+            out[i] = HO - cross(r0[i], P[i]), HO - cross(X, P[i])
         return out
 
     def momentum_audit_rows(self, Y) -> tuple[np.ndarray, np.ndarray]:
@@ -154,13 +159,13 @@ class FreeBaseSystem(StackedSystem):
             p, h, first = self.rod_momenta_at(y)
             X = (mb * rc[i] + first.sum(axis=0)) / total
             rods = h - (X[0] * p[:, 1] - X[1] * p[:, 0])
-            body = spin[i] + mb * _cross(rc[i] - X, vc[i])
+            body = spin[i] + mb * cross(rc[i] - X, vc[i])
             H[i] = rods.sum() + body
             G[i] = np.abs(rods).sum() + abs(body)
         return H, G
 
     def _observe_rows(self, times, Y):
-        out = super()._observe_rows(times, Y)
+        out = super()._observe_rows(times, Y)  # type: ignore[misc]
         r0 = self.root_states(Y)[0]
         for key, axis in (("x", 0), ("y", 1)):
             if key in out:
@@ -176,6 +181,31 @@ class FreeBaseSystem(StackedSystem):
         return out
 
 
-def _cross(a: np.ndarray, b: np.ndarray):
+class FreeBaseSystem(FreeBody, StackedSystem):
+    """The full model (the paper's rung, printed coefficients, compiled kernel) on a free
+    base (``free_base``)."""
+
+    accel_kernel = staticmethod(fb.base_accel)
+    locked_kernel = staticmethod(fb.base_accel_locked)
+    unit_kernel = staticmethod(fb.base_unit_responses)
+    compiled_rhs = staticmethod(fb.base_rhs)
+    compiled_mechanics = staticmethod(fb.base_mechanics)
+    compiled_rhs_locked = staticmethod(fb.base_rhs_locked)
+    compiled_events = staticmethod(fb.base_hinge_events)
+    momentum_kernel = staticmethod(fb.momentum)
+
+    def __init__(self, scene: Scene, coefficients: str = "printed", kernel: str = "numba"):
+        super().__init__(scene, coefficients, kernel)
+        self.Nc = 3 * self.n
+        self.N = self.Nc + 3
+        self.body_setup(scene)
+        self.y0 = self.with_body(self.chain_initial_state())
+        self.use_kernel()
+
+    def kernel_constants(self) -> np.ndarray:
+        return np.vstack([full_constants(self.cc, self.chain), self.body_rows()])
+
+
+def cross(a: np.ndarray, b: np.ndarray):
     """a x b (z component) of 2-vectors along the last axis."""
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]

@@ -222,44 +222,43 @@ class FullModel(PaperModel):
             "atol"
         )
 
-    def momentum_fix(self, scene: Scene) -> str:
-        """As the energy balance's; on a free base, where the exact kinematics is not built
-        yet (docs/base.md), the exudyn model as well."""
-        if scene.base.free and self.kinematics == "first-order":
-            return (
-                'kinematics = "exact" once it is built on a free base (docs/base.md); today the '
-                "exudyn model (the first-order kinematics drops O(bending) terms of the kinetic "
-                "energy, and its angular momentum drifts)"
-            )
-        return self.energy_fix()
-
     def check_base(self, scene: Scene) -> None:
-        """A free base runs on the paper's rung with the printed coefficients and the compiled
-        kernel (``free_base``); other options are refused for it, naming the option."""
-        if not scene.base.free:
+        """A free or prescribed base runs on every rung with the printed coefficients and the
+        compiled kernel (``free_base``, ``chain_base``); other options are refused for it,
+        naming the option."""
+        if not scene.base.moving:
             return
         for option, value, needed in (
-            ("shapes", self.shapes, PAPER_RUNG[0]),
-            ("kinematics", self.kinematics, PAPER_RUNG[1]),
             ("coefficients", self.coefficients, "printed"),
             ("kernel", self.kernel, "numba"),
         ):
             if value != needed:
                 raise ValueError(
-                    f"full model on a free base (base kind 'free'): {option} must be "
-                    f"{needed!r} (the free base is built on the paper's rung, docs/base.md), "
+                    f"full model on a {scene.base.kind} base: {option} must be {needed!r} "
+                    f"(the moving bases are built on the compiled kernels, docs/base.md), "
                     f"got {value!r}"
                 )
 
     def system(self, scene: Scene) -> PaperSystem:
-        """The system of ``scene`` on this model's rung; the free base's and the ladder's
-        modules (and their compiled kernels) are imported only by a scene that uses them."""
-        if scene.base.free:
+        """The system of ``scene`` on this model's rung and base; the free base's, the moving
+        bases' and the ladder's modules (and their compiled kernels) are imported only by a
+        scene that uses them."""
+        paper = (self.shapes, self.kinematics) == PAPER_RUNG
+        if scene.base.moving:
             self.check_base(scene)
-            from rodval.models.free_base_system import FreeBaseSystem
+            if scene.base.free and paper:
+                from rodval.models.free_base_system import FreeBaseSystem
 
-            return FreeBaseSystem(scene)
-        if (self.shapes, self.kinematics) == PAPER_RUNG:
+                return FreeBaseSystem(scene)
+            from rodval.models import moving_base
+
+            kind = (
+                moving_base.LadderFreeSystem
+                if scene.base.free
+                else (moving_base.LadderPrescribedSystem)
+            )
+            return kind(scene, self.coefficients, self.kernel, self.shapes, self.kinematics)
+        if paper:
             return FullSystem(scene, self.coefficients, self.kernel)
         from rodval.models.ladder import LadderSystem
 

@@ -184,18 +184,34 @@ class LadderSystem(StackedSystem):
     compiled_rhs_locked = staticmethod(ladder_rhs_locked)
     compiled_events = staticmethod(deployment.full_hinge_events)  # D from [phi; alpha; beta]
 
+    #: coordinates after the chain's (a free body's x_c, y_c, theta: ``moving_base``)
+    body_coordinates = 0
+
     def __init__(self, scene: Scene, coefficients: str, kernel: str, shapes: int, kinematics: str):
         check_rung_options(coefficients, kernel)
         self.p = check_shapes(shapes)
         self.exact = check_kinematics(kinematics) == "exact"
         super().__init__(scene, coefficients, kernel)
-        n, i = self.n, self.initial
-        self.N = n * (self.p + 2)
-        bubbles = np.zeros(n * (self.p - 1))
-        self.y0 = np.concatenate(
+        self.Nc = self.n * (self.p + 2)
+        self.N = self.Nc + self.body_coordinates
+        self.setup_base(scene)
+        self.y0 = self.initial_state()
+        self.use_kernel()
+
+    def setup_base(self, scene: Scene) -> None:
+        """What a base adds before the kernels are set up (``moving_base``): nothing on a pin."""
+
+    def initial_state(self) -> np.ndarray:
+        """The state at t = 0: the chain's (``chain_initial_state``)."""
+        return self.chain_initial_state()
+
+    def chain_initial_state(self) -> np.ndarray:
+        """[q; q'] of the chain at t = 0: the paper's coordinates, the bubbles at rest."""
+        i = self.initial
+        bubbles = np.zeros(self.n * (self.p - 1))
+        return np.concatenate(
             [i["phi"], i["alpha"], i["beta"], bubbles, i["dphi"], i["dalpha"], i["dbeta"], bubbles]
         )
-        self.use_kernel()
 
     @cached_property
     def shapes(self) -> RodShapes:
@@ -206,8 +222,9 @@ class LadderSystem(StackedSystem):
 
     def _split(self, y: np.ndarray):
         """(phi, phi', g (p+1, n), g' (p+1, n)) of one state."""
-        n, N, P1 = self.n, self.N, self.p + 1
-        return y[:n], y[N : N + n], y[n:N].reshape(P1, n), y[N + n :].reshape(P1, n)
+        n, N, Nc, P1 = self.n, self.N, self.Nc, self.p + 1
+        g = y[n:Nc].reshape(P1, n)
+        return y[:n], y[N : N + n], g, y[N + n : N + Nc].reshape(P1, n)
 
     def hinge_rows(self, hinges) -> np.ndarray:
         return rung_hinge_matrix(self.n, self.p)[hinges]
@@ -226,11 +243,13 @@ class LadderSystem(StackedSystem):
         """K_ii (N m) of the bubbles i = 2..p, (p - 1, n)."""
         return np.einsum("kii->ik", self.shapes.K)[2:]
 
+    def bubble_energies(self, Y: np.ndarray) -> np.ndarray:
+        return np.array([self.bubble_energy(y) for y in Y])
+
     def energy_rows(self, times, Y):
         kin = np.array([self.kinetic_energy(t, y) for t, y in zip(times, Y)])
-        bubbles = np.array([self.bubble_energy(y) for y in Y])
         alpha, beta = self.bending(times, Y)[:2]
-        return kin, self.potential(self.rigid(Y)[0], alpha, beta) + bubbles
+        return kin, self.potential(self.rigid(Y)[0], alpha, beta) + self.bubble_energies(Y)
 
     def energy_budget(self, t, y):
         return float(sum(self.energy_rows(np.array([t]), y[None, :]))[0])

@@ -79,7 +79,7 @@ def _block_times(V, P1, block, k, x, out, sign):
 
 
 @njit(cache=True)
-def _dot(V, P1, block, k, x):
+def shape_dot(V, P1, block, k, x):
     """v_k . x[:, k] for a shape vector v (a or b) of rod k."""
     total = 0.0
     for i in range(P1):
@@ -97,7 +97,7 @@ def bending_sums(V, g):
     Pg = np.zeros((P1, n))
     if V[LV_EXACT, 0] != 0.0:
         for k in range(n):
-            A[k] = _dot(V, P1, BLOCK_A, k, g)
+            A[k] = shape_dot(V, P1, BLOCK_A, k, g)
             _block_times(V, P1, BLOCK_P, k, g, Pg, 1.0)
     return A, Pg
 
@@ -116,7 +116,7 @@ def _velocity_terms(V, c, s, phi_rate, dg, A, Pg, fp, fg):
     for k in range(n):
         w = phi_rate[k]
         h = 0.5 * ml[k] * l[k]  # int m s ds
-        Ad = _dot(V, P1, BLOCK_A, k, dg)
+        Ad = shape_dot(V, P1, BLOCK_A, k, dg)
         ur = c[k] * Ax + s[k] * Ay  # conj(z_k) A_{k-1}
         ui = c[k] * Ay - s[k] * Ax
         own = h * ui - A[k] * ur
@@ -181,8 +181,8 @@ def ladder_solve(V, A, Pg, g, c, s, fp, fg, out):
     aG = np.empty(n)
     for k in range(n):
         _block_times(V, P1, BLOCK_PINV, k, fg, G, 1.0)
-        aG[k] = _dot(V, P1, BLOCK_A, k, G)
-        r[k] -= _dot(V, P1, BLOCK_B, k, G)
+        aG[k] = shape_dot(V, P1, BLOCK_A, k, G)
+        r[k] -= shape_dot(V, P1, BLOCK_B, k, G)
     upper_times(V, c, s, aG, True, r, -1.0)  # V_W = 1: sum_{j>k} l_k c_kj a_j . G_j
     d, a, b, e = schur_generators(V, c, s)
     if V[LV_EXACT, 0] != 0.0:
@@ -212,7 +212,7 @@ def ladder_solve(V, A, Pg, g, c, s, fp, fg, out):
 
 
 @njit(cache=True)
-def _shape_count(V):
+def shape_count(V):
     return int(V[LV_P1, 0])
 
 
@@ -221,7 +221,7 @@ def ladder_accel(V, y, has_load, SX, SY, damped, out):
     """Accelerations q'' (N) of the ladder at y = [q; q'] into ``out``; SX, SY: the load
     suffix sums (N) when ``has_load``. O(n p^2) time, O(n p) memory."""
     n = V.shape[1]
-    P1 = _shape_count(V)
+    P1 = shape_count(V)
     c = np.cos(y[:n])
     s = np.sin(y[:n])
     g = y[n : n * (P1 + 1)].reshape((P1, n))
@@ -236,7 +236,7 @@ def ladder_accel(V, y, has_load, SX, SY, damped, out):
 def ladder_unit_responses(V, q, locks, U):
     """U[j] = M(q)^-1 a_{locks[j]} (N each), O(n p^2) per hinge."""
     n = V.shape[1]
-    P1 = _shape_count(V)
+    P1 = shape_count(V)
     c = np.cos(q[:n])
     s = np.sin(q[:n])
     g = q[n:].reshape((P1, n))
@@ -288,7 +288,7 @@ def ladder_kinetic(V, y):
     """T = 1/2 int |r'|^2 dm + 1/2 sum mu_k |v_k|^2 (J) of the ladder's velocity field
     (first-order kinematics: the terms in g dropped, as in its mass matrix); O(n p^2)."""
     n = V.shape[1]
-    P1 = _shape_count(V)
+    P1 = shape_count(V)
     N = n * (P1 + 1)
     q, v = y[:N], y[N:]
     g = q[n:].reshape((P1, n))
@@ -302,9 +302,9 @@ def ladder_kinetic(V, y):
         c = np.cos(q[k])
         s = np.sin(q[k])
         w = v[k]
-        Wr = w * 0.5 * ml[k] * l[k] + _dot(V, P1, BLOCK_A, k, dg)  # int m (s phi' + eta')
+        Wr = w * 0.5 * ml[k] * l[k] + shape_dot(V, P1, BLOCK_A, k, dg)  # int m (s phi' + eta')
         Wi = w * A[k]  # int m eta phi'
-        J = w * w * ml[k] * l[k] * l[k] / 3.0 + 2.0 * w * _dot(V, P1, BLOCK_B, k, dg)
+        J = w * w * ml[k] * l[k] * l[k] / 3.0 + 2.0 * w * shape_dot(V, P1, BLOCK_B, k, dg)
         J += _quadratic(V, P1, BLOCK_P, k, dg, dg)
         for i in range(P1):
             J += w * w * g[i, k] * Pg[i, k]  # phi'^2 g^T P g (exact kinematics)
@@ -321,7 +321,7 @@ def ladder_damper_power(V, S, y):
     """The dampers' power (W): the hinges' sum nu (dD/dt)^2 plus every rod's g'^T C g';
     0 unless S[0] (the damped flag). O(n p^2)."""
     n = V.shape[1]
-    P1 = _shape_count(V)
+    P1 = shape_count(V)
     v = y[y.shape[0] // 2 :]
     dg = v[n:].reshape((P1, n))
     power = compiled_damper_power(V, S, v[:n], dg[0], dg[1])  # V_CB = 0: the hinges only

@@ -107,10 +107,10 @@ def lock_record(
     angles = np.array([latches[j].angle for j in locked])
     phi, dphi = (a[0] for a in system.rigid(y[None, :]))
     k = latches[new[0]].hinge
-    # the rigid-panel yardstick is a pinned chain's: none on a free base (docs/base.md)
+    # the rigid-panel yardstick is a pinned chain's: none on a moving base (docs/base.md)
     rigid = (
         {}
-        if system.scene.base.free
+        if system.scene.base.moving
         else rigid_lock(system.base_chain, phi, dphi, hinges.tolist(), int(hinges[-len(new)]))
     )
     T0, hinge0, bending0 = energy_parts(system, t, y)

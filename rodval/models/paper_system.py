@@ -25,6 +25,7 @@ from rodval.models.paper_matrices import (
     damper_power,
     damping_matrix,
     generalized_forces,
+    hinge_matrix,
     node_positions,
     rest_forces,
     stiffness_matrix,
@@ -523,6 +524,20 @@ class StackedSystem(PaperSystem):
     N: int
     locked_kernel: Any
     unit_kernel: Any
+
+    def chain_initial_state(self) -> np.ndarray:
+        """The chain's [q; q'] at t = 0 from the scene's initial state: [phi; alpha; beta]
+        and their rates (a ladder rung adds its bubbles, at rest)."""
+        i = self.initial
+        return np.concatenate([i["phi"], i["alpha"], i["beta"], i["dphi"], i["dalpha"], i["dbeta"]])
+
+    def hinge_rows(self, hinges) -> np.ndarray:
+        """The rows a_k of the paper's hinge matrix (D = A q) of the given hinges."""
+        return hinge_matrix(self.n)[hinges]
+
+    def bubble_energies(self, Y: np.ndarray) -> np.ndarray:
+        """The bending energy (J) of the shapes beyond the paper's cubic, per state: none."""
+        return np.zeros(len(Y))
 
     def generalized_rates(self, y):
         return y[self.N :]

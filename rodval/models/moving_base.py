@@ -1,0 +1,130 @@
+"""Every ladder rung (shapes p, first-order or exact kinematics) on a moving base: a free body
+(``LadderFreeSystem``) or a prescribed motion (``LadderPrescribedSystem``), on the compiled
+kernels of ``chain_base`` (docs/base.md derives them). The paper's rung on a free body keeps its
+own kernels (``free_base_system.FreeBaseSystem``); on a prescribed base it runs here (the
+first rung of the ladder is the paper's model to 1e-13, docs/model.md).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rodval.core.loads import motion_at
+from rodval.core.scene import Scene
+from rodval.models import chain_base as cb
+from rodval.models.deployment import lock_scalars
+from rodval.models.free_base_system import FreeBody
+from rodval.models.ladder import LadderSystem, ladder_constants
+from rodval.models.paper_energy import NO_LOADS, NO_MATRICES
+
+
+class LadderFreeSystem(FreeBody, LadderSystem):
+    """A ladder rung on a free body: state [q; x_c, y_c, theta; q'; rates] (N = n (p + 2) + 3)."""
+
+    body_coordinates = 3
+    accel_kernel = staticmethod(cb.free_accel)
+    locked_kernel = staticmethod(cb.free_accel_locked)
+    unit_kernel = staticmethod(cb.free_unit_responses)
+    compiled_rhs = staticmethod(cb.free_rhs)
+    compiled_mechanics = staticmethod(cb.free_mechanics)
+    compiled_rhs_locked = staticmethod(cb.free_rhs_locked)
+    compiled_events = staticmethod(cb.free_hinge_events)
+    momentum_kernel = staticmethod(cb.free_momentum)
+
+    def setup_base(self, scene: Scene) -> None:
+        self.body_setup(scene)
+
+    def initial_state(self) -> np.ndarray:
+        return self.with_body(self.chain_initial_state())
+
+    def kernel_constants(self) -> np.ndarray:
+        return np.vstack([ladder_constants(self.chain, self.p, self.exact), self.body_rows()])
+
+    def damper_power_at(self, y: np.ndarray) -> float:
+        """The dampers' power (W) in the current mode, hinge 0's rate from the body's
+        (``chain_base.moving_mechanics``)."""
+        self.compiled_mechanics(0.0, y, self.V, self._flags, NO_MATRICES, NO_LOADS, self._mech)
+        return float(self._mech[2])
+
+
+class LadderPrescribedSystem(FreeBody, LadderSystem):
+    """A ladder rung whose base moves by prescribed laws (``rodval.core.base.Motion``): a free
+    body's state (N = n (p + 2) + 3) whose accelerations are the laws', which reach the kernels
+    as the compiled form's M[0]; a massless body, so the drive's power is booked as external."""
+
+    body_coordinates = 3
+    unit_kernel = staticmethod(cb.prescribed_unit_responses)
+    compiled_rhs = staticmethod(cb.prescribed_rhs)
+    compiled_mechanics = staticmethod(cb.prescribed_mechanics)
+    compiled_rhs_locked = staticmethod(cb.prescribed_rhs)  # it reads the held hinges from S
+    compiled_events = staticmethod(cb.free_hinge_events)
+    momentum_kernel = staticmethod(cb.free_momentum)
+
+    def setup_base(self, scene: Scene) -> None:
+        self.body_setup(scene)
+        self.motion = scene.base.motion_table()
+
+    def initial_state(self) -> np.ndarray:
+        return self.with_body(self.chain_initial_state())
+
+    def kernel_constants(self) -> np.ndarray:
+        return np.vstack([ladder_constants(self.chain, self.p, self.exact), self.body_rows()])
+
+    def compiled_scratch(self) -> np.ndarray:
+        return self.motion[None, :, :]
+
+    def _sums(self, t: float) -> tuple[bool, np.ndarray, np.ndarray]:
+        sums = self.loads.suffix_sums(t)
+        SX, SY = (self._no_load, self._no_load) if sums is None else sums
+        return sums is not None, SX, SY
+
+    def rhs(self, t, y):
+        out = np.empty_like(y)
+        half = y.size // 2
+        out[:half] = y[half:]
+        out[half:], self._lam = self.accel_locked(t, y)
+        return out
+
+    def accel_locked(self, t, y):
+        has, SX, SY = self._sums(t)
+        out = np.empty(self.N)
+        lam = np.empty(self._lock_h.size)
+        mo = motion_at(self.motion, t)
+        cb.prescribed_accel_locked(self.V, y, mo, has, SX, SY, self.damped, self._lock_h, out, lam)
+        return out, lam
+
+    def mode_flags(self) -> np.ndarray:
+        """The compiled S of the current mode (its held hinges)."""
+        return lock_scalars(self._flags[0], self._lock_h, self._lock_a)
+
+    def mechanics_at(self, t: float, y: np.ndarray) -> np.ndarray:
+        """(T (J), P_ext with the drive's power (W), P_diss (W)) at one state in the current
+        mode (``chain_base.prescribed_mechanics``)."""
+        out = np.zeros(3)
+        table = self._load_table
+        L = NO_LOADS if table is None else table
+        M = self.compiled_scratch()
+        cb.prescribed_mechanics(t, y, self.V, self.mode_flags(), M, L, out)
+        return out
+
+    def power(self, t, y):
+        with self._mode_at(t):
+            mech = self.mechanics_at(t, y)
+        return float(mech[1]), float(mech[2])
+
+    def drive_rows(self, times, Y) -> np.ndarray:
+        """[F_dx, F_dy (N), M_d (N m)] per output time: the base's force on the chain at node 0
+        and its moment about the body's centre, M_d = rho x F_d + m_1 (``chain_base.drive``),
+        each in the mode in effect there."""
+        out = np.empty((len(Y), 3))
+        table = self._load_table
+        L = NO_LOADS if table is None else table
+        r0 = self.root_states(Y)[0]
+        rc = self.body_states(Y)[0]
+        for i, (t, y) in enumerate(zip(times, Y)):
+            with self._mode_at(t):
+                mo = motion_at(self.motion, t)
+                Fx, Fy, m1 = cb.drive(self.V, y, mo, self.mode_flags(), L, t)
+            rho = r0[i] - rc[i]
+            out[i] = Fx, Fy, rho[0] * Fy - rho[1] * Fx + m1
+        return out
