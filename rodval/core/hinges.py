@@ -33,12 +33,15 @@ class Latch:
     the angle from the initial state). At the lock the hinge's relative rate drops to zero
     (a plastic impact) and D stays at ``angle`` afterwards. ``window`` (s, > 0): the window
     over which the models measure the lock impulse (None: the first bending period of the
-    locked segment, ``rodval.core.lock_window``)."""
+    locked segment, ``rodval.core.lock_window``). ``held``: the hinge is held from t = 0 (a
+    clamp, or a joint locked before the run: its initial angle must be ``angle`` and its
+    initial rate zero); it never fires an event."""
 
     hinge: int
     angle: float
     direction: int | None = None
     window: float | None = None
+    held: bool = False
 
     def __post_init__(self) -> None:
         if (
@@ -59,6 +62,8 @@ class Latch:
             )
         if self.window is not None:
             check_number("latch window", self.window, low=0.0, low_open=True, finite=True, unit="s")
+        if not isinstance(self.held, bool):
+            raise ValueError(f"latch held must be true or false, got {self.held!r}")
 
 
 @dataclass(frozen=True)
@@ -126,14 +131,27 @@ def hinge_items(label: str, cls: type[Latch] | type[Stop], items: Any, n: int) -
     return out
 
 
-def check_latches(latches: tuple[Latch, ...], D0: np.ndarray) -> None:
+#: A held latch's hinge must start at its angle (rad) and at rest (rad/s) to this distance: the
+#: initial state is on the constraint (round-off of the angles' sums, 1e-12 rad, with room).
+HELD_START = 1e-9
+
+
+def check_latches(latches: tuple[Latch, ...], D0: np.ndarray, rate0: np.ndarray) -> None:
     """At most one latch per hinge, each ahead of its hinge's initial angle D0 (rad) in its
-    direction."""
+    direction; a held latch's hinge at its angle and at rest (rate0, rad/s)."""
     hinges = [latch.hinge for latch in latches]
     if len(set(hinges)) != len(hinges):
         raise ValueError(f"at most one latch per hinge, got hinges {hinges}")
     for latch in latches:
         d0 = D0[latch.hinge]
+        if latch.held:
+            if abs(d0 - latch.angle) > HELD_START or abs(rate0[latch.hinge]) > HELD_START:
+                raise ValueError(
+                    f"held latch on hinge {latch.hinge}: the hinge must start at its angle "
+                    f"{latch.angle:.6g} rad and at rest (within {HELD_START:g}), got D = "
+                    f"{d0:.6g} rad, dD/dt = {rate0[latch.hinge]:.6g} rad/s"
+                )
+            continue
         side = np.sign(latch.angle - d0)
         if side == 0 or (latch.direction is not None and side != latch.direction):
             raise ValueError(

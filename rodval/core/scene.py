@@ -413,7 +413,7 @@ class Scene:
                 "output 'base' needs a free or prescribed base (Base(kind='free', ...) or "
                 "Base(kind='prescribed', ...))"
             )
-        check_latches(self.latches, self.initial_hinge_angles())
+        check_latches(self.latches, self.initial_hinge_angles(), self.initial_hinge_rates())
 
     @property
     def n(self) -> int:
@@ -424,6 +424,13 @@ class Scene:
         init = self.initial.resolve(self.n)
         attitude = self.base.initial_attitude()
         return hinge_angles(init["phi"], init["alpha"], init["beta"], attitude)
+
+    def initial_hinge_rates(self) -> np.ndarray:
+        """dD_k/dt at t = 0 (rad/s), k = 0..n-1 (hinge 0 from the base's rate)."""
+        init = self.initial.resolve(self.n)
+        b = self.base
+        rate = b.state_at(0.0)[3] if b.prescribed else (b.rate if b.free else None)
+        return hinge_angles(init["dphi"], init["dalpha"], init["dbeta"], rate)
 
     @property
     def breakpoints(self) -> np.ndarray:

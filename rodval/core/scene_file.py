@@ -70,7 +70,7 @@ TOP_KEYS = {
     "latches",
     "stops",
 }
-LATCH_KEYS = ("hinge", "angle", "direction", "window")
+LATCH_KEYS = ("hinge", "angle", "direction", "window", "held")
 STOP_KEYS = ("hinge", "angle", "side", "stiffness", "damping")
 CHAIN_KEYS = set(Chain.FIELDS)
 INITIAL_KEYS = set(InitialState.KEYS)
@@ -129,6 +129,14 @@ def _load(spec: dict, n: int, where: str):
     if "node" not in args:
         raise ValueError(f"{where}: load {kind!r} needs 'node' (1..n or \"last\")")
     return factory(**args)
+
+
+def latch_dict(latch: Latch) -> dict:
+    """A latch's scene-file table (``held`` only when true: other scenes' records unchanged)."""
+    d = dataclasses.asdict(latch)
+    if not d["held"]:
+        del d["held"]
+    return d
 
 
 def _table_items(d: dict, key: str, cls: type, keys: tuple[str, ...], where: str) -> list:
@@ -359,7 +367,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "chain": scene.chain.as_dict(),
         "loads": [{"type": f.name, "node": f.node, **f.params} for f in scene.loads],
         "initial": {k: v.tolist() for k, v in init.items()},
-        "latches": [dataclasses.asdict(latch) for latch in scene.latches],
+        "latches": [latch_dict(latch) for latch in scene.latches],
         "stops": [dataclasses.asdict(stop) for stop in scene.stops],
         # a free body only: a pinned scene's dict (and every record made of it) is unchanged
         **({"base": scene.base.as_dict()} if scene.base.moving else {}),

@@ -91,6 +91,8 @@ class PaperSystem(PaperEnergy, OdeSystem):
             for la in self.latches
         )
         self._initial_stops = tuple(bool(st.acts(D0[st.hinge])) for st in self.stops)
+        #: latches held from t = 0 (``Latch.held``): locked in the initial mode
+        self._initial_locked = tuple(j for j, la in enumerate(self.latches) if la.held)
         #: mode: which stops act, which latches are locked (in lock order)
         self.stop_active: tuple[bool, ...] = self._initial_stops
         self.locked: tuple[int, ...] = ()
@@ -340,7 +342,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
 
     def _mode_for(self, t: float) -> tuple:
         """The mode in effect at time t: set by the last event strictly before t."""
-        mode = (self._initial_stops, ())
+        mode = (self._initial_stops, self._initial_locked)
         for ts, m in self._history:
             if ts < t:
                 mode = m
@@ -359,10 +361,10 @@ class PaperSystem(PaperEnergy, OdeSystem):
         return self._mode(self._mode_for(t))
 
     def reset(self) -> None:
-        """Back to the initial mode (no hinge locked, the stops the initial state is beyond),
-        forgetting the event history: called by the driver before a run."""
+        """Back to the initial mode (the held latches locked, the stops the initial state is
+        beyond), forgetting the event history: called by the driver before a run."""
         self._history = []
-        self._activate((self._initial_stops, ()))
+        self._activate((self._initial_stops, self._initial_locked))
 
     def _set_mode(self, mode: tuple, t: float) -> None:
         self._history.append((t, mode))

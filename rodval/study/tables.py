@@ -70,7 +70,9 @@ def cases_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFrame
                 **_case_columns(r, axes, full=True),
                 "l": json.dumps(r.lengths),
                 "latch_hinges": json.dumps(
-                    sorted(int(la["hinge"]) for la in r.scene.get("latches", []))
+                    sorted(
+                        int(la["hinge"]) for la in r.scene.get("latches", []) if not la.get("held")
+                    )
                 ),
                 "fingerprint": r.fingerprint,
             }
