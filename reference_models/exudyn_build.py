@@ -1,5 +1,5 @@
-"""Building the exudyn beam model of a scene: nodes, ANCF cable elements, a free base's rigid
-body, hinges (joints, spring-dampers, stops, latch joints), point masses, loads and sensors
+"""Building the exudyn beam model of a scene: nodes, ANCF cable elements, a free or prescribed
+base's rigid body, hinges (joints, spring-dampers, stops, latch joints), point masses, loads and sensors
 (``build``)."""
 
 from __future__ import annotations
@@ -31,7 +31,9 @@ class BuiltSystem:
     nodes: list  # beam node numbers per rod
     initial: tuple  # initial_node_states: ref, offsets, velocities
     latch_joints: dict  # hinge -> exudyn object number of its locking joint
-    body: int | None = None  # a free base's NodeRigidBody2D (None: pinned to the ground)
+    body: int | None = None  # a moving base's NodeRigidBody2D (None: pinned to the ground)
+    #: a prescribed base's CoordinateConstraints (x, y, theta), () otherwise
+    drives: tuple = ()
 
 
 def _items():
@@ -49,7 +51,10 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     ObjectJointGeneric, inactive until the pre-step function (``Latches``) switches it on.
     A free base is a NodeRigidBody2D (reference coordinates [x_c, y_c, theta] at the initial
     position and attitude) with an ObjectRigidBody2D of the body's mass and inertia; hinge 0
-    joins it, at the hinge offset, to rod 1 (instead of the ground)."""
+    joins it, at the hinge offset, to rod 1 (instead of the ground). A prescribed base is the
+    same node (referenced at its laws' values at t = 0, moving at their rates) with a nominal
+    ``PRESCRIBED_MASS``, ``PRESCRIBED_INERTIA`` body whose three coordinates are imposed by
+    CoordinateConstraints (``_add_drives``). A held latch's joint is active from the start."""
     import exudyn as exu
 
     chain = scene.chain
@@ -59,6 +64,7 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     ref, q0, v0 = initial_node_states(scene, E)
     nodes, elems = _add_rods(mbs, scene, E, EA, (ref, q0, v0))
     body_node, root_body = _add_body(mbs, scene, ground)
+    drives = _add_drives(mbs, scene, body_node)
     latch_joints = _add_hinges(mbs, scene, E, root_body, nodes, elems)
     it = _items()
     for k in range(chain.n):
@@ -77,26 +83,88 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     node_sensors = _add_sensors(mbs, scene, E, nodes, body_node)
     mbs.Assemble()
     return BuiltSystem(
-        SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints, body_node
+        SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints, body_node, drives
+    )
+
+
+#: A prescribed base's body in exudyn: a small positive mass (kg) and inertia (kg m^2) that
+#: keep its node's mass matrix regular; its motion is imposed, so they do not act on the chain
+#: (the constraints' forces carry them). The outputs treat the body as massless, as the native
+#: models do (``rodval.models.free_base_system.FreeBody.body_setup``).
+PRESCRIBED_MASS = 1.0
+PRESCRIBED_INERTIA = 1.0
+
+
+def body_start(scene: Scene) -> tuple[list[float], list[float], float, float]:
+    """A moving base's body at t = 0: [x_c, y_c, theta] (m, m, rad), their rates, and the
+    body's mass (kg) and inertia (kg m^2) in the exudyn model (a prescribed base's nominal
+    ``PRESCRIBED_MASS``, ``PRESCRIBED_INERTIA``)."""
+    b = scene.base
+    if b.prescribed:
+        r, v, th, w = b.state_at(0.0)
+        return (
+            [float(r[0]), float(r[1]), th],
+            [float(v[0]), float(v[1]), w],
+            PRESCRIBED_MASS,
+            PRESCRIBED_INERTIA,
+        )
+    return (
+        [b.position[0], b.position[1], b.attitude],
+        [b.velocity[0], b.velocity[1], b.rate],
+        *b.inertial(),
     )
 
 
 def _add_body(mbs, scene: Scene, ground: int) -> tuple[int | None, int]:
-    """A free base's rigid body: (its NodeRigidBody2D, its ObjectRigidBody2D), the node's
+    """A moving base's rigid body: (its NodeRigidBody2D, its ObjectRigidBody2D), the node's
     coordinates [x_c, y_c, theta] (m, m, rad) referenced at the initial position and attitude
-    and moving with the initial velocity and rate; (None, ground) on a pinned base."""
-    b = scene.base
-    if not b.free:
+    and moving with the initial velocity and rate (``body_start``); (None, ground) on a pinned
+    base."""
+    if not scene.base.moving:
         return None, ground
     it = _items()
-    node = mbs.AddNode(
-        it.NodeRigidBody2D(
-            referenceCoordinates=[b.position[0], b.position[1], b.attitude],
-            initialVelocities=[b.velocity[0], b.velocity[1], b.rate],
-        )
-    )
-    body = mbs.AddObject(it.ObjectRigidBody2D(mass=b.mass, inertia=b.inertia, nodeNumber=node))
+    ref, vel, mass, inertia = body_start(scene)
+    node = mbs.AddNode(it.NodeRigidBody2D(referenceCoordinates=ref, initialVelocities=vel))
+    body = mbs.AddObject(it.ObjectRigidBody2D(mass=mass, inertia=inertia, nodeNumber=node))
     return node, body
+
+
+def _add_drives(mbs, scene: Scene, node: int | None) -> tuple:
+    """A prescribed base's three CoordinateConstraints (x_c, y_c, theta), () otherwise: each
+    between a ground coordinate marker (marker 0) and the body node's coordinate (marker 1),
+    which exudyn holds at q_1 - q_0 = offset, q_1 the node's displacement from its reference
+    (the laws' values at t = 0): the offset user function returns f(t) - f(0) of the law, its
+    ``_t`` twin (index-2 solvers) f'(t)."""
+    if node is None or not scene.base.prescribed:
+        return ()
+    from rodval.core.loads import motion_at
+
+    it = _items()
+    table = scene.base.motion_table()
+    start = motion_at(table, 0.0)[:, 0].copy()
+    ground = mbs.AddNode(it.NodePointGround())
+    fixed = mbs.AddMarker(it.MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+    drives = []
+    for axis in range(3):
+        coord = mbs.AddMarker(it.MarkerNodeCoordinate(nodeNumber=node, coordinate=axis))
+
+        def offset(mbs, t, itemNumber, lOffset, axis=axis):
+            return float(motion_at(table, t)[axis, 0] - start[axis])
+
+        def offset_t(mbs, t, itemNumber, lOffset, axis=axis):
+            return float(motion_at(table, t)[axis, 1])
+
+        drives.append(
+            mbs.AddObject(
+                it.CoordinateConstraint(
+                    markerNumbers=[fixed, coord],
+                    offset=0.0,
+                    offsetUserFunction=offset,
+                    offsetUserFunction_t=offset_t,
+                )
+            )
+        )
+    return tuple(drives)
 
 
 def _add_rods(mbs, scene: Scene, E: int, EA: float, initial) -> tuple[list, list]:
@@ -141,7 +209,8 @@ def _add_rods(mbs, scene: Scene, E: int, EA: float, initial) -> tuple[list, list
 def _add_hinges(mbs, scene: Scene, E: int, root_body: int, nodes, elems) -> dict[int, int]:
     """Hinge k's joint, spring-damper, stops and latch joint; returns hinge -> latch joint.
     Hinge 0 joins ``root_body`` (the ground, or a free base's body at its hinge offset, the
-    angle measured from the body frame) to rod 1."""
+    angle measured from the body frame; a free or prescribed base) to rod 1. A held latch's
+    joint is active from the start."""
     it = _items()
     chain = scene.chain
     ini = scene.initial.resolve(chain.n)
@@ -153,11 +222,11 @@ def _add_hinges(mbs, scene: Scene, E: int, root_body: int, nodes, elems) -> dict
         stops_of.setdefault(stop.hinge, []).append(stop)
     latch_joints: dict[int, int] = {}
     for k in range(chain.n):
-        if k == 0 and scene.base.free:
+        if k == 0 and scene.base.moving:
             offset = [*scene.base.hinge_offset, 0.0]
             pos0 = mbs.AddMarker(it.MarkerBodyPosition(bodyNumber=root_body, localPosition=offset))
             rot0 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=root_body, localPosition=offset))
-            angle0 = tangent_left[0] - scene.base.attitude
+            angle0 = tangent_left[0] - scene.base.initial_attitude()
         elif k == 0:
             pos0 = mbs.AddMarker(it.MarkerBodyPosition(bodyNumber=root_body))
             rot0 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=root_body))
@@ -180,7 +249,8 @@ def _add_hinges(mbs, scene: Scene, E: int, root_body: int, nodes, elems) -> dict
         ]
         _add_springs(mbs, (rot0, rot1), angle0, springs)
         if k in latch_of:
-            latch_joints[k] = _add_latch_joint(mbs, (rot0, rot1), float(latch_of[k].angle))
+            latch = latch_of[k]
+            latch_joints[k] = _add_latch_joint(mbs, (rot0, rot1), float(latch.angle), latch.held)
     return latch_joints
 
 
@@ -206,24 +276,24 @@ def _add_springs(mbs, markers: tuple[int, int], angle0: float, springs: list) ->
         )
 
 
-def _add_latch_joint(mbs, markers: tuple[int, int], angle: float) -> int:
-    """The inactive rotation lock of a latch at ``angle`` (rad): joint frame 1 = marker 1
-    turned back by the latch angle, so the locked relative rotation is D_k = angle (locally
-    unique)."""
+def _add_latch_joint(mbs, markers: tuple[int, int], angle: float, held: bool = False) -> int:
+    """The rotation lock of a latch at ``angle`` (rad), inactive until its event (active from
+    the start if ``held``): joint frame 1 = marker 1 turned back by the latch angle, so the
+    locked relative rotation is D_k = angle (locally unique)."""
     c, sn = math.cos(-angle), math.sin(-angle)
     return mbs.AddObject(
         _items().ObjectJointGeneric(
             markerNumbers=list(markers),
             constrainedAxes=[0, 0, 0, 0, 0, 1],
             rotationMarker1=[[c, -sn, 0.0], [sn, c, 0.0], [0.0, 0.0, 1.0]],
-            activeConnector=False,
+            activeConnector=bool(held),
         )
     )
 
 
 #: Sensors per recorded node (coordinates, velocities, accelerations) and the doubles each
-#: stores at every step: the time and the node's coordinates (4 for a cable node, 3 for a free
-#: base's body node).
+#: stores at every step: the time and the node's coordinates (4 for a cable node, 3 for a
+#: moving base's body node).
 SENSORS_PER_NODE = 3
 CABLE_NODE_COORDINATES = 4
 BODY_NODE_COORDINATES = 3
@@ -246,13 +316,13 @@ def sensor_nodes(scene: Scene, E: int) -> set[tuple[int, int]]:
 def recorded_doubles(scene: Scene, E: int) -> int:
     """Doubles the sensors of a run of ``scene`` (E elements per rod) store at every step."""
     beam = len(sensor_nodes(scene, E)) * (1 + CABLE_NODE_COORDINATES)
-    body = (1 + BODY_NODE_COORDINATES) if scene.base.free else 0
+    body = (1 + BODY_NODE_COORDINATES) if scene.base.moving else 0
     return SENSORS_PER_NODE * (beam + body)
 
 
 def _add_sensors(mbs, scene: Scene, E: int, nodes, body_node: int | None = None) -> dict:
     """Sensors (coordinates, velocities, accelerations, stored internally) on the beam nodes
-    the outputs need (``sensor_nodes``), (rod, node) -> three sensor numbers, and on a free
+    the outputs need (``sensor_nodes``), (rod, node) -> three sensor numbers, and on a moving
     base's body node (``BODY`` -> its three: hinge 0 is measured from it)."""
     import exudyn as exu
 

@@ -9,7 +9,10 @@ Hinge 0 joins the ground frame (the x axis) to rod 1's root tangent, or on a fre
 (``Scene.base``) a rigid body (NodeRigidBody2D and ObjectRigidBody2D: the body's mass and
 inertia, free in the plane) at its hinge offset, the hinge angle measured from the body's
 attitude; the body's motion is then part of the outputs ("base", "momentum",
-"angular_momentum", the kinetic energy). The torsional springs use
+"angular_momentum", the kinetic energy). A prescribed base is the same body (of a nominal
+mass) with its three coordinates imposed by CoordinateConstraints following the laws; the
+outputs treat it as massless, as the native models do, and its run has no energy audit (the
+drive's work is not measured). The torsional springs use
 a NodeGenericData to keep their angle continuous beyond +-pi (hinge 0 turns past pi in the
 paper's example). Point masses mu_k sit on the end node of rod k; the scene's nodal forces act
 there through exudyn load user functions, exactly zero outside each force's support.
@@ -69,7 +72,7 @@ from reference_models.exudyn_budget import RunBudget, check_plan
 from reference_models.exudyn_build import BuiltSystem, build, recorded_doubles
 from reference_models.exudyn_guard import Guard
 from reference_models.exudyn_latches import Latches
-from reference_models.exudyn_observe import momentum_audit, observe, stop_events
+from reference_models.exudyn_observe import body_view, momentum_audit, observe, stop_events
 from reference_models.exudyn_settings import (
     newton_record,
     simulation_settings,
@@ -208,7 +211,8 @@ class ExudynModel(Model):
 
     def check_base(self, scene: Scene) -> None:
         """Every kind of base is modelled: a pinned base as the ground, a free one as a rigid
-        body (``exudyn_build``); nothing is refused."""
+        body, a prescribed one as a rigid body whose coordinates are imposed by constraints
+        (``exudyn_build``); nothing is refused."""
 
     @classmethod
     def check_options(cls, options: dict[str, Any]) -> dict[str, Any]:
@@ -333,7 +337,7 @@ class ExudynModel(Model):
         try:
             built = self._build(scene)
             sim = self._settings(scene)
-            guard = Guard(built, scene, self.elements, self.EA, factor, self.max_rotation_per_step)
+            guard = _guard(built, scene, self.elements, self.EA, factor, self.max_rotation_per_step)
         except Exception as exc:  # noqa: BLE001 - a failed build is data
             status, message = numerical_failure(exc, 0.0) or (
                 STATUS_ERROR,
@@ -369,8 +373,10 @@ class ExudynModel(Model):
                 else {}
             )
             stats.energy_residual, audit = account(
-                scene, self.elements, self.EA, times, t_rec, records, events, observed
+                body_view(scene), self.elements, self.EA, times, t_rec, records, events, observed
             )
+            if scene.base.prescribed:
+                stats.energy_residual, audit = _unaudited_drive(observed, events)
             if times.size and momentum_point(scene) is not None:
                 stats.momentum_residual = momentum_residual(
                     *momentum_audit(scene, self.elements, times, t_rec, records)
@@ -497,6 +503,36 @@ class ExudynModel(Model):
             options=self.options(),
             events=[dict(ev) for ev in events],
         )
+
+
+#: What a prescribed base's run leaves unaudited: the drive's work is not measured.
+DRIVE_UNAUDITED = ("work", "dissipated", "energy_residual")
+#: A lock window's accounts that need the work done on the chain (the drive's included).
+DRIVE_WINDOW_KEYS = ("work_window_end", "dissipated_window_end", "energy_residual_window_end")
+
+
+def _guard(built: BuiltSystem, scene: Scene, E: int, EA: float, factor: float, rotation: float):
+    """The run's ``Guard``. On a prescribed base it sees the massless body (``body_view``:
+    the lock records' kinetic energies are the chain's, as the native models') and checks no
+    energy budget: its drive's work, which the budget would need, is not measured (the
+    non-finite and rotation-per-step checks stay)."""
+    return Guard(
+        built, body_view(scene), E, EA, factor, rotation, checks_energy=not scene.base.prescribed
+    )
+
+
+def _unaudited_drive(observed: dict, events: list[dict]) -> tuple[None, dict]:
+    """A prescribed base's run is not audited for energy: its drive's power (the imposed
+    coordinates' constraint forces on the chain) is not measured, so the balance's work would
+    miss it. The audit's quantities are dropped from ``observed``, and the lock windows' work,
+    dissipation and residual from their records (their energies at the window's end stay);
+    returns (no residual, no settings entry) as for any unaudited run."""
+    for name in DRIVE_UNAUDITED:
+        observed.pop(name, None)
+    for ev in events:
+        for key in DRIVE_WINDOW_KEYS:
+            ev.pop(key, None)
+    return None, {}
 
 
 def _ended(

@@ -78,6 +78,7 @@ class Guard:
         EA: float,
         factor: float,
         max_rotation: float,
+        checks_energy: bool = True,
     ):
         mbs, chain = built.mbs, scene.chain
         ref, q0, v0 = built.initial
@@ -132,7 +133,8 @@ class Guard:
         )
         self.spec = GuardSpec(blowup_factor=float(factor), energy0_J=float(np.sum(parts)))
         self.energy = Monitor(self.spec)
-        self._checks_energy = self.spec.checks_energy
+        #: False where the work done on the chain is not measured (a prescribed base's drive)
+        self._checks_energy = self.spec.checks_energy and checks_energy
         self.verdict: tuple | None = None
         self.min_step, self.max_rotation_seen = math.inf, 0.0
         self.h = 0.0  # the coming step (s), set by pre_step

@@ -35,9 +35,15 @@ class Latches:
     extrapolation within the coming step, or of the cubic Hermite interpolant between the last
     two states when D is already past (bracketed between steps either way).
 
-    Hinge 0's left side is a free base's attitude (its body node's coordinate) or the ground's
-    x axis. Measures of each lock, on the beam solution: the kinetic energy v^T M v / 2 of the
-    whole system (consistent mass, a free base's body included) just before the activation
+    A held latch (``Latch.held``) has its joint active from the start (``exudyn_build``): it is
+    never armed and records no lock event; its hinge counts as held for the other latches'
+    locks (and for the root's angular momentum), and its lock time is 0 (the hinge moment is
+    the beam's from the start, ``exudyn_observe``).
+
+    Hinge 0's left side is a moving (free or prescribed) base's attitude (its body node's
+    coordinate) or the ground's x axis. Measures of each lock, on the beam solution: the
+    kinetic energy v^T M v / 2 of the whole system (consistent mass, a free base's body
+    included; a prescribed base's is massless, as the native models') just before the activation
     step and ``LOCK_SETTLE_STEPS`` steps after it, the chain's angular momentum about the
     root (node 0) and the angular momentum H_k of the outboard part (rods k+1..n and their
     node masses) about the hinge node k. The latch's cumulative angular impulse on the
@@ -55,7 +61,8 @@ class Latches:
         sd = built.mbs.systemData
         ltg = [[np.asarray(sd.GetNodeLTGODE2(nd), int) for nd in rod] for rod in built.nodes]
         self.ltg = ltg
-        # a free base's attitude coordinate: hinge 0's left side (None: the ground's x axis)
+        # a moving base's attitude coordinate: hinge 0's left side (None: the ground's x axis);
+        # ``free``: node 0 moves (a free or a prescribed base)
         self.free = built.body is not None
         body = int(sd.GetNodeLTGODE2(built.body)[2]) if built.body is not None else None
         size = guard.ref.size
@@ -73,7 +80,9 @@ class Latches:
                     "left": body if k == 0 else ltg[k - 1][E][2:],
                     "right": ltg[k][0][2:],
                     "D": float(D0[k]),
-                    "state": "armed",
+                    # a held latch's joint is active from the start (exudyn_build): never
+                    # armed, no lock event
+                    "state": "held" if latch.held else "armed",
                 }
             )
         # quadrature points of every rod (5 Gauss points per element) and the node masses:
@@ -118,11 +127,14 @@ class Latches:
         self._D = np.array([self.root["D"]] + [it["D"] for it in self.items])
         self._angle_of = np.array([it["latch"].angle for it in self.items], float)
         self._dir = np.array([it["dir"] for it in self.items], float)
-        self._armed = np.ones(len(self.items), bool)
+        self._armed = np.array([it["state"] == "armed" for it in self.items], bool)
         self.prev: dict | None = None
         self.pending: list[dict] = []
         self.events: list[dict] = []
-        self.lock_times: dict[int, float] = {}
+        # hinge -> time its joint was switched on (s): a held latch's from t = 0
+        self.lock_times: dict[int, float] = {
+            it["k"]: 0.0 for it in self.items if it["state"] == "held"
+        }
         self.step_count = 0
         self._cfg = None  # exudyn's configuration of the last accepted state (StartOfStep)
         self._root_shapes: dict[int, tuple] = {}  # rod -> Hermite slopes at its root
@@ -392,7 +404,7 @@ class Latches:
         root_jump = last["H_root"] - before["H_root"] - ev["root_integral"]
         latch = item["latch"]
         chords = before["chords"]
-        # the rigid-panel yardstick is a pinned chain's: none on a free base (as the native)
+        # the rigid-panel yardstick is a pinned chain's: none on a moving base (as the native)
         rigid = (
             {}
             if self.free

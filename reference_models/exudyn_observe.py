@@ -16,7 +16,36 @@ from reference_models.exudyn_beam import (
     system_momenta,
     wrap_angle,
 )
+from rodval.core.base import Base
+from rodval.core.bounds import MIN_POSITIVE
 from rodval.core.scene import QUANTITIES, Scene, hinge_angles
+
+#: The mass (kg) and inertia (kg m^2) the beam quadratures (``exudyn_beam``, which read a
+#: moving body's from ``scene.base.inertial()``) give a prescribed base's body: massless as in
+#: the native models (the drive's force is external to the chain), to round-off: its kinetic
+#: energy is below 1e-12 J per (m/s)^2 and (rad/s)^2.
+MASSLESS = MIN_POSITIVE
+
+
+def body_view(scene: Scene) -> Scene:
+    """The scene as the beam quadratures and the guard see it: ``scene`` itself, but a
+    prescribed base as a free body of mass and inertia ``MASSLESS`` starting in the laws'
+    state at t = 0 (its motion is the recorded body node's: only its mass is read)."""
+    b = scene.base
+    if not b.prescribed:
+        return scene
+    r, v, th, w = b.state_at(0.0)
+    free = Base(
+        "free",
+        mass=MASSLESS,
+        inertia=MASSLESS,
+        hinge_offset=b.hinge_offset,
+        position=(float(r[0]), float(r[1])),
+        velocity=(float(v[0]), float(v[1])),
+        attitude=th,
+        rate=w,
+    )
+    return scene.with_(base=free)
 
 
 def _states_at(times: np.ndarray, t_rec: np.ndarray, records: dict) -> dict:
@@ -52,7 +81,10 @@ def observe(
     moment EI kappa_b at the root of rod k+1 (the hinge has no inertia: it transmits that
     moment), kappa_b the curvature of the cable's field there. Hinge 0 is measured from a free
     base's attitude (its body node's record, ``BODY``), which also gives "base"; "momentum"
-    and "angular_momentum" are the whole system's (``system_momenta``)."""
+    and "angular_momentum" are the whole system's (``system_momenta``). A prescribed base's
+    body is massless (``body_view``): "energy", "momentum" and "angular_momentum" are the
+    chain's, as the native models'."""
+    scene = body_view(scene)
     n = scene.n
     rods = np.arange(1, n + 1)
     at = _states_at(times, t_rec, records)
@@ -94,7 +126,7 @@ def observe(
 
 
 def _base_quantities(at: dict, out: dict) -> None:
-    """The free base's "base" quantities into ``out``: base_position, base_velocity (m, m/s;
+    """A moving base's "base" quantities into ``out``: base_position, base_velocity (m, m/s;
     its centre of mass, k = 0, 1), base_attitude, base_rate (rad, rad/s; k = 0), from its body
     node's record."""
     q, v = at[BODY]
