@@ -70,7 +70,10 @@ def main() -> None:
     for omega in args.omega:
         runs = [("full", n, {"kinematics": k}) for k in ("first-order", "exact") for n in args.n]
         if not args.no_exudyn:
-            runs += [("exudyn", max(args.n), {"elements": e, "step": 1e-3}) for e in (2, 4)]
+            runs += [
+                ("exudyn", max(args.n), {"elements": e, "step": h, "EA": EA})
+                for e, h in ((2, 1e-3), (4, 5e-4))
+            ]
         for model, n, options in runs:
             scene = spin_up_scene(n, omega, args.t_end)
             start = time.perf_counter()

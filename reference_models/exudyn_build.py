@@ -137,7 +137,7 @@ def _add_drives(mbs, scene: Scene, node: int | None) -> tuple:
     ``_t`` twin (index-2 solvers) f'(t)."""
     if node is None or not scene.base.prescribed:
         return ()
-    from rodval.core.loads import motion_at
+    from rodval.core.motion import motion_at
 
     it = _items()
     table = scene.base.motion_table()

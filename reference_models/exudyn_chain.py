@@ -212,7 +212,13 @@ class ExudynModel(Model):
     def check_base(self, scene: Scene) -> None:
         """Every kind of base is modelled: a pinned base as the ground, a free one as a rigid
         body, a prescribed one as a rigid body whose coordinates are imposed by constraints
-        (``exudyn_build``); nothing is refused."""
+        (``exudyn_build``). The output "drive" (a prescribed base's force and moment on the
+        chain) is refused: the constraints' reactions are not measured."""
+        if scene.wants("drive"):
+            raise ValueError(
+                "exudyn model: output 'drive' (a prescribed base's force and moment on the chain) "
+                "is not measured by the exudyn model; drop it from outputs, or run the full model"
+            )
 
     @classmethod
     def check_options(cls, options: dict[str, Any]) -> dict[str, Any]:

@@ -21,7 +21,7 @@ import numpy as np
 
 from rodval.core.bounds import check_bounds
 from rodval.core.checks import check_choice, check_keys, check_number
-from rodval.core.loads import LAW_CONSTANT, LAW_HARMONIC, LAW_LINEAR, LAW_SPIN_UP, motion_at
+from rodval.core.motion import Motion, motion_at, motion_table
 
 #: The kinds of base: a fixed pin at the origin, a free rigid body, a prescribed motion.
 BASE_KINDS = ("pinned", "free", "prescribed")
@@ -29,93 +29,6 @@ BASE_KINDS = ("pinned", "free", "prescribed")
 BODY_FIELDS = ("mass", "inertia", "hinge_offset", "position", "velocity", "attitude", "rate")
 #: The prescribed coordinates of a base's motion: its centre's x, y (m) and attitude (rad).
 MOTION_AXES = ("x", "y", "attitude")
-#: Motion laws -> (their parameters, law code): f(t) on t >= 0, twice differentiable.
-MOTION_LAWS: dict[str, tuple[tuple[str, ...], int]] = {
-    "constant": (("value",), LAW_CONSTANT),
-    "linear": (("value", "rate"), LAW_LINEAR),
-    "harmonic": (("amplitude", "omega", "phase"), LAW_HARMONIC),
-    "spin_up": (("rate", "time"), LAW_SPIN_UP),
-}
-
-
-@dataclass(frozen=True)
-class Motion:
-    """A prescribed coordinate history f(t) of a base (m for x, y; rad for the attitude), twice
-    differentiable, with f' and f'' in closed form (``loads.law_motion``, the load laws'
-    formulas). ``law`` and its parameters (``MOTION_LAWS``):
-
-    * ``constant``: f = value;
-    * ``linear``: f = value + rate t;
-    * ``harmonic``: f = amplitude sin(omega t + phase) (omega > 0 in rad/s);
-    * ``spin_up``: Kane, Ryan and Banerjee's smooth spin-up to ``rate`` (per s) over ``time``
-      T (s): f = rate/T (t^2/2 + (T/2 pi)^2 (cos(2 pi t/T) - 1)) for t < T, rate (t - T/2)
-      after; f' and f'' are continuous (f'' = 0 at t = 0 and at T)."""
-
-    law: str = "constant"
-    params: tuple[float, ...] = (0.0,)
-
-    def __post_init__(self) -> None:
-        check_choice("motion law", self.law, tuple(MOTION_LAWS))
-        names = MOTION_LAWS[self.law][0]
-        if len(self.params) != len(names):
-            raise ValueError(
-                f"motion law {self.law!r} takes {len(names)} parameters "
-                f"({', '.join(names)}), got {len(self.params)}"
-            )
-        values = tuple(
-            check_number(f"motion {self.law} {name}", v, finite=True)
-            for name, v in zip(names, self.params)
-        )
-        for name in ("omega", "time"):
-            if name in names:
-                check_number(
-                    f"motion {self.law} {name}", values[names.index(name)], low=0.0, low_open=True
-                )
-        object.__setattr__(self, "params", values)
-
-    @classmethod
-    def from_dict(cls, d: Any, where: str) -> Motion:
-        """A Motion from a scene file's table ``{law = "spin_up", rate = 4.0, time = 15.0}``."""
-        if not isinstance(d, dict) or "law" not in d:
-            raise ValueError(f"{where}: a motion needs a 'law' (one of {', '.join(MOTION_LAWS)})")
-        law = d["law"]
-        check_choice(f"{where} law", law, tuple(MOTION_LAWS))
-        names = MOTION_LAWS[law][0]
-        check_keys(d, ("law", *names), where)
-        missing = [k for k in names if k not in d]
-        if missing:
-            raise ValueError(f"{where}: motion law {law!r} needs {', '.join(missing)}")
-        return cls(law, tuple(d[k] for k in names))
-
-    def as_dict(self) -> dict[str, Any]:
-        return {"law": self.law, **dict(zip(MOTION_LAWS[self.law][0], self.params))}
-
-    def rows(self, axis: int) -> list[tuple[float, ...]]:
-        """The law's rows of a base-motion table (``loads.LOAD_COLUMNS``; component = the
-        axis 0, 1, 2 = x, y, attitude)."""
-        code = MOTION_LAWS[self.law][1]
-        p = self.params
-        if self.law == "spin_up":
-            rate, T = p
-            return [
-                (0, axis, code, 0.0, T, 0, rate, T, 0.0, 0),
-                (0, axis, LAW_LINEAR, T, np.inf, 1, 0.5 * rate * T, rate, 0.0, 0),
-            ]
-        padded = (*p, 0.0, 0.0, 0.0)[:3]
-        return [(0, axis, code, 0.0, np.inf, 1, *padded, 0)]
-
-    @property
-    def breakpoints(self) -> tuple[float, ...]:
-        """Times (s) where f'' has a kink (the spin-up's end)."""
-        return (self.params[1],) if self.law == "spin_up" else ()
-
-
-def motion_table(motion: tuple[Motion, ...]) -> np.ndarray:
-    """The base-motion table (rows x ``LOAD_COLUMNS``) of the three axes' laws."""
-    rows = [r for axis, m in enumerate(motion) for r in m.rows(axis)]
-    return np.ascontiguousarray(np.array(rows, dtype=np.float64))
-
-
 def _vector(name: str, value: Any, unit: str) -> tuple[float, float]:
     """A 2-vector of finite real numbers (ValueError naming ``name`` otherwise)."""
     if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__len__") or len(value) != 2:

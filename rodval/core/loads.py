@@ -56,10 +56,6 @@ LAW_CONSTANT = 0  # p0
 LAW_RAISED_COSINE = 1  # p0 (1/2 - 1/2 cos(p1 t))
 LAW_LINEAR = 2  # p0 + p1 (t - t0)
 LAW_HARMONIC = 3  # p0 sin(p1 t + p2)
-#: Kane, Ryan and Banerjee's smooth spin-up (on [0, p1)): p0 / p1 (t^2 / 2 + (p1 / 2 pi)^2
-#: (cos(2 pi t / p1) - 1)), rate p0 reached at t = p1 with zero acceleration (a prescribed
-#: base's attitude, ``rodval.core.base.Motion``).
-LAW_SPIN_UP = 4
 
 Row = tuple[int, float, float, bool, float, float, float]  # law, t0, t1, closed, p0, p1, p2
 
@@ -542,51 +538,6 @@ def load_sums(L, t, SX, SY):
             SX[k] += SX[k + 1]
             SY[k] += SY[k + 1]
     return active
-
-
-@njit(cache=True)
-def law_motion(L, r, t):
-    """(f, f', f'') at t of row ``r`` of a law table (``LOAD_COLUMNS``), on its interval: the
-    value in the law's unit and its first and second time derivatives (a prescribed base's
-    motion, ``rodval.core.base.Motion``). The values are ``load_sums``' formulas."""
-    law, t0 = L[r, 2], L[r, 3]
-    p0, p1, p2 = L[r, 6], L[r, 7], L[r, 8]
-    if law == LAW_RAISED_COSINE:
-        return (
-            p0 * (0.5 - 0.5 * math.cos(p1 * t)),
-            0.5 * p0 * p1 * math.sin(p1 * t),
-            0.5 * p0 * p1 * p1 * math.cos(p1 * t),
-        )
-    if law == LAW_LINEAR:
-        return p0 + p1 * (t - t0), p1, 0.0
-    if law == LAW_HARMONIC:
-        x = p1 * t + p2
-        return p0 * math.sin(x), p0 * p1 * math.cos(x), -p0 * p1 * p1 * math.sin(x)
-    if law == LAW_SPIN_UP:
-        w = 2.0 * math.pi / p1
-        return (
-            p0 / p1 * (0.5 * t * t + (math.cos(w * t) - 1.0) / (w * w)),
-            p0 / p1 * (t - math.sin(w * t) / w),
-            p0 / p1 * (1.0 - math.cos(w * t)),
-        )
-    return p0, 0.0, 0.0
-
-
-@njit(cache=True)
-def motion_at(table, t):
-    """(3, 3) [[x, x', x''], [y, ...], [theta, ...]] (m, m/s, m/s^2; rad, rad/s, rad/s^2) at t
-    >= 0 from a base-motion table (``rodval.core.base.motion_table``): each axis's row whose
-    interval holds t (``law_motion``); O(rows)."""
-    out = np.zeros((3, 3))
-    for r in range(table.shape[0]):
-        t0, t1 = table[r, 3], table[r, 4]
-        if (t0 <= t and t < t1) or (t == t1 and table[r, 5] != 0.0):
-            f, df, ddf = law_motion(table, r, t)
-            axis = int(table[r, 1])
-            out[axis, 0] = f
-            out[axis, 1] = df
-            out[axis, 2] = ddf
-    return out
 
 
 class LoadSet:

@@ -42,8 +42,9 @@ from rodval.core.resources import check_rods, check_run_memory
 #: moment about the root, P linear momentum, M total mass); with a free base (``Base``) k = 1
 #: is about the whole system's centre of mass, body included. "momentum" (N s): the whole
 #: system's linear momentum (k = 0, 1: x, y). "base" (a free base only) yields the body's
-#: base_position, base_velocity (k = 0, 1: x, y), base_attitude and base_rate (k = 0);
-#: docs/quantities.md.
+#: base_position, base_velocity (k = 0, 1: x, y), base_attitude and base_rate (k = 0); "drive"
+#: (a prescribed base only) the base's force on the chain at node 0, drive_force (N, k = 0, 1:
+#: x, y), and its moment about the body's centre, drive_moment (N m, k = 0); docs/quantities.md.
 QUANTITIES = (
     "phi",
     "dphi",
@@ -57,11 +58,13 @@ QUANTITIES = (
     "angular_momentum",
     "momentum",
     "base",
+    "drive",
 )
-#: What the quantities "energy" and "base" yield in a trajectory.
+#: What the quantities "energy", "base" and "drive" yield in a trajectory.
 EXPANDS = {
     "energy": ("kinetic", "potential", "energy"),
     "base": ("base_position", "base_velocity", "base_attitude", "base_rate"),
+    "drive": ("drive_force", "drive_moment"),
 }
 #: Units of every trajectory quantity (the energy audit adds work, dissipated, residual).
 UNITS = {
@@ -85,6 +88,8 @@ UNITS = {
     "base_velocity": "m/s",
     "base_attitude": "rad",
     "base_rate": "rad/s",
+    "drive_force": "N",
+    "drive_moment": "N m",
 }
 
 
@@ -412,6 +417,10 @@ class Scene:
             raise ValueError(
                 "output 'base' needs a free or prescribed base (Base(kind='free', ...) or "
                 "Base(kind='prescribed', ...))"
+            )
+        if not self.base.prescribed and self.wants("drive"):
+            raise ValueError(
+                "output 'drive' needs a prescribed base (Base(kind='prescribed', ...))"
             )
         check_latches(self.latches, self.initial_hinge_angles(), self.initial_hinge_rates())
 

@@ -35,7 +35,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.core.loads import load_sums, motion_at
+from rodval.core.loads import load_sums
+from rodval.core.motion import motion_at
 from rodval.models.deployment import hinge_events, small_solve, superpose, unit_moment
 from rodval.models.kernels import V_KAPPA, V_L, V_NU, V_OUTER, V_REST, load_power, rhs_head
 from rodval.models.ladder_kernels import (

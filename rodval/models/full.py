@@ -153,10 +153,6 @@ class FullSystem(PaperSystem):
         M = assemble_mass(self.cc, angle_differences(phi)[0])
         return np.linalg.solve(M, hinge_matrix(n)[hinges].T).T
 
-    def hinge_rows(self, hinges) -> np.ndarray:
-        """The rows a_k of the hinge matrix A (D = A q) of the given hinges."""
-        return hinge_matrix(self.n)[hinges]
-
     def plastic_jump(self, y, hinges, angles):
         return plastic_jump(self, y, hinges, angles)
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rodval.core.loads import motion_at
+from rodval.core.motion import motion_at
 from rodval.core.scene import Scene
 from rodval.models import chain_base as cb
 from rodval.models.deployment import lock_scalars
@@ -127,4 +127,12 @@ class LadderPrescribedSystem(FreeBody, LadderSystem):
                 Fx, Fy, m1 = cb.drive(self.V, y, mo, self.mode_flags(), L, t)
             rho = r0[i] - rc[i]
             out[i] = Fx, Fy, rho[0] * Fy - rho[1] * Fx + m1
+        return out
+
+    def _observe_rows(self, times, Y):
+        out = super()._observe_rows(times, Y)
+        if self.scene.wants("drive"):
+            drive = self.drive_rows(times, Y)
+            out["drive_force"] = (drive[:, :2], np.arange(2))
+            out["drive_moment"] = (drive[:, 2:], np.zeros(1, dtype=int))
         return out

@@ -91,7 +91,6 @@ class PaperSystem(PaperEnergy, OdeSystem):
             for la in self.latches
         )
         self._initial_stops = tuple(bool(st.acts(D0[st.hinge])) for st in self.stops)
-        #: latches held from t = 0 (``Latch.held``): locked in the initial mode
         self._initial_locked = tuple(j for j, la in enumerate(self.latches) if la.held)
         #: mode: which stops act, which latches are locked (in lock order)
         self.stop_active: tuple[bool, ...] = self._initial_stops
@@ -371,6 +370,10 @@ class PaperSystem(PaperEnergy, OdeSystem):
         self._activate(mode)
 
     # ------------------------------------------------------------- deployment: events
+    def hinge_rows(self, hinges) -> np.ndarray:
+        """Rows a_k of the hinge matrix (D = A q, q = [phi; alpha; beta]) of these hinges."""
+        return hinge_matrix(self.n)[hinges]
+
     def hinge_angles_at(self, t: float, y: np.ndarray) -> np.ndarray:
         """D_k (rad, n) at one state in the current mode."""
         Y = y[None, :]
@@ -528,17 +531,12 @@ class StackedSystem(PaperSystem):
     unit_kernel: Any
 
     def chain_initial_state(self) -> np.ndarray:
-        """The chain's [q; q'] at t = 0 from the scene's initial state: [phi; alpha; beta]
-        and their rates (a ladder rung adds its bubbles, at rest)."""
+        """The chain's [q; q'] at t = 0 (a ladder rung adds its bubbles, at rest)."""
         i = self.initial
         return np.concatenate([i["phi"], i["alpha"], i["beta"], i["dphi"], i["dalpha"], i["dbeta"]])
 
-    def hinge_rows(self, hinges) -> np.ndarray:
-        """The rows a_k of the paper's hinge matrix (D = A q) of the given hinges."""
-        return hinge_matrix(self.n)[hinges]
-
     def bubble_energies(self, Y: np.ndarray) -> np.ndarray:
-        """The bending energy (J) of the shapes beyond the paper's cubic, per state: none."""
+        """The bending energy (J) of shapes beyond the paper's cubic, per state: none."""
         return np.zeros(len(Y))
 
     def generalized_rates(self, y):
