@@ -14,7 +14,7 @@ from reference_models.exudyn_guard import Guard
 from rodval.core.lock_window import lock_window
 from rodval.core.rigid import rigid_lock
 from rodval.core.root_momentum import root_momentum_fields
-from rodval.core.scene import Scene
+from rodval.core.scene import Chain, Scene
 
 #: Steps after the activation step at which a lock's "after" state is taken (the index-3
 #: constraint brings the relative rate to zero within the activation step; the extra steps let
@@ -57,7 +57,7 @@ class Latches:
 
     def __init__(self, built: BuiltSystem, guard: Guard, scene: Scene, E: int):
         self.mbs, self.guard, self.scene, self.E = built.mbs, guard, scene, E
-        chain, n = scene.chain, scene.n
+        chain = scene.chain
         sd = built.mbs.systemData
         ltg = [[np.asarray(sd.GetNodeLTGODE2(nd), int) for nd in rod] for rod in built.nodes]
         self.ltg = ltg
@@ -85,35 +85,7 @@ class Latches:
                     "state": "held" if latch.held else "armed",
                 }
             )
-        # quadrature points of every rod (5 Gauss points per element) and the node masses:
-        # position rows Gx, Gy (points x size), weights (kg), rod of each point
-        rows_x: list[np.ndarray] = []
-        rows_y: list[np.ndarray] = []
-        wts: list[float] = []
-        rod_of: list[int] = []
-        for k in range(n):
-            le = chain.l[k] / E
-            sg = 0.5 * le * (GAUSS_X + 1.0)
-            S = hermite_shapes(sg, le)[0]
-            for j in range(E):
-                a, b = ltg[k][j], ltg[k][j + 1]
-                dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
-                for g in range(sg.size):
-                    for rows, c in ((rows_x, 0), (rows_y, 1)):
-                        r = np.zeros(size)
-                        r[dofs[:, c]] = S[g]
-                        rows.append(r)
-                    wts.append(chain.m[k] * 0.5 * le * GAUSS_W[g])
-                    rod_of.append(k)
-            if chain.mu[k] > 0:
-                for rows, c in ((rows_x, 0), (rows_y, 1)):
-                    r = np.zeros(size)
-                    r[ltg[k][E][c]] = 1.0
-                    rows.append(r)
-                wts.append(chain.mu[k])
-                rod_of.append(k)
-        self.Gx, self.Gy = np.array(rows_x), np.array(rows_y)
-        self.w, self.rod_of = np.array(wts), np.array(rod_of)
+        self.Gx, self.Gy, self.w, self.rod_of = _mass_points(chain, ltg, E, size)
         self.loads = [(f, ltg[f.node - 1][E][:2], f.node) for f in scene.loads]
         self.stops: dict[int, list] = {}
         for stop in scene.stops:
@@ -438,6 +410,42 @@ class Latches:
         )
         item["state"] = "locked"
         self.pending.remove(ev)
+
+
+def _mass_points(
+    chain: Chain, ltg: list[list[np.ndarray]], E: int, size: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The chain's mass points: the quadrature points of every rod (5 Gauss points per
+    element, ``GAUSS_X``, ``GAUSS_W``) and the node masses mu_k at the rods' ends. ``ltg``:
+    each rod's beam nodes' ODE2 indices (rod, node 0..E, [x, y, slope x, slope y]); ``size``
+    the number of ODE2 coordinates. Returns (Gx, Gy (points, size): rows giving each point's
+    x, y (m) from the coordinates; w (points,) its mass, kg; rod_of (points,) its rod)."""
+    rows_x: list[np.ndarray] = []
+    rows_y: list[np.ndarray] = []
+    wts: list[float] = []
+    rod_of: list[int] = []
+    for k in range(chain.n):
+        le = chain.l[k] / E
+        sg = 0.5 * le * (GAUSS_X + 1.0)
+        S = hermite_shapes(sg, le)[0]
+        for j in range(E):
+            a, b = ltg[k][j], ltg[k][j + 1]
+            dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
+            for g in range(sg.size):
+                for rows, c in ((rows_x, 0), (rows_y, 1)):
+                    r = np.zeros(size)
+                    r[dofs[:, c]] = S[g]
+                    rows.append(r)
+                wts.append(chain.m[k] * 0.5 * le * GAUSS_W[g])
+                rod_of.append(k)
+        if chain.mu[k] > 0:
+            for rows, c in ((rows_x, 0), (rows_y, 1)):
+                r = np.zeros(size)
+                r[ltg[k][E][c]] = 1.0
+                rows.append(r)
+            wts.append(chain.mu[k])
+            rod_of.append(k)
+    return np.array(rows_x), np.array(rows_y), np.array(wts), np.array(rod_of)
 
 
 class _Sides:

@@ -46,7 +46,14 @@ from rodval.core.eigen import (
     symmetric_pencil,
 )
 from rodval.core.loads import constant
-from rodval.core.modal import ABOUT, Equilibrium, Modes, normalize_shapes, static_loads
+from rodval.core.modal import (
+    ABOUT,
+    Equilibrium,
+    Modes,
+    normalize_shapes,
+    split_rigid,
+    static_loads,
+)
 from rodval.core.scene import InitialState, Scene
 
 #: Elongation/displacement ratio above which an exudyn mode counts as axial.
@@ -140,47 +147,47 @@ def exudyn_modes(
     n = scene.n
     loads = static_loads(scene, load_at) if about == "equilibrium" else None
     held = _held_forces(loads)
+    if scene.base.free and held:
+        raise ValueError(
+            "a free base under static loads has no static equilibrium (the body accelerates); "
+            "use about='initial' (free vibration, loads left out)"
+        )
     prestressed = _springs_loaded(scene)
     if about == "equilibrium" and prestressed:
         scene = _at_rest_angles(scene)  # the static solve starts where the springs relax
     _, mbs, nodes = model.assembled(scene.with_(loads=held))
-    for row in nodes:
-        for nd in row:
-            if mbs.GetNode(nd)["nodeType"] != "Point2DSlope1":
-                raise RuntimeError("unexpected exudyn node numbering")
-    console = exu.config.printToConsole
-    exu.config.printToConsole = False
-    solved = about == "equilibrium" and (bool(held) or prestressed)
-    try:
-        iters, residual = _static_solve(exu, mbs, model, load_steps) if solved else (0, 0.0)
-        matrices = _linear_matrices(exu, mbs)
-    finally:
-        exu.config.printToConsole = console
+    _check_nodes(mbs, nodes)
+    # on a free base without loads the start at the rest angles is the equilibrium (a static
+    # solve of the unsupported body would be singular)
+    solved = about == "equilibrium" and (bool(held) or prestressed) and not scene.base.free
+    iters, residual, matrices = _linearized(exu, mbs, model, load_steps if solved else None)
     lam, V, s_damped, basis = _eigen(*matrices, damped=scene.chain.damped)
     idx, state = _node_states(exu, mbs, nodes, n)
-    lam, U, axial = _bending_modes(lam, V, idx, state, axial_tol, count)
-    dx, dy, hinge = _node_shapes(U, state)
-    omega = angular_frequencies(lam)
+    body = _body_index(mbs) if scene.base.free else None
+    free = body is not None
+    lam, U, axial, theta = _bending_modes(
+        lam, V, idx, state, axial_tol, None if free else count, body
+    )
     ends = np.concatenate([state[:1, 0, :2], state[:, -1, :2]])
     d = np.diff(ends, axis=0)
     phi0 = np.arctan2(d[:, 1], d[:, 0])
+    rigid_info: dict = {}
+    if free:
+        lam, dx, dy, hinge, rigid_info = _free_shapes(lam, U, state, theta, ends, count)
+    else:
+        dx, dy, hinge = _node_shapes(U, state)
+    omega = angular_frequencies(lam)
+    damping = _damping_ratios(omega, s_damped)
+    if free:
+        damping[:3] = np.nan
     eq = None
     if about == "equilibrium":
-        ini = scene.initial.resolve(n)
-        phi0 = ini["phi"] + (phi0 - ini["phi"] + np.pi) % (2 * np.pi) - np.pi
-        eq = Equilibrium(
-            q=np.concatenate([phi0, np.zeros(2 * n)]),
-            iterations=iters,
-            load_steps=int(load_steps),
-            residual=residual,
-            converged=True,
-            loads=loads,
-        )
+        phi0, eq = _equilibrium(scene, phi0, iters, load_steps, residual, loads)
     return Modes(
         model="exudyn",
         about=about,
         omega=omega,
-        damping=_damping_ratios(omega, s_damped),
+        damping=damping,
         dx=dx,
         dy=dy,
         hinge=hinge,
@@ -192,8 +199,79 @@ def exudyn_modes(
             "axial_modes_dropped": int(axial.sum()),
             "null_space": basis,
             "options": model.options(),
+            **rigid_info,
         },
+        rigid=3 if free else 0,
     )
+
+
+#: exudyn's modes exist on a free base (its three rigid modes separated, ``split_rigid``).
+exudyn_modes.FREE_BASE = True  # type: ignore[attr-defined]
+
+
+def _check_nodes(mbs, nodes) -> None:
+    """RuntimeError unless every beam node of ``nodes`` (rows of exudyn node numbers) is a
+    Point2DSlope1 (position x, y in m and slope vector, dimensionless)."""
+    for row in nodes:
+        for nd in row:
+            if mbs.GetNode(nd)["nodeType"] != "Point2DSlope1":
+                raise RuntimeError("unexpected exudyn node numbering")
+
+
+def _linearized(
+    exu, mbs, model: ExudynModel, load_steps: int | None
+) -> tuple[int, float, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """(Newton iterations, exudyn's last Newton residual (N), (M, K, D, J)): exudyn's static
+    solve in ``load_steps`` load steps first (None: no solve, (0, 0.0)), then the linear
+    matrices there (``_linear_matrices``: kg, N/m, N s/m and the constraint Jacobian),
+    exudyn's console output silenced meanwhile."""
+    console = exu.config.printToConsole
+    exu.config.printToConsole = False
+    try:
+        iters, residual = (
+            _static_solve(exu, mbs, model, load_steps) if load_steps is not None else (0, 0.0)
+        )
+        matrices = _linear_matrices(exu, mbs)
+    finally:
+        exu.config.printToConsole = console
+    return iters, residual, matrices
+
+
+def _free_shapes(lam, U, state, theta, ends: np.ndarray, count: int | None):
+    """A free base's modes: node shapes with hinge 0 measured from the body (rod 1's root
+    tangent less the body's theta, rad), the three rigid modes separated (``split_rigid``;
+    ``ends`` (n+1, 2) the nodes' positions, m), then the first ``count`` flexible ones
+    (default all), normalized. Returns (lam (1/s^2), dx, dy (m per unit), hinge (rad per the
+    same unit), the rigid modes' record)."""
+    d = np.diff(ends, axis=0)
+    dx, dy, hinge = _node_shapes(U, state, theta, normalize=False)
+    lam, dx, dy, hinge, rigid_info = split_rigid(
+        lam, dx, dy, hinge, ends[:, 0], ends[:, 1], float(np.mean(np.linalg.norm(d, axis=1)))
+    )
+    keep = lam.size if count is None else min(lam.size, 3 + int(count))
+    lam, dx, dy, hinge = lam[:keep], dx[:keep], dy[:keep], hinge[:keep]
+    dx, dy, hinge = normalize_shapes(dx, dy, hinge)
+    return lam, dx, dy, hinge, rigid_info
+
+
+def _equilibrium(
+    scene: Scene, phi0: np.ndarray, iters: int, load_steps: int, residual: float, loads
+) -> tuple[np.ndarray, Equilibrium]:
+    """The chord angles phi0 (rad) of the equilibrium, unwrapped to within pi of the scene's
+    initial ones, and its record (``Equilibrium``: Newton iterations, load steps, exudyn's last
+    Newton residual in N, the static loads held)."""
+    n = scene.n
+    ini = scene.initial.resolve(n)
+    phi0 = ini["phi"] + (phi0 - ini["phi"] + np.pi) % (2 * np.pi) - np.pi
+    eq = Equilibrium(
+        q=np.concatenate([phi0, np.zeros(2 * n)]),
+        iterations=iters,
+        load_steps=int(load_steps),
+        residual=residual,
+        converged=True,
+        loads=loads,
+    )
+    return phi0, eq
 
 
 def _springs_loaded(scene: Scene) -> bool:
@@ -270,10 +348,22 @@ def _node_states(exu, mbs, nodes, n: int) -> tuple[np.ndarray, np.ndarray]:
     return first, np.array(state).reshape(n, first.shape[1], 4)
 
 
-def _bending_modes(lam, V, idx, state, axial_tol: float, count: int | None):
+def _body_index(mbs) -> int:
+    """The first ODE2 index of a free base's rigid body node (NodeRigidBody2D: x_c, y_c,
+    theta)."""
+    for nd in range(mbs.systemData.NumberOfNodes()):
+        if "RigidBody2D" in str(mbs.GetNode(nd)["nodeType"]):
+            return int(mbs.GetNodeODE2Index(nd))
+    raise RuntimeError("free base: no NodeRigidBody2D in the exudyn system")
+
+
+def _bending_modes(
+    lam, V, idx, state, axial_tol: float, count: int | None, body: int | None = None
+):
     """The modes without axial content (element elongation along the tangent below
     ``axial_tol`` x the largest node displacement), ascending, the first ``count``:
-    (eigenvalues, beam-node shapes (modes, n, E+1, 4), which modes were axial)."""
+    (eigenvalues, beam-node shapes (modes, n, E+1, 4), which modes were axial, and the
+    body's theta in each mode (None without a free base: ``body`` its first ODE2 index))."""
     U = np.stack([V[idx + c] for c in range(4)], axis=-1)  # (n, E+1, modes, 4)
     U = np.moveaxis(U, 2, 0)  # (modes, n, E+1, 4)
     disp = U[..., :2]
@@ -283,17 +373,23 @@ def _bending_modes(lam, V, idx, state, axial_tol: float, count: int | None):
     dmax = np.max(np.linalg.norm(disp, axis=-1), axis=(1, 2))
     axial = np.max(elong, axis=(1, 2)) > axial_tol * np.maximum(dmax, 1e-300)
     keep = ~axial
+    theta = None if body is None else V[body + 2][keep]
     lam, U = lam[keep], U[keep]
     order = np.argsort(lam)
     lam, U = lam[order], U[order]
+    theta = None if theta is None else theta[order]
     if count is not None:
         lam, U = lam[: int(count)], U[: int(count)]
-    return lam, U, axial
+        theta = None if theta is None else theta[: int(count)]
+    return lam, U, axial, theta
 
 
-def _node_shapes(U, state) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Normalized node displacements dx, dy (node 0 = rod 1's root, node k = rod k's end) and
-    hinge-angle changes of each mode."""
+def _node_shapes(
+    U, state, theta=None, normalize: bool = True
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Node displacements dx, dy (node 0 = rod 1's root, node k = rod k's end) and
+    hinge-angle changes of each mode (normalized unless ``normalize`` is False); ``theta``:
+    a free body's attitude change per mode, which hinge 0 is measured from."""
     dx = np.concatenate([U[:, :1, 0, 0], U[:, :, -1, 0]], axis=1)
     dy = np.concatenate([U[:, :1, 0, 1], U[:, :, -1, 1]], axis=1)
 
@@ -304,7 +400,9 @@ def _node_shapes(U, state) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     end = dtheta(state[None, :, -1, 2:], U[:, :, -1, 2:])  # rod k end tangent
     hinge = root.copy()
     hinge[:, 1:] -= end[:, :-1]
-    return normalize_shapes(dx, dy, hinge)
+    if theta is not None:
+        hinge[:, 0] -= theta
+    return normalize_shapes(dx, dy, hinge) if normalize else (dx, dy, hinge)
 
 
 def _damping_ratios(omega: np.ndarray, s_damped) -> np.ndarray:

@@ -9,6 +9,9 @@ Comparison
 [dx; dy; l_mean * D] (hinge angles times the mean rod length, so that both parts are lengths);
 ``pair_modes`` pairs the modes of two models by shape (``scipy.optimize.linear_sum_assignment``
 on 1 - MAC), not by index; ``compare_modes`` tabulates several models against a reference.
+On a free base both compare the flexible modes only: each model reports its three rigid modes
+(omega ~ 0) first and apart (``Modes.rigid``, ``rodval.core.modal.split_rigid``), and
+``Modes.flexible`` leaves them out.
 """
 
 from __future__ import annotations
@@ -51,7 +54,10 @@ def model_modes(
 def pair_modes(a: Modes, b: Modes) -> pd.DataFrame:
     """Pair the modes of b with those of a by shape: maximum total MAC (Hungarian assignment on
     1 - MAC). One row per mode of a (by index), with b's paired mode (NaN if none), both
-    frequencies, the relative gap (omega_b - omega_a) / omega_a and the MAC."""
+    frequencies, the relative gap (omega_b - omega_a) / omega_a and the MAC. On a free base
+    the flexible modes are paired (``Modes.flexible``: the three rigid modes, omega ~ 0, left
+    out of both); mode numbers then count the flexible modes."""
+    a, b = a.flexible(), b.flexible()
     if a.dx.shape[1] != b.dx.shape[1]:
         raise ValueError("modes of different chains cannot be paired")
     macs = mac_matrix(a.shape_vectors(), b.shape_vectors())
@@ -91,7 +97,8 @@ def compare_modes(
     """Side-by-side table of the lowest ``count`` modes of ``reference`` (default: the last of
     ``models``, e.g. exudyn) with the paired modes of the other models: columns mode,
     omega_<ref>, and per other model omega_<m>, gap_<m> (relative to the reference) and
-    mac_<m>. ``computed`` may pass Modes already computed (name -> Modes); ``about``,
+    mac_<m>; on a free base the flexible modes (``Modes.flexible``), numbered from 1.
+    ``computed`` may pass Modes already computed (name -> Modes); ``about``,
     ``load_at``, ``allow_unbalanced``: see ``model_modes``; ``options``: each model takes the
     ones its modal analysis accepts (``modal_options``)."""
     models = tuple(models)
@@ -107,7 +114,7 @@ def compare_modes(
                 allow_unbalanced=allow_unbalanced,
                 **modal_options(m, options),
             )
-    ref = got[reference]
+    ref = got[reference].flexible()  # a free base's rigid modes are left out (pair_modes)
     table = pd.DataFrame({"mode": np.arange(1, min(count, ref.count) + 1)})
     table[f"omega_{reference}"] = ref.omega[: len(table)]
     for m in models:

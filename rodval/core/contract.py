@@ -127,11 +127,18 @@ class Model(ABC):
         )
         if cls.MODAL_ANALYSIS is None:
             raise ValueError(f"model {cls.name!r} has no modal analysis")
-        if scene.base.moving:
+        if scene.base.prescribed:
             raise ValueError(
-                f"model {cls.name!r}: modes of a chain on a {scene.base.kind} base (the free spacecraft) are "
-                "not built yet (docs/base.md)"
+                f"model {cls.name!r}: modes of a chain on a prescribed base (a motion that is a "
+                "law of time, not a configuration at rest) are not built (docs/base.md)"
             )
         module, function = cls.MODAL_ANALYSIS.split(":")
         analysis = getattr(importlib.import_module(module), function)
+        # a free base (the spacecraft): only analyses that separate its three rigid modes
+        # (``rodval.core.modal.split_rigid``) say so by a true ``FREE_BASE`` attribute
+        if scene.base.free and not getattr(analysis, "FREE_BASE", False):
+            raise ValueError(
+                f"model {cls.name!r}: modes of a chain on a free base (the free spacecraft) are "
+                "not built for this model (docs/base.md; the full and exudyn models have them)"
+            )
         return analysis(scene, about=about, count=count, load_at=load_at, **options)

@@ -12,7 +12,9 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
+from rodval.core.eigen import quadratic_eigenvalues
 from rodval.core.scene import Scene
 
 if TYPE_CHECKING:
@@ -118,6 +120,9 @@ class Modes:
     defined), dx, dy (count, n+1) node displacements of nodes 0..n, hinge (count, n) hinge
     angles D_0..D_{n-1} (rad per unit of the largest node displacement), phi0 (configuration
     chord angles), l (rod lengths), equilibrium (the static solve, when about="equilibrium").
+    ``rigid``: how many of the first modes are the rigid motions of a chain on a free base
+    (translation x, translation y, rotation about the system's centre of mass; omega ~ 0,
+    ``split_rigid``), 0 otherwise; the rest are the flexible modes (``flexible``).
     """
 
     model: str
@@ -131,6 +136,7 @@ class Modes:
     l: np.ndarray
     equilibrium: Equilibrium | None = None
     info: dict = field(default_factory=dict)
+    rigid: int = 0
 
     @property
     def f_hz(self) -> np.ndarray:
@@ -139,6 +145,30 @@ class Modes:
     @property
     def count(self) -> int:
         return self.omega.size
+
+    def rows(self, index) -> Modes:
+        """The modes ``index`` (a slice or index array) of these, as a Modes (``rigid``
+        counting the rigid ones kept)."""
+        keep = np.arange(self.count)[index]
+        return Modes(
+            model=self.model,
+            about=self.about,
+            omega=self.omega[keep],
+            damping=self.damping[keep],
+            dx=self.dx[keep],
+            dy=self.dy[keep],
+            hinge=self.hinge[keep],
+            phi0=self.phi0,
+            l=self.l,
+            equilibrium=self.equilibrium,
+            info=self.info,
+            rigid=int(np.sum(keep < self.rigid)),
+        )
+
+    def flexible(self) -> Modes:
+        """The flexible modes only (all of them on a pinned base): the rigid motions of a free
+        base (the first ``rigid``) left out, for frequency comparisons."""
+        return self if self.rigid == 0 else self.rows(slice(self.rigid, None))
 
     def shape_vectors(self) -> np.ndarray:
         """(count, 3n+2): [dx; dy; l_mean * D] per mode, the vectors MAC compares."""
@@ -162,6 +192,7 @@ class Modes:
             "hinge": self.hinge.tolist(),
             "phi0": self.phi0.tolist(),
             "l": self.l.tolist(),
+            "rigid": int(self.rigid),
         }
 
     @classmethod
@@ -177,6 +208,7 @@ class Modes:
             hinge=np.asarray(d["hinge"], float).reshape(len(d["omega"]), -1),
             phi0=np.asarray(d["phi0"], float),
             l=np.asarray(d["l"], float),
+            rigid=int(d.get("rigid", 0)),
         )
 
     def frequencies_frame(self) -> pd.DataFrame:
@@ -226,3 +258,160 @@ def normalize_shapes(dx: np.ndarray, dy: np.ndarray, hinge: np.ndarray):
         dy[i] *= s
         hinge[i] *= s
     return dx, dy, hinge
+
+
+#: A free base's three rigid modes must have omega below this fraction of the first flexible
+#: omega (``split_rigid``).
+RIGID_RATIO = 1e-6
+#: Largest relative residual of a rigid mode's shape against an exact rigid motion of the
+#: nodes (``split_rigid``): the eigenvectors of the zero cluster carry round-off of about
+#: eps lam_max / lam_flexible (exudyn's axial modes make that ~1e-7 for the beam model).
+RIGID_SHAPE_TOL = 1e-4
+
+
+def split_rigid(
+    lam: np.ndarray,
+    dx: np.ndarray,
+    dy: np.ndarray,
+    hinge: np.ndarray,
+    x: np.ndarray,
+    y: np.ndarray,
+    l_mean: float,
+    *,
+    ratio: float = RIGID_RATIO,
+    tol: float = RIGID_SHAPE_TOL,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
+    """Separate the three rigid modes of a chain on a free base from its flexible modes, the
+    same way for every model (native ``rodval.models.free_modes``, exudyn's
+    ``reference_models.exudyn_modes``).
+
+    ``lam`` (ascending, 1/s^2) are the eigenvalues of K x = lam M x, M symmetric positive
+    definite, whose eigenvectors x_i are M-orthonormal; dx, dy (modes, n+1), hinge (modes, n)
+    their (unnormalized) node displacements and hinge angles; x, y the nodes' coordinates
+    (m) of the configuration; l_mean scales the hinge angles in the shape vectors
+    [dx; dy; l_mean D]. The rigid modes are:
+
+    * the three smallest eigenvalues, each of |omega| <= ``ratio`` (1e-6) x the fourth's
+      omega (the first flexible mode), else ValueError;
+    * their span must hold the two translations of the whole system (node shapes [1..1; 0..0;
+      0] and [0..0; 1..1; 0], hinge angles 0), each to a relative least-squares residual below
+      ``tol``, else ValueError; the rotation is the combination M-orthogonal to both (in
+      coefficients of M-orthonormal eigenvectors: the cross product of theirs), i.e. the one
+      of zero linear momentum, a rotation about the system's centre of mass; its shape must be
+      a rigid rotation of the nodes (dx = a - w y, dy = b + w x, D = 0) to ``tol``.
+
+    Returns (lam, dx, dy, hinge, info): the three rigid modes first (translation x,
+    translation y, rotation, each with the Rayleigh quotient of its combination as lam),
+    then the flexible ones as given; ``info`` records the ratio and the shape residuals."""
+    lam = np.asarray(lam, float)
+    n1 = dx.shape[1]
+    measured = _rigid_ratio(lam, ratio)
+    S = np.hstack([dx[:3], dy[:3], l_mean * hinge[:3]])  # (3, L)
+    C, R, residual = _rigid_combinations(S, n1, hinge.shape[1], x, y)
+    bad = {k: v for k, v in residual.items() if not v <= tol}
+    if bad:
+        raise ValueError(
+            "the free base's three smallest modes are not rigid motions: shape residual "
+            + ", ".join(f"{k} {v:.3g}" for k, v in bad.items())
+            + f" (at most {tol:g})"
+        )
+    lam_r = np.einsum("ij,j,ij->i", C, lam[:3], C) / np.einsum("ij,ij->i", C, C)
+    L = n1
+    out = (
+        np.concatenate([lam_r, lam[3:]]),
+        np.vstack([R[:, :L], dx[3:]]),
+        np.vstack([R[:, L : 2 * L], dy[3:]]),
+        np.vstack([R[:, 2 * L :] / l_mean, hinge[3:]]),
+    )
+    info = {
+        "rigid_ratio": measured,
+        "rigid_shape_residual": residual,
+        "rigid_modes": ("translation_x", "translation_y", "rotation"),
+    }
+    return (*out, info)
+
+
+def _rigid_ratio(lam: np.ndarray, ratio: float) -> float:
+    """The ratio (dimensionless) of the largest |omega| of the three smallest eigenvalues
+    ``lam`` (ascending, 1/s^2) to the fourth's omega (rad/s, the first flexible mode); at
+    least four modes, and the ratio at most ``ratio``, else ValueError."""
+    if lam.size < 4:
+        raise ValueError(
+            f"a chain on a free base has three rigid modes and at least one flexible mode; "
+            f"got {lam.size} modes"
+        )
+    first = np.sqrt(abs(lam[3]))
+    measured = float(np.sqrt(np.max(np.abs(lam[:3]))) / first) if first > 0 else np.inf
+    if not measured <= ratio:
+        raise ValueError(
+            "the free base's three rigid modes were not found: the third smallest |omega| is "
+            f"{measured:.3g} of the first flexible one (at most {ratio:g} expected)"
+        )
+    return measured
+
+
+def _rigid_combinations(
+    S: np.ndarray, n1: int, n_hinge: int, x: np.ndarray, y: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
+    """The rigid modes as combinations of the three smallest modes' shape vectors ``S`` (3, L)
+    = [dx; dy; l_mean D] (m; n1 nodes, n_hinge hinges; x, y the nodes' coordinates, m):
+    (C (3 rigid, 3 eigenvectors), dimensionless coefficients; R = C S (3, L) their shapes,
+    m; the relative least-squares residuals, dimensionless, of translation x, translation y
+    and the rotation against exact rigid motions, ``split_rigid``)."""
+    zeros_h = np.zeros(n_hinge)
+    tx = np.concatenate([np.ones(n1), np.zeros(n1), zeros_h])
+    ty = np.concatenate([np.zeros(n1), np.ones(n1), zeros_h])
+    coef, residual = [], {}
+    for name, t in (("translation_x", tx), ("translation_y", ty)):
+        c = np.linalg.lstsq(S.T, t, rcond=None)[0]
+        residual[name] = float(np.linalg.norm(S.T @ c - t) / np.linalg.norm(t))
+        coef.append(c)
+    cr = np.cross(coef[0], coef[1])
+    coef.append(cr / np.linalg.norm(cr))
+    C = np.array(coef)  # (3 rigid, 3 eigenvectors)
+    R = C @ S
+    tr = np.concatenate([-np.asarray(y, float), np.asarray(x, float), zeros_h])
+    basis = np.column_stack([tx, ty, tr])
+    fit = np.linalg.lstsq(basis, R[2], rcond=None)[0]
+    residual["rotation"] = float(
+        np.linalg.norm(basis @ fit - R[2]) / max(float(np.linalg.norm(R[2])), 1e-300)
+    )
+    if not abs(fit[2]) > 0:
+        residual["rotation"] = np.inf
+    return C, R, residual
+
+
+def mac_matrix(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """MAC of every row of A against every row of B (dimensionless, in [0, 1]; shape vectors
+    in any one unit, real or complex)."""
+    A, B = np.asarray(A), np.asarray(B)
+    num = np.abs(A.conj() @ B.T) ** 2
+    den = np.outer(np.sum(np.abs(A) ** 2, 1), np.sum(np.abs(B) ** 2, 1))
+    return np.divide(num, den, out=np.zeros_like(num, dtype=float), where=den > 0)
+
+
+def damping_ratios(
+    M: np.ndarray, C: np.ndarray, K: np.ndarray, X: np.ndarray, omega: np.ndarray
+) -> np.ndarray:
+    """zeta_i (dimensionless) of the quadratic eigenproblem (M s^2 + C s + K) z = 0, paired
+    with the undamped modes X (columns, in the coordinates of M, C, K) of angular frequencies
+    ``omega`` (rad/s) by MAC (``mac_matrix``, Hungarian pairing): zeta = -Re(s) / |s| of the
+    paired eigenvalue (Im s > 0, 1/s); 0 for every omega > 0 without damping (C = 0), NaN where
+    undefined (omega <= 0, no partner). M, C, K in consistent units (kg, N s/m, N/m or their
+    rotational counterparts). Shared by the native fixed-base and free-base modes
+    (``rodval.models.linear_modes``, ``rodval.models.free_modes``)."""
+    zeta = np.full(omega.size, np.nan)
+    if not np.any(C):
+        zeta[omega > 0] = 0.0
+        return zeta
+    s, V = quadratic_eigenvalues(M, C, K)
+    up = s.imag > 0
+    s, Z = s[up], V[:, up]
+    keep = omega > 0
+    if not np.any(keep) or s.size == 0:
+        return zeta
+    cost = 1.0 - mac_matrix(X[:, keep].T, Z.T)
+    rows, cols = linear_sum_assignment(cost)
+    idx = np.flatnonzero(keep)
+    zeta[idx[rows]] = -s[cols].real / np.abs(s[cols])
+    return zeta

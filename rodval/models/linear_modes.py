@@ -84,13 +84,19 @@ import scipy.linalg
 from scipy.optimize import linear_sum_assignment
 
 from rodval.core.checks import check_choice, check_type
-from rodval.core.eigen import angular_frequencies, quadratic_eigenvalues, symmetric_pencil
+from rodval.core.eigen import angular_frequencies, symmetric_pencil
 from rodval.core.modal import (
     ABOUT,
     Modes,
+    damping_ratios,
     normalize_shapes,
     static_loads,
 )
+
+# ``mac_matrix`` lives with ``damping_ratios`` in ``rodval.core.modal`` (shared with the
+# free-base modes, ``rodval.models.free_modes``, without an import cycle); re-exported here
+# for its callers (``rodval.analysis.modes``)
+from rodval.core.modal import mac_matrix as mac_matrix
 from rodval.core.scene import Chain, InitialState, Scene
 from rodval.models.full import FullModel
 from rodval.models.ladder import (
@@ -108,6 +114,7 @@ from rodval.models.paper_matrices import (
 from rodval.models.reduced import ReducedModel, ReducedSystem
 from rodval.models.rungs import PAPER_RUNG, check_kinematics, check_shapes
 from rodval.models.statics import (
+    body_rest_angles,
     check_at_rest,
     load_stiffness,
     no_equilibrium,
@@ -336,33 +343,6 @@ def mac(a: np.ndarray, b: np.ndarray) -> float:
     return float((a @ b) ** 2 / den) if den > 0 else 0.0
 
 
-def mac_matrix(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """MAC of every row of A against every row of B."""
-    A, B = np.asarray(A), np.asarray(B)
-    num = np.abs(A.conj() @ B.T) ** 2
-    den = np.outer(np.sum(np.abs(A) ** 2, 1), np.sum(np.abs(B) ** 2, 1))
-    return np.divide(num, den, out=np.zeros_like(num, dtype=float), where=den > 0)
-
-
-def _damping_ratios(M, C, K, X, omega) -> np.ndarray:
-    """zeta_i of the quadratic eigenproblem, paired with the undamped modes X (columns)."""
-    zeta = np.full(omega.size, np.nan)
-    if not np.any(C):
-        zeta[omega > 0] = 0.0
-        return zeta
-    s, V = quadratic_eigenvalues(M, C, K)
-    up = s.imag > 0
-    s, Z = s[up], V[:, up]
-    keep = omega > 0
-    if not np.any(keep) or s.size == 0:
-        return zeta
-    cost = 1.0 - mac_matrix(X[:, keep].T, Z.T)
-    rows, cols = linear_sum_assignment(cost)
-    idx = np.flatnonzero(keep)
-    zeta[idx[rows]] = -s[cols].real / np.abs(s[cols])
-    return zeta
-
-
 def modes(
     scene: Scene,
     model: str = "full",
@@ -419,6 +399,23 @@ def modes_about(
     static equilibrium when asked for, the linear system, its eigen-solution and shapes.
     Dense: O(N^3) for the N = 3n (full; n (p + 2) on a ladder rung) or n (reduced)
     coordinates."""
+    if scene.base.moving:
+        if not (scene.base.free and model == FullModel.name):
+            raise ValueError(
+                f"model {model!r}: modes of a chain on a {scene.base.kind} base are not built "
+                "(the full model has them on a free base, docs/base.md)"
+            )
+        from rodval.models.free_modes import free_modes
+
+        return free_modes(
+            scene,
+            about=about,
+            count=count,
+            coefficients=coefficients,
+            load_at=load_at,
+            shapes=shapes,
+            kinematics=kinematics,
+        )
     chain, n = scene.chain, scene.n
     ini = scene.initial.resolve(n)
     q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
@@ -437,7 +434,7 @@ def modes_about(
     count = N if count is None else min(count, N)
     lam, X = lam[:count], X[:, :count]
     omega = angular_frequencies(lam)
-    zeta = _damping_ratios(M, C, K, X, omega)
+    zeta = damping_ratios(M, C, K, X, omega)
     # node displacements and hinge angles need phi, alpha, beta only (bubbles: zero at the ends)
     dx, dy, hinge = _shapes(chain, model, q0[:n], X[: 3 * n], lam, coefficients=coefficients)
     return Modes(
@@ -481,7 +478,7 @@ def check_configuration(
         return {}
     ini = scene.initial.resolve(scene.n)
     q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
-    R = static_residual(scene.chain, q0, rest=scene.chain.rest_angle)
+    R = static_residual(scene.chain, q0, rest=body_rest_angles(scene))
     return {"unbalanced_residual_Nm": float(np.max(np.abs(R)))}
 
 
@@ -489,3 +486,6 @@ def check_configuration(
 #: load_at, coefficients, ...) -> Modes, the form ``Model.modes`` calls
 full_modes = partial(modes_about, model=FullModel.name)
 reduced_modes = partial(modes_about, model=ReducedModel.name)
+#: The full model has modes on a free base (``rodval.models.free_modes``: its three rigid
+#: modes separated), on every rung; ``Model.modes`` refuses a free base to the others.
+full_modes.FREE_BASE = True  # type: ignore[attr-defined]

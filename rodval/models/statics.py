@@ -121,6 +121,17 @@ def no_equilibrium(chain: Chain, eq: Equilibrium) -> str:
 AT_REST_RTOL = 1e-8
 
 
+def body_rest_angles(scene: Scene) -> np.ndarray:
+    """The hinge rest angles (rad, n) in the chain's own hinge angles (hinge 0 from theta = 0):
+    on a free base hinge 0 is measured from the body's attitude theta (D_0 = phi_1 + alpha_1 -
+    theta), so its spring relaxes where phi_1 + alpha_1 = theta + rest_0."""
+    rest = np.array(scene.chain.rest_angle, float)
+    attitude = scene.base.initial_attitude() if scene.base.free else None
+    if attitude:
+        rest[0] += attitude
+    return rest
+
+
 def check_at_rest(scene: Scene) -> float:
     """The initial state's static residual max |R(q0)| (N m, ``static_residual`` with the
     hinge rest angles and without loads, which the linearization about the initial state
@@ -138,10 +149,19 @@ def check_at_rest(scene: Scene) -> float:
             "(about='equilibrium', --about equilibrium) or pass allow_unbalanced=True "
             "(--allow-unbalanced) to linearize about the initial positions anyway"
         )
+    base = scene.base
+    if base.free and (any(base.velocity) or base.rate):
+        raise ValueError(
+            "the initial state is not at rest (the free base's velocity or rate is not zero), "
+            "so there is no configuration to vibrate about; start the body at rest or pass "
+            "allow_unbalanced=True (--allow-unbalanced) to linearize about the initial "
+            "positions anyway"
+        )
     q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
     K = stiffness_matrix(chain)
-    R = static_residual(chain, q0, rest=chain.rest_angle, K=K)
-    spring = hinge_matrix(n).T @ (chain.kappa * chain.rest_angle)
+    rest = body_rest_angles(scene)
+    R = static_residual(chain, q0, rest=rest, K=K)
+    spring = hinge_matrix(n).T @ (chain.kappa * rest)
     scale = np.max(np.abs(K @ q0)) + np.max(np.abs(spring)) + 1.0
     worst = int(np.argmax(np.abs(R)))
     residual = float(abs(R[worst]))
