@@ -138,7 +138,8 @@ def scenes(draw) -> Scene:
         rate=draw(st.floats(-1.0, 1.0)),
     )
     base = draw(st.sampled_from([PINNED, free]))
-    quantities = [q for q in QUANTITIES if base.free or q != "base"]
+    # "base" needs a moving base, "drive" a prescribed one (none is drawn here)
+    quantities = [q for q in QUANTITIES if (base.free or q != "base") and q != "drive"]
     t_end = draw(st.floats(0.05, 1.0))
     times = draw(
         st.one_of(

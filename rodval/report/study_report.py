@@ -5,9 +5,11 @@
 
 ``build_report`` puts the sections in order: the header (study, models, machine), Acceptance
 (``rodval.report.acceptance``), Outcome, Discrepancies, Run time and Stability map
-(``study_summary``), the figures against the grid parameters (``study_figures``), Sample
-statistics (``sample_stats``), the Deployment section (here, with the events tables), Modes
-(``study_modes``) and the report cases' time histories and configurations (``study_figures``).
+(``study_summary``), the Error budget of the full model's ladder when the study runs its
+rungs (``error_budget``: also ``error_budget.csv`` and ``.md``), the figures against the grid
+parameters (``study_figures``), Sample statistics (``sample_stats``), the Deployment section
+(here, with the events tables), Modes (``study_modes``) and the report cases' time histories
+and configurations (``study_figures``).
 """
 
 from __future__ import annotations
@@ -29,12 +31,19 @@ from rodval.core.out_paths import STUDY_SCHEMA, is_stamped
 from rodval.models import get_model
 from rodval.models.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
+from rodval.report.error_budget import error_budget
 from rodval.report.markdown import to_markdown
 from rodval.report.sample_stats import sample_section
 from rodval.report.study_figures import case_figures, deployment_figures, param_figures
 from rodval.report.study_modes import modes_section
 from rodval.report.study_summary import summary_sections
-from rodval.report.tables import FIGURES, axis_columns, read_events, read_tables
+from rodval.report.tables import (
+    ERROR_BUDGET,
+    FIGURES,
+    axis_columns,
+    read_events,
+    read_tables,
+)
 
 #: Columns of the events table shown in the report, when present.
 EVENT_REPORT_COLUMNS = (
@@ -194,6 +203,41 @@ def _deployment_section(
     return [*lines, *deployment_figures(fig_dir, meta, tables, events)]
 
 
+def _error_budget_section(
+    out: Path, meta: dict[str, Any], tables: dict[str, pd.DataFrame]
+) -> list[str]:
+    """The Error budget section and ``out/error_budget.csv``, ``.md`` when the study runs the
+    rungs the split needs (``rodval.report.error_budget``); nothing otherwise (and a stale
+    budget of an earlier report of the folder is removed)."""
+    budget = error_budget(tables["discrepancies"], meta)
+    files = [out / f"{ERROR_BUDGET}.{ext}" for ext in ("csv", "md")]
+    if budget is None:
+        for path in files:
+            path.unlink(missing_ok=True)
+        return []
+    budget.to_csv(files[0], index=False)
+    table = to_markdown(_blanks(budget), ".3g")
+    files[1].write_text(table)
+    p_max = int(budget["p_max"].iloc[0])
+    ref = meta["reference"]
+    return [
+        "## Error budget of the model ladder\n",
+        f"Each case group's gap to `{ref}` (the Discrepancies' `max_abs` of each rung of the "
+        "full model, over all output times and rods, in the quantity's unit) split into "
+        'parts (docs/model.md, "The model ladder"): `kinematics` = gap(first-order, p = 1) '
+        "- gap(exact, p = 1), what the paper's first-order kinematics costs; `shapes` = "
+        f"gap(exact, 1) - gap(exact, {p_max}), what one cubic shape per rod costs; `base` = "
+        f"gap(exact, {p_max}) - the same gap of the pinned case, what a free base adds, when "
+        "the study varies the base kind (else blank, `base_note` says why); `remainder` = "
+        f"gap(exact, {p_max}) - base: the reference's own discretization error and what no "
+        "rung carries (the inextensible chord). The parts add up to the paper rung's gap; a "
+        "negative part means the rungs' errors cancel (a rung closer to the reference "
+        "because its error offsets another), not that relaxing an assumption hurts. Also "
+        f"`{ERROR_BUDGET}.csv` and `{ERROR_BUDGET}.md`.\n",
+        table,
+    ]
+
+
 def model_row(m: dict[str, Any]) -> dict[str, Any]:
     """A study model's row of the report's Models table: its options as the model runs them
     (defaults included) and the integrator settings that apply to it; "n/a" for a model that
@@ -266,6 +310,7 @@ def build_report(out: str | Path) -> Path:
     lines = _header(meta, prov)
     lines += acceptance_section(meta, tables, events)
     lines += summary_sections(meta, tables, params)
+    lines += _error_budget_section(out, meta, tables)
     figs = param_figures(fig_dir, meta, tables, params)
     if figs:
         lines += ["## Discrepancy, run time and speed-up against the grid parameters\n", *figs]

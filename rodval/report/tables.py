@@ -18,9 +18,12 @@ from rodval.analysis.metrics import METRICS
 from rodval.core.checks import as_path
 
 TABLES = ("cases", "trajectories", "discrepancies", "runtime")
+#: The report's error budget (``rodval.report.error_budget``): ``error_budget.csv``, ``.md``.
+ERROR_BUDGET = "error_budget"
 #: Every table a study may write (``<name>.csv``, some also ``<name>.md``): the four above,
-#: and events and modes tables when runs record them.
-ALL_TABLES = (*TABLES, "events", "modes", "mac", "mode_shapes")
+#: events and modes tables when runs record them, and the report's error budget
+#: (``rodval.report.error_budget``) when the study runs the full model's ladder.
+ALL_TABLES = (*TABLES, "events", "modes", "mac", "mode_shapes", ERROR_BUDGET)
 #: The report's figure folder in a study folder (the PNG files report.md links).
 FIGURES = "figures"
 FIXED = (
