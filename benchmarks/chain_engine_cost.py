@@ -21,7 +21,7 @@ from exudyn_speed import wing_scene
 from rodval.core.base import Base, Motion
 from rodval.core.scene import Chain, Scene
 from rodval.models import simulate
-from rodval.models.full import FullModel
+from rodval.models.presets.full import FullModel
 
 BASES = {
     "pinned": Base(),

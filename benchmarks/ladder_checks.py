@@ -26,9 +26,9 @@ import rodval
 from reference_models.exudyn_modes import exudyn_modes
 from rodval import simulate
 from rodval.core.scene import Chain, Scene
-from rodval.models.ladder import ladder_constants
-from rodval.models.ladder_kernels import ladder_accel
-from rodval.models.linear_modes import modes
+from rodval.models.kinematics.ladder import ladder_constants
+from rodval.models.kinematics.ladder_kernels import ladder_accel
+from rodval.models.observation.linear_modes import modes
 
 
 def lagrangian() -> None:

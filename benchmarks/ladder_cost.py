@@ -16,7 +16,7 @@ import timeit
 import numpy as np
 
 from rodval.core.scene import Chain, Scene
-from rodval.models.full import FullModel
+from rodval.models.presets.full import FullModel
 
 RUNGS = [(1, "exact"), (2, "exact"), (3, "exact"), (4, "exact"), (4, "first-order")]
 SIZES = (8, 64, 512, 4096)

@@ -1,4 +1,4 @@
-"""Cost of one reduced-model right-hand side: the O(n) solves of rodval.models.reduced_banded
+"""Cost of one reduced-model right-hand side: the O(n) solves of rodval.models.bending.reduced_banded
 against the dense kernels.reduced_accel (O(n^2) assembly + O(n^3) solve, timed for n <= 512).
 
 Columns: "default" = reduced_accel_banded (the sweep, work allocated per call); "sweep+work"
@@ -22,8 +22,8 @@ import time
 import numpy as np
 
 from rodval.core.scene import Chain
-from rodval.models import kernels
-from rodval.models import reduced_banded as rb
+from rodval.models.assembly import kernels
+from rodval.models.bending import reduced_banded as rb
 
 SIZES = (8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384, 32768, 65536, 100000)
 DENSE_MAX = 512
@@ -64,7 +64,7 @@ def seconds_per_call(f, min_time: float, repeats: int) -> float:
 def dense_setup(ch: Chain):
     """(V, Mt) of the dense kernel, built through the existing ReducedSystem."""
     from rodval.core.scene import Scene
-    from rodval.models.reduced import ReducedSystem
+    from rodval.models.presets.reduced import ReducedSystem
 
     system = ReducedSystem(Scene(chain=ch, t_end=1.0), "printed", "numba")
     return system.V, system.Mt

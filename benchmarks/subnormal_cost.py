@@ -4,7 +4,7 @@ On a long chain the pulse at the last node moves only the rods near the tip with
 towards the root the state and the O(n) solves' intermediate values decay geometrically
 through the subnormal range (|v| < 2.2e-308), and on x86 every operation on (or giving) a
 subnormal takes a microcode assist of ~100 cycles. In the reduced model's tip-to-root sweep
-(rodval/models/reduced_banded.py) one coefficient of the tail relation (F[0, 1], the P_y ->
+(rodval/models/bending/reduced_banded.py) one coefficient of the tail relation (F[0, 1], the P_y ->
 S_x coupling) even stays stuck at a few ulps of the smallest subnormal from where the motion
 dies out down to the root, so every rod of the sweep pays the assist.
 

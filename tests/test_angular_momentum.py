@@ -10,9 +10,9 @@ import pytest
 from rodval import Chain, paper_scene, simulate
 from rodval.analysis.metrics import relative_error
 from rodval.core.scene import InitialState, Scene
-from rodval.models import paper_matrices as pm
-from rodval.models.full import FullModel
-from rodval.models.reduced import ReducedModel
+from rodval.models.assembly import paper_matrices as pm
+from rodval.models.presets.full import FullModel
+from rodval.models.presets.reduced import ReducedModel
 
 
 def random_chain(rng, n, free_root=True) -> Chain:

@@ -11,7 +11,7 @@ from rodval.bench.stiffness import rigid_latch
 from rodval.core.scene import Chain, InitialState, Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.models import get_model
-from rodval.models.full import FullSystem
+from rodval.models.presets.full import FullSystem
 
 
 def proportional_chain(beta: float) -> Chain:

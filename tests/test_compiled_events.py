@@ -21,8 +21,8 @@ import pytest
 from rodval import Chain, InitialState, Latch, Scene, Stop, simulate
 from rodval.bench import four_panel_wing
 from rodval.core.scene_file import scene_from_dict
-from rodval.models.full import FullSystem
-from rodval.models.reduced import ReducedSystem
+from rodval.models.presets.full import FullSystem
+from rodval.models.presets.reduced import ReducedSystem
 
 #: The four-panel zig-zag wing of studies/deployment.toml (stowed, released by its
 #: pre-stressed hinges, latching straight), over its first two locks.

@@ -8,8 +8,8 @@ import pytest
 
 from rodval.core.scene import Chain, InitialState, Latch, Scene, Stop
 from rodval.core.settings import IntegratorSettings
-from rodval.models.full import FullModel, FullSystem
-from rodval.models.reduced import ReducedModel, ReducedSystem
+from rodval.models.presets.full import FullModel, FullSystem
+from rodval.models.presets.reduced import ReducedModel, ReducedSystem
 from rodval.solvers.driver import integrate
 
 MODELS = {"full": FullModel, "reduced": ReducedModel}

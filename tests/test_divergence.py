@@ -6,7 +6,7 @@ import numpy as np
 
 from rodval import IntegratorSettings, paper_scene, simulate
 from rodval.core.status import STATUS_BLOWUP, STATUS_DIVERGED, STATUS_STALLED
-from rodval.models.full import FullSystem
+from rodval.models.presets.full import FullSystem
 from rodval.solvers.guard import DivergenceGuard
 
 SCENE = paper_scene(times=[0.5, 1.0, 1.5, 2.0])

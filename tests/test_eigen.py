@@ -133,7 +133,7 @@ _LOWEST = textwrap.dedent(
     """
     import json
     from rodval import paper_scene
-    from rodval.models.linear_modes import modes
+    from rodval.models.observation.linear_modes import modes
     out = {m: float(modes(paper_scene(8), m, count=1).omega[0]) for m in ("full", "reduced")}
     try:
         from reference_models.exudyn_modes import exudyn_modes

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from rodval import FullModel, load_scene, simulate
-from rodval.models.paper_matrices import hinge_matrix
+from rodval.models.assembly.paper_matrices import hinge_matrix
 
 SCENE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "wing_stop_latches.toml"
 #: Output times either side of an event (s).

@@ -12,7 +12,7 @@ import pytest
 
 from rodval import Base, paper_scene, simulate
 from rodval.core.scene_file import scene_from_dict, scene_to_dict
-from rodval.models.free_base_system import FreeBaseSystem
+from rodval.models.base.free_base_system import FreeBaseSystem
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
 BODY = dict(kind="free", mass=50.0, inertia=20.0, hinge_offset=[0.5, 0.2])

@@ -1,7 +1,7 @@
 """Modes of a chain on a free base (issue 40, "modes of a free spacecraft"): the three rigid
 modes (translation x, translation y, rotation about the system's centre of mass; omega ~ 0)
 separated from the flexible ones (``rodval.core.modal.split_rigid``) in the native full model
-on every rung (``rodval.models.free_modes``) and in exudyn (``reference_models.exudyn_modes``).
+on every rung (``rodval.models.observation.free_modes``) and in exudyn (``reference_models.exudyn_modes``).
 
 Scene: 3 rods l = 1.5 m, m = 3 kg/m, EI = 1e5 N m^2, mu = 0.5 kg, kappa = 50 N m/rad (nu =
 0.01 N m s/rad, the paper's), straight at rest, on Base(free, 50 kg, 20 kg m^2, hinge offset
@@ -35,8 +35,8 @@ from rodval.analysis.modes import compare_modes, model_modes, pair_modes
 from rodval.core.base import Motion
 from rodval.core.loads import constant
 from rodval.core.modal import RIGID_RATIO
-from rodval.models.full import FullModel
-from rodval.models.reduced import ReducedModel
+from rodval.models.presets.full import FullModel
+from rodval.models.presets.reduced import ReducedModel
 
 BODY = dict(kind="free", mass=50.0, inertia=20.0, hinge_offset=(0.5, 0.0))
 #: exudyn's refined mesh for the comparison (modes' default EA, 1e8 N)

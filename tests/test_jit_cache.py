@@ -73,12 +73,12 @@ def test_a_cached_kernel_runs_the_new_code_of_a_callee_in_another_module(tmp_pat
 def test_rodval_installs_it_for_its_own_kernels():
     assert jit_cache.INSTALLED
     assert str(jit_cache.PACKAGE_ROOT) + "/" in jit_cache._ROOTS
-    kernels = jit_cache.PACKAGE_ROOT / "models" / "kernels.py"
+    kernels = jit_cache.PACKAGE_ROOT / "models" / "assembly" / "kernels.py"
     closure = {
         p.relative_to(jit_cache.PACKAGE_ROOT).as_posix() for p in jit_cache.import_closure(kernels)
     }
     # the full model's kernels reach the load kernels they call, not the CLI
-    assert {"models/kernels.py", "core/loads.py"} <= closure
+    assert {"models/assembly/kernels.py", "core/loads.py"} <= closure
     assert not any(p.startswith(("cli/", "report/", "study/")) for p in closure)
 
 

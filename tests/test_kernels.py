@@ -9,8 +9,8 @@ import pytest
 from rodval import paper_scene
 from rodval.core.loads import LoadSet, NodalForce, constant, load_sums, load_table, pulse
 from rodval.core.scene import Chain, Scene
-from rodval.models.full import FullSystem
-from rodval.models.reduced import ReducedSystem
+from rodval.models.presets.full import FullSystem
+from rodval.models.presets.reduced import ReducedSystem
 
 SYSTEMS = {"full": (FullSystem, 6), "reduced": (ReducedSystem, 2)}
 

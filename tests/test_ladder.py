@@ -16,11 +16,11 @@ from ladder_lagrangian import equations, kinetic_energy
 import rodval
 from rodval import simulate
 from rodval.core.scene import Chain, Latch, Scene
-from rodval.models.full import FullModel, FullSystem
-from rodval.models.ladder import LadderSystem, ladder_constants
-from rodval.models.ladder_kernels import ladder_accel, ladder_kinetic
-from rodval.models.linear_modes import modes
-from rodval.models.shapes import rod_shapes, shape_polynomials
+from rodval.models.kinematics.ladder import LadderSystem, ladder_constants
+from rodval.models.kinematics.ladder_kernels import ladder_accel, ladder_kinetic
+from rodval.models.kinematics.shapes import rod_shapes, shape_polynomials
+from rodval.models.observation.linear_modes import modes
+from rodval.models.presets.full import FullModel, FullSystem
 
 EPS = np.finfo(float).eps
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from rodval import Chain, InitialState, Scene, paper_scene, pulse, simulate
-from rodval.models.linear_modes import natural_frequencies
+from rodval.models.observation.linear_modes import natural_frequencies
 
 L, M_LEN, EI = 2.0, 3.0, 1e5
 EB_SCALE = np.sqrt(EI / (M_LEN * L**4))

@@ -11,8 +11,8 @@ import pytest
 
 from rodval import Chain, Scene, constant, paper_scene
 from rodval.analysis.modes import compare_modes, pair_modes
-from rodval.models.linear_modes import mac, modes, natural_frequencies
-from rodval.models.statics import static_equilibrium, static_residual
+from rodval.models.observation.linear_modes import mac, modes, natural_frequencies
+from rodval.models.observation.statics import static_equilibrium, static_residual
 
 L, M_LEN, EI = 2.0, 3.0, 1e5
 EB_SCALE = math.sqrt(EI / (M_LEN * L**4))
@@ -88,7 +88,7 @@ def test_static_equilibrium_residual_and_rest_angle_argument():
     assert np.max(np.abs(static_residual(chain, eq.q, SX, SY))) < 1e-8
     rest = np.array([0.1, -0.2, 0.3])
     eq2 = static_equilibrium(chain, rest=rest)
-    from rodval.models.paper_matrices import hinge_matrix
+    from rodval.models.assembly.paper_matrices import hinge_matrix
 
     np.testing.assert_allclose(hinge_matrix(3) @ eq2.q, rest, atol=1e-12)
     np.testing.assert_allclose(eq2.q[3:], 0.0, atol=1e-12)
@@ -97,7 +97,7 @@ def test_static_equilibrium_residual_and_rest_angle_argument():
 def test_damping_ratios_match_modal_approximation():
     """Paper chain n = 8 (nu = 0.01): damping ratios from the quadratic eigenproblem agree with
     the light-damping estimate x^T C x / (2 omega x^T M x) to 1e-3 (relative)."""
-    from rodval.models.linear_modes import eigen, linear_system
+    from rodval.models.observation.linear_modes import eigen, linear_system
 
     chain = Chain.uniform(8)
     M, C, K = linear_system(chain, "full")
@@ -326,7 +326,7 @@ def _mp_frequencies(M, K, dps=40):
 def test_published_spectrum_against_mpmath_n10():
     """n = 10 (30 x 30): every frequency of the published full model agrees with mpmath's
     (40 digits) to 1e-7 relative."""
-    from rodval.models.linear_modes import linear_matrices
+    from rodval.models.observation.linear_modes import linear_matrices
 
     chain = Chain.uniform(10)
     M, K = linear_matrices(chain, "full", coefficients="published")
@@ -344,7 +344,7 @@ def test_published_spectrum_n64_is_real_and_matches_mpmath():
     agree with the reduced model's to 1e-3 (measured 9e-5, the model difference)."""
     import scipy.linalg
 
-    from rodval.models.linear_modes import linear_matrices
+    from rodval.models.observation.linear_modes import linear_matrices
 
     chain = Chain.uniform(64)
     M, K = linear_matrices(chain, "full", coefficients="published")
@@ -363,7 +363,7 @@ def test_published_spectrum_n64_is_real_and_matches_mpmath():
 @pytest.mark.slow
 def test_published_spectrum_against_mpmath_n32_all():
     """n = 32 (96 x 96, ~75 s in mpmath): all 96 frequencies to 1e-7."""
-    from rodval.models.linear_modes import linear_matrices
+    from rodval.models.observation.linear_modes import linear_matrices
 
     chain = Chain.uniform(32)
     M, K = linear_matrices(chain, "full", coefficients="published")

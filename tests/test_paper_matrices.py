@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from rodval import Chain
-from rodval.models import paper_matrices as pm
+from rodval.models.assembly import paper_matrices as pm
 
 
 @pytest.fixture(params=[1, 2, 4])

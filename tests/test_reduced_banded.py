@@ -1,4 +1,4 @@
-"""The O(n) reduced-model solves (rodval.models.reduced_banded: the tip-to-root sweep and the
+"""The O(n) reduced-model solves (rodval.models.bending.reduced_banded: the tip-to-root sweep and the
 banded LU) against the dense numpy reference (ReducedSystem with kernel="numpy": numpy_rhs for
 phi'', recover_bending for gamma)."""
 
@@ -7,15 +7,15 @@ import pytest
 
 from rodval.core.loads import constant, pulse
 from rodval.core.scene import Chain, InitialState, Scene
-from rodval.models import reduced_band_lu as lu
-from rodval.models import reduced_banded as rb
-from rodval.models.paper_matrices import (
+from rodval.models.assembly.paper_matrices import (
     angle_differences,
     assemble_mass,
     chain_constants,
     convective_terms,
 )
-from rodval.models.reduced import ReducedSystem
+from rodval.models.bending import reduced_band_lu as lu
+from rodval.models.bending import reduced_banded as rb
+from rodval.models.presets.reduced import ReducedSystem
 
 RTOL = 1e-9
 TIMES = (0.3, 0.5, 1.7)  # both loads on; at the X kink; past the pulse (constant only)

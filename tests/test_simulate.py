@@ -17,7 +17,7 @@ from rodval import (
     simulate,
 )
 from rodval.core.status import STATUS_ERROR
-from rodval.models.reduced import ReducedSystem
+from rodval.models.presets.reduced import ReducedSystem
 
 
 def small_scene(**kw):

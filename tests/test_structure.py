@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from rodval.models.registry import MODEL_NAMES
+from rodval.models.presets.registry import MODEL_NAMES
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("rodval", "reference_models")

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from rodval import Chain, Scene, paper_scene
-from rodval.models.linear_modes import modes
+from rodval.models.observation.linear_modes import modes
 from rodval.study import load_study, run_study
 
 STUDY = """

@@ -1,6 +1,6 @@
 """Modes of every model side by side: ``model_modes`` checks once what the modes are about
-(``rodval.models.linear_modes.check_configuration``) and asks the model for them
-(``Model.modes``: the paper models' linearization in ``rodval.models.linear_modes``, exudyn's
+(``rodval.models.observation.linear_modes.check_configuration``) and asks the model for them
+(``Model.modes``: the paper models' linearization in ``rodval.models.observation.linear_modes``, exudyn's
 in ``reference_models.exudyn_modes``).
 
 Comparison
@@ -24,8 +24,8 @@ from scipy.optimize import linear_sum_assignment
 
 from rodval.core.modal import Modes
 from rodval.core.scene import Scene
-from rodval.models.linear_modes import check_arguments, check_configuration, mac_matrix
-from rodval.models.registry import MODEL_NAMES, modal_options, model_class
+from rodval.models.observation.linear_modes import check_arguments, check_configuration, mac_matrix
+from rodval.models.presets.registry import MODEL_NAMES, modal_options, model_class
 
 
 def model_modes(

@@ -21,7 +21,7 @@ from rodval.bench.precision import (
 from rodval.core.scene import paper_scene
 from rodval.core.settings import IntegratorSettings
 from rodval.models import get_model
-from rodval.models.registry import MODEL_NAMES, integrated_models, uses_integrator
+from rodval.models.presets.registry import MODEL_NAMES, integrated_models, uses_integrator
 from rodval.solvers.driver import integrate
 
 #: The wall-time ratios of ``speedup_vs_n`` ("a/b": model a's time over model b's), where

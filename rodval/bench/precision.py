@@ -16,8 +16,8 @@ from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.trajectory import Trajectory
 from rodval.models import get_model
-from rodval.models.paper_system import PaperSystem
-from rodval.models.registry import integrated_models, simulate, uses_integrator
+from rodval.models.assembly.paper_system import PaperSystem
+from rodval.models.presets.registry import integrated_models, simulate, uses_integrator
 from rodval.solvers.ode_model import OdeModel
 
 QUANTITIES = ("phi", "dphi", "alpha", "beta")

@@ -15,7 +15,7 @@ from rodval.bench.cost import fitted_exponent
 from rodval.bench.precision import SLOW_RUN_S, errors, paper_system_of, timed, with_provenance
 from rodval.core.scene import Scene, paper_scene
 from rodval.core.settings import IntegratorSettings
-from rodval.models.registry import integrated_models, simulate
+from rodval.models.presets.registry import integrated_models, simulate
 from rodval.solvers.driver import integrate
 from rodval.solvers.guard import GuardSpec
 

@@ -13,7 +13,7 @@ if TYPE_CHECKING:
 
 
 def register(sub) -> None:
-    from rodval.models.registry import MODEL_NAMES
+    from rodval.models.presets.registry import MODEL_NAMES
 
     p = sub.add_parser(
         "modes",
@@ -73,7 +73,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from rodval.analysis.modes import model_modes
-    from rodval.models.registry import model_class
+    from rodval.models.presets.registry import model_class
     from rodval.report.figures import plot_modes
 
     compare = _compare_list(args.compare)
@@ -110,7 +110,7 @@ def run(args) -> int:
 
 def _compare_list(text: str | None) -> tuple[str, ...]:
     """--compare MODELS as a tuple of registered model names (ValueError otherwise)."""
-    from rodval.models.registry import MODEL_NAMES
+    from rodval.models.presets.registry import MODEL_NAMES
 
     if not text:
         return ()
@@ -122,7 +122,7 @@ def _compare_list(text: str | None) -> tuple[str, ...]:
 
 def _options_for(model: str, pool: dict) -> dict:
     """The options of ``pool`` (the command line's) that ``model``'s modes take."""
-    from rodval.models.registry import model_class
+    from rodval.models.presets.registry import model_class
 
     accepted = model_class(model).MODES_OPTIONS
     return {k: v for k, v in pool.items() if k in accepted}
@@ -209,7 +209,7 @@ def _scene_and_model(args) -> tuple[Scene, str]:
     """The scene of SCENE ('paper', a TOML file, or a run.json: its recorded scene) and the
     model: --model, else a run.json's own model (when it has modes), else "full"."""
     from rodval.core.scene_file import load_scene, scene_from_dict
-    from rodval.models.registry import MODEL_NAMES
+    from rodval.models.presets.registry import MODEL_NAMES
     from rodval.report.run_files import read_run_record
 
     path = Path(args.scene)

@@ -29,6 +29,8 @@ BASE_KINDS = ("pinned", "free", "prescribed")
 BODY_FIELDS = ("mass", "inertia", "hinge_offset", "position", "velocity", "attitude", "rate")
 #: The prescribed coordinates of a base's motion: its centre's x, y (m) and attitude (rad).
 MOTION_AXES = ("x", "y", "attitude")
+
+
 def _vector(name: str, value: Any, unit: str) -> tuple[float, float]:
     """A 2-vector of finite real numbers (ValueError naming ``name`` otherwise)."""
     if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__len__") or len(value) != 2:

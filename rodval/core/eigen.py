@@ -1,6 +1,6 @@
 """Eigenproblems of linear structural dynamics, accurate over the whole spectrum and the same
 on every BLAS kernel: the one solver that every model's modal analysis uses (the native
-models' ``rodval.models.linear_modes`` and exudyn's ``reference_models.exudyn_modes``).
+models' ``rodval.models.observation.linear_modes`` and exudyn's ``reference_models.exudyn_modes``).
 
 Why not ``scipy.linalg.eigh(K, M)`` alone
 -----------------------------------------

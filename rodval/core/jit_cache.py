@@ -15,7 +15,7 @@ and ``TYPE_CHECKING`` blocks count too, which can only over-invalidate). (A spec
 a jitted function passed as an argument, ``bench.scale._rhs_loop(rhs, ...)``, is compiled in
 each process: numba 0.68 does not find it in its cache again.) So an edit recompiles exactly
 the kernels whose closure holds the edited file: an edit of the CLI, the report, the studies or
-the analysis recompiles nothing; an edit of the ladder's kernels (``models/ladder_kernels.py``)
+the analysis recompiles nothing; an edit of the ladder's kernels (``models/kinematics/ladder_kernels.py``)
 recompiles neither the integrators (they take right-hand sides as first-class function
 pointers, ``solvers.signature``) nor the paper models' kernels. ``tests/test_jit_cache.py``
 counts the compilations on a small package. Other packages' caches are untouched.

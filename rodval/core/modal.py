@@ -1,5 +1,5 @@
 """Results of a modal analysis, shared by the native models' analysis
-(``rodval.models.linear_modes``) and the reference model's (``reference_models.exudyn_modes``):
+(``rodval.models.observation.linear_modes``) and the reference model's (``reference_models.exudyn_modes``):
 the configuration a model is linearised about, its constant loads, and the modes.
 
 Units: frequencies in rad/s (``omega``) and Hz (``f_hz``); mode shapes as node displacements
@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
 #: What a model is linearised about: its initial state at rest (free vibration, loads
-#: ignored; it must be an equilibrium, see ``rodval.models.statics.check_at_rest``) or the
+#: ignored; it must be an equilibrium, see ``rodval.models.observation.statics.check_at_rest``) or the
 #: static equilibrium under the scene's static loads (``static_loads``) and hinge rest angles.
 ABOUT = ("initial", "equilibrium")
 
@@ -282,7 +282,7 @@ def split_rigid(
     tol: float = RIGID_SHAPE_TOL,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
     """Separate the three rigid modes of a chain on a free base from its flexible modes, the
-    same way for every model (native ``rodval.models.free_modes``, exudyn's
+    same way for every model (native ``rodval.models.observation.free_modes``, exudyn's
     ``reference_models.exudyn_modes``).
 
     ``lam`` (ascending, 1/s^2) are the eigenvalues of K x = lam M x, M symmetric positive
@@ -399,7 +399,7 @@ def damping_ratios(
     paired eigenvalue (Im s > 0, 1/s); 0 for every omega > 0 without damping (C = 0), NaN where
     undefined (omega <= 0, no partner). M, C, K in consistent units (kg, N s/m, N/m or their
     rotational counterparts). Shared by the native fixed-base and free-base modes
-    (``rodval.models.linear_modes``, ``rodval.models.free_modes``)."""
+    (``rodval.models.observation.linear_modes``, ``rodval.models.observation.free_modes``)."""
     zeta = np.full(omega.size, np.nan)
     if not np.any(C):
         zeta[omega > 0] = 0.0

@@ -18,7 +18,7 @@ from typing import Any
 import pandas as pd
 
 from rodval.core.scene import UNITS
-from rodval.models.rungs import KINEMATICS, PAPER_RUNG
+from rodval.models.kinematics.rungs import KINEMATICS, PAPER_RUNG
 from rodval.report.tables import axis_columns
 
 FIRST_ORDER, EXACT = KINEMATICS
@@ -48,6 +48,41 @@ def ladder_p_max(rungs: Sequence[tuple[str, int]] | set[tuple[str, int]]) -> int
     return max(exact)
 
 
+def _pinned_gaps(
+    table: dict[tuple[Any, ...], dict[tuple[str, int], float]],
+    keys: list[str],
+    match: list[int],
+    top: tuple[str, int],
+) -> dict[tuple[Any, ...], float]:
+    """The pinned cases' gap on the rung ``top``, by their key without the base columns."""
+    kind_at = keys.index("base_kind")
+    pinned: dict[tuple[Any, ...], float] = {}
+    for key, row in table.items():
+        if key[kind_at] == "pinned":
+            pinned.setdefault(tuple(key[i] for i in match), row.get(top, math.nan))
+    return pinned
+
+
+def _base_part(
+    key: tuple[Any, ...],
+    keys: list[str],
+    match: list[int],
+    pinned: dict[tuple[Any, ...], float],
+    last: float,
+) -> tuple[float, str]:
+    """(base part, the reason it is blank or ""): 0 on a pinned row, the gap ``last`` less its
+    pinned counterpart's on another base (``split_gaps``)."""
+    kind = key[keys.index("base_kind")]
+    counterpart = tuple(key[i] for i in match)
+    if kind == "pinned":
+        return 0.0, ""
+    if kind in (None, "-"):
+        return math.nan, NO_KIND
+    if counterpart in pinned:
+        return last - pinned[counterpart], ""
+    return math.nan, NO_PINNED
+
+
 def split_gaps(
     gaps: pd.DataFrame, by: Sequence[str] = (), base_columns: Sequence[str] = ()
 ) -> pd.DataFrame | None:
@@ -60,8 +95,7 @@ def split_gaps(
     beta, rad/s for dphi; NaN where the comparison was not made), and optionally
     ``base_kind`` ("pinned", "free", "prescribed"; None where not known). ``base_columns``:
     the columns of ``by`` that describe the base body (mass, inertia, ...), ignored when a
-    free case looks for its pinned counterpart. The first row of a duplicated (group, rung,
-    quantity) counts.
+    free case looks for its pinned counterpart (the first duplicate row counts).
 
     Returns None when the rungs are not all there (first-order p = 1, exact p = 1 and an
     exact p > 1; p_max below is the highest exact p of the table), else one row per group
@@ -85,10 +119,8 @@ def split_gaps(
     negative part means the rungs' errors cancel: e.g. shapes < 0 when exact p = 1 lies
     closer to the reference than exact p_max because its shape error partly offsets what no
     rung carries (or the reference's own error), not that more shapes make the model worse.
-    Every gap is a largest absolute difference, not a signed error, so the parts are
-    differences of distances to the reference and carry no sign of their own.
-    O(rows of ``gaps``).
-    """
+    The parts are differences of distances to the reference (each gap is a largest absolute
+    difference), with no sign of their own. O(rows of ``gaps``)."""
     by = list(by)
     rung_list = sorted(
         {(str(k), int(p)) for k, p in zip(gaps["kinematics"], gaps["shapes"])},
@@ -107,28 +139,14 @@ def split_gaps(
         row.setdefault((str(rec["kinematics"]), int(rec["shapes"])), float(rec["gap"]))
     top = (EXACT, p_max)
     match = [i for i, c in enumerate(keys) if c not in base_columns and c != "base_kind"]
-    pinned: dict[tuple[Any, ...], float] = {}
-    if base_varies:
-        kind_at = keys.index("base_kind")
-        for key, row in table.items():
-            if key[kind_at] == "pinned":
-                pinned.setdefault(tuple(key[i] for i in match), row.get(top, math.nan))
+    pinned = _pinned_gaps(table, keys, match, top) if base_varies else {}
     out = []
     for key, row in table.items():
         gap = {r: row.get(r, math.nan) for r in rung_list}
         first, exact1, last = gap[(FIRST_ORDER, 1)], gap[(EXACT, 1)], gap[top]
-        base, note = math.nan, NO_BASE_AXIS
-        if base_varies:
-            kind = key[keys.index("base_kind")]
-            counterpart = tuple(key[i] for i in match)
-            if kind == "pinned":
-                base, note = 0.0, ""
-            elif kind in (None, "-"):
-                note = NO_KIND
-            elif counterpart in pinned:
-                base, note = last - pinned[counterpart], ""
-            else:
-                note = NO_PINNED
+        base, note = (
+            _base_part(key, keys, match, pinned, last) if base_varies else (math.nan, NO_BASE_AXIS)
+        )
         quantity = key[-1]
         out.append(
             {
@@ -143,8 +161,7 @@ def split_gaps(
                 "base_note": note,
             }
         )
-    frame = pd.DataFrame(out)
-    lead = [*keys[:-1], "quantity", "unit"]
+    frame, lead = pd.DataFrame(out), [*keys[:-1], "quantity", "unit"]
     return frame[[*lead, *(c for c in frame.columns if c not in lead)]]
 
 

@@ -23,7 +23,7 @@ from rodval.analysis.metrics import pareto_front
 from rodval.core.modal import Modes
 from rodval.core.scene import UNITS
 from rodval.core.trajectory import Trajectory
-from rodval.models.registry import integrated_models
+from rodval.models.presets.registry import integrated_models
 
 
 def _figure(nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:

@@ -29,7 +29,7 @@ from rodval.analysis.events import (
 )
 from rodval.core.out_paths import STUDY_SCHEMA, is_stamped
 from rodval.models import get_model
-from rodval.models.registry import uses_integrator
+from rodval.models.presets.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
 from rodval.report.error_budget import error_budget
 from rodval.report.markdown import to_markdown

@@ -27,9 +27,9 @@ import numpy as np
 from rodval.core.lock_window import lock_window
 from rodval.core.rigid import node_velocities, rigid_lock
 from rodval.core.root_momentum import root_momentum_fields
-from rodval.models.paper_matrices import node_positions
+from rodval.models.assembly.paper_matrices import node_positions
 
-#: The systems these functions read: ``rodval.models.paper_system.PaperSystem`` (which imports
+#: The systems these functions read: ``rodval.models.assembly.paper_system.PaperSystem`` (which imports
 #: this module, so it is not imported here).
 PaperSystem = Any
 

@@ -11,11 +11,11 @@ import numpy as np
 
 from rodval.core.motion import motion_at
 from rodval.core.scene import Scene
-from rodval.models import chain_base as cb
-from rodval.models.deployment import lock_scalars
-from rodval.models.free_base_system import FreeBody
-from rodval.models.ladder import LadderSystem, ladder_constants
-from rodval.models.paper_energy import NO_LOADS, NO_MATRICES
+from rodval.models.assembly.paper_energy import NO_LOADS, NO_MATRICES
+from rodval.models.base import chain_base as cb
+from rodval.models.base.free_base_system import FreeBody
+from rodval.models.hinge_items.deployment import lock_scalars
+from rodval.models.kinematics.ladder import LadderSystem, ladder_constants
 
 
 class LadderFreeSystem(FreeBody, LadderSystem):

@@ -1,12 +1,12 @@
 """The rungs of the full model's ladder (docs/model.md, "The model ladder"): the bending shapes
 per rod and the kinematics a rung takes, and the checks of those options. Kept apart from the
-ladder's system and kernels (``rodval.models.ladder``) so that a model made on the paper's rung
+ladder's system and kernels (``rodval.models.kinematics.ladder``) so that a model made on the paper's rung
 imports none of them."""
 
 from __future__ import annotations
 
 from rodval.core.checks import check_choice, check_number
-from rodval.models.shapes import MAX_SHAPES
+from rodval.models.kinematics.shapes import MAX_SHAPES
 
 #: ``kinematics`` of the full model; the first is the paper's (the default).
 KINEMATICS = ("first-order", "exact")

@@ -1,4 +1,4 @@
-"""Compiled kernels of the model ladder (``rodval.models.ladder``): the full model with p + 1
+"""Compiled kernels of the model ladder (``rodval.models.kinematics.ladder``): the full model with p + 1
 bending shapes per rod (``shapes = p``) and first-order or exact assumed-mode kinematics.
 
 Coordinates q = [phi (n); g_0 (n); g_1 (n); ...; g_p (n)] (g_0 = alpha, g_1 = beta, g_i
@@ -25,8 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.models.deployment import locked_head, superpose, unit_moment
-from rodval.models.kernels import (
+from rodval.models.assembly.kernels import (
     V_KAPPA,
     V_L,
     V_NU,
@@ -40,6 +39,7 @@ from rodval.models.kernels import (
     upper_t_times,
     upper_times,
 )
+from rodval.models.hinge_items.deployment import locked_head, superpose, unit_moment
 
 #: Rows after the paper model's 19: rod mass m l (kg), node mass mu (kg), the number of
 #: shapes p + 1 and the exact-kinematics flag (the same in every column).

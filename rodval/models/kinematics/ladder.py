@@ -1,5 +1,5 @@
 """The model ladder: the full model with ``shapes = p`` bending shapes per rod
-(``rodval.models.shapes``) and ``kinematics = "first-order"`` (the paper's: every product of
+(``rodval.models.kinematics.shapes``) and ``kinematics = "first-order"`` (the paper's: every product of
 the bending coordinates g with phi'^2 or phi'' dropped) or ``"exact"`` (the assumed-mode
 kinematics r = r_{k-1} + s e_k + eta n_k kept whole in T, the forces and the momenta, so the
 model is Lagrangian and conserves energy to the integrator's tolerance). docs/model.md ("The
@@ -18,9 +18,19 @@ from functools import cached_property
 import numpy as np
 
 from rodval.core.scene import Chain, Scene
-from rodval.models import deployment
-from rodval.models.kernels import V_CB, V_EPS, V_KB, V_PI, V_RHO, V_TAU, V_W, constant_rows
-from rodval.models.ladder_kernels import (
+from rodval.models.assembly.kernels import V_CB, V_EPS, V_KB, V_PI, V_RHO, V_TAU, V_W, constant_rows
+from rodval.models.assembly.paper_matrices import (
+    angle_differences,
+    chain_constants,
+    hinge_matrix,
+    mass_matrix,
+)
+from rodval.models.assembly.paper_matrices import (
+    angular_momentum_rows as momentum_rows,
+)
+from rodval.models.assembly.paper_system import StackedSystem
+from rodval.models.hinge_items import deployment
+from rodval.models.kinematics.ladder_kernels import (
     BLOCK_A,
     BLOCK_B,
     BLOCK_C,
@@ -41,18 +51,8 @@ from rodval.models.ladder_kernels import (
     ladder_rhs_locked,
     ladder_unit_responses,
 )
-from rodval.models.paper_matrices import (
-    angle_differences,
-    chain_constants,
-    hinge_matrix,
-    mass_matrix,
-)
-from rodval.models.paper_matrices import (
-    angular_momentum_rows as momentum_rows,
-)
-from rodval.models.paper_system import StackedSystem
-from rodval.models.rungs import check_kinematics, check_rung_options, check_shapes
-from rodval.models.shapes import RodShapes, rod_shapes
+from rodval.models.kinematics.rungs import check_kinematics, check_rung_options, check_shapes
+from rodval.models.kinematics.shapes import RodShapes, rod_shapes
 
 
 def shapes_of(chain: Chain, p: int) -> RodShapes:

@@ -39,6 +39,7 @@ from functools import cached_property
 import numpy as np
 from scipy.linalg import solveh_banded
 
+from rodval.core.checks import check_choice
 from rodval.core.scene import Chain, hinge_angles
 
 VARIANTS = ("printed", "published")
@@ -78,8 +79,7 @@ class ChainConstants:
 
 def chain_constants(chain: Chain, variant: str = DEFAULT_VARIANT) -> ChainConstants:
     """Precompute everything in M and G that does not depend on the angles (O(n))."""
-    if variant not in VARIANTS:
-        raise ValueError(f"coefficients must be one of {VARIANTS}, got {variant!r}")
+    check_choice("coefficients", variant, VARIANTS)
     l, m, mu = chain.l, chain.m, chain.mu
     rod_mass = m * l
     outer = np.cumsum((mu + rod_mass)[::-1])[::-1] - rod_mass / 2.0

@@ -10,9 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from rodval.core.scene import Scene
-from rodval.models import deployment, kernels
-from rodval.models.lock_records import plastic_jump
-from rodval.models.paper_matrices import (
+from rodval.models.assembly import kernels
+from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
     angle_differences,
     angle_jacobian,
@@ -20,8 +19,15 @@ from rodval.models.paper_matrices import (
     convective_terms,
     hinge_matrix,
 )
-from rodval.models.paper_system import PaperModel, PaperSystem
-from rodval.models.rungs import PAPER_RUNG, check_kinematics, check_rung_options, check_shapes
+from rodval.models.assembly.paper_system import PaperModel, PaperSystem
+from rodval.models.hinge_items import deployment
+from rodval.models.hinge_items.lock_records import plastic_jump
+from rodval.models.kinematics.rungs import (
+    PAPER_RUNG,
+    check_kinematics,
+    check_rung_options,
+    check_shapes,
+)
 
 
 class FullSystem(PaperSystem):
@@ -173,13 +179,13 @@ class FullSystem(PaperSystem):
 
 class FullModel(PaperModel):
     """Full model (3n ODEs). ``coefficients``: "printed" (default) or "published" (erratum);
-    ``kernel``: "numba" (default) or "numpy"; the model ladder (``rodval.models.ladder``):
+    ``kernel``: "numba" (default) or "numpy"; the model ladder (``rodval.models.kinematics.ladder``):
     ``shapes`` p = 1..8 bending shapes per rod (default 1, the paper's cubic) and
     ``kinematics`` "first-order" (default, the paper's) or "exact"."""
 
     name = "full"
     system_class = FullSystem
-    MODAL_ANALYSIS = "rodval.models.linear_modes:full_modes"
+    MODAL_ANALYSIS = "rodval.models.observation.linear_modes:full_modes"
     OPTIONS = ("coefficients", "kernel", "shapes", "kinematics")
     MODES_OPTIONS = ("coefficients", "shapes", "kinematics")
 
@@ -243,10 +249,10 @@ class FullModel(PaperModel):
         if scene.base.moving:
             self.check_base(scene)
             if scene.base.free and paper:
-                from rodval.models.free_base_system import FreeBaseSystem
+                from rodval.models.base.free_base_system import FreeBaseSystem
 
                 return FreeBaseSystem(scene)
-            from rodval.models import moving_base
+            from rodval.models.base import moving_base
 
             kind = (
                 moving_base.LadderFreeSystem
@@ -256,6 +262,6 @@ class FullModel(PaperModel):
             return kind(scene, self.coefficients, self.kernel, self.shapes, self.kinematics)
         if paper:
             return FullSystem(scene, self.coefficients, self.kernel)
-        from rodval.models.ladder import LadderSystem
+        from rodval.models.kinematics.ladder import LadderSystem
 
         return LadderSystem(scene, self.coefficients, self.kernel, self.shapes, self.kinematics)

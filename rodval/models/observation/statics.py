@@ -1,6 +1,6 @@
 """Statics of the paper models: the load stiffness, the static residual and the static
 equilibrium by Newton's method with load stepping, and the at-rest check of a configuration
-(see ``rodval.models.linear_modes`` for the equations)."""
+(see ``rodval.models.observation.linear_modes`` for the equations)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from rodval.core.modal import (
     Equilibrium,
 )
 from rodval.core.scene import Chain, Scene
-from rodval.models.paper_matrices import (
+from rodval.models.assembly.paper_matrices import (
     hinge_matrix,
     stiffness_matrix,
 )

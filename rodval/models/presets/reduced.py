@@ -20,8 +20,8 @@ from types import SimpleNamespace
 import numpy as np
 
 from rodval.core.scene import Scene
-from rodval.models import deployment, kernels, reduced_banded
-from rodval.models.paper_matrices import (
+from rodval.models.assembly import kernels
+from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
     angle_differences,
     angle_jacobian,
@@ -30,7 +30,9 @@ from rodval.models.paper_matrices import (
     hinge_matrix,
     quasi_static_bending,
 )
-from rodval.models.paper_system import PaperModel, PaperSystem
+from rodval.models.assembly.paper_system import PaperModel, PaperSystem
+from rodval.models.bending import reduced_banded
+from rodval.models.hinge_items import deployment
 
 
 class ReducedSystem(PaperSystem):
@@ -320,7 +322,7 @@ class ReducedModel(PaperModel):
 
     name = "reduced"
     system_class = ReducedSystem
-    MODAL_ANALYSIS = "rodval.models.linear_modes:reduced_modes"
+    MODAL_ANALYSIS = "rodval.models.observation.linear_modes:reduced_modes"
 
     def energy_fix(self) -> str:
         """The quasi-static bending has no energy balance of its own (docs/stability.md)."""

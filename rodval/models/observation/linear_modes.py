@@ -94,16 +94,11 @@ from rodval.core.modal import (
 )
 
 # ``mac_matrix`` lives with ``damping_ratios`` in ``rodval.core.modal`` (shared with the
-# free-base modes, ``rodval.models.free_modes``, without an import cycle); re-exported here
+# free-base modes, ``rodval.models.observation.free_modes``, without an import cycle); re-exported here
 # for its callers (``rodval.analysis.modes``)
 from rodval.core.modal import mac_matrix as mac_matrix
 from rodval.core.scene import Chain, InitialState, Scene
-from rodval.models.full import FullModel
-from rodval.models.ladder import (
-    ladder_mass_matrix,
-    ladder_stiffness,
-)
-from rodval.models.paper_matrices import (
+from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
     chain_constants,
     damping_matrix,
@@ -111,9 +106,12 @@ from rodval.models.paper_matrices import (
     mass_matrix,
     stiffness_matrix,
 )
-from rodval.models.reduced import ReducedModel, ReducedSystem
-from rodval.models.rungs import PAPER_RUNG, check_kinematics, check_shapes
-from rodval.models.statics import (
+from rodval.models.kinematics.ladder import (
+    ladder_mass_matrix,
+    ladder_stiffness,
+)
+from rodval.models.kinematics.rungs import PAPER_RUNG, check_kinematics, check_shapes
+from rodval.models.observation.statics import (
     body_rest_angles,
     check_at_rest,
     load_stiffness,
@@ -121,6 +119,8 @@ from rodval.models.statics import (
     static_equilibrium,
     static_residual,
 )
+from rodval.models.presets.full import FullModel
+from rodval.models.presets.reduced import ReducedModel, ReducedSystem
 
 #: The models linearized here: the paper's two.
 PAPER_MODELS = (FullModel.name, ReducedModel.name)
@@ -405,7 +405,7 @@ def modes_about(
                 f"model {model!r}: modes of a chain on a {scene.base.kind} base are not built "
                 "(the full model has them on a free base, docs/base.md)"
             )
-        from rodval.models.free_modes import free_modes
+        from rodval.models.observation.free_modes import free_modes
 
         return free_modes(
             scene,
@@ -486,6 +486,6 @@ def check_configuration(
 #: load_at, coefficients, ...) -> Modes, the form ``Model.modes`` calls
 full_modes = partial(modes_about, model=FullModel.name)
 reduced_modes = partial(modes_about, model=ReducedModel.name)
-#: The full model has modes on a free base (``rodval.models.free_modes``: its three rigid
+#: The full model has modes on a free base (``rodval.models.observation.free_modes``: its three rigid
 #: modes separated), on every rung; ``Model.modes`` refuses a free base to the others.
 full_modes.FREE_BASE = True  # type: ignore[attr-defined]

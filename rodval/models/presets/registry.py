@@ -17,8 +17,8 @@ from rodval.core.trajectory import Trajectory
 
 #: name -> "module:Class". Each class lists its option names in ``OPTIONS``.
 REGISTRY: dict[str, str] = {
-    "full": "rodval.models.full:FullModel",
-    "reduced": "rodval.models.reduced:ReducedModel",
+    "full": "rodval.models.presets.full:FullModel",
+    "reduced": "rodval.models.presets.reduced:ReducedModel",
     "exudyn": "reference_models.exudyn_chain:ExudynModel",
 }
 

@@ -1,5 +1,5 @@
 """The full model on a free base: the paper's chain hanging from a rigid body free in the plane
-(a spacecraft), docs/base.md. Its equations and kernels: ``rodval.models.free_base``.
+(a spacecraft), docs/base.md. Its equations and kernels: ``rodval.models.base.free_base``.
 
 State y = [Q; Q'], Q = [phi; alpha; beta; x_c, y_c, theta] (3n + 3). Everything the pinned
 full model does runs here too: the compiled O(n) right-hand side, latches (a plastic lock in
@@ -16,10 +16,10 @@ import numpy as np
 
 from rodval.core.base import root_state
 from rodval.core.scene import Scene
-from rodval.models import free_base as fb
-from rodval.models.kernels import full_constants
-from rodval.models.paper_energy import NO_LOADS, NO_MATRICES
-from rodval.models.paper_system import StackedSystem
+from rodval.models.assembly.kernels import full_constants
+from rodval.models.assembly.paper_energy import NO_LOADS, NO_MATRICES
+from rodval.models.assembly.paper_system import StackedSystem
+from rodval.models.base import free_base as fb
 
 
 class FreeBody:

@@ -1,6 +1,6 @@
 """Energies and momenta of the paper's systems (a mixin of ``paper_system.PaperSystem``): what
 the energy audit, the observation map and the lock records read, each from one state or a
-history. The model ladder (``rodval.models.ladder``) overrides the hooks that depend on its
+history. The model ladder (``rodval.models.kinematics.ladder``) overrides the hooks that depend on its
 coordinates (``energy_rows``, ``bending_energy_at``, ``rod_momenta_at``, ``kinetic_energy``)."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import numpy as np
 
 from rodval.core.loads import LOAD_COLUMNS
 from rodval.core.scene import hinge_angles
-from rodval.models.paper_matrices import (
+from rodval.models.assembly.paper_matrices import (
     angle_differences,
     angular_momentum,
     assemble_mass,

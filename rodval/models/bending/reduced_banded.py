@@ -47,7 +47,7 @@ This is block elimination of the banded system below in the order tip to root (l
 articulated-body algorithm of multibody dynamics); each local 3 x 3 matrix is the Schur
 complement of the sub-chain k..n-1, itself a chain of the same model.
 
-Banded LU (METHOD_BAND): the fallback, in ``rodval.models.reduced_band_lu``.
+Banded LU (METHOD_BAND): the fallback, in ``rodval.models.bending.reduced_band_lu``.
 
 Cost: O(n) time and memory per evaluation, no n x n array anywhere: the sweep ~250 flops and
 19 doubles per rod, the banded LU ~800 flops and ~90 doubles per rod (U factor 7n x 11). phi''
@@ -59,7 +59,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.models.kernels import (
+from rodval.models.assembly.kernels import (
     V_KAPPA,
     V_KB,
     V_L,
@@ -73,8 +73,8 @@ from rodval.models.kernels import (
     rhs_head,
     upper_t_times,
 )
-from rodval.models.paper_matrices import DEFAULT_VARIANT, chain_constants
-from rodval.models.reduced_band_lu import (
+from rodval.models.assembly.paper_matrices import DEFAULT_VARIANT, chain_constants
+from rodval.models.bending.reduced_band_lu import (
     C_AP,
     C_BP,
     C_CSCALE,

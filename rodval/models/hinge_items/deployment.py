@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit
 from scipy.linalg import solveh_banded
 
-from rodval.models.kernels import (
+from rodval.models.assembly.kernels import (
     V_L,
     V_OUTER,
     V_PPDIAG,
@@ -35,8 +35,8 @@ from rodval.models.kernels import (
     generator_solve,
     rhs_head,
 )
-from rodval.models.reduced_band_lu import band_size, solve_band
-from rodval.models.reduced_banded import (
+from rodval.models.bending.reduced_band_lu import band_size, solve_band
+from rodval.models.bending.reduced_banded import (
     reduced_forces,
     reduced_rhs,
     solve_sweep,

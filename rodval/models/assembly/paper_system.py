@@ -14,10 +14,8 @@ from rodval.core.loads import LoadSet, load_table
 from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
-from rodval.models import deployment
-from rodval.models.lock_records import energy_parts, lock_record, plastic_jump, window_terms
-from rodval.models.paper_energy import NO_MATRICES, PaperEnergy
-from rodval.models.paper_matrices import (
+from rodval.models.assembly.paper_energy import NO_MATRICES, PaperEnergy
+from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
     VARIANTS,
     ChainConstants,
@@ -30,6 +28,7 @@ from rodval.models.paper_matrices import (
     rest_forces,
     stiffness_matrix,
 )
+from rodval.models.hinge_items import deployment, lock_records
 from rodval.solvers.ode_model import OdeModel
 from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE, first_class
 from rodval.solvers.system import CompiledForm, EventRecord, EventSpec, OdeSystem
@@ -484,7 +483,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
             and abs(D[la.hinge] - la.angle) <= deployment.SIMULTANEOUS_RAD
         ]
         locked = self.locked + tuple(group)
-        y_new, data = lock_record(self, t, y, locked, tuple(group))
+        y_new, data = lock_records.lock_record(self, t, y, locked, tuple(group))
         self._set_mode((self.stop_active, locked), t)
         hinges = [self.latches[i].hinge for i in group]
         label = "latch hinge " + ", ".join(str(h) for h in hinges)
@@ -492,11 +491,11 @@ class PaperSystem(PaperEnergy, OdeSystem):
 
     def window_terms(self, t: float, y: np.ndarray, hinge: int) -> tuple[float, ...]:
         """The lock window's integrands at one state (``lock_records.window_terms``)."""
-        return window_terms(self, t, y, hinge)
+        return lock_records.window_terms(self, t, y, hinge)
 
     def energy_parts(self, t: float, y: np.ndarray) -> tuple[float, float, float]:
         """(kinetic, hinge, bending) energy (J) in the current mode (``lock_records``)."""
-        return energy_parts(self, t, y)
+        return lock_records.energy_parts(self, t, y)
 
     def plastic_jump(self, y, hinges, angles) -> tuple[np.ndarray, np.ndarray]:
         """(state after the impact, multiplier impulses mu (N m s))."""
@@ -569,7 +568,7 @@ class StackedSystem(PaperSystem):
         return U
 
     def plastic_jump(self, y, hinges, angles):
-        return plastic_jump(self, y, hinges, angles)
+        return lock_records.plastic_jump(self, y, hinges, angles)
 
 
 class PaperModel(OdeModel):

@@ -53,10 +53,10 @@ from rodval.core.modal import (
     static_loads,
 )
 from rodval.core.scene import Scene
-from rodval.models.full import FullModel
-from rodval.models.ladder import ladder_stiffness
-from rodval.models.paper_matrices import damping_matrix, stiffness_matrix
-from rodval.models.rungs import check_kinematics, check_shapes
+from rodval.models.assembly.paper_matrices import damping_matrix, stiffness_matrix
+from rodval.models.kinematics.ladder import ladder_stiffness
+from rodval.models.kinematics.rungs import check_kinematics, check_shapes
+from rodval.models.presets.full import FullModel
 
 #: The coefficients of the full model on a moving base (its compiled kernels).
 FREE_COEFFICIENTS = "printed"

@@ -1,4 +1,4 @@
-"""The reduced model's banded LU solve, the fallback of ``rodval.models.reduced_banded``'s
+"""The reduced model's banded LU solve, the fallback of ``rodval.models.bending.reduced_banded``'s
 sweep, and the layout of the per-rod constants both read (``Cst``).
 
 Banded LU (METHOD_BAND; Gaussian elimination with partial pivoting over the whole band).
@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.models.kernels import (
+from rodval.models.assembly.kernels import (
     V_CB,
     V_KAPPA,
     V_KB,

@@ -37,9 +37,9 @@ from numba import njit
 
 from rodval.core.loads import load_sums
 from rodval.core.motion import motion_at
-from rodval.models.deployment import hinge_events, small_solve, superpose, unit_moment
-from rodval.models.kernels import V_KAPPA, V_L, V_NU, V_OUTER, V_REST, load_power, rhs_head
-from rodval.models.ladder_kernels import (
+from rodval.models.assembly.kernels import V_KAPPA, V_L, V_NU, V_OUTER, V_REST, load_power, rhs_head
+from rodval.models.hinge_items.deployment import hinge_events, small_solve, superpose, unit_moment
+from rodval.models.kinematics.ladder_kernels import (
     BLOCK_A,
     bending_sums,
     ladder_damper_power,

@@ -30,8 +30,7 @@ import numpy as np
 from numba import njit
 
 from rodval.core.loads import load_sums
-from rodval.models.deployment import hinge_events, locked_head, small_solve, superpose, unit_moment
-from rodval.models.kernels import (
+from rodval.models.assembly.kernels import (
     V_KAPPA,
     V_L,
     V_NU,
@@ -42,6 +41,13 @@ from rodval.models.kernels import (
     full_mechanics,
     full_solve,
     rhs_head,
+)
+from rodval.models.hinge_items.deployment import (
+    hinge_events,
+    locked_head,
+    small_solve,
+    superpose,
+    unit_moment,
 )
 
 # Rows of V after the full model's (``kernels.full_constants``, rows 0..18), each the same

@@ -1,0 +1,2 @@
+"""Kinematics and shapes: the model ladder (shapes p per rod, first-order or exact kinematics) and
+its rungs."""

@@ -1,0 +1,1 @@
+"""Observation: linearized modes (pinned and free spacecraft) and static equilibria."""
