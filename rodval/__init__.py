@@ -26,6 +26,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "Latch": ("rodval.core.scene", "Latch"),
     "Stop": ("rodval.core.scene", "Stop"),
     "Base": ("rodval.core.base", "Base"),
+    "Motion": ("rodval.core.motion", "Motion"),
     "NodalForce": ("rodval.core.loads", "NodalForce"),
     "pulse": ("rodval.core.loads", "pulse"),
     "constant": ("rodval.core.loads", "constant"),
@@ -59,6 +60,7 @@ __all__ = [
     "Latch",
     "Stop",
     "Base",
+    "Motion",
     "NodalForce",
     "pulse",
     "constant",
@@ -91,6 +93,7 @@ if TYPE_CHECKING:  # the names as mypy and editors see them; at run time ``__get
     from rodval.analysis.modes import model_modes as modes
     from rodval.core.base import Base
     from rodval.core.contract import Model
+    from rodval.core.motion import Motion
     from rodval.core.loads import NodalForce, constant, harmonic, pulse, ramp, tabulated
     from rodval.core.scene import (
         TABLE1_TIMES,
