@@ -93,8 +93,8 @@ if TYPE_CHECKING:  # the names as mypy and editors see them; at run time ``__get
     from rodval.analysis.modes import model_modes as modes
     from rodval.core.base import Base
     from rodval.core.contract import Model
-    from rodval.core.motion import Motion
     from rodval.core.loads import NodalForce, constant, harmonic, pulse, ramp, tabulated
+    from rodval.core.motion import Motion
     from rodval.core.scene import (
         TABLE1_TIMES,
         Chain,

@@ -38,7 +38,8 @@ from numba import njit
 from rodval.core.loads import load_sums
 from rodval.core.motion import motion_at
 from rodval.models.assembly.kernels import V_KAPPA, V_L, V_NU, V_OUTER, V_REST, load_power, rhs_head
-from rodval.models.hinge_items.deployment import hinge_events, small_solve, superpose, unit_moment
+from rodval.models.base.free_base import body_accelerations
+from rodval.models.hinge_items.deployment import hinge_events, locked_head, superpose, unit_moment
 from rodval.models.kinematics.ladder_kernels import (
     BLOCK_A,
     bending_sums,
@@ -208,29 +209,10 @@ def body_solve(V, parts, th, G, K, fp, fg, rb, out):
     ladder_solve(V, Aex, Pg, g, c, s, fp, fg, u)
     jx, jy = first_moment_rate(V, c, s, Am, u[:n], u[n:].reshape((P1, n)))
     rx, ry = offset_vector(V, th)
-    px, py = -ry, rx  # rho_perp
-    mch = body_value(V, CHAIN_MASS)
-    mt = mch + body_value(V, BODY_MASS)
-    E = np.array([[1.0, 0.0, px], [0.0, 1.0, py]])
-    Sig = np.empty((3, 3))  # D - E^T K E, by loops (the same digits everywhere)
-    for a in range(3):
-        for b in range(3):
-            acc = 0.0
-            for i in range(2):
-                for j in range(2):
-                    acc += E[i, a] * K[i, j] * E[j, b]
-            Sig[a, b] = -acc
-    Sig[0, 0] += mt
-    Sig[1, 1] += mt
-    Sig[0, 2] += mch * px
-    Sig[2, 0] += mch * px
-    Sig[1, 2] += mch * py
-    Sig[2, 1] += mch * py
-    Sig[2, 2] += body_value(V, BODY_INERTIA) + mch * (rx * rx + ry * ry)
-    r = np.array([rb[0] - jx, rb[1] - jy, rb[2] - px * jx - py * jy])
-    xb = small_solve(Sig, r)
-    g0 = xb[0] + xb[2] * px
-    g1 = xb[1] + xb[2] * py
+    mch, mb, J = body_value(V, CHAIN_MASS), body_value(V, BODY_MASS), body_value(V, BODY_INERTIA)
+    xb = body_accelerations(K, rx, ry, mch, mb, J, jx, jy, rb)
+    g0 = xb[0] - xb[2] * ry  # a_0 = a_c + theta'' rho_perp
+    g1 = xb[1] + xb[2] * rx
     for i in range(N):
         u[i] -= g0 * G[0, i] + g1 * G[1, i]
     out[N : N + 3] = xb
@@ -312,8 +294,9 @@ def free_rhs(t, y, P, S, M, L, out):
 
 @njit(cache=True)
 def held(S):
-    """The hinges held by a compiled form's S (``deployment.lock_scalars``; none for the
-    unlocked flags [damped])."""
+    """The hinges held by a compiled form's S (``deployment.lock_scalars``), or none for the
+    unlocked flags [damped]: a prescribed base's right-hand side serves both modes (its held
+    hinges' rows read theta'' from the state, so one kernel holds any set)."""
     m = int(S[1]) if S.shape[0] > 1 else 0
     locks = np.empty(m, np.int64)
     for j in range(m):
@@ -324,12 +307,7 @@ def held(S):
 @njit(cache=True)
 def free_rhs_locked(t, y, P, S, M, L, out):
     """y' with the hinges of S held; O(n p^2 m)."""
-    n = P.shape[1]
-    SX = np.empty(n)
-    SY = np.empty(n)
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    locks = held(S)
-    lam = np.empty(locks.shape[0])
+    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
     free_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[y.shape[0] // 2 :], lam)
 
 

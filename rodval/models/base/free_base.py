@@ -129,18 +129,16 @@ def field_responses(V, c, s, delta, G):
 
 
 @njit(cache=True)
-def base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out):
-    """x = M_tot^-1 [fp; fa; fb; rb] (the bordered total mass matrix, module docstring) into
-    ``out`` (3n + 3): q'' then (a_c (m/s^2), theta'' (rad/s^2)). O(n)."""
-    n = c.shape[0]
-    u = out[: 3 * n]
-    full_solve(V, c, s, fp, fa, fb, u)
-    jx, jy = _first_moment_rate(V, c, s, delta, u[:n], u[n : 2 * n], u[2 * n :])
-    rx, ry = _rho(V, th)
+def body_accelerations(K, rx, ry, mch, mb, J, jx, jy, rb):
+    """(a_c (m/s^2, 2), theta'' (rad/s^2)) of the body: the 3 x 3 Schur complement D - E^T K E
+    of the bordered mass matrix (E = [I, rho_perp], K = J_S M_c^-1 J_S^T, kg; rho = (rx, ry) m;
+    chain mass mch, body mass mb (kg), inertia J (kg m^2)) solved against rb - E^T (jx, jy)
+    (rb: the body's forces, N and N m; (jx, jy) = J_S u of the chain's free accelerations u),
+    by loops (no BLAS call: the same digits everywhere). Every rung's free body uses it."""
     px, py = -ry, rx  # rho_perp
-    mch, mt = V[V_MCH, 0], V[V_MCH, 0] + V[V_BM, 0]
+    mt = mch + mb
     E = np.array([[1.0, 0.0, px], [0.0, 1.0, py]])
-    Sig = np.empty((3, 3))  # D - E^T K E, by loops (no BLAS call: the same digits everywhere)
+    Sig = np.empty((3, 3))
     for a in range(3):
         for b in range(3):
             acc = 0.0
@@ -154,11 +152,23 @@ def base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out):
     Sig[2, 0] += mch * px
     Sig[1, 2] += mch * py
     Sig[2, 1] += mch * py
-    Sig[2, 2] += V[V_BJ, 0] + mch * (rx * rx + ry * ry)
+    Sig[2, 2] += J + mch * (rx * rx + ry * ry)
     r = np.array([rb[0] - jx, rb[1] - jy, rb[2] - px * jx - py * jy])
-    xb = small_solve(Sig, r)
-    g0 = xb[0] + xb[2] * px
-    g1 = xb[1] + xb[2] * py
+    return small_solve(Sig, r)
+
+
+@njit(cache=True)
+def base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out):
+    """x = M_tot^-1 [fp; fa; fb; rb] (the bordered total mass matrix, module docstring) into
+    ``out`` (3n + 3): q'' then (a_c (m/s^2), theta'' (rad/s^2)). O(n)."""
+    n = c.shape[0]
+    u = out[: 3 * n]
+    full_solve(V, c, s, fp, fa, fb, u)
+    jx, jy = _first_moment_rate(V, c, s, delta, u[:n], u[n : 2 * n], u[2 * n :])
+    rx, ry = _rho(V, th)
+    xb = body_accelerations(K, rx, ry, V[V_MCH, 0], V[V_BM, 0], V[V_BJ, 0], jx, jy, rb)
+    g0 = xb[0] - xb[2] * ry  # a_0 = a_c + theta'' rho_perp, rho_perp = (-ry, rx)
+    g1 = xb[1] + xb[2] * rx
     for i in range(3 * n):
         u[i] -= g0 * G[0, i] + g1 * G[1, i]
     out[3 * n : 3 * n + 3] = xb
