@@ -50,6 +50,7 @@ from rodval.core.modal import (
     ABOUT,
     Equilibrium,
     Modes,
+    check_no_mechanism,
     normalize_shapes,
     split_rigid,
     static_loads,
@@ -147,6 +148,8 @@ def exudyn_modes(
     n = scene.n
     loads = static_loads(scene, load_at) if about == "equilibrium" else None
     held = _held_forces(loads)
+    if scene.base.free:
+        check_no_mechanism(scene)
     if scene.base.free and held:
         raise ValueError(
             "a free base under static loads has no static equilibrium (the body accelerates); "

@@ -180,3 +180,16 @@ def test_exudyn_heavy_body_reproduces_the_pinned_chain():
     pinned = model_modes(free_scene().with_(base=Base()), "exudyn", count=6, **EXUDYN)
     check_rigid(heavy, 1e-6)
     np.testing.assert_allclose(heavy.flexible().omega, pinned.omega, rtol=2e-5)
+
+
+@pytest.mark.parametrize("model", ["full", pytest.param("exudyn", marks=pytest.mark.exudyn)])
+def test_a_hinge_without_a_spring_is_refused_naming_it(model):
+    """A free root (kappa_0 = 0) on a free body is a mechanism: a fourth zero-frequency mode
+    that is no rigid motion of the whole; refused before any work, naming the hinge and the
+    fix (a user's 5-panel boom with a free root met this as a cryptic split failure)."""
+    if model == "exudyn":
+        pytest.importorskip("exudyn")
+    scene = free_scene()
+    loose = scene.with_(chain=scene.chain.with_(kappa=[0.0, 50.0, 50.0]))
+    with pytest.raises(ValueError, match=r"hinge\(s\) \[0\] have no spring \(chain.kappa = 0\)"):
+        model_modes(loose, model)

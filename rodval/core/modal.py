@@ -9,7 +9,7 @@ Units: frequencies in rad/s (``omega``) and Hz (``f_hz``); mode shapes as node d
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
@@ -267,6 +267,20 @@ RIGID_RATIO = 1e-6
 #: nodes (``split_rigid``): the eigenvectors of the zero cluster carry round-off of about
 #: eps lam_max / lam_flexible (exudyn's axial modes make that ~1e-7 for the beam model).
 RIGID_SHAPE_TOL = 1e-4
+
+
+def check_no_mechanism(scene: Any) -> None:
+    """ValueError (before any work) when a chain on a free base has a hinge without a spring
+    (kappa = 0): it is then a mechanism, with a zero-frequency mode of its own beside the
+    body's three rigid ones, which ``split_rigid`` could not tell apart. Names the hinges and
+    the fix."""
+    loose = [int(k) for k in np.flatnonzero(np.asarray(scene.chain.kappa) == 0.0)]
+    if loose:
+        raise ValueError(
+            f"modes of a free spacecraft: hinge(s) {loose} have no spring (chain.kappa = 0), so "
+            "the chain is a mechanism with zero-frequency modes beside the three rigid ones; "
+            "give every hinge a spring (kappa > 0) for its modes"
+        )
 
 
 def split_rigid(

@@ -47,6 +47,7 @@ import numpy as np
 from rodval.core.eigen import angular_frequencies, symmetric_pencil
 from rodval.core.modal import (
     Modes,
+    check_no_mechanism,
     damping_ratios,
     normalize_shapes,
     split_rigid,
@@ -133,6 +134,7 @@ def check_free_base(scene: Scene, coefficients: str) -> None:
     ``FREE_COEFFICIENTS`` (the moving bases are built on the compiled kernels)."""
     if not scene.base.free:
         raise ValueError(f"free_modes needs a free base, got kind {scene.base.kind!r}")
+    check_no_mechanism(scene)
     if coefficients != FREE_COEFFICIENTS:
         raise ValueError(
             f"full model on a free base: coefficients must be {FREE_COEFFICIENTS!r} (the "
