@@ -149,12 +149,7 @@ def exudyn_modes(
     loads = static_loads(scene, load_at) if about == "equilibrium" else None
     held = _held_forces(loads)
     if scene.base.free:
-        check_no_mechanism(scene)
-    if scene.base.free and held:
-        raise ValueError(
-            "a free base under static loads has no static equilibrium (the body accelerates); "
-            "use about='initial' (free vibration, loads left out)"
-        )
+        _check_free(scene, held)
     prestressed = _springs_loaded(scene)
     if about == "equilibrium" and prestressed:
         scene = _at_rest_angles(scene)  # the static solve starts where the springs relax
@@ -210,6 +205,17 @@ def exudyn_modes(
 
 #: exudyn's modes exist on a free base (its three rigid modes separated, ``split_rigid``).
 exudyn_modes.FREE_BASE = True  # type: ignore[attr-defined]
+
+
+def _check_free(scene: Scene, held) -> None:
+    """ValueError before any work on a free base: a hinge without a spring
+    (``check_no_mechanism``), or static loads (a loaded free body has no equilibrium)."""
+    check_no_mechanism(scene)
+    if held:
+        raise ValueError(
+            "a free base under static loads has no static equilibrium (the body accelerates); "
+            "use about='initial' (free vibration, loads left out)"
+        )
 
 
 def _check_nodes(mbs, nodes) -> None:
