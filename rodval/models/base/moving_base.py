@@ -97,6 +97,12 @@ class LadderPrescribedSystem(FreeBody, LadderSystem):
         """The compiled S of the current mode (its held hinges)."""
         return lock_scalars(self._flags[0], self._lock_h, self._lock_a)
 
+    def kinetic_energy(self, t, y):
+        """T (J): a massless body's free-body T (``chain_base.free_mechanics``); the drive's
+        power, which needs the laws at t and a solve, is not part of it."""
+        cb.free_mechanics(0.0, y, self.V, self._flags, NO_MATRICES, NO_LOADS, self._mech)
+        return float(self._mech[0])
+
     def mechanics_at(self, t: float, y: np.ndarray) -> np.ndarray:
         """(T (J), P_ext with the drive's power (W), P_diss (W)) at one state in the current
         mode (``chain_base.prescribed_mechanics``)."""
