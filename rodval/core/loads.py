@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from rodval.core.checks import check_number
+from rodval.core.checks import as_path, check_number, check_type
 
 ForceLaw = Callable[[float], float]
 
@@ -205,6 +205,7 @@ class NodalForce:
                 f"load support must be a pair (t0, t1) of seconds, got {self.support!r}"
             )
         t0, t1 = (_real_or_inf("load support", v) for v in self.support)
+        check_type("load breakpoints", self.breakpoints, (tuple, list), "a tuple of seconds")
         if not (math.isfinite(t0) and t0 >= 0 and t1 > t0):
             raise ValueError(f"load support must satisfy 0 <= t0 < t1, got {self.support}")
         for b in self.breakpoints:
@@ -369,7 +370,7 @@ def tabulated(
     if file is not None:
         if t is not None or X is not None or Y is not None:
             raise ValueError("tabulated load: give either file or t with X/Y, not both")
-        t, X, Y = _read_history(Path(file))
+        t, X, Y = _read_history(as_path("tabulated file", file))
     if t is None or (X is None and Y is None):
         raise ValueError("tabulated load needs t and at least one of X, Y (or file)")
     tt = _samples("tabulated t (s)", t)

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from rodval.core.checks import check_choice, check_keys, check_number
+from rodval.core.checks import check_choice, check_keys, check_number, check_type
 from rodval.core.loads import LAW_CONSTANT, LAW_HARMONIC, LAW_LINEAR, LAW_RAISED_COSINE
 
 #: Kane, Ryan and Banerjee's smooth spin-up (on [0, p1)): p0 / p1 (t^2 / 2 + (p1 / 2 pi)^2
@@ -48,6 +48,9 @@ class Motion:
     def __post_init__(self) -> None:
         check_choice("motion law", self.law, tuple(MOTION_LAWS))
         names = MOTION_LAWS[self.law][0]
+        check_type(
+            "motion params", self.params, (tuple, list), f"a tuple of numbers ({', '.join(names)})"
+        )
         if len(self.params) != len(names):
             raise ValueError(
                 f"motion law {self.law!r} takes {len(names)} parameters "

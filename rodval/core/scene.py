@@ -157,6 +157,7 @@ class Chain:
             given = (l, m, EI, mu, kappa, nu, rest_angle, bending_damping)
             sizes = [np.size(v) for v in given if np.ndim(v) > 0]
             n = sizes[0] if sizes else 1
+        n = int(check_number("n (number of rods)", n, integer=True))
         if n < 1:
             raise ValueError(f"n (number of rods) must be >= 1, got {n}")
         check_rods(n)  # before any n-sized array

@@ -10,6 +10,7 @@ Every error is a ValueError that names the file and the offending key.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import inspect
 import tomllib
@@ -18,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from rodval.core.base import PINNED, Base
+from rodval.core.base import BASE_KINDS, PINNED, Base
 from rodval.core.checks import check_keys, check_number
 from rodval.core.damping import bending_damping_for_ratio
 from rodval.core.loads import LOAD_FACTORIES, pulse
@@ -36,9 +37,14 @@ from rodval.core.scene import (
     Stop,
     output_times,
 )
+from rodval.core.scene_keys import check_types, merge_documents, set_path
 
-#: The scenes a file may be ``based_on``: what the file omits takes that scene's values.
+#: The scenes a file may be ``based_on`` by name: what the file omits takes that scene's
+#: values. In a file, ``based_on`` may also be the path of another scene file
+#: (``read_scene_document``).
 BASED_ON = ("paper",)
+#: Most scene files one ``based_on`` chain may pass through (the file itself included).
+MAX_BASED_ON_DEPTH = 16
 #: The paper example's number of rods and horizon (s) (``paper_scene``'s defaults).
 PAPER_N = 8
 PAPER_T_END = 2.0
@@ -150,7 +156,7 @@ def _table_items(d: dict, key: str, cls: type, keys: tuple[str, ...], where: str
         check_keys(spec, set(keys), place)
         try:
             out.append(cls(**spec))
-        except TypeError as exc:
+        except ValueError as exc:
             raise ValueError(f"{place}: {exc}") from None
     return out
 
@@ -165,26 +171,36 @@ def _missing(key: str, what: str) -> ValueError:
 
 
 def _based_on(d: dict, where: str) -> str | None:
-    """The document's ``based_on`` (one of ``BASED_ON``) or None; a string ``base`` (the old
-    spelling of ``based_on``) is refused, so that no file silently changes meaning."""
-    base = d.get("base")
-    if isinstance(base, str):
-        raise ValueError(
-            f"{where} key 'base': base = {base!r} no longer names the scene the file starts "
-            f'from; write based_on = "paper" for the paper\'s example ([base] is a table: '
-            "the body node 0 belongs to)"
-        )
-    if base is not None and not isinstance(base, dict):
-        raise ValueError(
-            f"{where} key 'base': must be a [base] table (the body node 0 belongs to), got {base!r}"
-        )
+    """The document's ``based_on`` (one of ``BASED_ON``) or None."""
     based_on = d.get("based_on")
     if based_on is not None and (not isinstance(based_on, str) or based_on not in BASED_ON):
         raise ValueError(
             f"{where} key 'based_on': must be one of {BASED_ON} (the scene whose values fill "
-            f"in what the file omits), got {based_on!r}"
+            "in what the file omits) or, in a scene file, the path of another scene file "
+            f"(resolved when the file is read), got {based_on!r}"
         )
     return based_on
+
+
+def _base_advice(base: str) -> str:
+    """What a top-level string ``base = ...`` was meant to say, so that no file silently
+    changes meaning: a base kind is written in the [base] table (``[base] kind = "free"``),
+    the scene a file starts from is ``based_on`` (the old spelling was ``base = "paper"``)."""
+    if base in BASE_KINDS:
+        return (
+            f"base = {base!r} is not a table; the body node 0 belongs to is the [base] table: "
+            f'write [base] kind = "{base}" (with its keys, docs/base.md)'
+        )
+    if base in BASED_ON:
+        return (
+            f"base = {base!r} no longer names the scene the file starts from; write "
+            f'based_on = "{base}" for that ([base] is a table: the body node 0 belongs to)'
+        )
+    return (
+        f"must be the [base] table (the body node 0 belongs to: [base] kind = one of "
+        f"{', '.join(BASE_KINDS)}), got the string {base!r}; the scene a file starts from is "
+        "based_on"
+    )
 
 
 def _count(d: dict, based_on: str | None) -> int:
@@ -264,6 +280,9 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
     ValueError that names ``where`` (a file name) and the offending key.
     """
     check_keys(d, TOP_KEYS, where)
+    if isinstance(d.get("base"), str):  # the old spelling of based_on, or a base kind
+        raise ValueError(f"{where} key 'base': {_base_advice(d['base'])}")
+    check_types(d, where)
     based_on = _based_on(d, where)
     body = Base.from_dict(d["base"], f"{where} [base]") if "base" in d else PINNED
     try:
@@ -297,18 +316,56 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
 
 
 def read_scene_document(source: str | Path) -> dict[str, Any]:
-    """The scene document (dict form) of ``"paper"`` or a TOML scene file, not yet validated."""
+    """The scene document (dict form) of ``"paper"`` or a TOML scene file, not yet validated.
+    A file ``based_on`` another scene file (a path relative to its own folder) is laid over
+    that file's document (``merge_documents``: sections key by key, the later file winning),
+    down the chain of files (at most ``MAX_BASED_ON_DEPTH``; a loop is refused naming the
+    files); its name is its own ``name`` or its file name."""
     if str(source) in BASED_ON:
         return {"based_on": str(source)}
     path = Path(source)
     if not path.is_file():
         raise ValueError(f"SCENE must be 'paper' or an existing TOML file, got {str(source)!r}")
+    data, _ = scene_file_document(path)
+    data.setdefault("name", path.stem)
+    return data
+
+
+def scene_file_document(
+    path: Path, chain: tuple[Path, ...] = ()
+) -> tuple[dict[str, Any], tuple[Path, ...]]:
+    """The document of the scene file ``path`` with its ``based_on`` file (if any) resolved,
+    and the files read (``path`` first, then the files it is based on); ``chain``: the files
+    that led here (for loops and depth)."""
     try:
         data = tomllib.loads(path.read_text())
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
-    data.setdefault("name", path.stem)
-    return anchor_load_files(data, path.parent)
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read: {exc.strerror}") from None
+    data = anchor_load_files(data, path.parent)
+    parent = data.get("based_on")
+    if not isinstance(parent, str) or parent in BASED_ON:
+        return data, (path,)
+    here = (*chain, path)
+    target = path.parent / parent
+    names = " -> ".join(str(p) for p in (*here, target))
+    if not target.is_file():
+        raise ValueError(
+            f"{path} key 'based_on': {str(target)!r} is not a scene file (a based_on path is "
+            f'relative to the folder of the file that names it; or "paper")'
+        )
+    if any(target.resolve() == p.resolve() for p in here):
+        raise ValueError(f"{path} key 'based_on': the files start from each other: {names}")
+    if len(here) >= MAX_BASED_ON_DEPTH:
+        raise ValueError(
+            f"{path} key 'based_on': more than {MAX_BASED_ON_DEPTH} files start from one "
+            f"another ({names})"
+        )
+    earlier, files = scene_file_document(target, here)
+    earlier.pop("name", None)  # a file's name is its own (or its file name), never inherited
+    later = {k: v for k, v in data.items() if k != "based_on"}
+    return merge_documents(earlier, later), (path, *files)
 
 
 def anchor_load_files(doc: dict[str, Any], folder: Path) -> dict[str, Any]:
@@ -327,6 +384,27 @@ def anchor_load_files(doc: dict[str, Any], folder: Path) -> dict[str, Any]:
         for load in loads
     ]
     return {**doc, "loads": anchored}
+
+
+def scene_path(key: str) -> str | None:
+    """The dotted scene path a ``--set`` key names (``chain.EI``, or as a study's grid spells
+    it, ``scene.chain.EI``), or None when the key is not a scene key (a model option)."""
+    path = key.removeprefix("scene.")
+    return path if path.split(".")[0] in TOP_KEYS else None
+
+
+def with_overrides(doc: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
+    """A copy of the scene document ``doc`` with each value of ``overrides`` (dotted path ->
+    value, ``set_path``: a study grid's paths) set; ``doc`` is not changed. The values are
+    checked when the scene is built, like the file's. ValueError naming ``--set <path>`` when
+    a path runs into a value that is not a table or a list."""
+    out = copy.deepcopy(doc)
+    for path, value in overrides.items():
+        try:
+            set_path(out, path, value)
+        except ValueError as exc:
+            raise ValueError(f"--set {exc}") from None
+    return out
 
 
 def load_scene(source: str | Path) -> Scene:

@@ -14,7 +14,8 @@ from typing import Any
 from rodval.core.checks import check_keys
 from rodval.core.scene import Scene
 from rodval.core.scene_file import scene_from_dict
-from rodval.study.document import key_error, set_path
+from rodval.core.scene_keys import set_path
+from rodval.study.document import key_error
 from rodval.study.model_specs import ModelSpec, model_specs
 
 MODES_KEYS = {"count", "about", "load_at", "allow_unbalanced"}

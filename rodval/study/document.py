@@ -2,7 +2,8 @@
 
 One form for the errors of a study file, a ValueError naming the file and the dotted key
 (``key_error``), and dotted paths into the document: a grid's or a sample's keys, set in each
-case's copy of it (``set_path``; in a list, ``*`` is every element and an integer one).
+case's copy of it (``rodval.core.scene_keys.set_path``, the one definition that `--set`
+uses too; in a list, ``*`` is every element and an integer one).
 """
 
 from __future__ import annotations
@@ -41,36 +42,3 @@ def flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
         else:
             out[path] = v
     return out
-
-
-def set_path(doc: dict[str, Any], path: str, value: Any) -> None:
-    """Set ``value`` at the dotted ``path`` of ``doc``, creating tables on the way; in a list
-    a segment is an index or ``*`` (every element: every latch). ValueError when the path
-    runs into a value that is neither a table nor a list."""
-    _set_parts(doc, path.split("."), value, path)
-
-
-def _set_parts(node: Any, parts: list[str], value: Any, path: str) -> None:
-    """``set_path`` from ``node`` down the remaining segments ``parts`` of ``path``."""
-    head, rest = parts[0], parts[1:]
-    if isinstance(node, list):
-        if head == "*":
-            index = range(len(node))
-        elif head.isdigit() and int(head) < len(node):
-            index = range(int(head), int(head) + 1)
-        else:
-            raise ValueError(f"{path}: {head!r} is not '*' or an index of a list of {len(node)}")
-        for i in index:
-            if rest:
-                _set_parts(node[i], rest, value, path)
-            else:
-                node[i] = value
-        return
-    if not isinstance(node, dict):
-        raise ValueError(f"{path}: {head!r} goes into {node!r:.40}, which is not a table or list")
-    if not rest:
-        node[head] = value
-        return
-    if node.get(head) is None:
-        node[head] = {}
-    _set_parts(node[head], rest, value, path)

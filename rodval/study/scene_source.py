@@ -1,28 +1,30 @@
 """A study's ``[scene]`` that names a scene file: ``[scene] file = "wing.toml"`` and overrides.
 
 The file (a path relative to the study file's folder, or absolute) is read with
-``read_scene_document``, so its tabulated loads' CSV files are found relative to the scene
-file. The other keys of ``[scene]`` override the file's: a top-level key replaces the file's,
-the ``chain`` and ``initial`` tables are merged key by key (``MERGED_TABLES``), and a list
-(``latches``, ``stops``, ``loads``, ``times``) replaces the file's whole. The resolved table,
-not the path, is what the cases build, run and record; the file's SHA-256 goes into study.json
-so that a later run in the same folder notices that the file changed
-(``rodval.study.store``). Every error is one line naming ``scene.file``, before any case runs.
+``scene_file_document``, so its tabulated loads' CSV files are found relative to the scene
+file, and a file ``based_on`` another is resolved. The other keys of ``[scene]`` override the
+file's as a later file does (``rodval.core.scene_keys.merge_documents``): the sections
+(``chain``, ``initial``, ``base``, ``base.motion``) are merged key by key, any other value (a
+number, a list: ``latches``, ``stops``, ``loads``, ``times``) replaces the file's whole. The
+resolved table, not the path, is what the cases build, run and record; the file's SHA-256
+(with those of the files it is based on) goes into study.json so that a later run in the same
+folder notices that a file changed (``rodval.study.store``). Every error is one line naming
+``scene.file``, before any case runs; a study file named there is refused as one.
 """
 
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from rodval.core.scene_file import read_scene_document
+from rodval.core.scene_file import TOP_KEYS as SCENE_TOP_KEYS
+from rodval.core.scene_file import scene_file_document
+from rodval.core.scene_keys import merge_documents
 from rodval.study.document import key_error
 from rodval.study.toml_text import toml_text
-
-#: Tables of [scene] that override the file's key by key (the others replace it whole).
-MERGED_TABLES = ("chain", "initial")
 
 
 @dataclass(frozen=True)
@@ -38,26 +40,33 @@ class SceneFile:
         return {"path": self.path, "sha256": self.sha256}
 
 
-def resolve_scene(table: Any, folder: Path, where: str) -> tuple[Any, SceneFile | None]:
+def resolve_scene(
+    table: Any, folder: Path, where: str, study_keys: Iterable[str] = ()
+) -> tuple[Any, SceneFile | None]:
     """The [scene] ``table`` of the study ``where`` with its ``file`` (relative to
     ``folder``) read and the table's other keys laid over it (``merge_scene``), and the file
-    read; ``table`` itself and None when it names no file."""
+    read; ``table`` itself and None when it names no file. ``study_keys``: the top-level keys
+    of a study file; a file holding one that no scene file has is refused as a study file."""
     if not isinstance(table, dict) or "file" not in table:
         return table, None
     path = _scene_path(table, folder, where)
     document, digest = _read(path, where)
+    study = sorted((set(document) & set(study_keys)) - SCENE_TOP_KEYS)
+    if study:
+        raise key_error(
+            where,
+            "scene.file",
+            f"{str(path)!r} is a study file (it has [{study[0]}]), not a scene file; name a "
+            "scene file (docs/scene_file.md)",
+        )
     overrides = {k: v for k, v in table.items() if k != "file"}
     return merge_scene(document, overrides), SceneFile(str(path), digest)
 
 
 def merge_scene(document: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
-    """``document`` (a scene file's table) with ``overrides`` laid over it: top-level keys
-    replace, the ``MERGED_TABLES`` merge key by key. Neither argument is changed."""
-    merged = {**document, **overrides}
-    for key in MERGED_TABLES:
-        if isinstance(document.get(key), dict) and isinstance(overrides.get(key), dict):
-            merged[key] = {**document[key], **overrides[key]}
-    return merged
+    """``document`` (a scene file's table) with ``overrides`` laid over it as a later scene
+    file is (``merge_documents``). Neither argument is changed."""
+    return merge_documents(document, overrides)
 
 
 def _scene_path(table: dict[str, Any], folder: Path, where: str) -> Path:
@@ -87,15 +96,17 @@ def _scene_path(table: dict[str, Any], folder: Path, where: str) -> Path:
 
 
 def _read(path: Path, where: str) -> tuple[dict[str, Any], str]:
-    """The scene document of the file ``path`` (``read_scene_document``: its load files
-    anchored at its folder) and the SHA-256 (hex) of its bytes."""
+    """The scene document of the file ``path`` (``scene_file_document``: its load files
+    anchored at its folder, its ``based_on`` file resolved) and the SHA-256 (hex) of its bytes
+    (followed, for a file based on others, by theirs)."""
     try:
-        digest = hashlib.sha256(path.read_bytes()).hexdigest()
-        document = read_scene_document(path.absolute())
+        document, files = scene_file_document(path.absolute())
+        digest = hashlib.sha256(b"".join(f.read_bytes() for f in files)).hexdigest()
     except OSError as exc:
         raise key_error(where, "scene.file", f"cannot read {str(path)!r}: {exc.strerror}") from None
     except ValueError as exc:
         raise key_error(where, "scene.file", str(exc)) from None
+    document.setdefault("name", path.stem)
     return document, digest
 
 

@@ -231,7 +231,7 @@ def _resolve_scene(
         return None, text
     if not isinstance(doc["scene"], dict):
         raise key_error(where, "scene", "must be a table")
-    doc["scene"], scene_file = resolve_scene(doc["scene"], folder, where)
+    doc["scene"], scene_file = resolve_scene(doc["scene"], folder, where, TOP_KEYS)
     if scene_file is None:
         return None, text
     named = {**doc, "study": {"name": Path(where).stem, **doc["study"]}}
