@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import argparse
 import math
+import tomllib
 from pathlib import Path
 
+from rodval.core.scene_file import scene_path
 from rodval.core.settings import DEFAULTS, MAX_COUNT, METHODS, MIN_RTOL, RTOL_RANGE
 
 
@@ -29,7 +31,8 @@ def positive_float(
             v = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{name} must be {allowed}, got {text!r}") from None
-        if not (0 < v < below and v >= least) or (finite and math.isinf(v)):
+        inside = v < below or v == below == math.inf  # "inf allowed" when not finite
+        if not (0 < v and inside and v >= least) or (finite and math.isinf(v)):
             raise argparse.ArgumentTypeError(f"{name} must be {allowed}, got {text!r}")
         return v
 
@@ -75,11 +78,25 @@ def time_list(text: str) -> list[float]:
     return values
 
 
+def scene_value(raw: str) -> object:
+    """The VALUE of ``--set PATH=VALUE`` for a scene key, read as a TOML value (``2e8``,
+    ``[1, 2]``, ``true``, ``{ ratio = 0.01 }``, ``"text"``), or the text itself when it is not
+    one (``kind=free``); the scene checks it like the file's value."""
+    try:
+        return tomllib.loads(f"value = {raw}")["value"]
+    except tomllib.TOMLDecodeError:
+        return raw
+
+
 def key_value(text: str) -> tuple[str, object]:
-    """KEY=VALUE for model options; VALUE parsed as int, float or kept as text."""
+    """KEY=VALUE: a scene key's dotted path (``scene_path``: ``chain.EI=2e8``) with a TOML
+    value (``scene_value``), or a model option with VALUE parsed as int, float or kept as
+    text."""
     if "=" not in text:
         raise argparse.ArgumentTypeError(f"--set expects KEY=VALUE, got {text!r}")
     key, raw = text.split("=", 1)
+    if scene_path(key.strip()) is not None:
+        return key.strip(), scene_value(raw.strip())
     value: object = raw
     for cast in (int, float):
         try:
@@ -165,8 +182,9 @@ def add_model_options(p: argparse.ArgumentParser, *, coefficients_default: str |
         action="append",
         default=[],
         metavar="KEY=VALUE",
-        help="model option, e.g. elements=8 for exudyn (repeatable); the allowed "
-        "keys of each model: docs/scene_file.md",
+        help="a model option, e.g. elements=8 for exudyn, or a scene value by its dotted "
+        "key, e.g. chain.EI=2e8 or latches.*.angle=0.4 (a TOML value, checked like the "
+        "scene file's; repeatable); the keys: docs/scene_file.md",
     )
 
 
@@ -186,7 +204,7 @@ def set_options(pairs: list[tuple[str, object]]) -> dict[str, object]:
 def model_options(args: argparse.Namespace) -> dict[str, object]:
     """The model options of ``add_model_options``: the --set pairs and --coefficients (when
     given); --coefficients together with --set coefficients=... is refused (ValueError)."""
-    options = set_options(args.options)
+    options = {k: v for k, v in set_options(args.options).items() if scene_path(k) is None}
     if args.coefficients is not None:
         if "coefficients" in options:
             raise ValueError(
@@ -195,6 +213,20 @@ def model_options(args: argparse.Namespace) -> dict[str, object]:
             )
         options["coefficients"] = args.coefficients
     return options
+
+
+def scene_overrides(args: argparse.Namespace) -> dict[str, object]:
+    """The scene values of ``--set PATH=VALUE`` (path -> value, ``scene.`` dropped), a path
+    given twice refused (``set_options``)."""
+    paths = {k: scene_path(k) for k, _ in args.options}
+    out: dict[str, object] = {}
+    for key, value in set_options(args.options).items():
+        path = paths[key]
+        if path is not None:
+            if path in out:
+                raise ValueError(f"--set {path} given twice (as {key} and {path}); give it once")
+            out[path] = value
+    return out
 
 
 def add_junit_option(p) -> None:

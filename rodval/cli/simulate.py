@@ -22,11 +22,17 @@ from rodval.cli.options import (
     integrator_settings,
     model_options,
     positive_float,
+    scene_overrides,
     time_list,
 )
 from rodval.core.checks import check_keys
 from rodval.core.scene import EXPANDS, MAX_TIMES, Scene
-from rodval.core.scene_file import read_scene_document, scene_from_dict, with_horizon
+from rodval.core.scene_file import (
+    read_scene_document,
+    scene_from_dict,
+    with_horizon,
+    with_overrides,
+)
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.core.validity import describe
 from rodval.models import REGISTRY, simulate
@@ -229,10 +235,25 @@ def _request(args) -> tuple[dict[str, Any], str, dict[str, Any], dict[str, Any]]
     return dict(previous["scene"]), model, settings_kw, options
 
 
+def overridden(doc: dict[str, Any], args) -> tuple[dict[str, Any], str]:
+    """The scene document with the scene values of ``--set PATH=VALUE`` set (a study grid's
+    paths, ``with_overrides``), and the name its errors go by (SCENE, with the --set keys).
+    --set t_end beside --t-end, or times beside --times, is refused: one value each."""
+    overrides = scene_overrides(args)
+    for path, option in (("t_end", args.t_end), ("times", args.times)):
+        if path in overrides and option is not None:
+            flag = "--" + path.replace("_", "-")
+            raise ValueError(f"--set {path} and {flag} both given; give the value once")
+    if not overrides:
+        return doc, str(args.scene)
+    return with_overrides(doc, overrides), f"{args.scene} (with --set {', '.join(overrides)})"
+
+
 def run(args) -> int:
     start = args.started  # the command's start (rodval.cli.main): its budget counts from it
     doc, model, settings_kw, options = _request(args)
-    scene, notes = build_scene(doc, str(args.scene), args.t_end, args.times)
+    doc, where = overridden(doc, args)
+    scene, notes = build_scene(doc, where, args.t_end, args.times)
     options.update(model_options(args))
     settings_kw.update(integrator_settings(args))
     settings = IntegratorSettings(**settings_kw)
