@@ -51,4 +51,4 @@ def test_each_check_names_its_fix_only_when_broken():
     (ok,) = small_bending(0.01)
     assert "fix" not in ok.reason()
     (coarse,) = step_resolution(0.4, 0.1, step=2e-4)
-    assert coarse.reason().endswith("fix: step <= 5e-05 s")
+    assert "fix: step = 5e-05 (command line: --set step=5e-05)" in coarse.reason()

@@ -44,6 +44,41 @@ MOMENTUM_RESIDUAL_BOUND = 1e-2
 MOMENTUM_POINTS = ("centre of mass", "root")
 
 
+#: Where a setting a fix names lives: a model option (a study's ``[models.LABEL]``, the command
+#: line's ``--set KEY=VALUE``), an integrator setting (``[integrator]``, ``--KEY VALUE``) or a
+#: scene value (the scene file's table, ``--set PATH=VALUE``).
+SETTING_PLACES = ("model", "integrator", "scene")
+
+
+def _toml(value: Any) -> str:
+    """``value`` as TOML text: a string quoted, a number in its shortest form."""
+    if isinstance(value, str):
+        return f'"{value}"'
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
+def setting(key: str, value: Any, place: str = "model") -> str:
+    """A setting a fix names, in both spellings (the one definition of how a fix is
+    written): the file's and the command line's, e.g. 'kinematics = "exact" (command line:
+    --set kinematics=exact)'; an integrator setting 'rtol = 1e-10 in [integrator] (command
+    line: --rtol 1e-10)'; a scene value by its dotted path ``chain.bending_damping``:
+    '[chain] bending_damping = { ratio = 0.01 } (command line: --set
+    chain.bending_damping={ratio=0.01})'. ``value`` may be text already in TOML form (an
+    inline table)."""
+    if place not in SETTING_PLACES:
+        raise ValueError(f"place must be one of {SETTING_PLACES}, got {place!r}")
+    if place == "scene":
+        text = value if isinstance(value, str) else _toml(value)
+        table, _, leaf = key.rpartition(".")
+        file = f"[{table}] {leaf} = {text}" if table else f"{key} = {text}"
+        return f"{file} (command line: --set {key}={text.replace(' ', '')})"
+    text = _toml(value)
+    plain = value if isinstance(value, str) else text
+    if place == "integrator":
+        return f"{key} = {text} in [integrator] (command line: --{key.replace('_', '-')} {plain})"
+    return f"{key} = {text} (command line: --set {key}={plain})"
+
+
 @dataclass(frozen=True)
 class Check:
     """One assumption checked on one run: ``figure`` (in ``unit``) must not exceed ``bound``.
@@ -145,7 +180,7 @@ def step_resolution(rotation: float | None, bound: float, step: float | None = N
         return []
     fix = "a smaller step"
     if step is not None and rotation > 0 and math.isfinite(rotation):
-        fix = f"step <= {step * bound / rotation:.2g} s"
+        fix = f"{setting('step', float(f'{step * bound / rotation:.2g}'))} or smaller (s)"
     return [
         Check("step resolution", float(rotation), bound, "rad", "largest rotation per step", fix)
     ]
