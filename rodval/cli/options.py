@@ -7,7 +7,7 @@ import math
 import tomllib
 from pathlib import Path
 
-from rodval.core.scene_file import scene_path
+from rodval.core.scene_keys import scene_path
 from rodval.core.settings import DEFAULTS, MAX_COUNT, METHODS, MIN_RTOL, RTOL_RANGE
 
 

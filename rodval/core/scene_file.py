@@ -386,13 +386,6 @@ def anchor_load_files(doc: dict[str, Any], folder: Path) -> dict[str, Any]:
     return {**doc, "loads": anchored}
 
 
-def scene_path(key: str) -> str | None:
-    """The dotted scene path a ``--set`` key names (``chain.EI``, or as a study's grid spells
-    it, ``scene.chain.EI``), or None when the key is not a scene key (a model option)."""
-    path = key.removeprefix("scene.")
-    return path if path.split(".")[0] in TOP_KEYS else None
-
-
 def with_overrides(doc: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
     """A copy of the scene document ``doc`` with each value of ``overrides`` (dotted path ->
     value, ``set_path``: a study grid's paths) set; ``doc`` is not changed. The values are

@@ -269,6 +269,13 @@ def _check_table(table: dict[str, Any], keys: dict[str, Key], prefix: str, where
 # ------------------------------------------------------------------ paths and merging
 
 
+def scene_path(key: str) -> str | None:
+    """The dotted scene path a ``--set`` key names (``chain.EI``, or as a study's grid spells
+    it, ``scene.chain.EI``), or None when the key is not a scene key (a model option)."""
+    path = key.removeprefix("scene.")
+    return path if path.split(".")[0] in SCENE_KEYS else None
+
+
 def set_path(doc: dict[str, Any], path: str, value: Any) -> None:
     """Set ``value`` at the dotted ``path`` of ``doc``, creating tables on the way; in a list
     a segment is an index or ``*`` (every element: every latch). ValueError when the path
