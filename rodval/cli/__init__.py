@@ -102,15 +102,16 @@ def one_line(exc: BaseException) -> str:
 
 def _run(args: argparse.Namespace) -> int:
     """Run the subcommand. A command that writes a plain output folder (``out_folder`` set
-    by its parser) is refused one that holds files rodval did not write, before any work,
-    and the folder is marked rodval's once the command has written into it
+    by its parser) is refused, before any work, one that is or holds a link, holds files
+    rodval did not write or is another command's output folder, and the folder is marked
+    the command's, listing its files, once the command has written into it
     (``rodval.core.out_paths``)."""
     command = getattr(args, "out_folder", None)
     if command is None:
         return int(args.func(args) or 0)
     from rodval.core.out_paths import claim_output_folder, mark_output_folder
 
-    claim_output_folder(args.out)
+    claim_output_folder(args.out, command=command)
     try:
         return int(args.func(args) or 0)
     finally:

@@ -22,7 +22,10 @@ def register(sub) -> None:
         "node 0 where the body moved (output 'base'; a free-base run with neither x, y nor "
         "'base' is refused). Each run is drawn only at output times it has: the frames are "
         "the output times all runs share (a note says so when the runs' times differ; runs "
-        "sharing fewer than 2 are refused).",
+        "sharing fewer than 2 are refused). A free or prescribed base's body is drawn as a square "
+        "at its position and attitude (from output 'base', or a prescribed base's laws). "
+        "The folders above FILE are made when missing; FILE inside another command's output "
+        "folder, or a link, is refused before any work.",
     )
     p.add_argument("runs", metavar="RUN", type=Path, nargs="+", help="run folder(s)")
     p.add_argument("--out", required=True, type=Path, help="FILE.gif or FILE.mp4")
@@ -42,10 +45,16 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from rodval.core.out_paths import check_output_file, in_command_folder
     from rodval.core.scene_file import scene_from_dict
-    from rodval.report.animation import animate_runs, shared_times
+    from rodval.report.animation import FORMATS, animate_runs, shared_times
     from rodval.report.run_files import read_run, read_run_record
 
+    if args.out.suffix not in FORMATS:
+        raise ValueError(f"--out must end in one of {FORMATS}, got {args.out.name!r}")
+    # before any work: a place a file can be made (missing folders are), no link, no folder
+    # of another command; an existing animation there is replaced
+    check_output_file(args.out, "--out", reserved=in_command_folder, ours=lambda p: True)
     runs, lengths, bases = {}, {}, {}
     for folder in args.runs:
         traj = read_run(folder)
@@ -64,6 +73,8 @@ def run(args) -> int:
         f"{done.frames} frames, {len(done.events)} events marked, "
         f"t = {done.times[0]:g}..{done.times[-1]:g} s -> {done.path}"
     )
+    for note in done.notes:
+        print(f"note: {note}")
     counts = {label: traj.times.size for label, traj in runs.items()}
     if len(set(counts.values())) > 1:
         each = ", ".join(f"{label}: {c}" for label, c in counts.items())

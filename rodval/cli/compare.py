@@ -23,7 +23,10 @@ def register(sub) -> None:
         "rodval.analysis.events). "
         "A run whose trajectory is not the one its run.json records (cut, edited) or whose "
         "run.json records no digest of it is refused. DIR must be new, empty or an output "
-        "folder of rodval (refused before any work otherwise).",
+        "folder of rodval compare (refused before any work otherwise: another command's "
+        "folder, a folder holding a file or link rodval did not write); the files of an "
+        "earlier compare there are replaced (an events.csv the new runs have no locks for is "
+        "removed).",
     )
     p.add_argument("a", metavar="A", type=Path, help="run folder to compare")
     p.add_argument("b", metavar="B", type=Path, help="reference run folder")
@@ -40,6 +43,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from rodval.analysis.metrics import discrepancies
+    from rodval.core.out_paths import clear_previous, write_file, write_with
     from rodval.core.scene_file import scene_differences
     from rodval.report.figures import plot_time_histories
     from rodval.report.markdown import to_markdown
@@ -55,29 +59,32 @@ def run(args) -> int:
         )
     a, b = read_run(args.a), read_run(args.b)
     table = discrepancies(a, b)
-    args.out.mkdir(parents=True, exist_ok=True)
-    table.to_csv(args.out / "discrepancies.csv", index=False)
-    (args.out / "discrepancies.md").write_text(
-        f"# {args.a} ({a.model}) against {args.b} ({b.model})\n\n" + to_markdown(table)
+    locks = lock_table(a.events, b.events)
+    # this compare's files only: the earlier compare's (an events.csv of runs that locked) go
+    clear_previous(args.out, "compare")
+    write_file(args.out / "discrepancies.csv", table.to_csv(index=False))
+    write_file(
+        args.out / "discrepancies.md",
+        f"# {args.a} ({a.model}) against {args.b} ({b.model})\n\n" + to_markdown(table),
     )
     quantities = [q for q in ("phi", "dphi", "alpha", "beta") if q in table["quantity"].values]
     if quantities:
         n = int(max(b.k_index[quantities[0]]))
-        plot_time_histories(
-            {f"A: {a.model}": a, f"B: {b.model}": b},
-            quantities,
-            sorted({1, n}),
+        histories = {f"A: {a.model}": a, f"B: {b.model}": b}
+        write_with(
             args.out / "histories.png",
-            title=f"{args.a} against {args.b}",
+            lambda tmp: plot_time_histories(
+                histories, quantities, sorted({1, n}), tmp, title=f"{args.a} against {args.b}"
+            ),
         )
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3e}"))
     print(f"-> {args.out / 'discrepancies.md'}")
-    locks = lock_table(a.events, b.events)
     if not locks.empty:
-        locks.to_csv(args.out / "events.csv", index=False)
-        (args.out / "events.md").write_text(
+        write_file(args.out / "events.csv", locks.to_csv(index=False))
+        write_file(
+            args.out / "events.md",
             f"# Locks of {args.a} ({a.model}) against {args.b} ({b.model})\n\n"
-            + to_markdown(locks, ".6g")
+            + to_markdown(locks, ".6g"),
         )
         print(f"\nLocks: A = {args.a} ({a.model}) against B = {args.b} ({b.model}):")
         print(locks.to_string(index=False, na_rep="", float_format=lambda v: f"{v:.6g}"))

@@ -8,13 +8,24 @@ refuses any other folder before work, naming what it holds (``refuse_foreign``).
 file named on the command line (``--junit``) is checked before work: a writable place, not a
 folder, not an input of the command nor a file of its output folder, and not an existing file
 rodval did not write (``check_output_file``).
+
+Nothing is written through a symbolic link: rodval makes none, so an output folder that is a
+link, or holds one anywhere below it, is refused before work (``refuse_links``, part of
+``refuse_foreign``, which every folder claim goes through), and every file rodval writes goes
+through ``write_file`` / ``write_with`` (a temporary file beside it renamed over it, the target
+refused when it is a link) and every figure through ``write_figure``. A plain output folder
+(``rodval.json``) belongs to one command and lists the files it wrote: another command's output
+is refused there, a file it does not list (the user's) too, and ``clear_previous`` removes the
+listed files of the command's earlier run just before the new run writes (nothing else).
 """
 
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import os
+import re
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -25,6 +36,8 @@ SCHEMA_KEY, CHECKSUM_KEY = "rodval_schema", "rodval_checksum"
 STUDY_SCHEMA, RUN_SCHEMA = "rodval-study", "rodval-run"
 #: Entries of a folder that rodval itself keeps there while it works (its writer lock).
 HOUSEKEEPING = (".lock",)
+#: Name of the temporary file of an atomic write (``write_with``): ``.<name>.<pid>.tmp``.
+TEMPORARY = re.compile(r"\..+\.\d+\.tmp(\.\w+)?")
 
 
 def _digest(record: dict[str, Any]) -> str:
@@ -66,13 +79,74 @@ def _named(entries: list[str]) -> str:
     return first + (f" and {len(entries) - 3} more" if len(entries) > 3 else "")
 
 
+def _link_refusal(flag: str, link: Path, what: str) -> ValueError:
+    return ValueError(
+        f"{flag} {link}: {what} a symbolic link, which rodval did not make; rodval writes "
+        "through no link (it could overwrite another folder's files): remove the link or use "
+        "a new folder"
+    )
+
+
+def refuse_links(folder: Path, flag: str) -> None:
+    """ValueError naming ``flag`` and the link when ``folder`` is a symbolic link or holds one
+    anywhere below it (links are not followed): rodval makes no link, so writing there could
+    go into a file or folder of another (a run.json linked to another run's)."""
+    if folder.is_symlink():
+        raise _link_refusal(flag, folder, "is")
+    pending = [folder] if folder.is_dir() else []
+    while pending:
+        with os.scandir(pending.pop()) as entries:
+            for entry in entries:
+                if entry.is_symlink():
+                    raise _link_refusal(flag, Path(entry.path), "is")
+                if entry.is_dir(follow_symlinks=False):
+                    pending.append(Path(entry.path))
+
+
+def write_with(path: Path, produce: Callable[[Path], object], flag: str = "--out") -> Path:
+    """Write ``path`` by ``produce(tmp)`` (which writes the file it is given, a temporary
+    file beside ``path`` of the same suffix), then rename it over ``path``: never through a
+    link (ValueError naming ``flag`` when ``path`` is one), never half-written. Creates the
+    missing parent folders (as ``mkdir -p``)."""
+    path = Path(path)
+    if path.is_symlink():
+        raise _link_refusal(flag, path, "is")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp{path.suffix}")
+    try:
+        produce(tmp)
+        if path.is_symlink():  # made while the file was produced
+            raise _link_refusal(flag, path, "is")
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path
+
+
+def write_file(path: Path, data: bytes | str, flag: str = "--out") -> Path:
+    """Write ``data`` (text as UTF-8) to ``path`` through ``write_with``: the one way rodval
+    writes a file."""
+    raw = data.encode() if isinstance(data, str) else data
+    return write_with(path, lambda tmp: tmp.write_bytes(raw), flag)
+
+
+def write_figure(fig: Any, path: Path, flag: str = "--out", **savefig: Any) -> Path:
+    """Save a matplotlib figure to ``path`` (its format from the suffix) through
+    ``write_file``; ``savefig``: keyword arguments of ``Figure.savefig``."""
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format=Path(path).suffix.lstrip(".") or "png", **savefig)
+    return write_file(path, buffer.getvalue(), flag)
+
+
 def refuse_foreign(
     folder: Path, flag: str, owned: Callable[[Path], bool], kind: str, marker: str
 ) -> None:
     """ValueError naming ``flag`` unless ``folder`` is missing, empty, or rodval's
     (``owned(folder)``): rodval writes into no folder that holds files it did not write.
     ``kind`` ("study", "run") and ``marker`` (its file, e.g. "study.json") name the folder
-    rodval looked for in the refusal."""
+    rodval looked for in the refusal. A folder that is or holds a symbolic link is refused
+    first (``refuse_links``)."""
+    refuse_links(folder, flag)
     if not folder.exists():
         return
     if not folder.is_dir():
@@ -104,10 +178,11 @@ def check_output_file(
     ours: Callable[[Path], bool] = lambda p: False,
 ) -> Path:
     """``path`` as a Path when rodval may write a file there, else ValueError naming
-    ``flag``, before any work: a non-empty path, not a folder, under an existing folder
-    where a file can be created, none of the ``protected`` files (the command's inputs), not
+    ``flag``, before any work: a non-empty path, not a folder, where a file can be created,
+    none of the ``protected`` files (the command's inputs), not
     a file ``reserved`` for another purpose (it returns why, e.g. "a file of the study in
-    out/"), and, when the file exists, one rodval wrote (``ours(path)``)."""
+    out/"), not a symbolic link, and, when the file exists, one rodval wrote (``ours(path)``).
+    Missing folders above it are fine when they can be made (``write_with`` makes them)."""
     if not isinstance(path, str | os.PathLike) or str(path).strip() == "":
         raise ValueError(f"{flag}: needs a file path, got {str(path)!r}")
     p = Path(path)
@@ -119,9 +194,11 @@ def check_output_file(
     why = reserved(p)
     if why:
         raise ValueError(f"{flag} {p}: is {why}; name another file")
-    parent = p.parent
-    if not parent.is_dir():
-        raise ValueError(f"{flag} {p}: its folder {parent} does not exist (or is a file)")
+    if p.is_symlink():
+        raise _link_refusal(flag, p, "is")
+    parent = _existing_folder(p, flag)
+    if parent != p.parent:  # its missing folders are made when the file is written
+        return p
     if p.exists():
         if not p.is_file() or not ours(p):
             raise ValueError(
@@ -140,6 +217,49 @@ def check_output_file(
     return p
 
 
+def _existing_folder(p: Path, flag: str) -> Path:
+    """The nearest existing folder above file ``p``: ValueError naming ``flag`` when it is a
+    file (no folder can be made there) or cannot be written into (its missing folders are
+    made as ``mkdir -p`` does when the file is written)."""
+    parent = p.parent
+    while not parent.exists() and not parent.is_symlink() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ValueError(f"{flag} {p}: {parent} is a file, so no folder can hold {p.name} there")
+    if parent != p.parent and not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(
+            f"{flag} {p}: its folder {p.parent} does not exist and cannot be made in {parent} "
+            "(permission denied)"
+        )
+    return parent
+
+
+def owner_command(folder: Path) -> str | None:
+    """The rodval command whose output folder ``folder`` is (a stamped ``study.json``:
+    "study", ``run.json``: "simulate", ``rodval.json``: its command), or None."""
+    record = _marker(folder)
+    if record is not None:
+        return str(record.get("command"))
+    for marker, schema, command in (
+        ("study.json", STUDY_SCHEMA, "study"),
+        ("run.json", RUN_SCHEMA, "simulate"),
+    ):
+        if is_stamped(read_json(folder / marker), schema):
+            return command
+    return None
+
+
+def in_command_folder(path: Path) -> str | None:
+    """Why file ``path`` is not free for a command without a folder of its own (``rodval
+    animate --out``): it lies in the output folder of a rodval command (its folder or one
+    above), which holds that command's files only; else None."""
+    for folder in Path(os.path.abspath(path)).parents:
+        command = owner_command(folder)
+        if command is not None:
+            return f"in {folder}, the output folder of rodval {command} (its files only)"
+    return None
+
+
 def inside(path: Path, folder: Path) -> Path | None:
     """``path`` relative to ``folder`` when it lies inside it (both resolved), else None."""
     try:
@@ -149,8 +269,10 @@ def inside(path: Path, folder: Path) -> Path | None:
 
 
 #: The marker of a plain output folder (``rodval compare``, ``modes``, ``reproduce``,
-#: ``bench``): ``rodval.json``, stamped with ``OUTPUT_SCHEMA``, naming the command.
+#: ``bench``): ``rodval.json``, stamped with ``OUTPUT_SCHEMA``, naming the command that owns
+#: the folder and the files it wrote there (``FILES_KEY``: paths relative to the folder).
 OUTPUT_MARKER, OUTPUT_SCHEMA = "rodval.json", "rodval-output"
+FILES_KEY = "files"
 
 
 def output_folder_owned(folder: Path) -> bool:
@@ -158,13 +280,80 @@ def output_folder_owned(folder: Path) -> bool:
     return is_stamped(read_json(folder / OUTPUT_MARKER), OUTPUT_SCHEMA)
 
 
-def claim_output_folder(folder: Path, flag: str = "--out") -> None:
-    """Refuse, before work, an output folder that holds files rodval did not write."""
+def _marker(folder: Path) -> dict[str, Any] | None:
+    record = read_json(folder / OUTPUT_MARKER)
+    return record if is_stamped(record, OUTPUT_SCHEMA) else None
+
+
+def folder_files(folder: Path) -> list[str]:
+    """The files below ``folder`` (paths relative to it, '/'-separated, sorted) but its
+    marker, rodval's housekeeping and the temporary files of atomic writes."""
+    if not folder.is_dir():
+        return []
+    return sorted(
+        p.relative_to(folder).as_posix()
+        for p in folder.rglob("*")
+        if p.is_file()
+        and p.name not in (OUTPUT_MARKER, *HOUSEKEEPING)
+        and not TEMPORARY.fullmatch(p.name)
+    )
+
+
+def listed_files(folder: Path) -> list[str] | None:
+    """The files the marker of output folder ``folder`` lists as rodval's (None: a marker
+    of an older rodval, which lists none: every file there was taken as rodval's)."""
+    record = _marker(folder) or {}
+    files = record.get(FILES_KEY)
+    if not isinstance(files, list):
+        return None
+    return [f for f in files if isinstance(f, str) and ".." not in Path(f).parts]
+
+
+def claim_output_folder(folder: Path, flag: str = "--out", command: str | None = None) -> None:
+    """Refuse, before work, an output folder rodval may not write into: one that is or holds
+    a link, holds files rodval did not write (no marker, or files its marker does not
+    list), or, given ``command``, is the output folder of another command (each command's
+    folder holds its files only)."""
     refuse_foreign(folder, flag, output_folder_owned, "output", OUTPUT_MARKER)
+    record = _marker(folder)
+    if record is None:
+        return
+    owner = record.get("command")
+    if command is not None and owner != command:
+        raise ValueError(
+            f"{flag} {folder}: is the output folder of rodval {owner}; rodval {command} keeps "
+            "its files apart from another command's: use another folder"
+        )
+    listed = listed_files(folder)
+    unlisted = [f for f in folder_files(folder) if listed is not None and f not in listed]
+    if unlisted:
+        raise ValueError(
+            f"{flag} {folder}: holds {_named(unlisted)}, which its {OUTPUT_MARKER} does not "
+            "list among the files rodval wrote, so rodval will not write there; use a new or "
+            "empty folder"
+        )
+
+
+def clear_previous(folder: Path, command: str) -> list[str]:
+    """Remove the files the earlier run of ``command`` wrote into output folder ``folder``
+    (those its marker lists; nothing else): called by the command just before it writes its
+    own, so that the folder holds this run's files only (no events.csv of an earlier
+    compare whose runs locked). Returns the removed files."""
+    record = _marker(folder)
+    listed = listed_files(folder) if record and record.get("command") == command else None
+    removed = []
+    for name in listed or []:
+        path = folder / name
+        if path.is_file() and not path.is_symlink():
+            path.unlink()
+            removed.append(name)
+    return removed
 
 
 def mark_output_folder(folder: Path, command: str) -> None:
-    """Mark ``folder`` (when the command made or wrote it) as rodval's output folder."""
-    if folder.is_dir() and not output_folder_owned(folder):
-        record = stamp({"command": command}, OUTPUT_SCHEMA)
-        (folder / OUTPUT_MARKER).write_text(json.dumps(record, indent=1))
+    """Mark ``folder`` (when the command made or wrote it) as the output folder of
+    ``command``, listing the files there (``claim_output_folder`` let in no other)."""
+    if not folder.is_dir() or folder.is_symlink():
+        return
+    record = stamp({"command": command, FILES_KEY: folder_files(folder)}, OUTPUT_SCHEMA)
+    write_file(folder / OUTPUT_MARKER, json.dumps(record, indent=1))

@@ -17,6 +17,8 @@ from typing import Any
 
 import pandas as pd
 
+from rodval.core.out_paths import write_with
+
 #: The metrics an acceptance bound may limit (columns of discrepancies.csv); the study file's
 #: [[acceptance.bound]] tables are checked in ``rodval.study.acceptance``.
 BOUND_METRICS = ("max_abs", "rms")
@@ -238,7 +240,8 @@ def is_junit_report(path: Path) -> bool:
 
 def write_junit(checks: list[Check], path: Path, suite: str) -> Path:
     """A JUnit XML file of ``checks`` (one ``<testcase>`` each, a ``<failure>`` where one
-    broke) in one ``<testsuite>`` named ``suite``."""
+    broke) in one ``<testsuite>`` named ``suite``; the folders above ``path`` are made when
+    missing, and the file is never written through a link (``write_with``)."""
     failures = sum(not c.held for c in checks)
     root = ET.Element("testsuites", name=JUNIT_NAME, tests=str(len(checks)), failures=str(failures))
     ts = ET.SubElement(
@@ -248,10 +251,10 @@ def write_junit(checks: list[Check], path: Path, suite: str) -> Path:
         tc = ET.SubElement(ts, "testcase", classname=c.classname, name=c.name)
         if not c.held:
             ET.SubElement(tc, "failure", message=c.failure).text = c.failure
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
-    return path
+    tree = ET.ElementTree(root)
+    return write_with(
+        Path(path), lambda tmp: tree.write(tmp, encoding="utf-8", xml_declaration=True), "--junit"
+    )
 
 
 def gate(out: Path, junit: Path | None = None) -> list[str]:

@@ -17,6 +17,7 @@ from matplotlib import animation
 from matplotlib.figure import Figure
 
 from rodval.core.base import PINNED, Base, rotate
+from rodval.core.out_paths import write_with
 from rodval.core.trajectory import Trajectory
 from rodval.report.figures import MODEL_COLOURS
 
@@ -30,12 +31,34 @@ MAX_FPS = 120
 @dataclass(frozen=True)
 class Animated:
     """What was written: the file, the frame count, the frame times (s) and the events marked
-    (run label, t (s), event label)."""
+    (run label, t (s), event label); ``notes``: what could not be drawn (a free body whose run
+    recorded x, y but not its pose, output "base")."""
 
     path: Path
     frames: int
     times: np.ndarray
     events: tuple[tuple[str, float, str], ...]
+    notes: tuple[str, ...] = ()
+
+
+def body_pose(traj: Trajectory, base: Base) -> tuple[np.ndarray, np.ndarray] | None:
+    """The body's centre of mass (m, (nt, 2)) and attitude (rad, (nt,)) at the run's output
+    times: from its outputs base_position, base_attitude (output "base") when recorded, else
+    for a prescribed base from its motion laws (closed form); None for a pinned base and for
+    a free one without those outputs."""
+    if not base.moving:
+        return None
+    if "base_position" in traj.values and "base_attitude" in traj.values:
+        return np.asarray(traj.values["base_position"], float), np.asarray(
+            traj.values["base_attitude"], float
+        )[:, 0]
+    if base.prescribed:
+        states = [base.state_at(float(t)) for t in traj.times]
+        return (
+            np.array([s[0] for s in states]).reshape(-1, 2),
+            np.array([s[2] for s in states], float),
+        )
+    return None
 
 
 def node_history(
@@ -43,10 +66,11 @@ def node_history(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Node coordinates (m), each (nt, n + 1): x, y if the run recorded them, else the chord
     polygon from phi and the rod lengths ``l`` hung from node 0: the origin for a pinned
-    ``base``, r_0 = r_c + R(theta) h for a free one (from the run's base_position and
-    base_attitude, output "base"). ValueError when the outputs cannot place the chain, and
-    for a run with a free base's outputs given a pinned ``base``: a free base is never drawn
-    pinned. O(nt n)."""
+    ``base``, r_0 = r_c + R(theta) h for a moving one (``body_pose``: a free body's
+    base_position and base_attitude, output "base"; a prescribed body's motion laws).
+    ValueError when the outputs cannot place the chain (a free base without x, y or "base"),
+    and for a run with a moving base's outputs given a pinned ``base``: a moving base is
+    never drawn pinned. O(nt n)."""
     if "x" in traj.values and "y" in traj.values:
         return traj.values["x"], traj.values["y"]
     if "phi" not in traj.values:
@@ -54,21 +78,20 @@ def node_history(
             f"run {traj.model!r} has neither x, y nor phi among its outputs: nothing to draw"
         )
     phi = traj.values["phi"]
-    if base.free:
+    pose = body_pose(traj, base)
+    if base.free and pose is None:
         missing = [q for q in ("base_position", "base_attitude") if q not in traj.values]
-        if missing:
-            raise ValueError(
-                f"run {traj.model!r} has a free base but neither x, y nor {', '.join(missing)} "
-                "(output 'base') among its outputs, so the chain cannot be drawn where the "
-                "body moved; rerun it with outputs x, y or 'base'"
-            )
-        root = traj.values["base_position"] + rotate(
-            traj.values["base_attitude"][:, 0], np.asarray(base.hinge_offset, float)
+        raise ValueError(
+            f"run {traj.model!r} has a free base but neither x, y nor {', '.join(missing)} "
+            "(output 'base') among its outputs, so the chain cannot be drawn where the "
+            "body moved; rerun it with outputs x, y or 'base'"
         )
+    if pose is not None:
+        root = pose[0] + rotate(pose[1], np.asarray(base.hinge_offset, float))
     elif "base_position" in traj.values:
         raise ValueError(
-            f"run {traj.model!r} has a free base's outputs (base_position) but was given a "
-            "pinned base: a free base is never drawn pinned; pass the run's scene base"
+            f"run {traj.model!r} has a moving base's outputs (base_position) but was given a "
+            "pinned base: a moving base is never drawn pinned; pass the run's scene base"
         )
     else:
         root = np.zeros((phi.shape[0], 2))
@@ -77,6 +100,22 @@ def node_history(
         np.hstack([x0, x0 + np.cumsum(l * np.cos(phi), axis=1)]),
         np.hstack([y0, y0 + np.cumsum(l * np.sin(phi), axis=1)]),
     )
+
+
+def body_outline(
+    centre: np.ndarray, attitude: np.ndarray, half: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The body drawn as a square of half side ``half`` (m) about its centre (nt, 2), turned
+    by its attitude (nt,): the closed outline's x, y (m), each (nt, 5)."""
+    corners = half * np.array([[1, 1], [-1, 1], [-1, -1], [1, -1], [1, 1]], float)
+    turned = rotate(np.asarray(attitude)[:, None], corners[None, :, :])
+    return centre[:, None, 0] + turned[..., 0], centre[:, None, 1] + turned[..., 1]
+
+
+def body_size(base: Base, l: np.ndarray) -> float:
+    """Half side (m) of the square drawn for a body: its hinge offset's length (node 0 on
+    the square's edge), at least 5 % of the chain's length so that it shows."""
+    return max(float(np.hypot(*base.hinge_offset)), 0.05 * float(np.sum(l)))
 
 
 def _count(times: np.ndarray) -> str:
@@ -166,7 +205,10 @@ def animate_runs(
     """Write the runs' motion to ``path`` (.gif or .mp4): every run's chain in its own colour,
     one frame per frame time (``frame_times``), the time in the title, each latch drawn as a
     red square on its hinge node from its lock time on and each stop contact as an orange
-    diamond at its time, the events so far listed in the corner. ``lengths``: rod lengths (m)
+    diamond at its time, the events so far listed in the corner, a moving base's body as a
+    square in the run's colour at its position and attitude (``body_pose``, ``body_size``).
+    The missing folders above ``path`` are made; the file is written whole or not at all,
+    never through a link (``write_with``). ``lengths``: rod lengths (m)
     per run label; ``bases``: each run's base (default pinned: the pin drawn at the origin; a
     free base's chain hangs from its node 0, ``node_history``). Each run is drawn only at
     output times it has: the frames are the times all runs share (``shared_times``).
@@ -176,13 +218,14 @@ def animate_runs(
     times = frame_times(runs, frames)
     base = {k: (bases or {}).get(k, PINNED) for k in runs}
     nodes = {k: node_history(t, np.asarray(lengths[k], float), base[k]) for k, t in runs.items()}
+    bodies, notes = _bodies(runs, lengths, base)
     # every frame time is an output time of every run (within 1e-12 s): its own row
     index = {k: np.searchsorted(t.times, times - 1e-12) for k, t in runs.items()}
     marks = {k: _event_marks(t) for k, t in runs.items()}
     fig = Figure(figsize=(6.4, 5.2))
     ax = fig.add_subplot()
-    allx = np.concatenate([x.ravel() for x, _ in nodes.values()])
-    ally = np.concatenate([y.ravel() for _, y in nodes.values()])
+    allx = np.concatenate([x.ravel() for x, _ in [*nodes.values(), *bodies.values()]])
+    ally = np.concatenate([y.ravel() for _, y in [*nodes.values(), *bodies.values()]])
     pad = 0.05 * max(float(np.ptp(allx)), float(np.ptp(ally)), 1e-9)
     ax.set_xlim(allx.min() - pad, allx.max() + pad)
     ax.set_ylim(ally.min() - pad, ally.max() + pad)
@@ -190,7 +233,7 @@ def animate_runs(
     ax.set_xlabel("x, m")
     ax.set_ylabel("y, m")
     ax.grid(alpha=0.3)
-    if any(not b.free for b in base.values()):
+    if any(not b.moving for b in base.values()):
         ax.plot([0], [0], "k^", ms=9)  # the pin of the pinned runs
     lines = {
         k: ax.plot(
@@ -199,6 +242,7 @@ def animate_runs(
         for i, k in enumerate(runs)
     }
     locks = {k: ax.plot([], [], "s", color="red", ms=8, mfc="none", mew=2)[0] for k in runs}
+    body = {k: ax.plot([], [], "-", color=lines[k].get_color(), lw=2.2)[0] for k in bodies}
     stops = {k: ax.plot([], [], "D", color="orange", ms=7, mfc="none", mew=1.5)[0] for k in runs}
     ax.legend(loc="upper right", fontsize=7)
     note = ax.text(0.01, 0.01, "", transform=ax.transAxes, fontsize=7, va="bottom")
@@ -211,6 +255,8 @@ def animate_runs(
         for k in runs:
             x, y = nodes[k][0][index[k][i]], nodes[k][1][index[k][i]]
             lines[k].set_data(x, y)
+            if k in bodies:
+                body[k].set_data(bodies[k][0][index[k][i]], bodies[k][1][index[k][i]])
             done = [(te, node, lab) for te, node, lab in marks[k] if te <= t + 1e-12]
             latched = [node for _, node, lab in done if "latch" in lab]
             recent = [node for te, node, lab in done if "latch" not in lab and t - te <= step]
@@ -220,9 +266,32 @@ def animate_runs(
         note.set_text("\n".join(text))
         head.set_text(f"{title + ': ' if title else ''}t = {t:.3f} s")
 
-    with writer.saving(fig, str(path), dpi=90):
-        for i in range(times.size):
-            draw(i)
-            writer.grab_frame()
+    def produce(tmp: Path) -> None:
+        with writer.saving(fig, str(tmp), dpi=90):
+            for i in range(times.size):
+                draw(i)
+                writer.grab_frame()
+
+    write_with(path, produce)
     events = tuple((k, te, lab) for k in runs for te, _, lab in marks[k] if te <= times[-1])
-    return Animated(path, int(times.size), times, events)
+    return Animated(path, int(times.size), times, events, tuple(notes))
+
+
+def _bodies(
+    runs: Mapping[str, Trajectory], lengths: Mapping[str, np.ndarray], base: Mapping[str, Base]
+) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], list[str]]:
+    """The outline of each moving base's body at the run's output times (``body_outline``,
+    ``body_pose``) by run label, and a note for each free body whose pose the run did not
+    record (drawn from its x, y: the chain, not the body)."""
+    bodies, notes = {}, []
+    for k, traj in runs.items():
+        pose = body_pose(traj, base[k])
+        if pose is not None:
+            half = body_size(base[k], np.asarray(lengths[k], float))
+            bodies[k] = body_outline(pose[0], pose[1], half)
+        elif base[k].moving:
+            notes.append(
+                f"run {k}: its free body is not drawn (the run recorded x, y but not the "
+                "body's position and attitude, output 'base')"
+            )
+    return bodies, notes

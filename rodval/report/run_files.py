@@ -23,7 +23,9 @@ Files:
 rerun one exactly. It refuses a trajectory table that is not the one its run wrote (cut short,
 edited, damaged) or whose digest run.json does not record, naming the file and what is wrong.
 A new run into a run folder removes the files the previous run wrote that it does not write
-itself (a ``trajectory_wide.csv`` of another n), and nothing else.
+itself (a ``trajectory_wide.csv`` of another n), and nothing else. A run folder that is or holds
+a symbolic link (a run.json linked to another run's) is refused before any work, and every file
+is written through ``rodval.core.out_paths.write_file`` (never through a link).
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ from rodval.core.out_paths import (
     read_json,
     refuse_foreign,
     stamp,
+    write_file,
 )
 from rodval.core.provenance import provenance
 from rodval.core.scene import Scene
@@ -418,7 +421,7 @@ def write_run(
     for stale in set(_previous_files(out)) - set(files):
         (out / stale).unlink(missing_ok=True)
     data = tidy_csv(traj) if name == TABLE_CSV else trajectory_npz(traj)
-    (out / name).write_bytes(data)
+    write_file(out / name, data)
     record: dict[str, Any] = {
         "scene": doc,
         "model": traj.model,
@@ -431,18 +434,37 @@ def write_run(
         FILES_KEY: files,
     }
     if wide:
-        traj.to_frame(wide=True).to_csv(out / WIDE_CSV, index=False)
+        write_file(out / WIDE_CSV, traj.to_frame(wide=True).to_csv(index=False))
     if arrays:
         packed = _npz_bytes(arrays)
-        (out / ARRAYS_NPZ).write_bytes(packed)
+        write_file(out / ARRAYS_NPZ, packed)
         record[ARRAYS_KEY] = file_digest(packed)
     # a round trip through JSON first, so that the stamp is the checksum of what is read back
     plain = json.loads(json.dumps(record, default=str))
-    (out / RUN_JSON).write_text(json.dumps(stamp(plain, RUN_SCHEMA), indent=2))
+    write_file(out / RUN_JSON, json.dumps(stamp(plain, RUN_SCHEMA), indent=2))
     return files
 
 
 # ---------------------------------------------------------------------------- reading
+
+
+def check_events(events: Any, path: Path) -> None:
+    """ValueError naming ``path`` and the event unless ``events`` (run.json's key) is a list
+    of tables, each with a text ``label`` and a finite time ``t`` (s): rodval records every
+    event at the time it happened, so a blank, NaN or infinite time is an edited or damaged
+    record (compared, it would be a blank cell of events.csv with no reason)."""
+    if not isinstance(events, list) or not all(isinstance(e, dict) for e in events):
+        raise ValueError(f"{path}: key 'events' must be a list of tables, got {events!r:.60}")
+    for i, ev in enumerate(events):
+        t, label = ev.get("t"), ev.get("label")
+        if not isinstance(label, str):
+            raise ValueError(f"{path}: key 'events' item {i}: 'label' must be text, got {label!r}")
+        if isinstance(t, bool) or not isinstance(t, int | float) or not np.isfinite(t):
+            raise ValueError(
+                f"{path}: key 'events' item {i} ({label!r}): its time 't' must be a finite "
+                f"number (s), got {t!r} (rodval records every event at the time it happened: "
+                "the record was edited or damaged)"
+            )
 
 
 def read_run_record(path: Path) -> dict[str, Any]:
@@ -465,9 +487,7 @@ def read_run_record(path: Path) -> dict[str, Any]:
                 f"{path}: key {key!r} must be a {'table' if kind is dict else 'string'}, "
                 f"got {rec[key]!r:.60}"
             )
-    events = rec.get("events", [])
-    if not isinstance(events, list) or not all(isinstance(e, dict) for e in events):
-        raise ValueError(f"{path}: key 'events' must be a list of tables, got {events!r:.60}")
+    check_events(rec.get("events", []), path)
     files = rec.get(FILES_KEY, [])
     if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
         raise ValueError(

@@ -36,16 +36,15 @@ from typing import Any
 from rodval.core.out_paths import (
     HOUSEKEEPING,
     STUDY_SCHEMA,
+    TEMPORARY,
     inside,
     is_stamped,
     read_json,
     refuse_foreign,
     stamp,
+    write_file,
 )
 from rodval.report.tables import ALL_TABLES, FIGURES, MANIFEST
-
-#: Name of the temporary file of an atomic write (``write_text_atomic``): ``.<name>.<pid>.tmp``.
-TEMPORARY = re.compile(r"\..+\.\d+\.tmp")
 
 #: Longest case file name (characters, with ".json"): well below every file system's 255.
 MAX_NAME = 120
@@ -70,11 +69,9 @@ def case_file_name(case_id: str) -> str:
 
 
 def write_text_atomic(path: Path, text: str) -> None:
-    """Write to a temporary file beside ``path`` and rename it over ``path``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    """Write to a temporary file beside ``path`` and rename it over ``path``, never through
+    a link (``rodval.core.out_paths.write_file``)."""
+    write_file(path, text)
 
 
 def write_json_atomic(path: Path, obj: Any) -> None:
@@ -175,7 +172,7 @@ class StudyStore:
             files += [self.case_path(str(cid)) for cid in ids]
         for folder in (self.out, self.cases_dir):
             if folder.is_dir():
-                files += [p for p in folder.glob(".*.tmp") if TEMPORARY.fullmatch(p.name)]
+                files += [p for p in folder.glob(".*.tmp*") if TEMPORARY.fullmatch(p.name)]
         return files
 
     def claim(self, meta: dict[str, Any], *, fresh: bool) -> None:
