@@ -35,6 +35,7 @@ import numpy as np
 from numba import njit
 
 from rodval.core.checks import as_path, check_number, check_type
+from rodval.core.status import exception_line
 
 ForceLaw = Callable[[float], float]
 
@@ -584,7 +585,7 @@ def _evaluate(law: ForceLaw, t: float, node: int, label: str) -> float:
         v = law(t)
     except Exception as exc:  # noqa: BLE001 - a user's callable: named, then reported as data
         raise ValueError(
-            f"load {label} at node {node} raised at t = {t:.6g} s: {type(exc).__name__}: {exc}"
+            f"load {label} at node {node} raised at t = {t:.6g} s: {exception_line(exc)}"
         ) from exc
     if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
         raise ValueError(

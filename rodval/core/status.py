@@ -68,10 +68,20 @@ def numerical_failure(exc: BaseException, t: float) -> tuple[int, str] | None:
     be factored (singular, not positive definite; chains at the extremes of their bounds) is
     ``STATUS_FAILED``. The message names the exception and the time."""
     if isinstance(exc, (ZeroDivisionError, OverflowError, FloatingPointError)):
-        return STATUS_DIVERGED, f"diverged: {type(exc).__name__}: {exc} at t = {t:.6g} s"
+        return STATUS_DIVERGED, f"diverged: {exception_line(exc)} at t = {t:.6g} s"
     if isinstance(exc, np.linalg.LinAlgError):
         return STATUS_FAILED, (
-            f"numerical failure: {type(exc).__name__}: {exc} at t = {t:.6g} s "
+            f"numerical failure: {exception_line(exc)} at t = {t:.6g} s "
             "(a matrix of the model could not be factored)"
         )
     return None
+
+
+def exception_line(exc: BaseException) -> str:
+    """``exc`` as one line for a run's message (run.json, runtime.csv, the status line): its
+    type and the first non-empty line of its text, with the count of lines left out (numba's
+    typing errors run to 60 lines, which were dumped whole into stdout and run.json)."""
+    lines = [x.strip() for x in str(exc).splitlines() if x.strip()]
+    head = lines[0] if lines else ""
+    more = f" [{len(lines) - 1} more lines not shown]" if len(lines) > 1 else ""
+    return f"{type(exc).__name__}: {head}{more}"

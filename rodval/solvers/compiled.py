@@ -19,6 +19,7 @@ from rodval.core.status import (
     STATUS_ERROR,
     STATUS_FAILED,
     STATUS_WALL,
+    exception_line,
     numerical_failure,
 )
 from rodval.core.trajectory import SolverStats
@@ -164,7 +165,7 @@ def run_compiled(
             # raised by a model's kernel: the loop's time is lost, t_reached stays at its start
             stats.status, stats.message = numerical_failure(exc, t) or (
                 STATUS_ERROR,
-                f"{type(exc).__name__}: {exc}",
+                exception_line(exc),
             )
             stats.t_reached = t
             break

@@ -25,6 +25,7 @@ output times reached so far are kept.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -38,6 +39,7 @@ from rodval.core.status import (
     STATUS_ERROR,
     STATUS_FAILED,
     STATUS_WALL,
+    exception_line,
     numerical_failure,
 )
 from rodval.core.trajectory import SolverStats, Trajectory
@@ -62,6 +64,15 @@ _SOLVERS = {
 
 #: scipy methods that reject a step attempt whose error norm is not finite and cut the step.
 _REJECTS_NON_FINITE = ("RK23", "RK45", "DOP853")
+
+
+def _contiguous_states(dense: Callable[[Any], np.ndarray]) -> Callable[[Any], np.ndarray]:
+    """A step's dense output whose states are contiguous arrays: scipy's (N, k) array of
+    states at k times made Fortran-ordered, so each state ``states[:, i]`` (the energy
+    audit's, ``rodval.solvers.audit.step_integral``) is one contiguous column. A system's
+    compiled kernels take contiguous states only (numba's reshape of a strided one is a
+    TypingError)."""
+    return lambda ts: np.asfortranarray(dense(ts))
 
 
 class _Stop(Exception):
@@ -163,6 +174,8 @@ class _ScipyRun:
         if time.perf_counter() > self.deadline:
             raise _Stop(STATUS_WALL, self.settings.budget_message("max_wall_s", t))
         start, self.at_start = self.at_start, False
+        # scipy's finite-difference Jacobian (Radau, BDF) hands in strided columns
+        y = np.ascontiguousarray(y)
         if not np.all(np.isfinite(y)):
             return self._non_finite(
                 y, f"diverged: non-finite state in a step attempt at t = {t:.6g} s", start
@@ -190,7 +203,7 @@ class _ScipyRun:
         """The system's Jacobian for implicit methods; a non-finite one stops the run as
         diverged (scipy's LU refused it with "array must not contain infs or NaNs")."""
         try:
-            J = self.system.jacobian(t, y)
+            J = self.system.jacobian(t, np.ascontiguousarray(y))
         except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
             raise _Stop(*_failure(exc, t)) from exc
         if not np.all(np.isfinite(J)):
@@ -254,7 +267,7 @@ class _ScipyRun:
                 t_end = hit[1] if hit else t1
                 pending = self.out.upto(t_end)
                 if pending.size or self.ledger or hit:
-                    dense = solver.dense_output()
+                    dense = _contiguous_states(solver.dense_output())
                     own = self.out.write(dense(pending).T) if pending.size else np.zeros(0, bool)
                     if self.ledger:
                         self.ledger.step(dense, t0, t_end, pending[own])
@@ -289,7 +302,7 @@ class _ScipyRun:
 def _failure(exc: Exception, t: float) -> tuple[int, str]:
     """(status, message) of an exception raised at time t (s) inside a run: a numerical
     failure (``rodval.core.status.numerical_failure``) or a model error."""
-    return numerical_failure(exc, t) or (STATUS_ERROR, f"{type(exc).__name__}: {exc}")
+    return numerical_failure(exc, t) or (STATUS_ERROR, exception_line(exc))
 
 
 #: numpy's refusal of a non-finite matrix (``asarray_chkfinite``, scipy's LU): inside a step it

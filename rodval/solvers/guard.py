@@ -37,6 +37,7 @@ from rodval.core.status import (
     STATUS_DIVERGED,
     STATUS_ERROR,
     STATUS_STALLED,
+    exception_line,
     numerical_failure,
 )
 from rodval.solvers.system import OdeSystem
@@ -215,7 +216,7 @@ class DivergenceGuard:
             except Exception as exc:  # noqa: BLE001 - reported as data, the run stops
                 return numerical_failure(exc, t1) or (
                     STATUS_ERROR,
-                    f"energy check failed at t = {t1:.6g} s: {type(exc).__name__}: {exc}",
+                    f"energy check failed at t = {t1:.6g} s: {exception_line(exc)}",
                 )
         code = guard_step(self.g, self.mon, t1 - t0, mech, self.system is not None)
         return verdict(code, self.mon, t1, self.spec)

@@ -8,7 +8,7 @@ from abc import abstractmethod
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
-from rodval.core.status import STATUS_ERROR, numerical_failure
+from rodval.core.status import STATUS_ERROR, exception_line, numerical_failure
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.solvers.driver import integrate
 from rodval.solvers.system import OdeSystem
@@ -32,7 +32,7 @@ class OdeModel(Model):
         except Exception as exc:  # noqa: BLE001 - failures are data
             status, message = numerical_failure(exc, 0.0) or (
                 STATUS_ERROR,
-                f"{type(exc).__name__}: {exc}",
+                exception_line(exc),
             )
             stats = SolverStats(
                 status=status,
