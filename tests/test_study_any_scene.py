@@ -37,8 +37,10 @@ def latched_scene(t_end: float = 0.8) -> Scene:
 
 
 def case_scene_round_trips(scene: Scene) -> None:
-    """The study's only case runs ``scene``, from the dict and from its study.toml text."""
-    spec = rodval.Study.from_dict({"scene": scene, "models": MODELS})
+    """The study's only case runs ``scene``, from the dict and from its study.toml text (the
+    reduced model, which refuses a moving base when the study is read, left out there)."""
+    models = {"full": {}} if scene.base.moving else MODELS
+    spec = rodval.Study.from_dict({"scene": scene, "models": models})
     (case,) = spec.cases
     assert scene_to_dict(case.scene) == scene_to_dict(scene)
     again = study_from_dict(tomllib.loads(spec.text), where="study.toml")

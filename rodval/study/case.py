@@ -15,6 +15,7 @@ from rodval.core.checks import check_keys
 from rodval.core.scene import Scene
 from rodval.core.scene_file import scene_from_dict
 from rodval.core.scene_keys import set_path
+from rodval.models.presets.registry import check_scene, get_model
 from rodval.study.document import key_error
 from rodval.study.model_specs import ModelSpec, model_specs
 
@@ -111,6 +112,7 @@ def build_case(
     scene_dict.setdefault("name", cid)
     scene = scene_from_dict(scene_dict, where=f"{case_where} [scene]")
     models = model_specs(case_doc, case_where)
+    check_refusals(scene, models, where, cid)
     return Case(
         id=cid,
         params={labels[p]: v for p, v in combo.items()},
@@ -121,3 +123,26 @@ def build_case(
         where=case_where,
         modes=modes_spec(case_doc.get("modes"), where),
     )
+
+
+def check_refusals(scene: Scene, models: tuple[ModelSpec, ...], where: str, cid: str) -> None:
+    """Each model of a case against what it refuses for the case's scene before any work
+    (``rodval.models.presets.registry.check_scene``, the check ``simulate`` makes): a
+    ValueError naming the study file ``where``, the case ``cid``, the model and the reason,
+    when the study is read, so no case runs a model that would refuse it. A model that cannot
+    be imported here (exudyn not installed) is not an error of the file: its runs fail and
+    say why."""
+    for spec in models:
+        try:
+            model = get_model(spec.model, **spec.options)
+        except ValueError as exc:
+            if isinstance(exc.__cause__, ImportError):
+                continue
+            raise
+        try:
+            check_scene(model, scene, spec.settings)
+        except ValueError as exc:
+            raise ValueError(
+                f"{where}: case {cid!r}: model {spec.label!r} ({spec.model}) refuses it "
+                f"before any work: {exc}"
+            ) from None

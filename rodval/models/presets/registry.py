@@ -80,6 +80,16 @@ def get_model(name: str | Model, **options: Any) -> Model:
     return cls(**options)
 
 
+def check_scene(model: Model, scene: Scene, settings: IntegratorSettings) -> None:
+    """What ``model`` (with its options) refuses for ``scene`` with ``settings``, before any
+    work: a ValueError naming the reason. The settings against the scene's horizon
+    (``IntegratorSettings.check_horizon``) and the base and outputs the model has
+    (``Model.check_base``: a moving base on the reduced model, the output "drive" on exudyn).
+    The one definition ``simulate`` and a study's plan (``rodval.study.case``) both ask."""
+    settings.check_horizon(scene.t_end)
+    model.check_base(scene)
+
+
 def _unknown_keyword(model: str, key: str, allowed: tuple[str, ...]) -> str:
     """One line for an unknown keyword of ``simulate``/``get_model``: the model's options and
     the integrator settings (both are keywords of ``simulate``), with the nearest name."""
@@ -131,6 +141,7 @@ def simulate(
             f"both (got settings= and {', '.join(sorted(integ))})"
         )
     m = get_model(model, **options)
+    check_scene(m, scene, settings)
     check_run_memory(
         scene.n,
         scene.times.size,
