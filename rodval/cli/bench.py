@@ -15,6 +15,7 @@ import pandas as pd
 
 from rodval import bench
 from rodval.cli.options import positive_float
+from rodval.core.out_paths import write_file
 from rodval.core.provenance import provenance
 from rodval.core.scene import paper_scene
 from rodval.core.settings import METHODS
@@ -176,11 +177,11 @@ def register(sub) -> None:
 
 def _write(out: Path, stem: str, frame, title: str, body: list[str]) -> None:
     out.mkdir(parents=True, exist_ok=True)
-    frame.to_csv(out / f"{stem}.csv", index=False)
-    (out / "provenance.json").write_text(json.dumps(provenance(), indent=2, default=str))
+    write_file(out / f"{stem}.csv", frame.to_csv(index=False))
+    write_file(out / "provenance.json", json.dumps(provenance(), indent=2, default=str))
     command = "rodval " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     text = [f"# {title}", "", f"Command: `{command}`", "", *body, ""]
-    (out / f"{stem}.md").write_text("\n".join(text))
+    write_file(out / f"{stem}.md", "\n".join(text))
     print(f"-> {out / (stem + '.md')}")
 
 
@@ -200,7 +201,7 @@ def run_work_precision(args) -> int:
     ratios = bench.baseline_ratios(
         paper_scene(args.n, times=np.linspace(0, 2, 41)), repeats=args.repeats
     )
-    ratios.to_csv(args.out / "baseline_ratios.csv", index=False)
+    write_file(args.out / "baseline_ratios.csv", ratios.to_csv(index=False))
     best = bench.cheapest(frame)
     cols = [
         "model",
@@ -412,12 +413,12 @@ def run_scale(args) -> int:
         args.n_values, args.models, repeats=args.repeats, budget_s=args.budget
     )
     args.out.mkdir(parents=True, exist_ok=True)
-    frame.to_csv(args.out / "scale.csv", index=False)
+    write_file(args.out / "scale.csv", frame.to_csv(index=False))
     fits = bench.scale_fits(frame, 64)
     speedup = None
     if args.speedup:
         speedup = bench.speedup_scale(args.speedup_n, repeats=args.repeats)
-        speedup.to_csv(args.out / "speedup_scale.csv", index=False)
+        write_file(args.out / "speedup_scale.csv", speedup.to_csv(index=False))
     plot = plot_scale(frame, speedup, args.out / "scale.png")
     wall = frame.pivot(index="n", columns="model", values="wall_s")
     wall.columns = [f"{m} wall (s)" for m in wall.columns]

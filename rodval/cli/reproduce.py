@@ -6,6 +6,7 @@ import importlib.util
 from pathlib import Path
 
 from rodval.cli import CliError
+from rodval.core.out_paths import write_file
 
 
 def register(sub) -> None:
@@ -63,8 +64,8 @@ def run(args) -> int:
     from rodval.analysis.crosscheck import crosscheck_paper
 
     table, runs = crosscheck_paper()
-    table.to_csv(args.out / "crosscheck.csv", index=False)
-    (args.out / "crosscheck.md").write_text(crosscheck_markdown(table, runs["exudyn"]))
+    write_file(args.out / "crosscheck.csv", table.to_csv(index=False))
+    write_file(args.out / "crosscheck.md", crosscheck_markdown(table, runs["exudyn"]))
     print("Cross-check against exudyn (phi/alpha/beta max |gap| in rad, dphi relative):")
     print(table.drop(columns="status").to_string(index=False, float_format=lambda v: f"{v:.2e}"))
     print(f"wrote {args.out}/crosscheck.csv, crosscheck.md")

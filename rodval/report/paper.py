@@ -15,6 +15,7 @@ from rodval.analysis.reproduce import (
     compare_table1,
     run_paper_models,
 )
+from rodval.core.out_paths import write_file
 from rodval.core.scene import TABLE1_TIMES, paper_scene
 from rodval.core.trajectory import Trajectory
 from rodval.report.figures import plot_configurations
@@ -93,9 +94,9 @@ def reproduce_paper(out: Path | str, coefficients: str = "printed") -> pd.DataFr
     trajs = run_paper_models(coefficients)
     table = compare_table1(trajs)
     errors = column_errors(table)
-    table.to_csv(out / "table1.csv", index=False)
+    write_file(out / "table1.csv", table.to_csv(index=False))
     stats = {f: t.stats.as_dict() for f, t in trajs.items()}
-    (out / "table1.md").write_text(table1_markdown(table, errors, coefficients, stats))
+    write_file(out / "table1.md", table1_markdown(table, errors, coefficients, stats))
     scene = paper_scene(times=TABLE1_TIMES)
     plot_configurations(
         {

@@ -27,7 +27,7 @@ from rodval.analysis.events import (
     MIN_WINDOW_STEPS,
     event_discrepancies,
 )
-from rodval.core.out_paths import STUDY_SCHEMA, is_stamped
+from rodval.core.out_paths import STUDY_SCHEMA, is_stamped, write_file
 from rodval.models import get_model
 from rodval.models.presets.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
@@ -215,9 +215,9 @@ def _error_budget_section(
         for path in files:
             path.unlink(missing_ok=True)
         return []
-    budget.to_csv(files[0], index=False)
+    write_file(files[0], budget.to_csv(index=False))
     table = to_markdown(_blanks(budget), ".3g")
-    files[1].write_text(table)
+    write_file(files[1], table)
     p_max = int(budget["p_max"].iloc[0])
     ref = meta["reference"]
     return [
@@ -319,5 +319,5 @@ def build_report(out: str | Path) -> Path:
     lines += modes_section(out, fig_dir, meta)
     lines += ["## Time histories and configurations\n", *case_figures(fig_dir, meta, tables)]
     path = out / "report.md"
-    path.write_text("\n".join(x for x in lines if x))
+    write_file(path, "\n".join(x for x in lines if x))
     return path

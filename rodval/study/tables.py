@@ -31,12 +31,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-# EVENT_COLUMNS: the events table's leading columns, named here for the table's readers
 from rodval.analysis.events import EVENT_COLUMNS as EVENT_COLUMNS
 from rodval.analysis.events import events_frame
 from rodval.analysis.metrics import METRICS
 from rodval.analysis.modes import pair_modes
 from rodval.core.modal import Modes
+from rodval.core.out_paths import write_file
+
+# EVENT_COLUMNS: the events table's leading columns, named here for the table's readers
 from rodval.core.status import STATUS_MESSAGES
 from rodval.core.validity import broken
 from rodval.report.markdown import to_markdown
@@ -247,18 +249,19 @@ def write_tables(out: str | Path, spec: StudySpec | None = None) -> dict[str, pd
     out = Path(out)
     tables = build_tables(out, spec)
     for name, df in tables.items():
-        df.to_csv(out / f"{name}.csv", index=False)
+        write_file(out / f"{name}.csv", df.to_csv(index=False))
     meta = StudyStore(out).meta()
     assert meta is not None
-    (out / "discrepancies.md").write_text(to_markdown(tables["discrepancies"]))
-    (out / "runtime.md").write_text(to_markdown(tables["runtime"]))
+    write_file(out / "discrepancies.md", to_markdown(tables["discrepancies"]))
+    write_file(out / "runtime.md", to_markdown(tables["runtime"]))
     if "events" in tables:
-        (out / "events.md").write_text(to_markdown(tables["events"], ".6g"))
+        write_file(out / "events.md", to_markdown(tables["events"], ".6g"))
     for name in ("modes", "mac"):
         if name in tables:
-            (out / f"{name}.md").write_text(to_markdown(tables[name], ".6g"))
-    (out / "trajectories.md").write_text(
-        to_markdown(trajectory_samples(tables["trajectories"], meta, tables["cases"]), ".6g")
+            write_file(out / f"{name}.md", to_markdown(tables[name], ".6g"))
+    write_file(
+        out / "trajectories.md",
+        to_markdown(trajectory_samples(tables["trajectories"], meta, tables["cases"]), ".6g"),
     )
     write_json_atomic(out / MANIFEST, {name: table_digest(out / f"{name}.csv") for name in tables})
     return tables
