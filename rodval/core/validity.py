@@ -79,6 +79,10 @@ def setting(key: str, value: Any, place: str = "model") -> str:
     return f"{key} = {text} (command line: --set {key}={plain})"
 
 
+#: The fix that damps the rods' bending, in both spellings (``setting``).
+DAMPING_FIX = setting("chain.bending_damping", "{ ratio = ... }", "scene")
+
+
 @dataclass(frozen=True)
 class Check:
     """One assumption checked on one run: ``figure`` (in ``unit``) must not exceed ``bound``.

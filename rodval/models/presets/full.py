@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from rodval.core.scene import Scene
+from rodval.core.validity import DAMPING_FIX, setting
 from rodval.models.assembly import kernels
 from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
@@ -210,15 +211,15 @@ class FullModel(PaperModel):
         rung does (to round-off); on the exact rung what is left is integration error."""
         if self.kinematics == "first-order":
             return (
-                'kinematics = "exact" (the first-order kinematics drops O(bending) terms of '
-                "the kinetic energy; docs/model.md)"
+                f"{setting('kinematics', 'exact')} (the first-order kinematics drops "
+                "O(bending) terms of the kinetic energy; docs/model.md)"
             )
         return "a tighter rtol (integration error)"
 
     def stiffness_fix(self, scene: Scene) -> str:
         """Stiff vibrations of the full model are its rods' bending modes."""
         return (
-            "damp the rods' bending ([chain] bending_damping = { ratio = ... }; a ratio of each "
+            f"damp the rods' bending ({DAMPING_FIX}; a ratio of each "
             "rod's first mode damps a locked segment's slower modes less, docs/model.md), the "
             "reduced model (quasi-static bending, no bending vibrations), or a looser rtol and "
             "atol"

@@ -20,6 +20,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from rodval.core.scene import Scene
+from rodval.core.validity import DAMPING_FIX, setting
 from rodval.models.assembly import kernels
 from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
@@ -327,15 +328,15 @@ class ReducedModel(PaperModel):
     def energy_fix(self) -> str:
         """The quasi-static bending has no energy balance of its own (docs/stability.md)."""
         return (
-            'the full model with kinematics = "exact" (the reduced model\'s quasi-static '
-            "bending keeps no energy balance; docs/stability.md)"
+            f"the full model with {setting('kinematics', 'exact')} (the reduced model's "
+            "quasi-static bending keeps no energy balance; docs/stability.md)"
         )
 
     def stiffness_fix(self, scene: Scene) -> str:
         """The reduced model's stiff vibration is a held hinge's locked pair ringing against
         the quasi-static bending (undamped: the bending damping has nothing to act on)."""
         return (
-            "the full model with damped bending ([chain] bending_damping = { ratio = ... }: a "
+            f"the full model with damped bending ({DAMPING_FIX}: a "
             "held hinge's pair rings against the quasi-static bending here, undamped), or a "
             "looser rtol and atol"
         )
