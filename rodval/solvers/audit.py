@@ -94,10 +94,23 @@ def audit_quantities(
     }, scalar
 
 
+#: Intervals of the audit grid: the momentum residual is read at AUDIT_INTERVALS + 1 evenly
+#: spaced times of [0, t_end] (``audit_times``), whatever the scene's output times.
+AUDIT_INTERVALS = 500
+
+
+def audit_times(t_end: float) -> np.ndarray:
+    """The audit grid (s): AUDIT_INTERVALS + 1 evenly spaced times of [0, t_end], on which
+    every model reads its momentum residual (the native models by dense output,
+    ``rodval.solvers.outputs.AuditGrid``; exudyn from its recorded steps)."""
+    return np.linspace(0.0, float(t_end), AUDIT_INTERVALS + 1)
+
+
 def momentum_residual(H: np.ndarray, G: np.ndarray) -> float:
     """max |H(t) - H(0)| / max G(t) (0 when nothing moves): the angular momentum H (N m s)
     about a conserved point and the gross G (N m s), the sum of its parts' magnitudes
-    (``rodval.core.validity``, ``momentum_balance``), at the output times."""
+    (``rodval.core.validity``, ``momentum_balance``), on the audit grid's states
+    (``rodval.solvers.outputs.AuditGrid``), not the output times."""
     if H.size == 0:
         return 0.0
     scale = float(np.max(G))

@@ -48,7 +48,7 @@ from rodval.solvers.audit import PowerLedger, audit_quantities, momentum_residua
 from rodval.solvers.events import EventMonitor, apply_hit
 from rodval.solvers.guard import DivergenceGuard
 from rodval.solvers.limits import MAX_IMPLICIT_SIZE
-from rodval.solvers.outputs import LockWindows, Outputs
+from rodval.solvers.outputs import AuditGrid, LockWindows, Outputs
 from rodval.solvers.progress import report
 from rodval.solvers.system import OdeSystem
 
@@ -358,14 +358,19 @@ def _bending_validity(
         stats.small_bending = bool(largest <= SMALL_BENDING_RAD)
 
 
-def _momentum_audit(system: OdeSystem, scene: Scene, Y: np.ndarray, stats: SolverStats) -> None:
-    """``stats.momentum_residual`` where the scene conserves angular momentum
-    (``momentum_point``) and the system measures it (``momentum_audit_rows``)."""
-    rows = getattr(system, "momentum_audit_rows", None)
-    if rows is None or not len(Y) or momentum_point(scene) is None:
+def _audits_momentum(system: OdeSystem, scene: Scene) -> bool:
+    """Whether a run audits angular momentum: the scene conserves it (``momentum_point``)
+    and the system measures it (``momentum_audit_rows``)."""
+    return momentum_point(scene) is not None and hasattr(system, "momentum_audit_rows")
+
+
+def _momentum_audit(system: OdeSystem, Y: np.ndarray, stats: SolverStats) -> None:
+    """``stats.momentum_residual`` from the states ``Y`` on the audit grid reached
+    (``outputs.AuditGrid``: the same whatever the output times)."""
+    if not len(Y):
         return
     try:
-        stats.momentum_residual = momentum_residual(*rows(Y))
+        stats.momentum_residual = momentum_residual(*system.momentum_audit_rows(Y))
     except Exception:  # noqa: BLE001 - a measure of validity must not fail the run
         stats.momentum_residual = None
 
@@ -392,7 +397,8 @@ def integrate(
         from rodval.solvers.compiled import run_compiled  # loads the compiled loop once
     times = np.asarray(scene.times)
     windows = LockWindows(system)
-    out = Outputs(times, system.y0.size, windows)
+    grid = AuditGrid(scene.t_end, system.y0.size) if _audits_momentum(system, scene) else None
+    out = Outputs(times, system.y0.size, windows, grid)
     stats = SolverStats()
     y = system.y0.astype(float).copy()
     audit = scene.wants("energy") and system.has_energy
@@ -435,7 +441,8 @@ def integrate(
         stats.status, stats.message = status, f"observation failed: {message}"
     reached, observed = _finite_prefix(reached, observed, stats)
     _bending_validity(system, reached, out.Y[: reached.size], observed, stats)
-    _momentum_audit(system, scene, out.Y[: reached.size], stats)
+    if grid is not None:
+        _momentum_audit(system, grid.states(), stats)
     stats.wall_s = time.perf_counter() - start
     return Trajectory(
         model=model,
