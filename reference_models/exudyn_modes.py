@@ -51,6 +51,8 @@ from rodval.core.modal import (
     Equilibrium,
     Modes,
     check_no_mechanism,
+    equilibrium_angles,
+    held_hinges,
     normalize_shapes,
     split_rigid,
     static_loads,
@@ -285,7 +287,8 @@ def _equilibrium(
 
 def _springs_loaded(scene: Scene) -> bool:
     """Whether the initial state loads the structure without any load: a hinge spring away
-    from its rest angle (a stowed wing, a rest angle), an acting stop, or bent rods. Such a
+    from its rest angle (a stowed wing, a rest angle; not on a held latch's hinge, whose joint
+    takes the spring's moment), an acting stop, or bent rods. Such a
     state is no equilibrium, so modes "about equilibrium" need the static solve (before, only
     rest angles counted, and a folded wing relaxed at 0 was reported balanced as it was)."""
     ini = scene.initial.resolve(scene.n)
@@ -293,18 +296,25 @@ def _springs_loaded(scene: Scene) -> bool:
     chain = scene.chain
     stops = any(st.acts(D[st.hinge]) for st in scene.stops)
     bent = np.any(ini["alpha"] != 0) or np.any(ini["beta"] != 0)
-    return bool(np.any(chain.kappa * (D - chain.rest_angle) != 0) or stops or bent)
+    # a held latch carries its hinge spring's moment (its joint is active): no load
+    moment = chain.kappa * (D - chain.rest_angle)
+    moment[held_hinges(scene)] = 0.0
+    return bool(np.any(moment != 0) or stops or bent)
 
 
 def _at_rest_angles(scene: Scene) -> Scene:
-    """``scene`` started from straight rods with every hinge at its rest angle (chord angles
-    phi_k = theta + rest_0 + ... + rest_{k-1}, at rest): without loads or acting stops the
+    """``scene`` started from straight rods with every hinge at its rest angle, a held latch's
+    hinge at the latch's angle (chord angles phi_k = theta + D_0 + ... + D_{k-1},
+    ``equilibrium_angles``, at rest): without loads or acting stops the
     equilibrium itself, otherwise the start of the static solve. From a stowed wing exudyn's
     Newton does not reach it (its load steps scale loads, not the springs' pre-stress)."""
     theta = scene.base.attitude if scene.base.free else 0.0
-    phi = theta + np.cumsum(scene.chain.rest_angle)
-    # latches play no part in modes (in every model); one at its angle would refuse the start
-    return scene.with_(initial=InitialState(phi=phi), latches=())
+    phi = theta + np.cumsum(equilibrium_angles(scene))
+    # held latches are held (their hinges start at their angles, ``equilibrium_angles``); the
+    # others play no part in modes (in every model), and one at its angle would refuse the start
+    return scene.with_(
+        initial=InitialState(phi=phi), latches=tuple(la for la in scene.latches if la.held)
+    )
 
 
 def _held_forces(loads) -> tuple:

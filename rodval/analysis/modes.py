@@ -50,6 +50,28 @@ def model_modes(
     return m
 
 
+def rerun_options(model: str, options: dict[str, Any], where: str) -> tuple[dict, dict]:
+    """A run's model options (its run.json's ``options``, ``where`` naming the file) split for
+    a modal analysis of the same ``model``: (the ones its modes take, ``MODES_OPTIONS``: the
+    model's equations, e.g. the full model's coefficients, shapes and kinematics; the ones
+    that set only how the run was computed, the model's ``OPTIONS`` its modes leave out: the
+    native models' ``kernel``, the same equations compiled or in numpy, which a
+    linearization does not run). Any other option is refused (ValueError naming it)."""
+    cls = model_class(model)
+    taken = {k: v for k, v in options.items() if k in cls.MODES_OPTIONS}
+    computed = {
+        k: v for k, v in options.items() if k in getattr(cls, "OPTIONS", ()) and k not in taken
+    }
+    other = sorted(set(options) - set(taken) - set(computed))
+    if other:
+        raise ValueError(
+            f"{where}: the {model} run's option {other[0]!r} cannot be honoured by its modes "
+            f"(a modal analysis of the {model} model takes: "
+            f"{', '.join(cls.MODES_OPTIONS) or 'none'})"
+        )
+    return taken, computed
+
+
 # -- pairing -----------------------------------------------------------------------------------
 def pair_modes(a: Modes, b: Modes) -> pd.DataFrame:
     """Pair the modes of b with those of a by shape: maximum total MAC (Hungarian assignment on

@@ -6,7 +6,8 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from rodval.cli.options import add_model_options, positive_int, set_options
+from rodval.cli.options import add_model_options, model_options, positive_int
+from rodval.core.out_paths import clear_previous, write_file
 
 if TYPE_CHECKING:
     from rodval.core.scene import Scene
@@ -27,7 +28,11 @@ def register(sub) -> None:
         "also DIR/compare.csv: the modes of the other models paired with this "
         "model's by MAC (see docs/modes.md).",
     )
-    p.add_argument("scene", metavar="SCENE", help="'paper', a TOML scene file or a run.json")
+    p.add_argument(
+        "scene",
+        metavar="SCENE",
+        help="'paper', a TOML scene file or a run.json (its scene, model and model options)",
+    )
     p.add_argument(
         "--model", choices=MODEL_NAMES, help="model (default full; a run.json's own model)"
     )
@@ -36,7 +41,8 @@ def register(sub) -> None:
         "--count",
         type=positive_int("--count"),
         default=10,
-        help="number of lowest modes to write (default 10)",
+        help="number of lowest modes to write (default 10); on a free base the flexible "
+        "ones, the three rigid modes reported apart",
     )
     p.add_argument(
         "--about",
@@ -59,7 +65,7 @@ def register(sub) -> None:
         help="linearize about an initial state that is not an equilibrium (refused otherwise; "
         "its static residual is recorded in modes.json)",
     )
-    add_model_options(p, coefficients_default="printed")
+    add_model_options(p, coefficients_default=None)
     p.add_argument(
         "--compare",
         nargs="?",
@@ -73,20 +79,13 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from rodval.analysis.modes import model_modes
-    from rodval.models.presets.registry import model_class
     from rodval.report.figures import plot_modes
 
     compare = _compare_list(args.compare)
-    scene, model = _scene_and_model(args)
+    scene, model, carried, computed = _scene_and_model(args)
     args.model = model
-    given = set_options(args.options)
-    unknown = sorted(set(given) - set(model_class(model).MODES_OPTIONS))
-    if unknown and not compare:
-        raise ValueError(
-            f"--set {', '.join(unknown)} does not apply to the {model} model's modes "
-            f"(its options: {', '.join(model_class(model).MODES_OPTIONS) or 'none'})"
-        )
-    pool = {"coefficients": args.coefficients, **given}
+    given = _given_options(args, model, compare)
+    pool = {**carried, **given}  # the command line's over the run.json's
     m = model_modes(
         scene,
         model,
@@ -96,16 +95,43 @@ def run(args) -> int:
         allow_unbalanced=args.allow_unbalanced,
         **_options_for(model, pool),
     )
-    args.out.mkdir(parents=True, exist_ok=True)
-    m.frequencies_frame().to_csv(args.out / "frequencies.csv", index=False)
-    m.modes_frame().to_csv(args.out / "modes.csv", index=False)
+    flex = m.flexible()  # a free base's rigid modes are reported apart (--count: flexible)
+    clear_previous(args.out, "modes")  # no compare.csv of an earlier --compare left behind
+    write_file(args.out / "frequencies.csv", flex.frequencies_frame().to_csv(index=False))
+    write_file(args.out / "modes.csv", flex.modes_frame().to_csv(index=False))
     plot_modes(m, args.out / "modes.png", title=f"{scene.name}: {m.model} about {m.about}")
     lines = _summary(scene, m, args)
+    if computed:
+        lines.append(
+            "not used by a modal analysis (the run.json's options that set how the run was "
+            "computed, not the model): " + ", ".join(f"{k}={v!r}" for k, v in computed.items())
+        )
     if compare:
         lines += _comparison(scene, m, compare, pool, args)
-    (args.out / "modes.json").write_text(json.dumps(_record(scene, m, args), indent=2, default=str))
+    write_file(args.out / "modes.json", json.dumps(_record(scene, m, args), indent=2, default=str))
     print("\n".join(lines))
     return 0
+
+
+def _given_options(args, model: str, compare: tuple[str, ...]) -> dict:
+    """The model options of the command line (--set KEY=VALUE, --coefficients; the two for
+    one key refused, ``model_options``), each one that the modes of ``model`` or of a
+    --compare model take (``MODES_OPTIONS``); any other --set is refused, naming it."""
+    from rodval.models.presets.registry import model_class
+
+    given = model_options(args)
+    other = [k for k, _ in args.options if k not in given]  # --set of a scene value
+    models = (model, *compare)
+    accepted = sorted({k for name in models for k in model_class(name).MODES_OPTIONS})
+    unknown = sorted(k for k in given if k not in accepted)
+    if other or unknown:
+        name = (other or unknown)[0]
+        flag = "--coefficients" if name == "coefficients" and args.coefficients else f"--set {name}"
+        raise ValueError(
+            f"{flag} does not apply to the modes of {', '.join(dict.fromkeys(models))} "
+            f"(their options: {', '.join(accepted) or 'none'})"
+        )
+    return given
 
 
 def _compare_list(text: str | None) -> tuple[str, ...]:
@@ -129,17 +155,31 @@ def _options_for(model: str, pool: dict) -> dict:
 
 
 def _record(scene: Scene, m, args) -> dict:
-    """modes.json: what the modes are of and about, and the equilibrium found."""
+    """modes.json: what the modes are of and about (the options the analysis ran with, the
+    held hinges it held), the count of flexible modes written, a free base's rigid modes
+    (reported apart from them) and the equilibrium found."""
+    from rodval.core.modal import held_hinges
+    from rodval.models.presets.registry import model_class
+
+    options = dict(m.info.get("options", {}))  # exudyn's: the model's resolved options
+    options.update({k: m.info[k] for k in model_class(m.model).MODES_OPTIONS if k in m.info})
     record = {
         "scene": scene.name,
         "model": m.model,
         "about": m.about,
         "coefficients": m.info.get("coefficients"),
-        "options": m.info.get("options", {}),
-        "count": m.count,
+        "options": options,
+        "held_hinges": held_hinges(scene).tolist(),
+        "count": m.flexible().count,
         "load_at": args.load_at,
         **({k: v for k, v in m.info.items() if k == "unbalanced_residual_Nm"}),
     }
+    if m.rigid:
+        record["rigid_modes"] = {
+            "modes": list(m.info.get("rigid_modes", ())),
+            "omega_rad_s": m.omega[: m.rigid].tolist(),
+            "shape_residual": m.info.get("rigid_shape_residual", {}),
+        }
     eq = m.equilibrium
     if eq is not None:
         record["equilibrium"] = {
@@ -172,10 +212,18 @@ def _summary(scene: Scene, m, args) -> list[str]:
         unit = "N m" if "coefficients" in m.info else "(exudyn's Newton residual norm)"
         res = f", residual {eq.residual:.2g} {unit}" if np.isfinite(eq.residual) else ""
         lines.append(f"static equilibrium: {eq.iterations} Newton iterations{res}{ign}")
+    if m.rigid:
+        names = ", ".join(str(x).replace("_", " ") for x in m.info.get("rigid_modes", ()))
+        omega = ", ".join(f"{w:.3g}" for w in m.omega[: m.rigid])
+        lines.append(
+            f"{m.rigid} rigid modes ({names}; omega {omega} rad/s) reported apart: the modes "
+            "below and in the files are the flexible ones (--count counts them)"
+        )
+    flex = m.flexible()
     lines.append(" mode   omega (rad/s)        f (Hz)   damping ratio")
-    for i in range(m.count):
-        z = "" if not np.isfinite(m.damping[i]) else f"{m.damping[i]:.3e}"
-        lines.append(f"{i + 1:5d} {m.omega[i]:15.6g} {m.f_hz[i]:13.6g}   {z}")
+    for i in range(flex.count):
+        z = "" if not np.isfinite(flex.damping[i]) else f"{flex.damping[i]:.3e}"
+        lines.append(f"{i + 1:5d} {flex.omega[i]:15.6g} {flex.f_hz[i]:13.6g}   {z}")
     return lines
 
 
@@ -198,23 +246,26 @@ def _comparison(scene: Scene, m, models: tuple[str, ...], pool: dict, args) -> l
     table = compare_modes(
         scene, order, about=args.about, count=args.count, reference=args.model, computed=computed
     )
-    table.to_csv(args.out / "compare.csv", index=False)
+    write_file(args.out / "compare.csv", table.to_csv(index=False))
     return [
         "paired by MAC (gap relative to " + args.model + "):",
         table.to_string(index=False, float_format=lambda v: f"{v:.6g}"),
     ]
 
 
-def _scene_and_model(args) -> tuple[Scene, str]:
-    """The scene of SCENE ('paper', a TOML file, or a run.json: its recorded scene) and the
-    model: --model, else a run.json's own model (when it has modes), else "full"."""
+def _scene_and_model(args) -> tuple[Scene, str, dict, dict]:
+    """The scene of SCENE ('paper', a TOML file, or a run.json: its recorded scene), the
+    model (--model, else a run.json's own model, else "full") and, for a run.json of the same
+    model, its model options as ``rodval simulate`` reruns them (``rodval.cli.simulate``'s
+    one reading of a run.json): (the ones the modes take, the ones that set only how the run
+    was computed; ``rodval.analysis.modes.rerun_options``, which refuses any other)."""
+    from rodval.analysis.modes import rerun_options
+    from rodval.cli.simulate import rerun_request
     from rodval.core.scene_file import load_scene, scene_from_dict
-    from rodval.models.presets.registry import MODEL_NAMES
-    from rodval.report.run_files import read_run_record
 
     path = Path(args.scene)
     if path.suffix != ".json":
-        return load_scene(args.scene), args.model or "full"
-    record = read_run_record(path)
-    ran = record["model"] if record["model"] in MODEL_NAMES else "full"
-    return scene_from_dict(record["scene"], where=str(path)), args.model or ran
+        return load_scene(args.scene), args.model or "full", {}, {}
+    doc, model, _, options = rerun_request(args)
+    carried, computed = rerun_options(model, options, str(path))
+    return scene_from_dict(doc, where=str(path)), model, carried, computed

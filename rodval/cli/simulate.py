@@ -217,7 +217,7 @@ def integration_budget(max_wall_s: float, used_s: float, setup_s: float, write_s
 # ------------------------------------------------------------------------- the command
 
 
-def _request(args) -> tuple[dict[str, Any], str, dict[str, Any], dict[str, Any]]:
+def rerun_request(args) -> tuple[dict[str, Any], str, dict[str, Any], dict[str, Any]]:
     """(scene document, model, integrator settings, options) of SCENE: a run.json's own, or
     a scene file's with the defaults."""
     path = Path(args.scene)
@@ -251,7 +251,7 @@ def overridden(doc: dict[str, Any], args) -> tuple[dict[str, Any], str]:
 
 def run(args) -> int:
     start = args.started  # the command's start (rodval.cli.main): its budget counts from it
-    doc, model, settings_kw, options = _request(args)
+    doc, model, settings_kw, options = rerun_request(args)
     doc, where = overridden(doc, args)
     scene, notes = build_scene(doc, where, args.t_end, args.times)
     options.update(model_options(args))

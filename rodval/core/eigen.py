@@ -195,3 +195,31 @@ def coordinate_null_space(J: np.ndarray) -> np.ndarray | None:
             continue
         B[i, column.setdefault(r, len(column))] = 1.0
     return B[:, : len(column)]
+
+
+def constraint_basis(A: np.ndarray) -> np.ndarray:
+    """A basis Z (N, N - m) of the null space of the linear constraints A q = 0 (A: (m, N),
+    full row rank), q = Z u: exact where every row has a pivot, a coordinate of its own that
+    no other row touches (a held hinge's alpha_k, rod k's root slope: its row is
+    phi_k + alpha_k - phi_{k-1} - beta_{k-1}), which is then eliminated, q_pivot =
+    -(row's other terms) / A[row, pivot], every other coordinate kept as it is (a 0/1
+    column, or one with the row's ratios: no rotation of coordinates into each other, so the
+    condensed pencil Z^T K Z, Z^T M Z keeps the stiffness scales apart); otherwise an
+    orthonormal basis (``scipy.linalg.null_space``). Cost O(m N) to find the pivots,
+    O(N (N - m)) to write Z."""
+    A = np.atleast_2d(np.asarray(A, float))
+    m, N = A.shape
+    nonzero = A != 0
+    touched = nonzero.sum(axis=0)
+    pivots = []
+    for i in range(m):
+        own = np.flatnonzero(nonzero[i] & (touched == 1))
+        if own.size == 0:
+            return scipy.linalg.null_space(A)
+        pivots.append(int(own[np.argmax(np.abs(A[i, own]))]))
+    keep = np.setdiff1d(np.arange(N), pivots)
+    Z = np.zeros((N, keep.size))
+    Z[keep, np.arange(keep.size)] = 1.0
+    for i, p in enumerate(pivots):
+        Z[p] = -A[i, keep] / A[i, p]
+    return Z

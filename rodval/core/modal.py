@@ -260,6 +260,25 @@ def normalize_shapes(dx: np.ndarray, dy: np.ndarray, hinge: np.ndarray):
     return dx, dy, hinge
 
 
+def held_hinges(scene: Any) -> np.ndarray:
+    """The hinges (ascending indices 0..n-1) of the scene's held latches (``Latch.held``:
+    clamped from t = 0), which every model's modes hold: a held hinge's relative rotation is
+    fixed (a constraint: the native models condense it out of M, C and K, exudyn keeps its
+    latch joint active). The other latches play no part in modes: at the configuration the
+    modes are about they have not locked (a latch ahead of its hinge's angle)."""
+    return np.array(sorted(latch.hinge for latch in scene.latches if latch.held), dtype=int)
+
+
+def equilibrium_angles(scene: Any) -> np.ndarray:
+    """The hinge angles D_k (rad, n) of the unloaded equilibrium: each hinge's rest angle, a
+    held latch's angle on its hinge (the latch holds the spring's moment there)."""
+    D = np.array(scene.chain.rest_angle, float)
+    for latch in scene.latches:
+        if latch.held:
+            D[latch.hinge] = float(latch.angle)
+    return D
+
+
 #: A free base's three rigid modes must have omega below this fraction of the first flexible
 #: omega (``split_rigid``).
 RIGID_RATIO = 1e-6
@@ -271,15 +290,18 @@ RIGID_SHAPE_TOL = 1e-4
 
 def check_no_mechanism(scene: Any) -> None:
     """ValueError (before any work) when a chain on a free base has a hinge without a spring
-    (kappa = 0): it is then a mechanism, with a zero-frequency mode of its own beside the
-    body's three rigid ones, which ``split_rigid`` could not tell apart. Names the hinges and
-    the fix."""
-    loose = [int(k) for k in np.flatnonzero(np.asarray(scene.chain.kappa) == 0.0)]
+    (kappa = 0) that no held latch holds: it is then a mechanism, with a zero-frequency mode
+    of its own beside the body's three rigid ones, which ``split_rigid`` could not tell
+    apart. Names the hinges and the fix."""
+    held = set(held_hinges(scene).tolist())  # a held hinge is no mechanism (no rotation)
+    loose = [
+        int(k) for k in np.flatnonzero(np.asarray(scene.chain.kappa) == 0.0) if int(k) not in held
+    ]
     if loose:
         raise ValueError(
             f"modes of a free spacecraft: hinge(s) {loose} have no spring (chain.kappa = 0), so "
             "the chain is a mechanism with zero-frequency modes beside the three rigid ones; "
-            "give every hinge a spring (kappa > 0) for its modes"
+            "give every hinge a spring (kappa > 0) or hold it (a held latch) for its modes"
         )
 
 

@@ -21,6 +21,7 @@ from matplotlib.typing import ColorType
 
 from rodval.analysis.metrics import pareto_front
 from rodval.core.modal import Modes
+from rodval.core.out_paths import write_figure
 from rodval.core.scene import UNITS
 from rodval.core.trajectory import Trajectory
 from rodval.models.presets.registry import integrated_models
@@ -129,7 +130,7 @@ def plot_configurations(
     if title:
         ax.set_title(fit_title(title, fig.get_figwidth(), _title_size("axes.titlesize")))
     path = Path(path)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
+    write_figure(fig, path, dpi=120, bbox_inches="tight")
     return path
 
 
@@ -236,7 +237,7 @@ def _save(fig: Figure, path: Path | str, title: str = "") -> Path:
         fig.suptitle(fit_title(title, fig.get_figwidth(), _title_size()))
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=110)
+    write_figure(fig, path, dpi=110)
     return path
 
 
@@ -353,16 +354,27 @@ def plot_work_precision(
             axes[0][0].legend(fontsize=7)
             fig.tight_layout()
             path = out_dir / f"wp_{model}_{'wall' if xcol == 'wall_s' else 'nfev'}.png"
-            fig.savefig(path, dpi=110)
+            write_figure(fig, path, dpi=110)
             paths.append(path)
     return paths
 
 
+def drawn_modes(m: Modes, count: int = 4) -> Modes:
+    """The modes ``plot_modes`` draws: the first ``count`` flexible modes (a free base's
+    rigid modes, ``Modes.flexible``, left out: they move the chain as a body), numbered from
+    1 as the files and ``--count`` number them."""
+    flex = m.flexible()
+    return flex.rows(slice(0, min(count, flex.count)))
+
+
 def plot_modes(m: Modes, path: Path, title: str = "", count: int = 4) -> Path:
-    """The first ``count`` mode shapes drawn on the chain: the configuration in metres, each
-    normalized shape (largest node displacement 1) drawn at 0.15 of the chain's span, which
-    the legend states (shapes have no unit of their own; hinge angles are in modes.csv)."""
-    k = min(count, m.count)
+    """The first ``count`` flexible mode shapes (``drawn_modes``) drawn on the chain: the
+    configuration in metres, each normalized shape (largest node displacement 1) drawn at
+    0.15 of the chain's span, which the legend states (shapes have no unit of their own;
+    hinge angles are in modes.csv). A free base's rigid modes are named in the title."""
+    rigid = m.rigid
+    m = drawn_modes(m, count)
+    k = m.count
     x0, y0 = m.node_positions()
     span = max(np.ptp(x0), np.ptp(y0), float(np.sum(m.l)) * 0.2)
     amp = 0.15 * span
@@ -385,10 +397,12 @@ def plot_modes(m: Modes, path: Path, title: str = "", count: int = 4) -> Path:
         ax.set_title(f"mode {i + 1}: {m.omega[i]:.4g} rad/s ({m.f_hz[i]:.4g} Hz)", fontsize=9)
     axes[-1, 0].set_xlabel("x (m)")
     axes[0, 0].legend(fontsize=7, loc="upper left")
+    if rigid:
+        title = f"{title}{'; ' if title else ''}flexible modes ({rigid} rigid modes not drawn)"
     if title:
         fig.suptitle(fit_title(title, fig.get_figwidth(), 10), fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    write_figure(fig, path, dpi=110)
     return path
 
 
@@ -466,5 +480,5 @@ def plot_scale(frame: pd.DataFrame, speedup: pd.DataFrame | None, path: Path) ->
     axes[0].legend(fontsize=7)
     axes[1].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    write_figure(fig, path, dpi=110)
     return path

@@ -24,7 +24,10 @@ with
   body under static loads has no static equilibrium (it accelerates), so
   ``about="equilibrium"`` is refused when the scene has static loads; without them the
   equilibrium is the body's attitude theta with straight rods at the hinges' rest angles
-  (phi_k = theta + rest_0 + ... + rest_{k-1}).
+  (phi_k = theta + rest_0 + ... + rest_{k-1}; a held latch's angle on its hinge).
+* held latches (``rodval.core.modal.held_hinges``): their hinges' relative rotation fixed,
+  the pencil taken on the exact basis Z of the motions that keep them
+  (``rodval.core.eigen.constraint_basis``): Z^T M Z, Z^T K Z, Z^T C Z.
 
 K has the three rigid motions as its null space (translations x, y; a rotation of the whole
 system, theta and every phi_k together), so the undamped pencil (``symmetric_pencil``,
@@ -44,11 +47,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from rodval.core.eigen import angular_frequencies, symmetric_pencil
+from rodval.core.eigen import angular_frequencies, constraint_basis, symmetric_pencil
 from rodval.core.modal import (
     Modes,
     check_no_mechanism,
     damping_ratios,
+    equilibrium_angles,
+    held_hinges,
     normalize_shapes,
     split_rigid,
     static_loads,
@@ -112,7 +117,8 @@ def stiffness_and_damping(system, chain, shapes: int) -> tuple[np.ndarray, np.nd
 
 def configuration(system, scene: Scene, about: str, load_at) -> np.ndarray:
     """Q0 (N): the initial state's positions, or (``about="equilibrium"``, no static loads)
-    the body's attitude with straight rods at the hinges' rest angles."""
+    the body's attitude with straight rods at the hinges' rest angles (a held latch's angle
+    on its hinge, ``equilibrium_angles``)."""
     Q0 = np.array(system.y0[: system.N], float)
     if about != "equilibrium":
         return Q0
@@ -125,8 +131,24 @@ def configuration(system, scene: Scene, about: str, load_at) -> np.ndarray:
     n, Nc = scene.n, system.Nc
     theta = Q0[Nc + 2]
     Q0[:Nc] = 0.0
-    Q0[:n] = theta + np.cumsum(scene.chain.rest_angle)
+    Q0[:n] = theta + np.cumsum(equilibrium_angles(scene))
     return Q0
+
+
+def held_free_basis(system, scene: Scene) -> np.ndarray | None:
+    """Z (N, N - m): the motions of the free system that keep the scene's m held hinges at
+    their angles (``constraint_basis`` of their hinge rows, hinge 0's from the body's
+    theta; each eliminates its alpha_k), or None without held latches."""
+    held = held_hinges(scene)
+    return constraint_basis(system.hinge_rows(held)) if held.size else None
+
+
+def free_residual(K: np.ndarray, A: np.ndarray, Q0: np.ndarray, chain, Z) -> float:
+    """The springs' and bending's static residual max |K Q0 - A^T kappa rest| (N m; K (N, N),
+    A (n, N) the hinge rows, Q0 (N)) that no held latch carries (Z^T of it with the held
+    basis Z, ``held_free_basis``; None: none held). The caller checked it is small."""
+    R = K @ Q0 - A.T @ (chain.kappa * chain.rest_angle)
+    return float(np.max(np.abs(R if Z is None else Z.T @ R)))
 
 
 def check_free_base(scene: Scene, coefficients: str) -> None:
@@ -216,9 +238,12 @@ def free_modes(
     M = mass_matrix(system, Q0)
     K, C = stiffness_and_damping(system, chain, p)
     A = system.hinge_rows(np.arange(n))
-    # the springs' and bending's static residual there (N m; the caller checked it is small)
-    residual = float(np.max(np.abs(K @ Q0 - A.T @ (chain.kappa * chain.rest_angle))))
+    Z = held_free_basis(system, scene)
+    residual = free_residual(K, A, Q0, chain, Z)
+    if Z is not None:  # the held hinges held: the pencil on the motions that keep them
+        M, K, C = (Z.T @ B @ Z for B in (M, K, C))
     lam, X, Xs, (Ms, Ks, Cs) = scaled_pencil(M, K, C)
+    X = X if Z is None else Z @ X
     dx, dy, hinge, xn, yn = mode_shapes(scene, X.T, Q0, Nc, A)
     l = chain.l
     lam, dx, dy, hinge, rigid = split_rigid(lam, dx, dy, hinge, xn, yn, float(np.mean(l)))
@@ -252,6 +277,7 @@ def free_modes(
             "kinematics": kin,
             "base": "free",
             "static_residual_Nm": residual,
+            "held_hinges": held_hinges(scene).tolist(),
             **rigid,
         },
         rigid=3,

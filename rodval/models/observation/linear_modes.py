@@ -31,6 +31,15 @@ hinge rest angles, found by Newton's method on the static residual
 K + K_L, and load stepping when the full step fails. The reduced model's equilibrium is the
 same phi (its bending rows are the full model's, condensed).
 
+Held latches
+------------
+A held latch (``Latch.held``, ``rodval.core.modal.held_hinges``) fixes its hinge's relative
+rotation: the full model (every rung) solves its pencil on the exact basis Z of the motions
+that keep the held hinges (``statics.held_basis``: each row eliminates its alpha_k), the
+reduced model condenses its bending with the held hinges as equations (``held_reduced``),
+and the equilibrium is found on the same basis. Other latches play no part (not locked at the
+configuration). docs/modes.md, "Latches".
+
 Frequencies and damping
 -----------------------
 Undamped: the generalized eigenproblem (K + K_L) x = omega^2 M x. For the full model with the
@@ -77,6 +86,7 @@ Each paper model's ``modes`` (``rodval.core.contract.Model.modes``) runs ``modes
 from __future__ import annotations
 
 import numbers
+from collections.abc import Callable
 from functools import partial
 
 import numpy as np
@@ -87,8 +97,10 @@ from rodval.core.checks import check_choice, check_type
 from rodval.core.eigen import angular_frequencies, symmetric_pencil
 from rodval.core.modal import (
     ABOUT,
+    Equilibrium,
     Modes,
     damping_ratios,
+    held_hinges,
     normalize_shapes,
     static_loads,
 )
@@ -112,12 +124,13 @@ from rodval.models.kinematics.ladder import (
 )
 from rodval.models.kinematics.rungs import PAPER_RUNG, check_kinematics, check_shapes
 from rodval.models.observation.statics import (
+    balance_residual,
     body_rest_angles,
     check_at_rest,
+    held_basis,
     load_stiffness,
     no_equilibrium,
     static_equilibrium,
-    static_residual,
 )
 from rodval.models.presets.full import FullModel
 from rodval.models.presets.reduced import ReducedModel, ReducedSystem
@@ -218,6 +231,34 @@ def _node_transform(chain: Chain, model: str) -> tuple[np.ndarray, np.ndarray]:
     return T[:, perm], np.repeat(np.arange(n), per)
 
 
+def _qz_run(Kz: np.ndarray, Mz: np.ndarray, rod: np.ndarray, rho: float) -> dict | None:
+    """QZ of the pencil (Kz, Mz) (rod-major node displacements) under the exact similarity
+    diag(rho^rod) (``_general_eig``): its eigenvalues, right eigenvectors, first-order error
+    estimates and which are real; None when QZ returns an infinite or NaN eigenvalue. The
+    scaling multiplies an entry (i, j) by rho^(rod_j - rod_i): on a dense pencil (the reduced
+    model's condensed bending couples every rod) rho^59 = 3e35 (rho = 4, 60 rods) drowns the
+    near-diagonal entries, QZ then finds beta = 0 (59 infinite eigenvalues for 60 rods of
+    0.1 m, EI 1e6 N m^2), and such a run carries nothing to match (the Hungarian matching
+    of ``_general_eig`` needs finite distances: scipy's "cost matrix is infeasible")."""
+    eps = np.finfo(float).eps
+    # D^-1 X D with D = diag(rho^rod): entry (i, j) times rho^(rod_j - rod_i); entries far
+    # from the band are (near) zero in the straight configuration; the exponent is clipped
+    # so that a bent configuration cannot overflow.
+    S = np.float64(rho) ** np.clip(rod[None, :] - rod[:, None], -60, 60)
+    Ks, Ms = Kz * S, Mz * S
+    lam, VL, VR = scipy.linalg.eig(Ks, Ms, left=True, right=True)
+    if not np.all(np.isfinite(lam)):
+        return None
+    kappa = (
+        np.linalg.norm(VL, axis=0)
+        * np.linalg.norm(VR, axis=0)
+        / np.maximum(np.abs(np.sum(VL.conj() * (Ms @ VR), axis=0)), 1e-300)
+    )
+    err = eps * (np.linalg.norm(Ks, 2) + np.abs(lam) * np.linalg.norm(Ms, 2)) * kappa
+    real = np.abs(lam.imag) <= IMAG_TOL * np.max(np.abs(lam))
+    return {"rho": rho, "lam": lam, "VR": VR, "err": err, "real": real}
+
+
 def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors: bool = True):
     """Eigenvalues (and right eigenvectors in q) of K x = lam M x for a non-symmetric M, by QZ
     on the equivalent pencil in rod-major node displacements with the exact similarity
@@ -235,23 +276,12 @@ def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors
     real spectrum (the caller decides)."""
     T, rod = _node_transform(chain, model)
     Kz, Mz = T.T @ K @ T, T.T @ M @ T
-    eps = np.finfo(float).eps
-    runs = []
-    for rho in RHO:
-        # D^-1 X D with D = diag(rho^rod): entry (i, j) times rho^(rod_j - rod_i); entries far
-        # from the band are (near) zero in the straight configuration; the exponent is clipped
-        # so that a bent configuration cannot overflow.
-        S = np.float64(rho) ** np.clip(rod[None, :] - rod[:, None], -60, 60)
-        Ks, Ms = Kz * S, Mz * S
-        lam, VL, VR = scipy.linalg.eig(Ks, Ms, left=True, right=True)
-        kappa = (
-            np.linalg.norm(VL, axis=0)
-            * np.linalg.norm(VR, axis=0)
-            / np.maximum(np.abs(np.sum(VL.conj() * (Ms @ VR), axis=0)), 1e-300)
+    runs = [r for r in (_qz_run(Kz, Mz, rod, rho) for rho in RHO) if r is not None]
+    if not runs:
+        raise ValueError(
+            "the linearized pencil has infinite eigenvalues in every scaling (its mass matrix "
+            "is singular to working precision)"
         )
-        err = eps * (np.linalg.norm(Ks, 2) + np.abs(lam) * np.linalg.norm(Ms, 2)) * kappa
-        real = np.abs(lam.imag) <= IMAG_TOL * np.max(np.abs(lam))
-        runs.append({"rho": rho, "lam": lam, "VR": VR, "err": err, "real": real})
 
     def rel(r):
         return np.median(r["err"] / np.maximum(np.abs(r["lam"]), 1e-300))
@@ -314,8 +344,11 @@ def _shapes(
     lam: np.ndarray,
     M: np.ndarray | None = None,
     coefficients: str = DEFAULT_VARIANT,
+    recover: Callable[[np.ndarray, float], np.ndarray] | None = None,
 ):
-    """Node displacements and hinge angles of eigenvectors X (columns)."""
+    """Node displacements and hinge angles of eigenvectors X (columns); the reduced model's
+    bending from its bending rows at each mode's eigenvalue, or by ``recover`` (dphi, lam)
+    -> gamma (with held hinges, ``held_reduced``)."""
     n, l = chain.n, chain.l
     if model == "full":
         Q = X.T  # (count, 3n)
@@ -328,7 +361,11 @@ def _shapes(
         for i in range(X.shape[1]):
             dphi = X[:, i]
             Q[i, :n] = dphi
-            Q[i, n:] = -np.linalg.solve(B, (K[g, p] - lam[i] * Mfull[g, p]) @ dphi)
+            Q[i, n:] = (
+                recover(dphi, lam[i])
+                if recover is not None
+                else -np.linalg.solve(B, (K[g, p] - lam[i] * Mfull[g, p]) @ dphi)
+            )
     dphi = Q[:, :n]
     dx = np.hstack([np.zeros((Q.shape[0], 1)), np.cumsum(-l * np.sin(phi0) * dphi, axis=1)])
     dy = np.hstack([np.zeros((Q.shape[0], 1)), np.cumsum(l * np.cos(phi0) * dphi, axis=1)])
@@ -417,26 +454,21 @@ def modes_about(
             kinematics=kinematics,
         )
     chain, n = scene.chain, scene.n
-    ini = scene.initial.resolve(n)
-    q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
-    eq, SX, SY = None, None, None
-    if about == "equilibrium":
-        loads = static_loads(scene, load_at)
-        SX, SY = loads.SX, loads.SY
-        eq = static_equilibrium(chain, SX, SY, q0=q0, rest=chain.rest_angle)
-        eq.loads = loads
-        if not eq.converged:
-            raise ValueError(no_equilibrium(chain, eq))
-        q0 = eq.q
+    held = check_held(scene, model, coefficients)
+    q0, eq, SX, SY = _configuration(scene, about, load_at)
     M, C, K = linear_system(chain, model, q0, coefficients, SX, SY, shapes, kinematics)
+    M, C, K, Z, recover = _held_pencil(scene, model, (M, C, K), q0, (coefficients, SX, SY))
     lam, X = eigen(K, M, chain, model)
     N = lam.size
     count = N if count is None else min(count, N)
     lam, X = lam[:count], X[:, :count]
     omega = angular_frequencies(lam)
     zeta = damping_ratios(M, C, K, X, omega)
+    X = X if Z is None else Z @ X
     # node displacements and hinge angles need phi, alpha, beta only (bubbles: zero at the ends)
-    dx, dy, hinge = _shapes(chain, model, q0[:n], X[: 3 * n], lam, coefficients=coefficients)
+    dx, dy, hinge = _shapes(
+        chain, model, q0[:n], X[: 3 * n], lam, coefficients=coefficients, recover=recover
+    )
     return Modes(
         model=model,
         about=about,
@@ -448,8 +480,109 @@ def modes_about(
         phi0=q0[:n].copy(),
         l=chain.l.copy(),
         equilibrium=eq,
-        info={"coefficients": coefficients, "q0": q0, "shapes": shapes, "kinematics": kinematics},
+        info={
+            "coefficients": coefficients,
+            "q0": q0,
+            "shapes": shapes,
+            "kinematics": kinematics,
+            "held_hinges": held.tolist(),
+        },
     )
+
+
+def check_held(scene: Scene, model: str, coefficients: str) -> np.ndarray:
+    """The scene's held hinges (``held_hinges``), after the check that ``model`` holds them
+    with these ``coefficients``: the full model on its symmetric (printed) mass matrix only
+    (ValueError naming the held hinges otherwise; the reduced model takes both)."""
+    held = held_hinges(scene)
+    if held.size and model == FullModel.name and coefficients != DEFAULT_VARIANT:
+        raise ValueError(
+            f"held latches (hinges {held.tolist()}): the full model's modes hold them on its "
+            f"symmetric mass matrix, coefficients={DEFAULT_VARIANT!r}; got "
+            f"coefficients={coefficients!r} (the reduced model takes both)"
+        )
+    return held
+
+
+def _configuration(
+    scene: Scene, about: str, load_at: float | None
+) -> tuple[np.ndarray, Equilibrium | None, np.ndarray | None, np.ndarray | None]:
+    """(q0 = [phi; alpha; beta] (rad) the modes are about, its static solve or None, the
+    static loads' suffix sums SX, SY (N) or None): the initial state, or the static
+    equilibrium under the static loads and hinge rest angles with the held latches held
+    (``static_equilibrium`` on ``held_basis``)."""
+    chain, n = scene.chain, scene.n
+    ini = scene.initial.resolve(n)
+    q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
+    if about != "equilibrium":
+        return q0, None, None, None
+    loads = static_loads(scene, load_at)
+    eq = static_equilibrium(
+        chain, loads.SX, loads.SY, q0=q0, rest=chain.rest_angle, held=held_basis(scene)
+    )
+    eq.loads = loads
+    if not eq.converged:
+        raise ValueError(no_equilibrium(chain, eq, held_hinges(scene)))
+    return eq.q, eq, loads.SX, loads.SY
+
+
+def _held_pencil(
+    scene: Scene, model: str, MCK: tuple[np.ndarray, ...], q0: np.ndarray, variant: tuple
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, Callable | None]:
+    """The linear system (M, C, K) = ``MCK`` with the scene's held latches held: (M, C, K) in
+    the coordinates it is solved in, Z mapping them back to q (None: q itself) and the
+    reduced model's bending recovery (None: the model's own). Full model (every rung): the
+    exact basis Z of ``held_basis``, Z^T M Z, Z^T C Z, Z^T K Z. Reduced model: its bending
+    condensed with the held hinges as equations (``held_reduced``; ``variant`` = the
+    coefficients and static loads' SX, SY it is linearized with)."""
+    M, C, K = MCK
+    held = held_hinges(scene)
+    if not held.size:
+        return M, C, K, None, None
+    if model == FullModel.name:
+        Z = held_basis(scene, M.shape[0])
+        assert Z is not None
+        return Z.T @ M @ Z, Z.T @ C @ Z, Z.T @ K @ Z, Z, None
+    n = scene.n
+    full = linear_system(scene.chain, FullModel.name, q0, *variant)
+    M_r, C_r, K_r, gamma = held_reduced(full, hinge_matrix(n)[held], n)
+    return M_r, C_r, K_r, None, gamma
+
+
+def held_reduced(
+    MCK: tuple[np.ndarray, ...], A: np.ndarray, n: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, Callable[[np.ndarray, float], np.ndarray]]:
+    """The reduced model's (M_r, C_r, K_r) (n, n) with held hinges, from the full model's
+    linear (M, C, K) = ``MCK`` (3n) and the held hinges' rows A (m, 3n): the reduced model
+    holds them as equations of its quasi-static bending (``ReducedSystem.solve_locked``, the
+    kappa -> infinity limit), so with S = [[B, A_g^T], [A_g, 0]] (B = K_gg) and
+    E = [K_pg, A_p^T] the bending and the latches' multipliers are condensed out exactly:
+
+        M_r = M_pp - E S^-1 [M_gp; 0],  C_r = C_pp - E S^-1 [C_gp; 0],
+        K_r = K_pp - E S^-1 [K_gp; A_p]
+
+    (without held hinges S = B and these are the reduced model's own). Also returns
+    gamma(dphi, lam): a mode's bending coordinates (2n) from its chord angles at eigenvalue
+    lam = omega^2. O(n^3) (dense)."""
+    M, C, K = MCK
+    p, g = slice(0, n), slice(n, 3 * n)
+    m = A.shape[0]
+    S = np.zeros((2 * n + m, 2 * n + m))
+    S[: 2 * n, : 2 * n] = K[g, g]
+    S[: 2 * n, 2 * n :] = A[:, g].T
+    S[2 * n :, : 2 * n] = A[:, g]
+    E = np.hstack([K[p, g], A[:, p].T])
+    lu = scipy.linalg.lu_factor(S)
+    none = np.zeros((m, n))
+
+    def condense(B: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return B[p, p] - E @ scipy.linalg.lu_solve(lu, np.vstack([B[g, p], rows]))
+
+    def gamma(dphi: np.ndarray, lam: float) -> np.ndarray:
+        rhs = np.concatenate([(K[g, p] - lam * M[g, p]) @ dphi, A[:, p] @ dphi])
+        return -scipy.linalg.lu_solve(lu, rhs)[: 2 * n]
+
+    return condense(M, none), condense(C, none), condense(K, A[:, p]), gamma
 
 
 def check_configuration(
@@ -478,7 +611,7 @@ def check_configuration(
         return {}
     ini = scene.initial.resolve(scene.n)
     q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
-    R = static_residual(scene.chain, q0, rest=body_rest_angles(scene))
+    R = balance_residual(scene, q0, body_rest_angles(scene))
     return {"unbalanced_residual_Nm": float(np.max(np.abs(R)))}
 
 

@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from rodval.core.eigen import constraint_basis
 from rodval.core.modal import (
     Equilibrium,
+    held_hinges,
 )
 from rodval.core.scene import Chain, Scene
 from rodval.models.assembly.paper_matrices import (
@@ -20,6 +22,21 @@ from rodval.models.assembly.paper_matrices import (
 def load_stiffness(l: np.ndarray, phi: np.ndarray, SX: np.ndarray, SY: np.ndarray) -> np.ndarray:
     """K_L = -dQ/dphi (n, n), diagonal: l_k (sin phi_k SY_k + cos phi_k SX_k) (N m/rad)."""
     return np.diag(l * (np.sin(phi) * SY + np.cos(phi) * SX))
+
+
+def held_basis(scene: Scene, columns: int | None = None) -> np.ndarray | None:
+    """Z (N, N - m) with q = Z u exactly the motions that keep the scene's m held hinges
+    (``rodval.core.modal.held_hinges``) at their angles (``constraint_basis`` of their hinge
+    rows, each eliminating its alpha_k), or None without held latches. ``columns``: N, the
+    model's coordinates (default 3n; a ladder rung's n (p + 2), whose hinge rows are the
+    paper's padded with zeros for the bubbles)."""
+    held = held_hinges(scene)
+    if not held.size:
+        return None
+    n = scene.n
+    A = np.zeros((held.size, 3 * n if columns is None else columns))
+    A[:, : 3 * n] = hinge_matrix(n)[held]
+    return constraint_basis(A)
 
 
 def static_residual(
@@ -49,11 +66,15 @@ def static_equilibrium(
     rtol: float = 1e-12,
     max_iter: int = 30,
     max_steps: int = 256,
+    held: np.ndarray | None = None,
 ) -> Equilibrium:
     """Static equilibrium R(q) = 0 (``static_residual``) by Newton's method with the exact
     Jacobian K + K_L, starting from q0 (default straight). If a Newton solve fails, the load
     (and rest angles) are applied in more equal steps (1, 2, 4, ... up to ``max_steps``).
-    Converged when max |R| <= rtol * (max |K q| + max |Q| + 1 N m)."""
+    Converged when max |R| <= rtol * (max |K q| + max |Q| + 1 N m). ``held``: the basis Z of
+    the motions that keep the held hinges at their angles (``held_basis``; q0 must hold them):
+    q stays on q0 + Z u, the residual is then Z^T R (the held hinges' moments are the
+    latches' reactions) and the Jacobian Z^T (K + K_L) Z."""
     n = chain.n
     K = stiffness_matrix(chain)
     SX = np.zeros(n) if SX is None else np.asarray(SX, float)
@@ -68,38 +89,62 @@ def static_equilibrium(
         for i in range(1, steps + 1):
             f = i / steps
             args = (f * SX, f * SY, None if rest is None else f * rest)
-            for _ in range(max_iter):
-                R = static_residual(chain, q, *args, K=K)
-                Q = chain.l * (np.cos(q[:n]) * args[1] - np.sin(q[:n]) * args[0])
-                scale = np.max(np.abs(K @ q)) + np.max(np.abs(Q)) + 1.0
-                if np.max(np.abs(R)) <= rtol * scale:
-                    break
-                J = K.copy()
-                J[:n, :n] += load_stiffness(chain.l, q[:n], args[0], args[1])
-                try:
-                    q = q - np.linalg.solve(J, R)
-                except np.linalg.LinAlgError:  # singular: no Newton step; try more load steps
-                    q = np.full_like(q, np.nan)
-                total += 1
-                if not np.all(np.isfinite(q)):
-                    break
-            else:
-                R = static_residual(chain, q, *args, K=K)
-            if not (np.all(np.isfinite(q)) and np.max(np.abs(R)) <= rtol * scale):
+            q, residual, scale, used = _newton(chain, K, q, args, held, rtol, max_iter)
+            total += used
+            if not (np.all(np.isfinite(q)) and residual <= rtol * scale):
                 ok = False
                 break
         if ok:
-            return Equilibrium(q, total, steps, float(np.max(np.abs(R))), True)
+            return Equilibrium(q, total, steps, residual, True)
         steps *= 2
     R = static_residual(chain, q, SX, SY, rest, K=K)
+    R = R if held is None else held.T @ R
     return Equilibrium(q, total, steps // 2, float(np.max(np.abs(R))), False)
 
 
-def no_equilibrium(chain: Chain, eq: Equilibrium) -> str:
+def _newton(
+    chain: Chain,
+    K: np.ndarray,
+    q: np.ndarray,
+    args: tuple[np.ndarray, np.ndarray, np.ndarray | None],
+    held: np.ndarray | None,
+    rtol: float,
+    max_iter: int,
+) -> tuple[np.ndarray, float, float, int]:
+    """Newton's method on the static residual at the loads and rest angles ``args`` (SX, SY,
+    rest) from q (3n), on q + Z u when ``held`` is the basis Z: (q, max |R| (N m; Z^T R when
+    held), its convergence scale (N m), Newton iterations). A singular Jacobian gives a NaN q
+    (the caller then tries more load steps)."""
+    n = chain.n
+    used = 0
+    for _ in range(max_iter + 1):
+        R = static_residual(chain, q, args[0], args[1], args[2], K=K)
+        R = R if held is None else held.T @ R
+        Q = chain.l * (np.cos(q[:n]) * args[1] - np.sin(q[:n]) * args[0])
+        scale = np.max(np.abs(K @ q)) + np.max(np.abs(Q)) + 1.0
+        residual = float(np.max(np.abs(R)))
+        if residual <= rtol * scale or used == max_iter or not np.all(np.isfinite(q)):
+            break
+        J = K.copy()
+        J[:n, :n] += load_stiffness(chain.l, q[:n], args[0], args[1])
+        try:
+            if held is None:
+                q = q - np.linalg.solve(J, R)
+            else:
+                q = q - held @ np.linalg.solve(held.T @ J @ held, R)
+        except np.linalg.LinAlgError:  # singular: no Newton step; try more load steps
+            q = np.full_like(q, np.nan)
+        used += 1
+    return q, residual, scale, used
+
+
+def no_equilibrium(chain: Chain, eq: Equilibrium, held: np.ndarray | None = None) -> str:
     """Why ``static_equilibrium`` found none, in one line: hinges without stiffness
-    (kappa = 0) that the loads do not hold leave the chain free to turn there (a singular
-    stiffness, no unique equilibrium); otherwise Newton's method did not converge."""
-    free = [int(k) for k in np.flatnonzero(chain.kappa == 0)]
+    (kappa = 0) that neither a held latch (``held``: their indices) nor the loads hold leave
+    the chain free to turn there (a singular stiffness, no unique equilibrium); otherwise
+    Newton's method did not converge."""
+    fixed = set() if held is None else {int(k) for k in held}
+    free = [int(k) for k in np.flatnonzero(chain.kappa == 0) if int(k) not in fixed]
     if free:
         return (
             f"static equilibrium not found: hinge(s) {free} have no stiffness (kappa = 0), so "
@@ -160,7 +205,7 @@ def check_at_rest(scene: Scene) -> float:
     q0 = np.concatenate([ini["phi"], ini["alpha"], ini["beta"]])
     K = stiffness_matrix(chain)
     rest = body_rest_angles(scene)
-    R = static_residual(chain, q0, rest=rest, K=K)
+    R = balance_residual(scene, q0, rest, K)
     spring = hinge_matrix(n).T @ (chain.kappa * rest)
     scale = np.max(np.abs(K @ q0)) + np.max(np.abs(spring)) + 1.0
     worst = int(np.argmax(np.abs(R)))
@@ -176,3 +221,20 @@ def check_at_rest(scene: Scene) -> float:
             "anyway"
         )
     return residual
+
+
+def balance_residual(
+    scene: Scene, q0: np.ndarray, rest: np.ndarray, K: np.ndarray | None = None
+) -> np.ndarray:
+    """The static residual (N m, 3n) of q0 without loads that no held latch carries: R(q0)
+    (``static_residual`` about the hinge rest angles ``rest``) with each held hinge's moment
+    taken by its latch, i.e. R less its component along the held hinges' rows (the least-
+    squares multipliers; R itself without held latches). A held hinge away from its rest
+    angle is thus in equilibrium (the latch holds the spring's moment)."""
+    R = static_residual(scene.chain, q0, rest=rest, K=K)
+    held = held_hinges(scene)
+    if not held.size:
+        return R
+    A = hinge_matrix(scene.n)[held]
+    lam = np.linalg.lstsq(A.T, R, rcond=None)[0]
+    return R - A.T @ lam
