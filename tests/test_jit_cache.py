@@ -7,6 +7,7 @@ one process, the callee's module is edited, and a second process must run the ne
 """
 
 import json
+import os
 import subprocess
 import sys
 import textwrap
@@ -43,16 +44,22 @@ RUN = textwrap.dedent(
 )
 
 
-def _run(root: Path, code: str = RUN) -> str:
+def _run(root: Path, code: str = RUN, bytecode: bool = False) -> str:
     """``code`` run by a fresh Python with ``root`` (holding the package ``kernels``) and
-    rodval importable; its stdout."""
-    env_path = f"{root}:{Path(rodval.__file__).resolve().parents[1]}"
+    rodval importable; its stdout. Without ``bytecode`` Python writes no compiled copies
+    (``.pyc``): it checks them by whole-second modification time and size, so a same-size edit
+    in the second of the first run would run the old code (this test failed about half its
+    runs that way)."""
+    env = {"PYTHONPATH": f"{root}:{Path(rodval.__file__).resolve().parents[1]}"}
+    env.update(OMP_NUM_THREADS="1", PATH="/usr/bin:/bin")
+    if not bytecode:
+        env["PYTHONDONTWRITEBYTECODE"] = "1"
     out = subprocess.run(
         [sys.executable, "-c", code, str(root)],
         capture_output=True,
         text=True,
         timeout=120,
-        env={"PYTHONPATH": env_path, "OMP_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"},
+        env=env,
         check=True,
     )
     return out.stdout.strip()
@@ -68,6 +75,36 @@ def test_a_cached_kernel_runs_the_new_code_of_a_callee_in_another_module(tmp_pat
     assert list(pkg.glob("__pycache__/caller.twice-*.nbi"))  # cached by the first process
     (pkg / "callee.py").write_text(CALLEE.format(5))
     assert _run(tmp_path) == "10"
+
+
+def _set_mtime(path: Path, seconds: float) -> None:
+    """Give ``path`` the modification time ``seconds`` (explicit: no dependence on the clock)."""
+    ns = int(seconds * 1e9)
+    os.utime(path, ns=(ns, ns))
+
+
+def test_a_kernel_compiled_from_stale_bytecode_is_not_served_after_python_recompiles(tmp_path):
+    """A same-size edit in the second Python wrote the callee's ``.pyc`` (stamps set
+    explicitly): Python loads the old bytecode (its own rule: whole-second mtime and size), so
+    that run computes 2. Once the source is touched Python compiles it again, and the kernels
+    must run the new callee (10), not the machine code compiled from the stale copy, which a
+    key of the sources' contents alone served again."""
+    pkg = tmp_path / "kernels"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "caller.py").write_text(CALLER)
+    callee = pkg / "callee.py"
+    callee.write_text(CALLEE.format(1))
+    second = 1_700_000_000
+    _set_mtime(callee, second + 0.1)
+    assert _run(tmp_path, bytecode=True) == "2"
+    (pyc,) = pkg.glob("__pycache__/callee.*.pyc")
+    _set_mtime(pyc, second + 0.2)  # the copy written at 0.2 s
+    callee.write_text(CALLEE.format(5))  # same size
+    _set_mtime(callee, second + 0.6)  # edited at 0.6 s, the same second
+    assert _run(tmp_path, bytecode=True) == "2"  # Python's stale copy (not rodval's doing)
+    _set_mtime(callee, second + 5.0)  # touched: Python compiles the source again
+    assert _run(tmp_path, bytecode=True) == "10"
 
 
 def test_rodval_installs_it_for_its_own_kernels():

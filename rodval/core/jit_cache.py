@@ -20,6 +20,12 @@ recompiles neither the integrators (they take right-hand sides as first-class fu
 pointers, ``solvers.signature``) nor the paper models' kernels. ``tests/test_jit_cache.py``
 counts the compilations on a small package. Other packages' caches are untouched.
 
+numba compiles the bytecode Python loaded, which is not always the source's: Python reuses a
+compiled copy (``.pyc``) whose whole-second modification time and size match the source, so a
+same-size edit within the second of the copy runs the old code. Such a copy goes into the key
+too (``_stale_bytecode``): the kernel compiled from it is never served for the source once
+Python compiles the source again (it would have been, keyed by the source's content alone).
+
 Cost: the closures are read once per process (a regular expression over each file's import
 statements, memoised: 0.09 s for every kernel module of rodval);
 ``import rodval`` does not import this module (the hook in ``rodval/__init__`` installs it on
@@ -33,6 +39,7 @@ whose internals differ, ``install`` returns False and numba's own caching applie
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import os
 import re
 from functools import cache
@@ -113,14 +120,52 @@ def import_closure(path: Path, root: Path = PACKAGE_ROOT) -> tuple[Path, ...]:
     return tuple(sorted(seen))
 
 
+def _stale_bytecode(file: Path) -> bytes | None:
+    """The compiled copy (``.pyc``) Python may load for ``file`` although it may not be the
+    compiled source, else None.
+
+    Python checks a timestamp ``.pyc`` by the source's modification time in whole seconds and
+    its size only: a same-size edit within the second the copy was written leaves a copy that
+    Python keeps loading. Flagged: a timestamp copy whose header matches the source's stamp but
+    that was written before the source's last change, or a hash-based copy whose hash is not
+    the source's (loaded when unchecked)."""
+    try:
+        pyc = Path(importlib.util.cache_from_source(str(file)))
+        with pyc.open("rb") as stream:
+            head = stream.read(16)
+        source = file.stat()
+        written = pyc.stat().st_mtime_ns
+    except (OSError, ValueError, NotImplementedError):  # no copy, or no cache tag
+        return None
+    if len(head) < 16 or head[:4] != importlib.util.MAGIC_NUMBER:
+        return None
+    if int.from_bytes(head[4:8], "little") & 1:  # hash-based
+        stale = head[8:16] != importlib.util.source_hash(file.read_bytes())
+    else:
+        stamp = (int(source.st_mtime) & 0xFFFFFFFF, source.st_size & 0xFFFFFFFF)
+        header = (int.from_bytes(head[8:12], "little"), int.from_bytes(head[12:16], "little"))
+        stale = header == stamp and written < source.st_mtime_ns
+    try:
+        return pyc.read_bytes() if stale else None
+    except OSError:
+        return None
+
+
 @cache
 def closure_digest(path: Path, root: Path = PACKAGE_ROOT) -> str:
-    """SHA-256 over the relative paths and contents of ``import_closure(path, root)``."""
+    """SHA-256 over the relative paths and contents of ``import_closure(path, root)``, and
+    over the compiled copy Python may load in place of a source (``_stale_bytecode``): numba
+    compiles the bytecode Python loaded, so a kernel compiled from a stale copy is cached
+    under a key of its own, never under the source's (where it would outlive the copy)."""
     h = hashlib.sha256()
     for file in import_closure(path, root):
         h.update(file.relative_to(root).as_posix().encode())
         h.update(b"\0")
         h.update(file.read_bytes())
+        stale = _stale_bytecode(file)
+        if stale is not None:
+            h.update(b"\0stale bytecode\0")
+            h.update(stale)
     return h.hexdigest()
 
 
