@@ -135,11 +135,9 @@ def test_cli_paper_over_1e6_s_ends_at_its_wall_budget(tmp_path, capsys):
 
 def test_cli_refuses_the_unbounded_run_at_once(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(ExudynModel, "_build", _no_build)
-    start = time.perf_counter()
-    code = main(
+    code = main(  # refused before the model is built (_no_build), not timed
         ["simulate", "paper", "--model", "exudyn", "--t-end", "1e6", "--out", str(tmp_path / "y")]
     )
-    assert time.perf_counter() - start < 5.0
     err = capsys.readouterr().err
     lines = [line for line in err.splitlines() if line.strip()]
     assert code == 2 and len(lines) == 1, err
