@@ -20,78 +20,44 @@ Default budget: a few dozen examples per test, about a minute in all. More on de
 lists, study files); the tests that run a study or build a report (damaged case records,
 study runs, damaged tables) take a fortieth of it. ``RODVAL_FUZZ_STATS`` appends the counts
 of each test (examples, tracebacks, hangs, silent non-finite successes, wall time) as JSON
-lines.
+lines. The helpers every fuzz file shares (budgets, counts, ``run_cli``, ``run_api``) are in
+``tests/fuzz_helpers.py``.
 """
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import math
-import os
 import shutil
-import signal
-import time
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, given, settings
+from fuzz_helpers import (
+    BUDGET,
+    RUN_SCENE,
+    SMALL_STUDY,
+    Counts,
+    anything,
+    budget,
+    check_run,
+    claims_success,
+    read_record,
+    refusal_is_clear,
+    refused_late,
+    run_api,
+    run_cli,
+    small_scene,
+    to_toml,
+    write_scene,
+)
+from hypothesis import given
 from hypothesis import strategies as st
 
 from rodval.cli import main
-from rodval.study.toml_text import toml_text
 
 pytestmark = pytest.mark.fuzz
-
-EXAMPLES = int(os.environ.get("RODVAL_FUZZ_EXAMPLES", "0") or 0)
-#: Time limit of one example (s).
-LIMIT_S = 60.0
-#: Budgets given to every run (the fuzzed options may come after them and override them).
-BUDGET = ["--max-wall", "2", "--max-evaluations", "50000"]
-
-
-def budget(default: int, *, expensive: bool = False) -> settings:
-    n = default if not EXAMPLES else max(EXAMPLES // 40, 1) if expensive else EXAMPLES
-    return settings(
-        max_examples=n,
-        deadline=None,
-        database=None,
-        suppress_health_check=list(HealthCheck),
-    )
-
-
-class Counts:
-    """Counts of one fuzz test, appended to RODVAL_FUZZ_STATS at the end."""
-
-    def __init__(self, name: str):
-        self.name = name
-        self.examples = self.tracebacks = self.hangs = self.nonfinite = self.ignored = 0
-        self.late = 0
-        self.exits: dict[int, int] = {}
-        self.start = self.last = time.perf_counter()
-
-    def save(self) -> None:
-        path = os.environ.get("RODVAL_FUZZ_STATS")
-        if not path:
-            return
-        row = {
-            "test": self.name,
-            "examples": self.examples,
-            "tracebacks": self.tracebacks,
-            "hangs": self.hangs,
-            "nonfinite_successes": self.nonfinite,
-            "ignored_inputs": self.ignored,
-            "silent_wrong": self.nonfinite + self.ignored,
-            "late_refusals": self.late,
-            "exit_codes": {str(k): v for k, v in sorted(self.exits.items())},
-            "wall_s": round(self.last - self.start, 1),
-        }
-        with open(path, "a") as fh:
-            fh.write(json.dumps(row) + "\n")
 
 
 @pytest.fixture(scope="module")
@@ -102,75 +68,10 @@ def counts(request):
         c.save()
 
 
-class Hang(Exception):
-    pass
-
-
-def _alarm(signum, frame):
-    raise Hang(f"example exceeded {LIMIT_S:g} s")
-
-
-def run_cli(argv: list[str], c: Counts) -> tuple[int, str, str]:
-    """(exit code, stdout, stderr) of ``rodval ARGV``, checking the contract."""
-    c.examples += 1
-    out, err = io.StringIO(), io.StringIO()
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.setitimer(signal.ITIMER_REAL, LIMIT_S)
-    start = time.perf_counter()
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            try:
-                code = main([str(a) for a in argv])
-            except SystemExit as exc:  # argparse: bad option, --help
-                code = exc.code if isinstance(exc.code, int) else 2
-    except Hang:
-        c.hangs += 1
-        raise AssertionError(f"hang: rodval {argv}") from None
-    except Exception as exc:  # noqa: BLE001 - counted, then reported
-        c.tracebacks += 1
-        raise AssertionError(f"exception escaped: rodval {argv}: {exc!r}") from exc
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
-    wall = time.perf_counter() - start
-    c.last = time.perf_counter()
-    if wall > LIMIT_S:
-        c.hangs += 1
-        raise AssertionError(f"hang ({wall:.0f} s): rodval {argv}")
-    c.exits[code] = c.exits.get(code, 0) + 1
-    stderr = err.getvalue()
-    if "Traceback" in stderr or "internal error" in stderr:
-        c.tracebacks += 1
-        raise AssertionError(f"rodval {argv}: {stderr}")
-    assert code in (0, 1, 2), (argv, code, stderr)
-    if code == 2:
-        lines = [line for line in stderr.splitlines() if line.strip()]
-        assert len(lines) == 1, (argv, stderr)
-    return code, out.getvalue(), stderr
-
-
 # ----------------------------------------------------------------------------- TOML writing
 
 
-#: the library's own writer (study.toml of a Python study): one TOML writer
-to_toml = toml_text
-
-
 # ----------------------------------------------------------------------------- strategies
-
-numbers = st.one_of(
-    st.integers(-3, 10),
-    st.floats(-2.0, 10.0),
-    st.sampled_from([0.0, -1.0, 1e-300, 1e-15, 1e13, 1e160, 1e305, math.inf, -math.inf, math.nan]),
-)
-junk = st.one_of(
-    st.text(max_size=5),
-    st.booleans(),
-    st.just([]),
-    st.just({}),
-    st.lists(st.integers(), max_size=3),
-)
-anything = st.one_of(numbers, numbers, junk)
 
 
 @st.composite
@@ -290,37 +191,6 @@ def valid_scene_doc(draw) -> dict:
         for _ in range(draw(st.integers(0, 2)))
     ]
     return doc
-
-
-def write_scene(tmp: Path, doc: dict, raw: bytes | None = None) -> Path:
-    path = tmp / "scene.toml"
-    if raw is not None:
-        path.write_bytes(raw)
-    else:
-        path.write_text(to_toml(doc))
-    return path
-
-
-def claims_success(stats) -> bool:
-    """A run's stats (SolverStats or run.json's dict) claim a correct result: status 0 and
-    not ``valid = false`` (a missing ``valid`` is unknown: the status alone counts)."""
-    get = stats.get if isinstance(stats, dict) else lambda k, d=None: getattr(stats, k, d)
-    return get("status") == 0 and get("valid", None) is not False
-
-
-def check_run(out: Path, code: int) -> int:
-    """A run that reports success has finite outputs only; returns 1 for a silent
-    non-finite success."""
-    run = out / "run.json"
-    if code not in (0, 1) or not run.is_file():
-        return 0
-    rec = json.loads(run.read_text())
-    if not claims_success(rec["stats"]):
-        return 0
-    from rodval.report.run_files import read_run
-
-    values = read_run(out).values.values()
-    return 0 if all(np.all(np.isfinite(v)) for v in values) else 1
 
 
 # ----------------------------------------------------------------------------- tests
@@ -478,15 +348,6 @@ def test_fuzz_study_files(tmp_path_factory, counts, doc, raw):
     (tmp / "busy").write_text("a file, not a folder")
     code, _, stderr = run_cli(["study", path, "--out", tmp / "busy", "--no-progress"], c)
     assert code == 2, stderr
-
-
-SMALL_STUDY = {
-    "study": {"name": "fz", "reference": "reduced"},
-    "scene": {"based_on": "paper", "n": 2, "t_end": 0.05, "times": {"num": 3}},
-    "integrator": {"max_evaluations": 50000, "max_wall_s": 10.0},
-    "models": {"reduced": {}, "pub": {"model": "reduced", "coefficients": "published"}},
-    "grid": {"scene.n": [2, 3]},
-}
 
 
 @st.composite
@@ -722,55 +583,6 @@ def test_fuzz_damaged_tables(tmp_path_factory, counts, finished_study, data):
 # Besides tracebacks and hangs these count *silently wrong* results: a run that claims
 # success (``claims_success``) with non-finite outputs, or one that ignored an input.
 
-#: Python's own messages: an exit-2 line made of one of them is an exception that slipped
-#: past the checks (counted as a traceback), not a refusal naming the key.
-INTERNAL_PHRASES = (
-    "Unknown format code",
-    "inhomogeneous",
-    "unsupported operand",
-    "not subscriptable",
-    "has no attribute",
-    "object is not",
-    "codec can't decode",
-    "math domain error",
-    "division by zero",
-    "index out of",
-    "NoneType",
-    "argument must be",
-)
-
-
-def refusal_is_clear(stderr: str, c: Counts) -> None:
-    """An exit-2 line says what is wrong in rodval's words, not Python's."""
-    leaked = [p for p in INTERNAL_PHRASES if p in stderr]
-    if leaked:
-        c.tracebacks += 1
-        raise AssertionError(f"a Python-internal message as refusal ({leaked[0]!r}): {stderr}")
-
-
-def refused_late(stdout: str, c: Counts) -> None:
-    """A ValueError about the input is raised before any work (exit 2), not reported as a
-    run that failed at set-up or at its first observation (exit 1, "ValueError" in the
-    status line: the check ran inside the model, naming the model's parameter)."""
-    if "ValueError" in stdout:
-        c.late += 1
-        raise AssertionError(f"input error reported as a failed run, not refused: {stdout}")
-
-
-def small_scene(draw, *, n_max: int = 4) -> dict:
-    """A small valid scene document (n <= n_max, t_end <= 0.3 s) that moves."""
-    n = draw(st.integers(1, n_max))
-    doc = {
-        "based_on": "paper",
-        "n": n,
-        "t_end": draw(st.floats(0.01, 0.3)),
-        "times": {"num": draw(st.integers(1, 6))},
-        "outputs": ["phi", "dphi"],
-    }
-    if draw(st.booleans()):
-        doc["initial"] = {"dphi": draw(st.floats(-3.0, 3.0))}
-    return doc
-
 
 BAD_HINGES = st.sampled_from([-1, 1.0, 0.5, "1", True, 1e300, -1.0, [1]])
 BAD_ANGLES = st.sampled_from([math.nan, math.inf, -math.inf, 1e300, "0.1", True, [0.1]])
@@ -834,15 +646,6 @@ def stops_latches_doc(draw) -> dict:
     if draw(st.integers(0, 9)) == 0:
         doc[draw(st.sampled_from(["latches", "stops"]))] = draw(anything)
     return doc
-
-
-def read_record(out: Path) -> dict | None:
-    """The run record of ``out`` as rodval reads it (large scene arrays put back from
-    scene_arrays.npz), or None when the run wrote none."""
-    from rodval.report.run_files import read_run_record
-
-    path = out / "run.json"
-    return read_run_record(path) if path.is_file() else None
 
 
 @budget(4)
@@ -1000,17 +803,6 @@ def test_fuzz_tabulated_load_files(tmp_path_factory, counts, doc, history, node,
             raise AssertionError(f"column {name} of a {kind} file not used as given")
 
 
-RUN_SCENE = {
-    "based_on": "paper",
-    "n": 2,
-    "t_end": 0.05,
-    "times": {"num": 3},
-    "outputs": ["phi", "dphi"],
-    "initial": {"dphi": 0.5},
-    "stops": [{"hinge": 1, "angle": 0.02, "side": "upper", "stiffness": 1e3, "damping": 1.0}],
-}
-
-
 @pytest.fixture(scope="module")
 def finished_runs(tmp_path_factory):
     """Run folders of `rodval simulate` (made once per module): the tiny scene with the
@@ -1166,47 +958,6 @@ def test_fuzz_edited_run_records(tmp_path_factory, counts, finished_runs, data):
     if not same(ran, value):
         c.ignored += 1
         raise AssertionError(f"{'.'.join(map(str, path))} = {value!r} ran as {ran!r}")
-
-
-def run_api(fn, kwargs: dict, c: Counts, names: tuple[str, ...], shown: str = ""):
-    """``fn(**kwargs)`` under the time limit: its result, or None when it raised a
-    ValueError/TypeError/KeyError whose message is one line naming the parameter (one of
-    ``names``); any other exception is a traceback."""
-    c.examples += 1
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.setitimer(signal.ITIMER_REAL, LIMIT_S)
-    start = time.perf_counter()
-    call = f"{getattr(fn, '__qualname__', fn)}({shown or kwargs!r})"
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            result = fn(**kwargs)
-    except Hang:
-        c.hangs += 1
-        raise AssertionError(f"hang: {call}") from None
-    except (ValueError, TypeError, KeyError) as exc:
-        msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else str(exc)
-        msg = str(msg)
-        named = any(n.lower() in msg.lower().replace(" ", "_") for n in names)
-        if len(msg.strip().splitlines()) != 1 or not (named or any(n in msg for n in names)):
-            c.tracebacks += 1
-            raise AssertionError(
-                f"{call}: {type(exc).__name__} not naming {names[0]!r} on one line: {msg!r}"
-            ) from exc
-        c.exits[2] = c.exits.get(2, 0) + 1
-        return None
-    except Exception as exc:  # noqa: BLE001 - counted, then reported
-        c.tracebacks += 1
-        raise AssertionError(f"{call}: {type(exc).__name__}: {exc}") from exc
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
-        c.last = time.perf_counter()
-    if time.perf_counter() - start > LIMIT_S:
-        c.hangs += 1
-        raise AssertionError(f"hang: {call}")
-    c.exits[0] = c.exits.get(0, 0) + 1
-    return result
 
 
 BAD_VALUES = st.sampled_from(

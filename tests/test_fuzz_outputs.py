@@ -3,19 +3,28 @@ compare, modes) pointed at folders that hold a user's files, files that look lik
 but are not (a foreign or edited study.json, run.json or rodval.json, a forged stamp, random
 bytes) and --junit targets of every kind. The property: a file rodval did not write is never
 changed or removed, and every refusal is one line. Counted as "data loss" beside the counts
-of ``tests/test_fuzz.py`` (same budgets: RODVAL_FUZZ_EXAMPLES, RODVAL_FUZZ_STATS).
+of ``tests/test_fuzz.py`` (``tests/fuzz_helpers.py``; same budgets: RODVAL_FUZZ_EXAMPLES, RODVAL_FUZZ_STATS).
 """
 
 from __future__ import annotations
 
 import json
 import shutil
-from pathlib import Path
 
 import pytest
+from fuzz_helpers import (
+    BUDGET,
+    RUN_SCENE,
+    SMALL_STUDY,
+    Counts,
+    budget,
+    lost_files,
+    refusal_is_clear,
+    run_cli,
+    snapshot,
+)
 from hypothesis import given
 from hypothesis import strategies as st
-from test_fuzz import BUDGET, RUN_SCENE, SMALL_STUDY, Counts, budget, refusal_is_clear, run_cli
 
 from rodval.cli import main
 from rodval.core.out_paths import (
@@ -50,27 +59,10 @@ NAMES = (
 LOOKS = ("text", "bytes", "foreign json", "edited stamp", "forged stamp")
 
 
-class OutputCounts(Counts):
-    """Counts with the files lost (changed or removed while rodval did not write them)."""
-
-    def __init__(self, name: str):
-        super().__init__(name)
-        self.lost = 0
-
-    def save(self) -> None:
-        import os
-
-        path = os.environ.get("RODVAL_FUZZ_STATS")
-        super().save()
-        if path:  # the data-loss count on a line of its own, read with the row above
-            with open(path, "a") as fh:
-                fh.write(json.dumps({"test": self.name, "data_loss": self.lost}) + "\n")
-
-
 @pytest.fixture(scope="module")
 def counts():
-    registry: dict[str, OutputCounts] = {}
-    yield lambda name: registry.setdefault(name, OutputCounts(name))
+    registry: dict[str, Counts] = {}
+    yield lambda name: registry.setdefault(name, Counts(name))
     for c in registry.values():
         c.save()
 
@@ -121,12 +113,6 @@ def content(draw, name: str, markers: dict) -> bytes:
     return json.dumps(doc).encode()
 
 
-def snapshot(folder: Path) -> dict[str, bytes]:
-    return {
-        str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()
-    }
-
-
 @budget(5, expensive=True)
 @given(data=st.data())
 def test_fuzz_output_folders(tmp_path_factory, counts, inputs, data):
@@ -166,12 +152,10 @@ def test_fuzz_output_folders(tmp_path_factory, counts, inputs, data):
     before = snapshot(folder)
     own = {p: p.read_bytes() for p in (tmp / "user.xml", tmp / "plain", inputs["study"])}
     code, _, stderr = run_cli(argv, c)
-    after = snapshot(folder)
-    lost = [name for name, data_ in before.items() if after.get(name) != data_]
+    lost = lost_files(before, snapshot(folder))
     lost += [str(p) for p, data_ in own.items() if p.read_bytes() != data_]
     if lost:
-        c.lost += 1
-        raise AssertionError(f"rodval {argv} changed or removed the user's {lost}")
+        c.fail("lost", f"rodval {argv} changed or removed the user's {lost}")
     if code == 2:
         refusal_is_clear(stderr, c)
 
