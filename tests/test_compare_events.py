@@ -182,6 +182,19 @@ def test_an_exudyn_window_of_too_few_steps_is_not_comparable():
     assert event_discrepancies(_frame(native, fine), "ref")["not_comparable"].iloc[0] == ""
 
 
+@pytest.mark.parametrize("side", ["model", "reference"])
+def test_a_lock_without_a_finite_impulse_says_why_its_cells_are_blank(side):
+    """Issue 46: a NaN impulse in an (edited) run.json went into events.csv as blank cells
+    with an empty not_comparable; the row now says why."""
+    good = [_ev(0.1, "latch hinge 1")]
+    bad = [_ev(0.1, "latch hinge 1", impulse=math.nan)]
+    events = _frame(bad, good) if side == "model" else _frame(good, bad)
+    row = event_discrepancies(events, "ref").iloc[0]
+    assert math.isnan(row["impulse_rel"])
+    who = "its" if side == "model" else "the reference's"
+    assert row["not_comparable"] == f"{who} record has no finite lock impulse (a damaged run record)"
+
+
 def test_the_root_jump_is_blank_once_hinge_0_is_held(tmp_path):
     run = _simulate(tmp_path, ROOT, "full", "R")
     events = json.loads((run / "run.json").read_text())["events"]

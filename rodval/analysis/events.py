@@ -146,7 +146,11 @@ def comparability(
     model's or the reference's), an exudyn window of fewer than MIN_WINDOW_STEPS steps
     (``window_steps``), a grazing lock (``GRAZING_LOSS``), an earlier lock of the case more
     than COMPARABLE_DT_S apart, a kinetic energy before the lock more than COMPARABLE_ENERGY
-    apart."""
+    apart. A lock whose record has no finite impulse (a damaged or edited run record: rodval
+    records every lock's) says so first."""
+    for who, record in (("its", ev), ("the reference's", r)):
+        if _is_lock(record.get("label")) and not math.isfinite(_number(record.get("impulse"))):
+            return f"{who} record has no finite lock impulse (a damaged run record)"
     for who, record, run in (("its", ev, own_run), ("the reference's", r, ref_run)):
         if run is None or not _is_lock(record.get("label")):
             continue
