@@ -19,10 +19,22 @@ import numpy as np
 _BARE = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
+def _text(v: str, where: str) -> str:
+    """A TOML string of ``v``; ValueError naming ``where`` for text that is not Unicode
+    scalars (a lone surrogate: JSON escapes it as \\udXXX, which TOML readers refuse)."""
+    try:
+        v.encode("utf-8")
+    except UnicodeEncodeError:
+        raise ValueError(
+            f"{where}: text {v!r:.40} holds a lone surrogate, which a study file cannot hold"
+        ) from None
+    return json.dumps(v, ensure_ascii=False)
+
+
 def _key(k: Any, where: str) -> str:
     if not isinstance(k, str):
         raise ValueError(f"{where}: keys must be strings, got {k!r}")
-    return k if _BARE.match(k) else json.dumps(k)
+    return k if _BARE.match(k) else _text(k, where)
 
 
 def toml_value(v: Any, where: str = "study") -> str:
@@ -42,7 +54,7 @@ def toml_value(v: Any, where: str = "study") -> str:
             return "inf" if v > 0 else "-inf"
         return repr(v)
     if isinstance(v, str):
-        return json.dumps(v)
+        return _text(v, where)
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(toml_value(x, f"{where}[{i}]") for i, x in enumerate(v)) + "]"
     if isinstance(v, dict):
