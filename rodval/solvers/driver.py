@@ -410,9 +410,9 @@ def integrate(
     try:
         guard = DivergenceGuard(system, settings, scene.t_end, y)
         at_zero = out.upto(0.0)
-        out.write(np.repeat(y[None, :], at_zero.size, axis=0))
-        if ledger:
-            for _ in at_zero:
+        own = out.write(np.repeat(y[None, :], at_zero.size, axis=0))
+        if ledger:  # one record per output time at t = 0 (not per probe there)
+            for _ in range(int(np.count_nonzero(own))):
                 ledger.record()
         if form is not None:
             run_compiled(system, y, edges, scene, settings, guard.spec, out, stats, ledger, events)
