@@ -764,10 +764,13 @@ def test_fuzz_modes(tmp_path_factory, counts, world, data):
             given_ = 3 if "shapes=3" in want["sets"] else 2
             honoured(c, "the run's shapes", given_, rec.get("options", {}).get("shapes"))
         return
+    # each --set key ran in every model that takes it (--model's options, --compare's)
+    ran = [rec.get("options", {}), *rec.get("compared", {}).values()]
     for s in want["sets"]:
         key, value = s.split("=")
-        honoured(c, f"--set {s}", int(value) if value.isdigit() else value,
-                 rec.get("options", {}).get(key))  # fmt: skip
+        for options in [o for o in ran if key in o] or [{}]:
+            honoured(c, f"--set {s}", int(value) if value.isdigit() else value,
+                     options.get(key))  # fmt: skip
     if want["held"] and rec.get("model") in ("full", "reduced"):
         free = {**want["doc"], "latches": []}
         opts = {k: int(v) if v.isdigit() else v for k, v in (s.split("=") for s in want["sets"])}

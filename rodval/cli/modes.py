@@ -106,9 +106,14 @@ def run(args) -> int:
             "not used by a modal analysis (the run.json's options that set how the run was "
             "computed, not the model): " + ", ".join(f"{k}={v!r}" for k, v in computed.items())
         )
+    record = _record(scene, m, args)
     if compare:
-        lines += _comparison(scene, m, compare, pool, args)
-    write_file(args.out / "modes.json", json.dumps(_record(scene, m, args), indent=2, default=str))
+        table, others = _comparison(scene, m, compare, pool, args)
+        lines += table
+        record["compared"] = {
+            name: _ran_options(other) for name, other in others.items() if name != m.model
+        }
+    write_file(args.out / "modes.json", json.dumps(record, indent=2, default=str))
     print("\n".join(lines))
     return 0
 
@@ -154,21 +159,28 @@ def _options_for(model: str, pool: dict) -> dict:
     return {k: v for k, v in pool.items() if k in accepted}
 
 
+def _ran_options(m) -> dict:
+    """The options the modal analysis of ``m`` ran with (its model's ``MODES_OPTIONS``, and
+    exudyn's resolved model options)."""
+    from rodval.models.presets.registry import model_class
+
+    options = dict(m.info.get("options", {}))  # exudyn's: the model's resolved options
+    options.update({k: m.info[k] for k in model_class(m.model).MODES_OPTIONS if k in m.info})
+    return options
+
+
 def _record(scene: Scene, m, args) -> dict:
     """modes.json: what the modes are of and about (the options the analysis ran with, the
     held hinges it held), the count of flexible modes written, a free base's rigid modes
     (reported apart from them) and the equilibrium found."""
     from rodval.core.modal import held_hinges
-    from rodval.models.presets.registry import model_class
 
-    options = dict(m.info.get("options", {}))  # exudyn's: the model's resolved options
-    options.update({k: m.info[k] for k in model_class(m.model).MODES_OPTIONS if k in m.info})
     record = {
         "scene": scene.name,
         "model": m.model,
         "about": m.about,
         "coefficients": m.info.get("coefficients"),
-        "options": options,
+        "options": _ran_options(m),
         "held_hinges": held_hinges(scene).tolist(),
         "count": m.flexible().count,
         "load_at": args.load_at,
@@ -227,8 +239,11 @@ def _summary(scene: Scene, m, args) -> list[str]:
     return lines
 
 
-def _comparison(scene: Scene, m, models: tuple[str, ...], pool: dict, args) -> list[str]:
-    """The other models' modes paired by MAC with ``m`` (written to DIR/compare.csv)."""
+def _comparison(
+    scene: Scene, m, models: tuple[str, ...], pool: dict, args
+) -> tuple[list[str], dict]:
+    """The other models' modes paired by MAC with ``m`` (written to DIR/compare.csv): the
+    lines printed and every model's modes (name -> Modes; modes.json records their options)."""
     from rodval.analysis.modes import compare_modes, model_modes
 
     computed = {args.model: m}
@@ -250,7 +265,7 @@ def _comparison(scene: Scene, m, models: tuple[str, ...], pool: dict, args) -> l
     return [
         "paired by MAC (gap relative to " + args.model + "):",
         table.to_string(index=False, float_format=lambda v: f"{v:.6g}"),
-    ]
+    ], computed
 
 
 def _scene_and_model(args) -> tuple[Scene, str, dict, dict]:
