@@ -233,3 +233,18 @@ def test_a_fix_is_given_in_both_spellings():
     )
     (coarse,) = step_resolution(0.4, 0.1, step=2e-4)
     assert "fix: step = 5e-05 (command line: --set step=5e-05)" in coarse.reason()
+
+
+@pytest.mark.parametrize("value", ["array", "text"])
+def test_a_prescribed_base_given_a_position_of_any_type_names_it(value):
+    """A fuzz find: Base(kind="prescribed", position=np.array([1.0])) raised numpy's "truth
+    value of an array is ambiguous"; a position in any form is refused naming it (the laws
+    give a prescribed base its position), the default's numbers in another form accepted."""
+    import numpy as np
+
+    from rodval.core.base import Base
+
+    given = np.array([1.0]) if value == "array" else "x"
+    with pytest.raises(ValueError, match=r"^base position: a prescribed base"):
+        Base(kind="prescribed", position=given)
+    assert Base(kind="prescribed", position=[0.0, 0.0]).prescribed

@@ -157,8 +157,16 @@ class Base:
         return tuple(b for m in (self.motion or ()) for b in m.breakpoints)
 
     def _given(self, name: str) -> bool:
+        """Whether field ``name`` holds other than its default (by value: an array or list of
+        the default's numbers is the default; anything that is no such number is given)."""
         default = next(f.default for f in fields(self) if f.name == name)
-        return getattr(self, name) != default
+        value = getattr(self, name)
+        if default is None or value is None:
+            return value is not default
+        try:
+            return not np.array_equal(np.asarray(value, float), np.asarray(default, float))
+        except (TypeError, ValueError):
+            return True
 
     @property
     def free(self) -> bool:
