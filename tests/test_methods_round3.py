@@ -60,7 +60,7 @@ OUTPUTS = {
 }
 #: the models: registry name and options
 MODELS = {
-    "full": ("full", {}),
+    "full": ("full", {"kinematics": "first-order"}),
     "full-exact-p2": ("full", {"kinematics": "exact", "shapes": 2}),
     "reduced": ("reduced", {}),
 }
@@ -169,7 +169,7 @@ def test_a_prescribed_base_drive_and_audit_on_a_scipy_method(method):
     """The issue's failure: the drive and the energy audit of a prescribed base on scipy's
     methods (a TypingError in the model's kernel, 60 lines in the run's message)."""
     sc = scene("prescribed").with_(outputs=("phi", "drive", "energy"))
-    tr = simulate(sc, "full", method=method, **TOLERANCES)
+    tr = simulate(sc, "full", method=method, **MODELS["full"][1], **TOLERANCES)
     assert tr.success, tr.stats.message
     ref = reference("full", "prescribed")
     force = scales(ref, scene("prescribed"))["drive_force"]
@@ -230,6 +230,23 @@ def test_a_study_refuses_the_reduced_model_on_a_prescribed_base_when_it_is_read(
     assert "\n" not in message
     for part in ("hub", "case 'EI=1000'", "'quasi' (reduced)", "no prescribed base"):
         assert part in message
+
+
+def test_a_study_refusal_of_a_scene_from_a_file_names_the_file(tmp_path):
+    """A fuzz find: the refusal of the reduced model on a prescribed base read from
+    [scene] file = "driven.toml" named the study and the case, not the file the base is in."""
+    from rodval.study.spec import load_study
+    from rodval.study.toml_text import toml_text
+
+    table = study({"full": {}})["scene"]
+    (tmp_path / "driven.toml").write_text(toml_text(table))
+    doc = {"study": {"name": "hub"}, "scene": {"file": "driven.toml"}, "models": {"full": {},
+           "reduced": {}}}  # fmt: skip
+    (tmp_path / "s.toml").write_text(toml_text(doc))
+    with pytest.raises(ValueError) as err:
+        load_study(tmp_path / "s.toml")
+    message = str(err.value)
+    assert "\n" not in message and "driven.toml" in message and "no prescribed base" in message
 
 
 def test_a_study_refuses_the_drive_on_exudyn_when_it_is_read():

@@ -194,7 +194,12 @@ def study_from_dict(
     scene_file, text = _resolve_scene(doc, Path(folder or "."), where, text)
     expand = sample_design if "sample" in doc else grid_design
     design = expand(doc, where, max_cases, announce)
-    cases = _build_cases(doc, design, where)
+    try:
+        cases = _build_cases(doc, design, where)
+    except ValueError as exc:  # a case's scene, from the file [scene] names: name the file
+        if scene_file is None or scene_file["path"] in str(exc):
+            raise
+        raise ValueError(f"{exc} (its [scene]: file {scene_file['path']!r})") from None
     _check_file_names([c.id for c in cases], where)
     _check_resources(cases, where)
     return StudySpec(
