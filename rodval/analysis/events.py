@@ -110,7 +110,8 @@ def _ratio(a: float, b: float) -> float:
     return a / b if b != 0 else math.nan
 
 
-def _is_lock(label: Any) -> bool:
+def is_lock(label: Any) -> bool:
+    """Whether an event's label names a lock ("latch ..."): the one test the tables use."""
     return str(label).startswith("latch")
 
 
@@ -121,7 +122,7 @@ def overlapping_lock(ev: pd.Series, run: pd.DataFrame) -> tuple[str, float] | No
     hold each other's reactions: they are not separable."""
     t, w = _number(ev.get("t")), _number(ev.get("impulse_window"))
     for idx, other in run.iterrows():
-        if idx == ev.name or not _is_lock(other.get("label")):
+        if idx == ev.name or not is_lock(other.get("label")):
             continue
         t_o, w_o = _number(other.get("t")), _number(other.get("impulse_window"))
         inside = t <= t_o <= t + w if w >= 0 else False
@@ -149,10 +150,10 @@ def comparability(
     apart. A lock whose record has no finite impulse (a damaged or edited run record: rodval
     records every lock's) says so first."""
     for who, record in (("its", ev), ("the reference's", r)):
-        if _is_lock(record.get("label")) and not math.isfinite(_number(record.get("impulse"))):
+        if is_lock(record.get("label")) and not math.isfinite(_number(record.get("impulse"))):
             return f"{who} record has no finite lock impulse (a damaged run record)"
     for who, record, run in (("its", ev, own_run), ("the reference's", r, ref_run)):
-        if run is None or not _is_lock(record.get("label")):
+        if run is None or not is_lock(record.get("label")):
             continue
         hit = overlapping_lock(record, run)
         if hit is not None:
@@ -301,7 +302,7 @@ def lock_comparison(events: pd.DataFrame, model: str, reference: str) -> pd.Data
     impulse_to_rigid; a lock only one of them has is listed with blanks and
     not_comparable "only in <model>" or "only in <reference>". Case order, then time."""
     cols = list(LOCK_COLUMNS)
-    locks = events[events["label"].map(_is_lock)] if not events.empty else events
+    locks = events[events["label"].map(is_lock)] if not events.empty else events
     locks = locks[locks["model"].isin([model, reference])] if not locks.empty else locks
     if locks.empty:
         return pd.DataFrame(columns=cols)
