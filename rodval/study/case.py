@@ -1,6 +1,7 @@
 """A case of a study: the study document with one combination of grid or sample values set,
-its scene, models and [modes] built and checked (``build_case``), what a worker needs to run
-it (``Case.payload``) and the fingerprint that decides whether a saved record is reused."""
+its scene, models, [modes] and [agreement] built and checked (``build_case``), what a worker
+needs to run it (``Case.payloads``: the case, and the reference's twin when [agreement.twin]
+asks for one) and the fingerprint that decides whether a saved record is reused."""
 
 from __future__ import annotations
 
@@ -11,15 +12,22 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from rodval.core.checks import check_keys
-from rodval.core.scene import Scene
-from rodval.core.scene_file import scene_from_dict
+from rodval.analysis.agreement import DEFAULT_QUANTITIES, DEFAULT_TOL, twin_label
+from rodval.analysis.events import COMPARABLE_DT_S
+from rodval.core.checks import check_keys, check_number
+from rodval.core.scene import Scene, trajectory_quantities
+from rodval.core.scene_file import scene_from_dict, scene_to_dict
 from rodval.core.scene_keys import set_path
 from rodval.models.presets.registry import check_scene, get_model
 from rodval.study.document import key_error
 from rodval.study.model_specs import ModelSpec, model_specs
 
 MODES_KEYS = {"count", "about", "load_at", "allow_unbalanced"}
+AGREEMENT_KEYS = {"tol", "quantities", "lock_dt", "reference_error", "twin"}
+REFERENCE_ERROR_KEYS = {"rel", "lock_dt", "impulse_rel"}
+TWIN_KEYS = {"rod", "angle"}
+#: Largest twin perturbation (rad): far below any tolerance of the agreement horizon.
+MAX_TWIN_ANGLE = 1e-3
 #: Most modes a study may ask for per model.
 MAX_MODES = 200
 
@@ -37,6 +45,8 @@ class Case:
     where: str
     #: ``{"count": k, "about": "initial" | "equilibrium"}`` when the study asks for modes.
     modes: dict[str, Any] | None = None
+    #: The twin's perturbation ``{"rod": k, "angle": rad}`` ([agreement.twin]) or None.
+    twin: dict[str, Any] | None = None
 
     @property
     def fingerprint(self) -> str:
@@ -48,6 +58,7 @@ class Case:
                 "reference": self.reference,
                 "models": [m.as_dict() for m in self.models],
                 **({"modes": self.modes} if self.modes else {}),
+                **({"twin": self.twin} if self.twin else {}),
             },
             sort_keys=True,
             default=repr,
@@ -62,6 +73,34 @@ class Case:
             "scene": self.scene_dict,
             "models": [m.as_dict() for m in self.models],
             "modes": self.modes,
+        }
+
+    @property
+    def labels(self) -> list[str]:
+        """The labels of the case's runs: its models', then the reference's twin if any."""
+        return [m.label for m in self.models] + ([twin_label(self.reference)] if self.twin else [])
+
+    def payloads(self) -> list[dict[str, Any]]:
+        """What workers run for the case: ``payload``, and the twin's (``twin_payload``)."""
+        return [self.payload(), *([self.twin_payload()] if self.twin else [])]
+
+    def twin_payload(self) -> dict[str, Any]:
+        """The reference's twin run: the reference model, labelled ``twin_label``, on the
+        case's scene with the initial chord angle of rod ``twin["rod"]`` moved by
+        ``twin["angle"]`` rad (one extra run; ``"part": "twin"``)."""
+        assert self.twin is not None
+        scene = scene_to_dict(self.scene)
+        phi = list(scene["initial"]["phi"])
+        phi[int(self.twin["rod"]) - 1] += float(self.twin["angle"])
+        scene["initial"] = {**scene["initial"], "phi": phi}
+        ref = next(m for m in self.models if m.label == self.reference)
+        return {
+            "case": self.id,
+            "part": "twin",
+            "where": f"{self.where} (twin)",
+            "scene": scene,
+            "models": [{**ref.as_dict(), "label": twin_label(self.reference)}],
+            "modes": None,
         }
 
 
@@ -122,6 +161,9 @@ def build_case(
         reference=case_doc["study"]["reference"],
         where=case_where,
         modes=modes_spec(case_doc.get("modes"), where),
+        twin=case_twin(
+            case_doc.get("agreement"), scene, models, case_doc["study"]["reference"], case_where
+        ),
     )
 
 
@@ -146,3 +188,125 @@ def check_refusals(scene: Scene, models: tuple[ModelSpec, ...], where: str, cid:
                 f"{where}: case {cid!r}: model {spec.label!r} ({spec.model}) refuses it "
                 f"before any work: {exc}"
             ) from None
+
+
+def _bound(where: str, key: str, value: Any, **limits: Any) -> float:
+    """``check_number`` on a study key, the error naming the file and the key."""
+    try:
+        return check_number(key, value, **limits)
+    except ValueError as exc:
+        raise key_error(where, key, str(exc).removeprefix(f"{key} ")) from None
+
+
+def agreement_spec(table: Any, where: str) -> dict[str, Any]:
+    """The study's [agreement] table checked, with its defaults (``rodval.analysis.agreement``,
+    docs/deployment.md): ``tol`` in (0, 1) (fraction of each watched quantity's scale,
+    default DEFAULT_TOL), ``quantities`` (non-empty list of output quantities, default
+    DEFAULT_QUANTITIES), ``lock_dt`` > 0 s (default COMPARABLE_DT_S), ``reference_error``
+    (the reference's own error bars, each >= 0: ``rel``, ``lock_dt`` s, ``impulse_rel``) and
+    ``twin`` ({rod, angle}: the reference's twin run; none by default)."""
+    table = {} if table is None else table
+    if not isinstance(table, dict):
+        raise key_error(where, "agreement", "must be a table")
+    check_keys(table, AGREEMENT_KEYS, f"{where}:", path="agreement")
+    out: dict[str, Any] = {
+        "tol": _bound(
+            where,
+            "agreement.tol",
+            table.get("tol", DEFAULT_TOL),
+            low=0,
+            high=1,
+            low_open=True,
+            high_open=True,
+        ),
+        "quantities": _quantities(table.get("quantities", list(DEFAULT_QUANTITIES)), where),
+        "lock_dt": _bound(
+            where,
+            "agreement.lock_dt",
+            table.get("lock_dt", COMPARABLE_DT_S),
+            unit="s",
+            low=0,
+            low_open=True,
+            finite=True,
+        ),
+    }
+    ref = table.get("reference_error", {})
+    if not isinstance(ref, dict):
+        raise key_error(where, "agreement.reference_error", "must be a table")
+    check_keys(ref, REFERENCE_ERROR_KEYS, f"{where}:", path="agreement.reference_error")
+    out["reference_error"] = {
+        k: _bound(where, f"agreement.reference_error.{k}", v, low=0, finite=True)
+        for k, v in ref.items()
+    }
+    if "twin" in table:
+        out["twin"] = _twin(table["twin"], where)
+    return out
+
+
+def _quantities(value: Any, where: str) -> list[str]:
+    """[agreement] quantities: a non-empty list of quantity names."""
+    if not isinstance(value, list) or not value or not all(isinstance(q, str) for q in value):
+        raise key_error(
+            where,
+            "agreement.quantities",
+            f"must be a non-empty list of quantity names, got {value!r}",
+        )
+    return list(value)
+
+
+def _twin(value: Any, where: str) -> dict[str, Any]:
+    """[agreement.twin]: the rod (integer >= 1) whose initial chord angle moves, by ``angle``
+    rad (0 < |angle| <= MAX_TWIN_ANGLE)."""
+    if not isinstance(value, dict):
+        raise key_error(where, "agreement.twin", "must be a table {rod = k, angle = rad}")
+    check_keys(value, TWIN_KEYS, f"{where}:", path="agreement.twin")
+    for key in TWIN_KEYS:
+        if key not in value:
+            raise key_error(where, f"agreement.twin.{key}", "is missing")
+    rod = int(_bound(where, "agreement.twin.rod", value["rod"], low=1, integer=True))
+    angle = _bound(
+        where,
+        "agreement.twin.angle",
+        value["angle"],
+        unit="rad",
+        low=-MAX_TWIN_ANGLE,
+        high=MAX_TWIN_ANGLE,
+    )
+    if angle == 0:
+        raise key_error(
+            where,
+            "agreement.twin.angle",
+            f"must be a nonzero angle within +-{MAX_TWIN_ANGLE:g} rad, got 0",
+        )
+    return {"rod": rod, "angle": angle}
+
+
+def case_twin(
+    table: Any, scene: Scene, models: tuple[ModelSpec, ...], reference: str, where: str
+) -> dict[str, Any] | None:
+    """The case's twin perturbation ([agreement.twin], checked against the case: rod <= n,
+    the twin's label not a model's, the watched quantities output by the scene), or None
+    (``reference``: the study's reference label)."""
+    spec = agreement_spec(table, where)
+    outputs = set(trajectory_quantities(scene.outputs))
+    missing = [q for q in spec["quantities"] if q not in outputs]
+    if table is not None and "quantities" in table and missing:
+        raise key_error(
+            where,
+            "agreement.quantities",
+            f"{missing[0]!r} is not an output of the scene ({sorted(outputs)})",
+        )
+    twin = spec.get("twin")
+    if twin is None:
+        return None
+    if any(m.label == twin_label(reference) for m in models):
+        raise key_error(
+            where,
+            f"models.{twin_label(reference)}",
+            "is the label of the reference's twin run ([agreement.twin]); rename that model",
+        )
+    if twin["rod"] > scene.n:
+        raise key_error(
+            where, "agreement.twin.rod", f"must be in 1..{scene.n} (n), got {twin['rod']}"
+        )
+    return twin

@@ -10,6 +10,7 @@ physics: comparisons come from ``rodval.analysis.metrics``.
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,12 +34,21 @@ from rodval.study.store import StudyStore, write_json_atomic, write_text_atomic
 RETRIED = (STATUS_TIMEOUT, STATUS_CRASHED)
 
 
-def study_meta(spec: StudySpec) -> dict[str, Any]:
-    """The study's description saved beside the tables (the report reads it)."""
+def study_meta(spec: StudySpec, out: Path | None = None) -> dict[str, Any]:
+    """The study's description saved beside the tables (the report reads it); with the
+    study folder ``out``, ``source_path``: the study file's path relative to it (when the
+    study was read from a file), which the report names."""
+    relative = (
+        {"source_path": os.path.relpath(Path(spec.source).resolve(), out.resolve())}
+        if out is not None and _is_file(spec.source)
+        else {}
+    )
     return {
         "name": spec.name,
         "description": spec.description,
         "source": spec.source,
+        **relative,
+        "agreement": spec.agreement,
         "reference": spec.reference,
         "models": [m.as_dict() for m in spec.models],
         "axes": spec.axes,
@@ -53,10 +63,19 @@ def study_meta(spec: StudySpec) -> dict[str, Any]:
     }
 
 
+def _is_file(source: str) -> bool:
+    """Whether a study's ``source`` names a file (a study built in Python names none)."""
+    try:
+        return Path(source).is_file()
+    except OSError:
+        return False
+
+
 def case_record(case: Case, runs: list[dict[str, Any]]) -> CaseRecord:
-    """The record of a finished case: its runs in the study's model order, and the
-    discrepancies of every model against the reference."""
-    order = {m.label: i for i, m in enumerate(case.models)}
+    """The record of a finished case: its runs in the study's model order (the reference's
+    twin last), and the discrepancies of every run against the reference (the twin's: how
+    far the reference parts from itself under the twin's perturbation)."""
+    order = {label: i for i, label in enumerate(case.labels)}
     typed = sorted((RunRecord.from_dict(r) for r in runs), key=lambda r: order[r.label])
     for run in typed:
         _no_silent_nonfinite(run.trajectory)
@@ -95,7 +114,7 @@ def _reusable(store: StudyStore, case: Case, warnings: list[str]) -> bool:
     if not path.exists():
         return False
     try:
-        rec = read_case(path, labels=[m.label for m in case.models])
+        rec = read_case(path, labels=case.labels)
     except DamagedRecord as exc:
         warnings.append(f"{exc}; recomputing case {case.id!r}")
         return False
@@ -163,7 +182,7 @@ def run_study(
     store.check_folder()
     warnings: list[str] = []
     with store.lock():
-        store.claim(study_meta(spec), fresh=fresh)
+        store.claim(study_meta(spec, store.out), fresh=fresh)
         write_json_atomic(store.out / "provenance.json", provenance())
         write_text_atomic(store.out / "study.toml", spec.text)
         reused = [c.id for c in spec.cases if resume and _reusable(store, c, warnings)]
@@ -233,22 +252,31 @@ def _run_cases(
     progress: bool,
 ) -> int:
     """Run the cases ``todo`` on the backend, writing each one's record to ``store`` as it
-    finishes (with a progress bar named ``name``); returns the number of failed model runs."""
+    finishes (with a progress bar named ``name``); returns the number of failed model runs.
+    A case with a twin run ([agreement.twin]) is two payloads, the case's and the twin's
+    (``Case.payloads``); its record is written when both have finished."""
     by_id = {c.id: c for c in todo}
+    parts: dict[str, tuple[int, list[list[dict[str, Any]]]]] = {
+        c.id: (len(c.payloads()), []) for c in todo
+    }
     failed = 0
     bar = tqdm(total=len(todo), desc=name, unit="case", disable=not progress or not todo)
 
     def done(payload: dict[str, Any], runs: list[dict[str, Any]]) -> None:
-        """Record a finished case (its payload and run records) and advance the bar."""
+        """Record a finished case (its payloads' run records) and advance the bar."""
         nonlocal failed
         case = by_id[payload["case"]]
-        record = case_record(case, runs)
+        expected, got = parts[case.id]
+        got.append(runs)
+        if len(got) < expected:
+            return
+        record = case_record(case, [run for part in got for run in part])
         write_text_atomic(store.case_path(case.id), record.to_json())
         failed += sum(r.status != 0 for r in record.runs)
         bar.update(1)
         bar.set_postfix(failed_runs=failed)
 
-    payloads = [c.payload() for c in todo]
+    payloads = [p for c in todo for p in c.payloads()]
     try:
         if backend == "processes":
             run_processes(payloads, done, workers, case_timeout)

@@ -11,7 +11,7 @@ axis values (``n=8,t_end=2``), so it stays the same when other axes or values ar
 
 This module reads the file and assembles the study; its parts are checked by
 ``rodval.study.model_specs`` ([integrator], [models]), ``rodval.study.grid`` ([grid],
-[sample]), ``rodval.study.case`` (each case, [modes]), ``rodval.study.report_spec``
+[sample]), ``rodval.study.case`` (each case, [modes], [agreement]), ``rodval.study.report_spec``
 ([report]) and ``rodval.study.acceptance`` ([acceptance]); a [scene] that names a scene file
 (``file = "wing.toml"`` and overrides) is resolved by ``rodval.study.scene_source``.
 
@@ -41,7 +41,7 @@ from rodval.core.resources import (
 from rodval.core.scene import trajectory_quantities
 from rodval.core.scene_file import anchor_load_files
 from rodval.study.acceptance import acceptance_spec
-from rodval.study.case import Case, build_case
+from rodval.study.case import Case, agreement_spec, build_case
 from rodval.study.document import key_error, plain_document
 from rodval.study.grid import Design, grid_design, sample_design, sample_meta
 from rodval.study.model_specs import ModelSpec, model_specs
@@ -60,6 +60,7 @@ TOP_KEYS = {
     "report",
     "modes",
     "acceptance",
+    "agreement",
 }
 #: Most cases a study grid may have by default: every case is built and checked before any
 #: runs (about 1-3 ms each on the 2-core machine, so ~1 min at the limit); raise it with
@@ -91,6 +92,9 @@ class StudySpec:
     #: The scene file [scene] names (``rodval.study.scene_source``): its path, SHA-256 and
     #: the [scene] table it resolved to; None for a scene written in the study.
     scene_file: dict[str, Any] | None = None
+    #: The checked [agreement] table with its defaults (``rodval.study.case.agreement_spec``:
+    #: the tolerances of the report's answer and the reference's twin run).
+    agreement: dict[str, Any] | None = None
 
     @classmethod
     def from_dict(
@@ -222,6 +226,7 @@ def study_from_dict(
             where,
         ),
         scene_file=scene_file,
+        agreement=agreement_spec(doc.get("agreement"), where),
     )
 
 
