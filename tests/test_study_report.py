@@ -157,3 +157,78 @@ def test_a_quantity_without_a_relative_discrepancy_keeps_its_columns():
     )
     table = "\n".join(_discrepancies(disc, pd.DataFrame(), "exudyn", 2, []))
     assert "work max_abs" in table and "work max_rel" in table
+
+
+def test_the_study_file_is_named_relative_to_the_study_folder(study_dir):
+    """The header names the study file by its path from the folder report.md lies in (the
+    study was run from another folder: a path relative to that one would not resolve)."""
+    report = (study_dir / "report.md").read_text()
+    assert "Study file: `../tiny.toml` (copied to `study.toml`)" in report
+
+
+def _latched_study(**extra):
+    """A one-case latched deployment of the native models (a few seconds)."""
+    return {
+        "study": {"name": "latched", "reference": "full"},
+        "scene": {
+            "n": 3,
+            "t_end": 0.6,
+            "times": {"num": 31},
+            "outputs": ["phi", "dphi"],
+            "chain": {"l": 1.0, "m": 3.0, "EI": 5e4, "mu": 0.5, "kappa": [1e5, 50.0, 50.0]},
+            "initial": {"phi": [0.0, 3.0915926535897933, 0.0]},
+            "latches": [{"hinge": 2, "angle": 0.0}],
+        },
+        "models": {"full": {}, "reduced": {}},
+        **extra,
+    }
+
+
+def test_a_one_case_report_opens_with_the_answer_and_drops_constant_columns(tmp_path):
+    """The report's first section is the Answer (a paragraph and one short table, model by
+    model); no table repeats a column that is the same throughout the study (case, n,
+    horizon, reference), the header says their values once; the sentence that called later
+    lock gaps "different motions, not model error" without measuring it is gone."""
+    from rodval.study import StudySpec
+
+    run_study(StudySpec.from_dict(_latched_study()), tmp_path / "out", workers=1, progress=False)
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert report.splitlines()[2] == "## Answer"
+    answer = report.split("## Study")[0]
+    assert "`reduced` is " in answer and "it agrees with `full` until" in answer
+    assert "whether the motion is predictable is not measured" in answer
+    assert (
+        "Left out of the tables as the same throughout: case = base, n = 3, horizon = 0.6 s"
+        in report
+    )
+    for table in _tables(report):
+        head = [c.strip() for c in table[0].strip("|").split("|")]
+        assert not {"case", "n", "horizon", "reference"} & set(head), head
+    assert "not model error" not in report
+
+
+def _sampled_study(count: int) -> dict:
+    return {
+        **_latched_study(),
+        "sample": {
+            "design": "sobol",
+            "count": count,
+            "seed": 7,
+            "keys": {"scene.chain.kappa": {"dist": "uniform", "low": 40.0, "high": 60.0}},
+        },
+    }
+
+
+def test_a_sampled_study_report_does_not_grow_with_its_samples(tmp_path):
+    """A sampled study's report gives distributions and worst cases, not per-case tables:
+    four times the samples, the same report length (it was 1,704 lines for 200 samples)."""
+    from rodval.study import StudySpec
+
+    sizes, reports = {}, {}
+    for count in (4, 16):
+        spec = StudySpec.from_dict(_sampled_study(count))
+        run_study(spec, tmp_path / str(count), workers=2, progress=False)
+        reports[count] = (tmp_path / str(count) / "report.md").read_text()
+        sizes[count] = len(reports[count].splitlines())
+    assert sizes[16] <= sizes[4] + 2, sizes
+    assert "## Answer" in reports[16] and "valid in" in reports[16]

@@ -112,3 +112,60 @@ def sample_section(
     if not disc.empty:
         lines += ["### Discrepancies\n", to_markdown(disc, floatfmt=".3g")]
     return lines
+
+
+#: The events' quantities whose distribution a sampled study's report gives per lock.
+EVENT_QUANTITIES = ("t", "impulse", "energy_lost")
+
+
+def percentile_rows(
+    df: pd.DataFrame, by: list[str], columns: tuple[str, ...], absolute: bool = False
+) -> pd.DataFrame:
+    """Per group of ``by``: the number of rows and, for each of ``columns``, its percentiles
+    (PERCENTILES, over the group's non-blank values) and the case of its largest value (of
+    its largest |value| when ``absolute``). O(rows)."""
+    rows = []
+    for key, part in df.groupby(by, sort=False):
+        row = dict(zip(by, key if isinstance(key, tuple) else (key,)))
+        row["samples"] = len(part)
+        for col in columns:
+            vals = pd.to_numeric(part[col], errors="coerce").dropna()
+            for p in PERCENTILES:
+                row[f"{col}_p{p}"] = float(np.percentile(vals, p)) if len(vals) else np.nan
+            if len(vals):
+                at = (vals.abs() if absolute else vals).idxmax()
+                row[f"{col}_worst"] = float(vals[at])
+                row[f"{col}_worst_case"] = part.loc[at, "case"]
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def sample_events_section(
+    meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
+) -> list[str]:
+    """A sampled study's Deployment section: per model and lock, the percentiles of its
+    time (s), impulse (N m s) and energy lost (J) over the samples, and of its gaps to the
+    reference (dt s, impulse_rel), each with its worst case; every event stays in
+    ``events.csv`` (markdown lines, as long for 10 samples as for 10,000)."""
+    from rodval.analysis.events import event_discrepancies
+
+    have = [c for c in EVENT_QUANTITIES if c in events]
+    lines = [
+        "## Deployment: locks, impulses and residual vibration\n",
+        "Over the samples, per model and lock: percentiles of the lock time t (s), the lock "
+        "impulse (N m s) and the energy lost (J), and the sample of the largest value "
+        "(`_worst`, `_worst_case`); every event of every sample: `events.csv` "
+        "(docs/deployment.md defines each column).\n",
+        to_markdown(percentile_rows(events, ["model", "label"], tuple(have)), ".4g"),
+    ]
+    disc = event_discrepancies(events, meta["reference"])
+    if not disc.empty:
+        lines += [
+            f"Gaps to `{meta['reference']}` at each lock over the samples (dt s, impulse_rel "
+            "= |dS| / |S_ref|), with the sample of the largest |gap|:\n",
+            to_markdown(
+                percentile_rows(disc, ["model", "label"], ("dt", "impulse_rel"), absolute=True),
+                ".3g",
+            ),
+        ]
+    return lines

@@ -3,13 +3,19 @@
 ``events.csv`` when some run recorded events: the deployment section) and the study's
 ``study.json`` / ``provenance.json``; nothing is recomputed.
 
-``build_report`` puts the sections in order: the header (study, models, machine), Acceptance
+``build_report`` puts the sections in order: the title and the Answer (``study_summary.
+answer_section``: each model against the reference, from ``rodval.analysis.agreement``), the
+header (study, models, machine), Acceptance
 (``rodval.report.acceptance``), Outcome, Discrepancies, Run time and Stability map
 (``study_summary``), the Error budget of the full model's ladder when the study runs its
 rungs (``error_budget``: also ``error_budget.csv`` and ``.md``), the figures against the grid
 parameters (``study_figures``), Sample statistics (``sample_stats``), the Deployment section
 (here, with the events tables), Modes (``study_modes``) and the report cases' time histories
-and configurations (``study_figures``).
+and configurations (``study_figures``). The tables leave out the identity columns constant
+over the study (``rodval.report.tables.study_constants``: case in a one-case study, n,
+horizon, reference), stated once in the header. A sampled study's report gives
+distributions and worst cases instead of per-case tables (``sample_stats``), so its length
+does not grow with the number of samples.
 """
 
 from __future__ import annotations
@@ -33,16 +39,18 @@ from rodval.models.presets.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
 from rodval.report.error_budget import error_budget
 from rodval.report.markdown import to_markdown
-from rodval.report.sample_stats import sample_section
+from rodval.report.sample_stats import sample_events_section, sample_section
 from rodval.report.study_figures import case_figures, deployment_figures, param_figures
 from rodval.report.study_modes import modes_section
-from rodval.report.study_summary import summary_sections
+from rodval.report.study_summary import answer_section, summary_sections
 from rodval.report.tables import (
     ERROR_BUDGET,
     FIGURES,
     axis_columns,
+    drop_study_constants,
     read_events,
     read_tables,
+    study_constants,
 )
 
 #: Columns of the events table shown in the report, when present.
@@ -130,14 +138,23 @@ def _blanks(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def _deployment_section(
-    fig_dir: Path, meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
+    fig_dir: Path,
+    meta: dict[str, Any],
+    tables: dict[str, pd.DataFrame],
+    events: pd.DataFrame,
+    constants: dict[str, Any],
 ) -> list[str]:
     """The Deployment section when runs recorded events (``events``): the events, the lock
     discrepancies against the reference, peak hinge moments, residual vibration after the
-    last lock, and the report cases' deployment figures (markdown lines)."""
+    last lock, and the report cases' deployment figures (markdown lines); a sampled study's
+    gives their distributions instead (``sample_events_section``). ``constants``: the
+    columns left out of every table (``study_constants``)."""
     if events.empty:
         return []
+    if meta.get("sample"):
+        return sample_events_section(meta, tables, events)
     ref, labels = meta["reference"], [m["label"] for m in meta["models"]]
+    keep = _keep(constants)
     lines = [
         "## Deployment: locks, impulses and residual vibration\n",
         "Every recorded event (`events.csv`): lock time t (s); the lock impulse (N m s, on "
@@ -159,7 +176,7 @@ def _deployment_section(
         "leaves it unchanged while hinge 0 is free; blank once hinge 0 is held, where the "
         "ground's or the base's holding moment makes it meaningless). docs/deployment.md "
         "defines each.\n",
-        to_markdown(_blanks(events[[c for c in EVENT_REPORT_COLUMNS if c in events]]), ".5g"),
+        to_markdown(_blanks(keep(events[[c for c in EVENT_REPORT_COLUMNS if c in events]])), ".5g"),
     ]
     silent = [lab for lab in labels if not (events["model"] == lab).any()]
     if silent:
@@ -181,26 +198,29 @@ def _deployment_section(
             "lock's window overlapping another lock of its run (the windowed impulses are not "
             "separable) and neither an exudyn window of fewer than "
             f"{MIN_WINDOW_STEPS} steps of its fixed step; "
-            "`not_comparable` says why otherwise. After the "
-            "first lock each model carries its own vibration (the full model keeps the lock's "
-            "energy as bending vibration unless the rods are damped, the reduced model has no "
-            "bending dynamics, exudyn's generalized-alpha damps the unresolved modes), so later "
-            "lock times, impulses and the trajectories' pointwise discrepancies after the "
-            "first lock that is not comparable measure different motions, not model error:"
+            "`not_comparable` says why otherwise: the two runs reach that lock in different "
+            "states, so its pointwise gap adds up the earlier differences. Whether such a gap "
+            "is a model's error or the motion's own sensitivity is measured, not assumed: the "
+            "Answer above compares it with the reference's twin run when the study has one:"
             "\n",
-            to_markdown(disc, ".3g"),
+            to_markdown(keep(disc), ".3g"),
         ]
     peaks = peak_hinge_moments(tables["trajectories"], events)
     if not peaks.empty:
-        lines += ["Peak hinge moments (N m):\n", to_markdown(peaks, ".4g")]
+        lines += ["Peak hinge moments (N m):\n", to_markdown(keep(peaks), ".4g")]
     resid = residual_vibration(tables["trajectories"], events, tables["cases"])
     if not resid.empty:
         lines += [
             "Residual vibration after the last lock (tip y amplitude and mean in m, largest "
             "|alpha|, |beta| in rad, spread of the chord angles at the end in rad):\n",
-            to_markdown(resid, ".4g"),
+            to_markdown(keep(resid), ".4g"),
         ]
     return [*lines, *deployment_figures(fig_dir, meta, tables, events)]
+
+
+def _keep(constants: dict[str, Any]) -> Any:
+    """A function that drops the study's constant columns from a table."""
+    return lambda df: drop_study_constants(df, constants)
 
 
 def _error_budget_section(
@@ -256,18 +276,47 @@ def model_row(m: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def _header(meta: dict[str, Any], prov: dict[str, Any]) -> list[str]:
-    """The report's title, description, study file, grid, reference, Models table and the
-    machine and packages it ran on (``prov``: provenance.json)."""
+def study_file(meta: dict[str, Any]) -> str:
+    """The study file's path relative to the study folder (where report.md lies), as the
+    study recorded it when it ran (``source_path``); the name it was given when it recorded
+    none (a study built in Python, or an older study.json)."""
+    return str(meta.get("source_path") or meta["source"])
+
+
+def _design(meta: dict[str, Any]) -> str:
+    """The grid (its axes and values) or the sample (its count and keys) in a few words."""
+    sample = meta.get("sample")
+    if sample:
+        keys = ", ".join(f"`{k}`" for k in sample["keys"])
+        return f"Sample: {sample['count']} cases ({sample['design']}) of {keys}"
+    axes = "; ".join(f"`{p}` = {v}" for p, v in meta["axes"].items()) or "none (one case)"
+    return f"Grid: {axes}"
+
+
+def _header(meta: dict[str, Any], prov: dict[str, Any], constants: dict[str, Any]) -> list[str]:
+    """The report's description, study file (relative to the study folder), grid or
+    sample, reference, the columns constant over the study (``constants``), the Models table
+    and the machine and packages it ran on (``prov``: provenance.json)."""
     models = pd.DataFrame([model_row(m) for m in meta["models"]])
     mach = prov["machine"]
     pkgs = ", ".join(f"{k} {v}" for k, v in prov["packages"].items() if v)
-    axes = "; ".join(f"`{p}` = {v}" for p, v in meta["axes"].items()) or "none (one case)"
+    units = {"horizon": " s"}
+    same = ", ".join(
+        f"{k} = {v:g}{units.get(k, '')}" if isinstance(v, float) else f"{k} = {v}"
+        for k, v in constants.items()
+        if k != "reference"
+    )
     return [
-        f"# Study `{meta['name']}`\n",
+        "## Study\n",
         f"{meta['description']}\n" if meta["description"] else "",
-        f"Study file: `{meta['source']}` (copied to `study.toml`). Grid: {axes}. "
-        f"Reference model: `{meta['reference']}`.\n",
+        f"Study file: `{study_file(meta)}` (copied to `study.toml`). {_design(meta)}. "
+        f"Reference model: `{meta['reference']}`."
+        + (
+            f" Left out of the tables as the same throughout: {same} and the reference."
+            if same
+            else ""
+        )
+        + "\n",
         "Models:\n",
         to_markdown(models),
         f"Machine: {mach['processor']}, {mach['cpu_count']} cores, {mach['platform']}, "
@@ -307,15 +356,17 @@ def build_report(out: str | Path) -> Path:
     fig_dir = out / FIGURES
     fig_dir.mkdir(exist_ok=True)
     events = read_events(out)
-    lines = _header(meta, prov)
+    constants = study_constants(tables["cases"], meta["reference"])
+    lines = [f"# Study `{meta['name']}`\n", *answer_section(meta, tables, events)]
+    lines += _header(meta, prov, constants)
     lines += acceptance_section(meta, tables, events)
-    lines += summary_sections(meta, tables, params)
+    lines += summary_sections(meta, tables, params, constants)
     lines += _error_budget_section(out, meta, tables)
     figs = param_figures(fig_dir, meta, tables, params)
     if figs:
         lines += ["## Discrepancy, run time and speed-up against the grid parameters\n", *figs]
     lines += sample_section(meta, tables, events)
-    lines += _deployment_section(fig_dir, meta, tables, events)
+    lines += _deployment_section(fig_dir, meta, tables, events, constants)
     lines += modes_section(out, fig_dir, meta)
     lines += ["## Time histories and configurations\n", *case_figures(fig_dir, meta, tables)]
     path = out / "report.md"

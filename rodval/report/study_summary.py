@@ -1,6 +1,8 @@
-"""The study report's summary sections, from the saved tables: the Outcome (runs, failures,
-invalid runs, comparisons made and not made, by reason), the Discrepancies against the
-reference, the Run time with speed-ups, and the Stability map."""
+"""The study report's summary sections, from the saved tables: the Answer it opens with
+(``answer_section``: each model's verdict, agreement horizon, parting lock and its measured
+cause, worst lock gaps and run time; ``rodval.analysis.agreement``), the Outcome (runs,
+failures, invalid runs, comparisons made and not made, by reason), the Discrepancies against
+the reference, the Run time with speed-ups, and the Stability map."""
 
 from __future__ import annotations
 
@@ -8,10 +10,17 @@ from typing import Any
 
 import pandas as pd
 
+from rodval.analysis.agreement import (
+    AgreementSettings,
+    agreement_table,
+    check_names,
+    twin_label,
+)
 from rodval.analysis.metrics import left_out_quantities
 from rodval.core.validity import ENERGY_RESIDUAL_BOUND, SMALL_BENDING_RAD
 from rodval.report.figures import speedups
 from rodval.report.markdown import to_markdown
+from rodval.report.tables import drop_constant, drop_study_constants
 
 
 def left_out_table(traj: pd.DataFrame, reference: str) -> pd.DataFrame:
@@ -33,32 +42,86 @@ def left_out_table(traj: pd.DataFrame, reference: str) -> pd.DataFrame:
 
 
 def summary_sections(
-    meta: dict[str, Any], tables: dict[str, pd.DataFrame], params: list[str]
+    meta: dict[str, Any],
+    tables: dict[str, pd.DataFrame],
+    params: list[str],
+    constants: dict[str, Any] | None = None,
 ) -> list[str]:
     """Outcome, Discrepancies against the reference, Run time and, when a run failed or was
     audited for energy, the Stability map (markdown lines); ``params``: the cases' parameter
-    columns, "-" where a union of grids ([[grid]]) leaves one unset."""
+    columns, "-" where a union of grids ([[grid]]) leaves one unset; ``constants``: the
+    columns constant over the study, left out of every table (``study_constants``). A
+    sampled study's sections give distributions and the worst cases, not per-case rows
+    (``_sampled_sections``)."""
     disc, runtime = (
         tables[k].fillna({p: "-" for p in params}) for k in ("discrepancies", "runtime")
     )
     ref = meta["reference"]
     failed = runtime[runtime["status"] != "success"]
     left = left_out_table(tables["trajectories"], ref)
-    lines = _outcome(disc, runtime, failed, left)
-    lines += _discrepancies(disc, left, ref, len(meta["models"]), params)
-    lines += _run_time(runtime, ref, params)
+    keep = dict(constants or {})
+    lines = _outcome(disc, runtime, failed, left, keep, sampled=bool(meta.get("sample")))
+    if meta.get("sample"):
+        return lines + _sampled_sections(disc, runtime, ref)
+    lines += _discrepancies(disc, left, ref, len(meta["models"]), params, keep)
+    lines += _run_time(runtime, ref, params, keep)
     if not failed.empty or (
         "energy_residual" in runtime and runtime["energy_residual"].notna().any()
     ):
-        lines += _stability_map(runtime, params)
+        lines += _stability_map(runtime, params, keep)
+    return lines
+
+
+#: How many worst cases a sampled study's report lists per table.
+WORST_CASES = 5
+
+
+def _sampled_sections(disc: pd.DataFrame, runtime: pd.DataFrame, ref: str) -> list[str]:
+    """A sampled study's Discrepancies and Run time: the worst cases of each model and
+    quantity (the percentiles are in Sample statistics) and the run time's percentiles per
+    model; per-case values stay in discrepancies.csv and runtime.csv."""
+    ok = disc[disc["status"] == "ok"]
+    lines = [f"## Discrepancies against `{ref}`\n"]
+    if not ok.empty:
+        idx = ok.groupby(["model", "quantity"], sort=False)["max_abs"].idxmax()
+        worst = ok.loc[idx, ["model", "quantity", "case", "max_abs", "max_rel"]]
+        lines += [
+            "The case of largest `max_abs` per model and quantity (their percentiles over "
+            "the samples: Sample statistics; every case: `discrepancies.csv`):\n",
+            to_markdown(worst, ".3g"),
+        ]
+    done = runtime[runtime["status"] == "success"]
+    rows = [
+        {
+            "model": model,
+            "runs": len(part),
+            **{f"wall_s p{p}": part["wall_s"].quantile(p / 100) for p in (5, 50, 95)},
+            "wall_s max": part["wall_s"].max(),
+            "slowest case": part.loc[part["wall_s"].idxmax(), "case"],
+        }
+        for model, part in done.groupby("model", sort=False)
+    ]
+    if rows:
+        lines += [
+            "## Run time\n",
+            "Integration wall time (s) of the successful runs over the samples (every run: "
+            "`runtime.csv`):\n",
+            to_markdown(pd.DataFrame(rows), ".3g"),
+        ]
     return lines
 
 
 def _outcome(
-    disc: pd.DataFrame, runtime: pd.DataFrame, failed: pd.DataFrame, left: pd.DataFrame
+    disc: pd.DataFrame,
+    runtime: pd.DataFrame,
+    failed: pd.DataFrame,
+    left: pd.DataFrame,
+    constants: dict[str, Any] | None = None,
+    sampled: bool = False,
 ) -> list[str]:
     """The Outcome section: counts of cases, runs, failed and invalid runs and comparisons,
-    the comparisons not made by reason, the failed runs and the invalid runs."""
+    the comparisons not made by reason, the failed runs and the invalid runs (of a sampled
+    study: counted by model and reason, the first WORST_CASES failed runs listed)."""
     invalid = runtime[runtime["valid"].astype(str) == "False"] if "valid" in runtime else failed[:0]
     not_made = disc[disc["status"] != "ok"]
     lines = [
@@ -79,9 +142,17 @@ def _outcome(
         )
         lines += ["Comparisons not made, by reason:\n", to_markdown(why)]
     if not failed.empty:
+        shown = failed.head(WORST_CASES) if sampled else failed
+        more = len(failed) - len(shown)
         lines += [
-            "Failed runs:\n",
-            to_markdown(failed[["case", "model", "status", "t_reached", "message"]]),
+            "Failed runs"
+            + (f" (the first {len(shown)}; {more} more in `runtime.csv`)" if more else "")
+            + ":\n",
+            to_markdown(
+                drop_study_constants(
+                    shown[["case", "model", "status", "t_reached", "message"]], constants or {}
+                )
+            ),
         ]
     lines.append(
         "Validity: a run is invalid when it broke an assumption of its model (small bending, "
@@ -90,13 +161,27 @@ def _outcome(
         "docs/stability.md), whether or not it reached its end; its results are not those of "
         "the model's premise." + (" Invalid runs:\n" if len(invalid) else "\n")
     )
-    if len(invalid):
-        lines.append(to_markdown(invalid[["case", "model", "status", "invalid_because"]]))
+    if len(invalid) and sampled:
+        counts = (
+            invalid.assign(check=invalid["invalid_because"].map(check_names))
+            .groupby(["model", "check"], sort=False)
+            .size()
+            .reset_index(name="runs")
+        )
+        lines.append(to_markdown(counts))
+    elif len(invalid):
+        cols = ["case", "model", "status", "invalid_because"]
+        lines.append(to_markdown(drop_study_constants(invalid[cols], constants or {})))
     return lines
 
 
 def _discrepancies(
-    disc: pd.DataFrame, left: pd.DataFrame, ref: str, models: int, params: list[str]
+    disc: pd.DataFrame,
+    left: pd.DataFrame,
+    ref: str,
+    models: int,
+    params: list[str],
+    constants: dict[str, Any] | None = None,
 ) -> list[str]:
     """The Discrepancies section: per model, max_abs and max_rel of each quantity against
     the reference ``ref`` per case, and the quantities left out of the comparison
@@ -132,11 +217,14 @@ def _discrepancies(
         order = [f"{q} {m}" for q in dict.fromkeys(ok["quantity"]) for m in ("max_abs", "max_rel")]
         # reindex: a quantity whose reference is zero throughout (the work of a scene without
         # loads) has no max_rel, a column pivot_table drops; it stays, blank
-        lines.append(to_markdown(wide.reindex(columns=order).reset_index()))
+        table = wide.reindex(columns=order).reset_index()
+        lines.append(to_markdown(drop_study_constants(table, constants or {})))
     return lines
 
 
-def _run_time(runtime: pd.DataFrame, ref: str, params: list[str]) -> list[str]:
+def _run_time(
+    runtime: pd.DataFrame, ref: str, params: list[str], constants: dict[str, Any] | None = None
+) -> list[str]:
     """The Run time section: each successful run's integration wall time (s) per case and
     model, and each model's speed-up against the reference ``ref``."""
     ok = runtime[runtime["status"] == "success"]
@@ -152,11 +240,13 @@ def _run_time(runtime: pd.DataFrame, ref: str, params: list[str]) -> list[str]:
         "Integration wall time in s (without model set-up); speed-up = wall time of "
         f"`{ref}` / wall time of the model.\n",
         "Failed runs are left out.\n",
-        to_markdown(wall.reset_index()),
+        to_markdown(drop_study_constants(wall.reset_index(), constants or {})),
     ]
 
 
-def _stability_map(runtime: pd.DataFrame, params: list[str]) -> list[str]:
+def _stability_map(
+    runtime: pd.DataFrame, params: list[str], constants: dict[str, Any] | None = None
+) -> list[str]:
     """Case x model: how each run ended, its cost and (when audited) its energy residual."""
 
     def cell(row: pd.Series) -> str:
@@ -177,5 +267,210 @@ def _stability_map(runtime: pd.DataFrame, params: list[str]) -> list[str]:
         "Each run: status, integration wall time, the time reached if it did not finish, "
         "and R = max |E - E(0) - W_ext + D| / max(E, |W_ext|), the energy balance "
         "residual (see docs/stability.md), when the scene asks for energy.\n",
-        to_markdown(grid.reset_index()),
+        to_markdown(drop_study_constants(grid.reset_index(), constants or {})),
     ]
+
+
+# ---- the answer the report opens with ----------------------------------------------------
+
+#: A study of more cases than this (or a sampled one) gets the answer per model over its
+#: cases (percentiles and the worst case), not one row per case.
+MAX_ANSWER_CASES = 12
+
+
+def answer_section(
+    meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
+) -> list[str]:
+    """The report's opening: a paragraph and one short table, model by model, from the runs
+    (``rodval.analysis.agreement.agreement_table``): valid or out of domain and why, the
+    agreement horizon, the first lock where it parts and the measured cause, the worst
+    lock-time and impulse gaps, the run time (markdown lines)."""
+    ref = meta["reference"]
+    settings = AgreementSettings.from_dict(meta.get("agreement"))
+    table = agreement_table(tables["trajectories"], events, tables["runtime"], ref, settings)
+    if table.empty:
+        return []
+    lines = ["## Answer\n", _definition(settings, ref)]
+    if meta.get("sample") or table["case"].nunique() > MAX_ANSWER_CASES:
+        lines += _answer_over_cases(table, ref)
+    else:
+        lines += [" ".join(_sentences(table, ref, settings)) + "\n"]
+        lines.append(to_markdown(drop_constant(_answer_rows(table, settings), ("case",))))
+    return lines
+
+
+def _definition(settings: AgreementSettings, ref: str) -> str:
+    """The sentence that states the tolerances the answer uses."""
+    bars = [
+        f"{name} {value:g}{unit}"
+        for name, value, unit in (
+            ("scale fraction", settings.reference_rel, ""),
+            ("lock time", settings.reference_dt, " s"),
+            ("impulse fraction", settings.reference_impulse, ""),
+        )
+        if value > 0
+    ]
+    bar = f" plus the reference's own error bar ({', '.join(bars)})" if bars else ""
+    twin = settings.twin
+    twin_text = (
+        f" The twin run `{twin_label(ref)}` is `{ref}` with the initial chord angle of rod "
+        f"{twin['rod']} moved by {twin['angle']:g} rad; its horizon is the predictability "
+        "horizon."
+        if twin
+        else " No twin run ([agreement.twin]): whether the motion is predictable is not measured."
+    )
+    return (
+        f"A model agrees with `{ref}` until the first output time where "
+        f"max_k |q - q_ref| exceeds {settings.tol:g} x the largest |q_ref| for "
+        f"{', '.join(f'`{q}`' for q in settings.quantities)}{bar}; it parts at a lock that it "
+        f"lacks, reaches out of order or more than {settings.lock_dt * 1e3:g} ms from the "
+        f'reference\'s (docs/deployment.md, "The answer").{twin_text}\n'
+    )
+
+
+def _verdict(row: pd.Series) -> str:
+    """A run's verdict in words."""
+    if row["status"] != "success":
+        return f"failed ({row['status']})"
+    if row["out_of_domain"]:
+        return f"out of domain: {row['out_of_domain']}"
+    return "valid" if row["valid"] is not False else "invalid"
+
+
+def _until(row: pd.Series) -> str:
+    """Its agreement horizon in words."""
+    if row["role"] == "reference":
+        return "(reference)"
+    if pd.isna(row["compared_to"]):
+        return "not compared"
+    if pd.isna(row["horizon"]):
+        return f"the end ({row['compared_to']:.4g} s)"
+    return f"t = {row['horizon']:.4g} s ({row['horizon_quantity']})"
+
+
+def _ms(dt: float) -> str:
+    return f"{dt * 1e3:+.3g} ms"
+
+
+def _parts(row: pd.Series) -> str:
+    """Its parting lock in words."""
+    if not row["part_lock"] or pd.isna(row["part_lock"]):
+        return "" if row["role"] == "reference" else "none"
+    dt = "" if pd.isna(row["part_dt"]) else f", {_ms(row['part_dt'])}"
+    return f"{row['part_lock']} ({row['part_why']}{dt})"
+
+
+def _worst(row: pd.Series) -> tuple[str, str]:
+    """Its worst lock-time and impulse gaps in words."""
+    dt = "" if pd.isna(row["worst_dt"]) else f"{_ms(row['worst_dt'])} ({row['worst_dt_lock']})"
+    imp = (
+        ""
+        if pd.isna(row["worst_impulse_rel"])
+        else f"{row['worst_impulse_rel'] * 100:.3g} % ({row['worst_impulse_lock']})"
+    )
+    return dt, imp
+
+
+def _answer_rows(table: pd.DataFrame, settings: AgreementSettings) -> pd.DataFrame:
+    """The short table: one row per case and run."""
+    rows = []
+    for _, row in table.iterrows():
+        dt, imp = _worst(row)
+        rows.append(
+            {
+                "case": row["case"],
+                "model": row["model"],
+                "verdict": _verdict(row),
+                "agrees until": _until(row),
+                "first lock where it parts": _parts(row),
+                "cause": row["cause"] if isinstance(row["cause"], str) else "",
+                "worst lock dt": dt,
+                "worst impulse gap": imp,
+                "run time": f"{row['wall_s']:.3g} s",
+            }
+        )
+    out = pd.DataFrame(rows)
+    if settings.reference_dt > 0 or settings.reference_impulse > 0:
+        out["reference error bar"] = (
+            f"{settings.reference_dt * 1e3:g} ms, {settings.reference_impulse:.1%}"
+        )
+    return out
+
+
+def _sentences(table: pd.DataFrame, ref: str, settings: AgreementSettings) -> list[str]:
+    """The opening paragraph's sentences, one per run, with the figures."""
+    out = []
+    for _, row in table.iterrows():
+        name = f"`{row['model']}`" + (
+            f" (case `{row['case']}`)" if table["case"].nunique() > 1 else ""
+        )
+        verdict = _verdict(row)
+        if row["role"] == "reference":
+            out.append(f"The reference {name} is {verdict} (run time {row['wall_s']:.3g} s).")
+            continue
+        head = f"{name} is {verdict}; it agrees with `{ref}` until {_until(row)}"
+        if row["role"] == "twin":
+            dt, _ = _worst(row)
+            moved = f" and moves the locks by at most {dt}" if dt else ""
+            horizon = (
+                "it has no predictability horizon within the run"
+                if pd.isna(row["horizon"])
+                else "that is the predictability horizon"
+            )
+            out.append(f"{head}: {horizon}{moved}.")
+            continue
+        parts = _parts(row)
+        text = head + (
+            f", parts first at {parts}: {row['cause']}" if parts != "none" else ", at every lock"
+        )
+        dt, imp = _worst(row)
+        if dt:
+            text += f"; worst lock-time gap {dt}, impulse gap {imp or 'n/a'}"
+        out.append(f"{text}; run time {row['wall_s']:.3g} s.")
+    return out
+
+
+def _answer_over_cases(table: pd.DataFrame, ref: str) -> list[str]:
+    """The answer of a study of many cases: per run label, over the cases, how many valid,
+    the agreement horizon's percentiles and its worst case, how many part at a lock, the
+    causes by kind, the worst gaps with their cases, the median run time."""
+    rows, sentences = [], []
+    for model, part in table.groupby("model", sort=False):
+        n = len(part)
+        valid = int((part["valid"] == True).sum())  # noqa: E712 - None is not valid
+        row: dict[str, Any] = {"model": model, "cases": n, "valid": f"{valid}/{n}"}
+        if (part["role"] != "reference").any():
+            h = part["horizon"].fillna(part["compared_to"])
+            worst = part.loc[h.idxmin()] if h.notna().any() else None
+            row["agrees until p5 / p50 (s)"] = (
+                f"{h.quantile(0.05):.4g} / {h.median():.4g}" if h.notna().any() else ""
+            )
+            row["shortest (case)"] = "" if worst is None else f"{h.min():.4g} s ({worst['case']})"
+            parted = part[part["part_lock"].fillna("") != ""]
+            row["parts at a lock"] = f"{len(parted)}/{n}"
+            kinds = parted["cause"].fillna("").str.split(" \\(|;").str[0].value_counts()
+            row["causes"] = ", ".join(f"{k}: {v}" for k, v in kinds.items() if k)
+            for col, label, fmt in (
+                ("worst_dt", "worst lock dt (case)", _ms),
+                ("worst_impulse_rel", "worst impulse gap (case)", lambda x: f"{x:.1%}"),
+            ):
+                vals = part[col].abs()
+                row[label] = (
+                    f"{fmt(part.loc[vals.idxmax(), col])} ({part.loc[vals.idxmax(), 'case']})"
+                    if vals.notna().any()
+                    else ""
+                )
+        row["run time p50 (s)"] = f"{part['wall_s'].median():.3g}"
+        rows.append(row)
+        sentences.append(
+            f"`{model}`: valid in {valid} of {n} cases"
+            + (
+                f", agrees with `{ref}` until t = {row['shortest (case)']} at the shortest"
+                f" (median {row['agrees until p5 / p50 (s)'].split(' / ')[-1]} s), parts at a "
+                f"lock in {row['parts at a lock']} cases ({row['causes'] or 'no cause'})."
+                if "parts at a lock" in row and row["shortest (case)"]
+                else "."
+            )
+        )
+    table = pd.DataFrame(rows).astype(object)
+    return [" ".join(sentences) + "\n", to_markdown(table.where(table.notna(), ""))]

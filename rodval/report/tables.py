@@ -272,7 +272,8 @@ def trajectory_samples(
     traj: pd.DataFrame, meta: dict[str, Any], cases: pd.DataFrame
 ) -> pd.DataFrame:
     """The report cases' values at the report times (nearest output time) for the report rods
-    and quantities, one column per model: a small table like the paper's Table 1."""
+    and quantities, one column per model: a small table like the paper's Table 1; a
+    ``case`` column when the study has more than one case (``IDENTITY_COLUMNS``)."""
     rep = meta["report"]
     parts = []
     for cid in rep["cases"]:
@@ -295,7 +296,8 @@ def trajectory_samples(
         wide = pick.pivot_table(
             index=["quantity", "k", "t"], columns="model", values="value", sort=False
         ).reset_index()
-        wide.insert(0, "case", cid)
+        if len(cases) > 1:
+            wide.insert(0, "case", cid)
         parts.append(wide)
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
 
@@ -313,3 +315,32 @@ def read_events(out: Path) -> pd.DataFrame:
     if missing:
         raise ValueError(f"{path}: column {missing[0]!r} is missing")
     return events
+
+
+#: Columns that name a case or a comparison: a report table leaves out any of them that is
+#: constant over it (``drop_constant``); the report states their values once.
+IDENTITY_COLUMNS = ("case", "n", "horizon", "reference")
+
+
+def drop_constant(df: pd.DataFrame, columns: tuple[str, ...] = IDENTITY_COLUMNS) -> pd.DataFrame:
+    """``df`` without those of ``columns`` (identity columns by default) that hold one value
+    over all of its rows (a table of one row keeps ``case`` only when the study has several
+    cases: pass the columns to drop)."""
+    drop = [c for c in columns if c in df.columns and len(df) and df[c].nunique(dropna=False) <= 1]
+    return df.drop(columns=drop)
+
+
+def study_constants(cases: pd.DataFrame, reference: str) -> dict[str, Any]:
+    """The identity columns constant over the whole study (column -> its one value): case in
+    a one-case study, n and horizon when no case changes them, and the reference."""
+    out: dict[str, Any] = {}
+    for col in ("case", "n", "horizon"):
+        if col in cases and len(cases) and cases[col].nunique() == 1:
+            out[col] = cases[col].iloc[0]
+    out["reference"] = reference
+    return out
+
+
+def drop_study_constants(df: pd.DataFrame, constants: dict[str, Any]) -> pd.DataFrame:
+    """``df`` without the columns constant over the whole study (``study_constants``)."""
+    return df.drop(columns=[c for c in constants if c in df.columns])
