@@ -2,8 +2,13 @@
 one check per case, bounded pair and quantity (and per model run when every run must be
 valid), per case and event bound (the locks against the reference's,
 ``rodval.analysis.events.lock_comparison``), per model for ``all_latched``, per run for the
-residuals; the breaches as one line each, and a JUnit XML report that CI systems display (one
-test case per check, a ``<failure>`` exactly where a bound broke).
+residuals, per case and absolute requirement of a model's own results
+([[acceptance.require]]: every latch locked by a time, a hinge's lock time and |impulse| in
+a range from events.csv, the peak |hinge_moment| over the output times and a quantity's
+value at t_end from trajectories.csv; ``_require_checks``); the breaches as one line each
+(``acceptance breached: CASE: MODEL: hinge 2 lock time: t = 0.6312 s > max 0.61 s``), and
+a JUnit XML report that CI systems display (one test case per check, a ``<failure>`` exactly
+where a bound broke).
 """
 
 from __future__ import annotations
@@ -29,6 +34,12 @@ EVENT_METRICS = ("lock_time", "impulse")
 #: latch of the scene locked, per model), ``energy_residual`` and ``momentum_residual`` (the
 #: largest |residual| of runtime.csv's column of that name, per run).
 SCALAR_KEYS = ("all_latched", "energy_residual", "momentum_residual")
+#: What an [[acceptance.require]] table may require of a model's own results (absolute, not
+#: against the reference): ``locked_by`` (s, every latch of the scene locked at or before),
+#: ``lock_time`` (s, a hinge's lock time in [min, max]), ``impulse`` (N m s, |a hinge's lock
+#: impulse| in [min, max]), ``peak_hinge_moment`` (N m, max |hinge_moment| over the output
+#: times), ``final`` (a quantity's value at the last output time in [min, max]).
+REQUIRE_ITEMS = ("locked_by", "lock_time", "impulse", "peak_hinge_moment", "final")
 #: Why a run has no energy residual: it was not audited.
 NO_ENERGY_RESIDUAL = (
     'no energy residual recorded (a run audits its energy only with "energy" among the '
@@ -74,6 +85,7 @@ def acceptance_checks(
     disc, runtime = tables["discrepancies"], tables["runtime"]
     index = {(str(r["case"]), r["model"], r["quantity"]): r for _, r in disc.iterrows()}
     comparisons = _lock_comparisons(spec.get("events", []), ref, events)
+    own = _own_results(tables, events) if spec.get("requires") else {}
     checks = []
     for case in tables["cases"]["case"].astype(str):
         for b in spec["bounds"]:
@@ -96,6 +108,7 @@ def acceptance_checks(
                 checks.append(Check("acceptance.valid", f"{case}: {run['model']} valid", why))
         checks += _event_checks(spec.get("events", []), ref, case, comparisons)
         checks += _residual_checks(spec, case, runtime)
+        checks += _require_checks(spec.get("requires", []), case, own)
     if "all_latched" in spec:
         labels = [m["label"] for m in meta["models"]]
         checks += _latched_checks(spec["all_latched"], labels, tables["cases"], events)
@@ -173,6 +186,145 @@ def _residual_checks(spec: dict[str, Any], case: str, runtime: pd.DataFrame) -> 
             fail = "" if abs(value) <= bound else f"|{key}| = {abs(value):.3g} > {bound:g}"
             checks.append(Check("acceptance.residuals", name, fail))
     return checks
+
+
+def _own_results(tables: dict[str, pd.DataFrame], events: pd.DataFrame) -> dict[str, Any]:
+    """What the requirements read, split by case once (case as text): its cases.csv row,
+    its trajectories and its events."""
+
+    def by_case(frame: pd.DataFrame) -> dict[str, pd.DataFrame]:
+        return dict(iter(frame.groupby(frame["case"].astype(str), sort=False)))
+
+    empty = pd.DataFrame(columns=["case", "model", "t", "quantity", "k", "value"])
+    cases = tables["cases"].assign(case=tables["cases"]["case"].astype(str)).set_index("case")
+    return {
+        "cases": cases,
+        "trajectories": by_case(tables.get("trajectories", empty)),
+        "events": by_case(events),
+        "empty": empty,
+        "no_events": events.iloc[0:0],
+    }
+
+
+def _require_checks(requires: list[dict[str, Any]], case: str, own: dict[str, Any]) -> list[Check]:
+    """One check per requirement of each [[acceptance.require]] table in ``case`` (classname
+    ``acceptance.require``), from the model's own lock events and trajectories (``own``:
+    ``_own_results``): locked_by (every latch of the case's latch_hinges), lock_time and
+    impulse (the hinge's first lock), peak_hinge_moment (max |hinge_moment| over the output
+    times), final (the value at the case's horizon). A lock, value or time that is not there
+    breaks the requirement."""
+    if not requires:
+        return []
+    row = own["cases"].loc[case]
+    traj = own["trajectories"].get(case, own["empty"])
+    ev = own["events"].get(case, own["no_events"])
+    checks = []
+    for req in requires:
+        model = req["model"]
+        head = f"{case}: {model}"
+        locks = _first_locks(ev[ev["model"] == model])
+        if "locked_by" in req:
+            latched = json.loads(str(row.get("latch_hinges", "[]")))
+            checks.append(_locked_by_check(head, req["locked_by"], latched, locks))
+        for r in req.get("lock_time", []):
+            lock = locks.get(r["hinge"])
+            t = math.nan if lock is None else lock[0]
+            name = f"{head}: hinge {r['hinge']} lock time"
+            checks.append(_range_check(name, "t", t, r, "s", "no lock"))
+        for r in req.get("impulse", []):
+            lock = locks.get(r["hinge"])
+            value = math.nan if lock is None else abs(lock[1])
+            name = f"{head}: hinge {r['hinge']} lock impulse"
+            absent = (
+                "no lock" if lock is None else f"no impulse recorded (lock at t = {lock[0]:.6g} s)"
+            )
+            checks.append(_range_check(name, "|impulse|", value, r, "N m s", absent))
+        own = traj[traj["model"] == model]
+        if "peak_hinge_moment" in req:
+            checks.append(_peak_check(head, req["peak_hinge_moment"], own))
+        for r in req.get("final", []):
+            checks.append(_final_check(head, r, own, float(row["horizon"])))
+    return checks
+
+
+def _first_locks(events: pd.DataFrame) -> dict[int, tuple[float, float]]:
+    """Hinge -> (t s, impulse N m s) of its first lock among one run's ``events``."""
+    from rodval.report.sample_stats import locked_hinges
+
+    locks: dict[int, tuple[float, float]] = {}
+    for _, e in events.sort_values("t", kind="stable").iterrows():
+        for h in locked_hinges(e["label"]):
+            impulse = pd.to_numeric(pd.Series([e.get("impulse")]), errors="coerce").iloc[0]
+            locks.setdefault(h, (float(e["t"]), float(impulse)))
+    return locks
+
+
+def _range_check(
+    name: str, what: str, value: float, r: dict[str, Any], unit: str, absent: str = "no value"
+) -> Check:
+    """``value`` within r's [min, max]; a value that is not there (nan) breaks it, said by
+    ``absent``."""
+    bounds = f"[{r.get('min', -math.inf):g}, {r.get('max', math.inf):g}] {unit}"
+    if math.isnan(value):
+        return Check("acceptance.require", name, f"{absent} (required in {bounds})")
+    fail = ""
+    if "max" in r and not value <= r["max"]:
+        fail = f"{what} = {value:.6g} {unit} > max {r['max']:g} {unit}"
+    elif "min" in r and not value >= r["min"]:
+        fail = f"{what} = {value:.6g} {unit} < min {r['min']:g} {unit}"
+    return Check("acceptance.require", name, fail)
+
+
+def _locked_by_check(
+    head: str, by: float, latched: list[int], locks: dict[int, tuple[float, float]]
+) -> Check:
+    """Every latched hinge of the case locked at or before ``by`` s."""
+    late = []
+    for h in sorted(latched):
+        if h not in locks:
+            late.append(f"hinge {h} never locked")
+        elif not locks[h][0] <= by:
+            late.append(f"hinge {h} locked at t = {locks[h][0]:.6g} s")
+    name = f"{head}: every latch locked by {by:g} s"
+    return Check("acceptance.require", name, f"{', '.join(late)} > {by:g} s" if late else "")
+
+
+def _peak_check(head: str, r: dict[str, Any], traj: pd.DataFrame) -> Check:
+    """max |hinge_moment| over the output times (of r's hinge, or of every hinge) <= max."""
+    rows = traj[traj["quantity"] == "hinge_moment"]
+    which = "every hinge" if "hinge" not in r else f"hinge {r['hinge']}"
+    if "hinge" in r:
+        rows = rows[rows["k"] == r["hinge"]]
+    name = f"{head}: peak |hinge_moment| ({which})"
+    values = rows["value"].abs()
+    if values.empty or values.isna().any():
+        return Check("acceptance.require", name, "no hinge_moment values (run failed?)")
+    at = rows.loc[values.idxmax()]
+    peak = float(values.max())
+    where = "" if "hinge" in r else f" (hinge {int(at['k'])})"
+    fail = (
+        ""
+        if peak <= r["max"]
+        else f"{peak:.6g} N m at t = {float(at['t']):.6g} s{where} > max {r['max']:g} N m"
+    )
+    return Check("acceptance.require", name, fail)
+
+
+def _final_check(head: str, r: dict[str, Any], traj: pd.DataFrame, horizon: float) -> Check:
+    """The quantity's value at the case's horizon (its last output time) in [min, max]."""
+    from rodval.core.scene import UNITS
+
+    q, k = r["quantity"], r["k"]
+    rows = traj[(traj["quantity"] == q) & (traj["k"] == k)]
+    name = f"{head}: final {q}[{k}]"
+    unit = UNITS.get(q, "")
+    if rows.empty:
+        return Check("acceptance.require", name, f"no {q}[{k}] in the trajectories")
+    last = rows.loc[rows["t"].idxmax()]
+    if not math.isclose(float(last["t"]), horizon, rel_tol=1e-9, abs_tol=1e-12):
+        why = f"the output ends at t = {float(last['t']):.6g} s, not t_end = {horizon:g} s"
+        return Check("acceptance.require", name, why)
+    return _range_check(name, f"{q}[{k}] at t = {horizon:g} s", float(last["value"]), r, unit)
 
 
 def _latched_checks(

@@ -224,6 +224,7 @@ def study_from_dict(
             reference,
             {q for c in cases for q in trajectory_quantities(c.scene.outputs)},
             where,
+            scenes=[c.scene for c in cases],
         ),
         scene_file=scene_file,
         agreement=agreement_spec(doc.get("agreement"), where),
