@@ -103,6 +103,7 @@ def test_shipped_studies_and_the_readme_example_are_valid():
         "companion_three_panel_free": 2,
         "deployment": 1,
         "deployment_stiff": 1,
+        "deployment_stiff_panels": 1,
         "deployment_sample": 256,
         "exudyn_convergence": 80,
         "model_error_budget": 8,
