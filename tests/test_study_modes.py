@@ -72,3 +72,27 @@ def test_modes_of_a_scene_without_a_modal_form_are_recorded_not_fatal():
     scene = Scene(chain=Chain.uniform(2), t_end=0.1)
     rec = case_modes(scene, {"model": "nosuch", "options": {}}, {"count": 2, "about": "initial"})
     assert "modes_error" in rec and "modes" not in rec
+
+
+def test_a_free_spacecraft_study_tables_its_flexible_modes_numbered_as_mac(tmp_path):
+    """Issue 46: on a free base the study's modes.csv listed the three rigid motions as modes
+    1-3 while mac.csv numbered the flexible modes from 1 (rodval modes writes the flexible
+    ones only); both now number the flexible modes from 1, as the modal analysis gives them."""
+    from rodval.core.base import Base
+    from rodval.models.observation.free_modes import free_modes
+
+    study = STUDY.replace("[models.reduced]\n", "").replace(
+        "[grid]\nscene.n = [2, 3]",
+        '[scene.base]\nkind = "free"\nmass = 50.0\ninertia = 20.0\nhinge_offset = [0.5, 0.0]\n'
+        "[grid]\nscene.n = [2]",
+    )
+    path = tmp_path / "m.toml"
+    path.write_text(study.format(modes="[modes]\ncount = 3"))
+    run_study(load_study(path), tmp_path / "out", workers=1, progress=False)
+    freq = pd.read_csv(tmp_path / "out" / "modes.csv").sort_values("mode")
+    scene = paper_scene(2, t_end=0.1).with_(
+        base=Base(kind="free", mass=50.0, inertia=20.0, hinge_offset=(0.5, 0.0))
+    )
+    flexible = free_modes(scene, count=3).flexible()
+    assert freq["mode"].tolist() == list(range(1, flexible.count + 1))
+    np.testing.assert_allclose(freq["omega_rad_s"], flexible.omega, rtol=1e-12)

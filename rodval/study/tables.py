@@ -200,7 +200,9 @@ def modes_tables(records: list[CaseRecord], axes: dict[str, str]) -> dict[str, p
     f_hz, damping_ratio, or the modal analysis' error), ``mac`` (each model's modes paired by
     shape with the reference's, ``rodval.analysis.modes.pair_modes``: mode of the reference,
     both frequencies, rel_gap, mac) and ``mode_shapes`` (tidy: case, model, mode, kind,
-    k, value; kind node_dx/node_dy/hinge, and node_x0/node_y0 for the configuration, mode 0)."""
+    k, value; kind node_dx/node_dy/hinge, and node_x0/node_y0 for the configuration, mode 0).
+    On a free base the modes are the flexible ones, numbered from 1 as ``rodval modes`` and
+    ``mac`` number them (the three rigid motions stay in the case records)."""
     freq, mac, shapes = [], [], []
     for rec in records:
         base = _case_columns(rec, axes)
@@ -209,7 +211,7 @@ def modes_tables(records: list[CaseRecord], axes: dict[str, str]) -> dict[str, p
             if run.modes is None:
                 freq.append({**base, "model": run.label, "error": run.modes_error})
                 continue
-            m = got[run.label]
+            m = got[run.label].flexible()  # a free base's rigid modes are not tabled
             frame = m.frequencies_frame()
             freq += [{**base, "model": run.label, **row} for row in frame.to_dict("records")]
             x0, y0 = m.node_positions()
