@@ -45,6 +45,11 @@ class Model(ABC):
         """Run the scene (default integrator settings when None) and judge the run's validity;
         never raise for a failed integration (report it in the stats)."""
         settings = IntegratorSettings() if settings is None else settings
+        model, chosen = self.for_scene(scene)
+        if model is not self:  # an option resolved for the scene: run it, say what it chose
+            trajectory = model.simulate(scene, settings)
+            trajectory.stats.notes = [*chosen, *trajectory.stats.notes]
+            return trajectory
         settings.check_horizon(scene.t_end)
         self.check_base(scene)
         trajectory = self.run(scene, settings)
@@ -60,6 +65,13 @@ class Model(ABC):
     @abstractmethod
     def run(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
         """Run the scene; never raise for a failed integration (report it in the stats)."""
+
+    def for_scene(self, scene: Scene) -> tuple[Model, list[str]]:
+        """This model with its options that depend on the scene ("auto") resolved for
+        ``scene``, and the notes that say what they resolved to and why (recorded in
+        ``SolverStats.notes``); ``simulate`` runs the resolved model. By default itself, no
+        notes."""
+        return self, []
 
     def check_base(self, scene: Scene) -> None:
         """ValueError (before any work) unless this model, with its options, has the scene's

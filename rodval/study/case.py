@@ -47,6 +47,10 @@ class Case:
     modes: dict[str, Any] | None = None
     #: The twin's perturbation ``{"rod": k, "angle": rad}`` ([agreement.twin]) or None.
     twin: dict[str, Any] | None = None
+    #: label -> the options each model runs this scene with, its scene-dependent defaults
+    #: resolved (``Model.for_scene``: the full model's kinematics = "auto"), in the
+    #: fingerprint, so a record made under another default is not reused.
+    ran_options: dict[str, dict[str, Any]] | None = None
 
     @property
     def fingerprint(self) -> str:
@@ -59,6 +63,7 @@ class Case:
                 "models": [m.as_dict() for m in self.models],
                 **({"modes": self.modes} if self.modes else {}),
                 **({"twin": self.twin} if self.twin else {}),
+                **({"ran_options": self.ran_options} if self.ran_options else {}),
             },
             sort_keys=True,
             default=repr,
@@ -151,7 +156,7 @@ def build_case(
     scene_dict.setdefault("name", cid)
     scene = scene_from_dict(scene_dict, where=f"{case_where} [scene]")
     models = model_specs(case_doc, case_where)
-    check_refusals(scene, models, where, cid)
+    ran_options = check_refusals(scene, models, where, cid)
     return Case(
         id=cid,
         params={labels[p]: v for p, v in combo.items()},
@@ -164,16 +169,21 @@ def build_case(
         twin=case_twin(
             case_doc.get("agreement"), scene, models, case_doc["study"]["reference"], case_where
         ),
+        ran_options=ran_options,
     )
 
 
-def check_refusals(scene: Scene, models: tuple[ModelSpec, ...], where: str, cid: str) -> None:
+def check_refusals(
+    scene: Scene, models: tuple[ModelSpec, ...], where: str, cid: str
+) -> dict[str, dict[str, Any]]:
     """Each model of a case against what it refuses for the case's scene before any work
     (``rodval.models.presets.registry.check_scene``, the check ``simulate`` makes): a
     ValueError naming the study file ``where``, the case ``cid``, the model and the reason,
     when the study is read, so no case runs a model that would refuse it. A model that cannot
     be imported here (exudyn not installed) is not an error of the file: its runs fail and
-    say why."""
+    say why. Returns label -> the options each model runs the scene with (its "auto"
+    defaults resolved, ``Model.for_scene``)."""
+    ran: dict[str, dict[str, Any]] = {}
     for spec in models:
         try:
             model = get_model(spec.model, **spec.options)
@@ -188,6 +198,8 @@ def check_refusals(scene: Scene, models: tuple[ModelSpec, ...], where: str, cid:
                 f"{where}: case {cid!r}: model {spec.label!r} ({spec.model}) refuses it "
                 f"before any work: {exc}"
             ) from None
+        ran[spec.label] = model.for_scene(scene)[0].options()
+    return ran
 
 
 def _bound(where: str, key: str, value: Any, **limits: Any) -> float:

@@ -61,7 +61,7 @@ from rodval.core.modal import (
 from rodval.core.scene import Scene
 from rodval.models.assembly.paper_matrices import damping_matrix, stiffness_matrix
 from rodval.models.kinematics.ladder import ladder_stiffness
-from rodval.models.kinematics.rungs import check_kinematics, check_shapes
+from rodval.models.kinematics.rungs import check_shapes, resolve_kinematics
 from rodval.models.presets.full import FullModel
 
 #: The coefficients of the full model on a moving base (its compiled kernels).
@@ -230,7 +230,7 @@ def free_modes(
     (default all). The configuration check (at rest, balanced) is the caller's
     (``check_configuration``). Dense: O(N^2) evaluations of T and O(N^3) eigensolves."""
     check_free_base(scene, coefficients)
-    p, kin = check_shapes(shapes), check_kinematics(kinematics)
+    p, kin = check_shapes(shapes), resolve_kinematics(kinematics, scene, coefficients)
     chain, n = scene.chain, scene.n
     system = free_system(scene, p, kin)
     Nc = system.Nc

@@ -122,7 +122,12 @@ from rodval.models.kinematics.ladder import (
     ladder_mass_matrix,
     ladder_stiffness,
 )
-from rodval.models.kinematics.rungs import PAPER_RUNG, check_kinematics, check_shapes
+from rodval.models.kinematics.rungs import (
+    PAPER_RUNG,
+    check_kinematics,
+    check_shapes,
+    resolve_kinematics,
+)
 from rodval.models.observation.statics import (
     balance_residual,
     body_rest_angles,
@@ -400,7 +405,7 @@ def modes(
     ``count``: the lowest ``count`` modes (default all)."""
     check_arguments(scene, count)
     check_choice("model", model, PAPER_MODELS)
-    rung = (check_shapes(shapes), check_kinematics(kinematics))
+    rung = (check_shapes(shapes), check_kinematics(kinematics, auto=True))
     if model != "full" and rung != PAPER_RUNG:
         raise ValueError(
             f"shapes and kinematics are options of the full model, not of {model!r} "
@@ -435,7 +440,9 @@ def modes_about(
     """``modes`` about a configuration already checked (``check_configuration``): the
     static equilibrium when asked for, the linear system, its eigen-solution and shapes.
     Dense: O(N^3) for the N = 3n (full; n (p + 2) on a ladder rung) or n (reduced)
-    coordinates."""
+    coordinates. ``kinematics = "auto"`` is resolved as a run's is (``auto_kinematics``)."""
+    if model == FullModel.name:
+        kinematics = resolve_kinematics(kinematics, scene, coefficients)
     if scene.base.moving:
         if not (scene.base.free and model == FullModel.name):
             raise ValueError(

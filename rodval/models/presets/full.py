@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from rodval.core.scene import Scene
+from rodval.core.settings import IntegratorSettings
+from rodval.core.trajectory import Trajectory
 from rodval.core.validity import DAMPING_FIX, setting
 from rodval.models.assembly import kernels
 from rodval.models.assembly.paper_matrices import (
@@ -24,7 +26,9 @@ from rodval.models.assembly.paper_system import PaperModel, PaperSystem
 from rodval.models.hinge_items import deployment
 from rodval.models.hinge_items.lock_records import plastic_jump
 from rodval.models.kinematics.rungs import (
+    AUTO,
     PAPER_RUNG,
+    auto_kinematics,
     check_kinematics,
     check_rung_options,
     check_shapes,
@@ -182,7 +186,8 @@ class FullModel(PaperModel):
     """Full model (3n ODEs). ``coefficients``: "printed" (default) or "published" (erratum);
     ``kernel``: "numba" (default) or "numpy"; the model ladder (``rodval.models.kinematics.ladder``):
     ``shapes`` p = 1..8 bending shapes per rod (default 1, the paper's cubic) and
-    ``kinematics`` "first-order" (default, the paper's) or "exact"."""
+    ``kinematics`` "first-order" (the paper's), "exact" or "auto" (default: one of them chosen
+    for each scene, ``rodval.models.kinematics.rungs.auto_kinematics``)."""
 
     name = "full"
     system_class = FullSystem
@@ -195,16 +200,31 @@ class FullModel(PaperModel):
         coefficients: str = DEFAULT_VARIANT,
         kernel: str = "numba",
         shapes: int = 1,
-        kinematics: str = "first-order",
+        kinematics: str = AUTO,
     ):
         super().__init__(coefficients, kernel)
         self.shapes = check_shapes(shapes)
-        self.kinematics = check_kinematics(kinematics)
-        if (self.shapes, self.kinematics) != PAPER_RUNG:
+        self.kinematics = check_kinematics(kinematics, auto=True)
+        if (self.shapes, self.kinematics) not in (PAPER_RUNG, (PAPER_RUNG[0], AUTO)):
             check_rung_options(self.coefficients, self.kernel)
 
     def options(self):
         return {**super().options(), "shapes": self.shapes, "kinematics": self.kinematics}
+
+    def for_scene(self, scene: Scene) -> tuple[FullModel, list[str]]:
+        """This model with ``kinematics = "auto"`` resolved for ``scene`` (``auto_kinematics``,
+        the one rule) and the note that says what it chose and why; itself, no note, when the
+        kinematics was given."""
+        if self.kinematics != AUTO:
+            return self, []
+        kinematics, note = auto_kinematics(scene, self.coefficients, self.kernel)
+        return FullModel(self.coefficients, self.kernel, self.shapes, kinematics), [note]
+
+    def run(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
+        """The run of ``scene`` on the kinematics it resolves to (``for_scene``), so that the
+        trajectory's options hold the kinematics that ran."""
+        model = self.for_scene(scene)[0]
+        return super().run(scene, settings) if model is self else model.run(scene, settings)
 
     def energy_fix(self) -> str:
         """The first-order kinematics does not keep energy (docs/stability.md): its exact
@@ -246,6 +266,8 @@ class FullModel(PaperModel):
         """The system of ``scene`` on this model's rung and base; the free base's, the moving
         bases' and the ladder's modules (and their compiled kernels) are imported only by a
         scene that uses them."""
+        if self.kinematics == AUTO:
+            return self.for_scene(scene)[0].system(scene)
         paper = (self.shapes, self.kinematics) == PAPER_RUNG
         if scene.base.moving:
             self.check_base(scene)
