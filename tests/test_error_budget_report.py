@@ -122,7 +122,7 @@ def _disc(rows):
 def test_rungs_as_model_labels():
     meta = _meta(
         [
-            ("paper", "full", {}),
+            ("paper", "full", {"kinematics": "first-order"}),
             ("exact1", "full", {"kinematics": "exact"}),
             ("exact2", "full", {"kinematics": "exact", "shapes": 2}),
             ("exudyn", "exudyn", {"elements": 8}),

@@ -11,6 +11,7 @@ rungs the split needs (first-order p = 1, exact p = 1 and an exact p > 1).
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -172,12 +173,34 @@ def _key(value: Any) -> Any:
     return value
 
 
-def ladder_rungs(meta: dict[str, Any]) -> dict[tuple[str, str], tuple[str, int]]:
+def ran_options(runtime: pd.DataFrame | None) -> dict[tuple[str, str], dict[str, Any]]:
+    """(case id, model label) -> the options each run recorded it ran with (runtime.csv's
+    ``options`` column, JSON: "auto" options resolved, e.g. the full model's kinematics);
+    empty without the column (a table written before it) or ``runtime``."""
+    if runtime is None or "options" not in runtime.columns:
+        return {}
+    out = {}
+    for case, label, text in zip(runtime["case"], runtime["model"], runtime["options"]):
+        try:
+            options = json.loads(text)
+        except (TypeError, ValueError):  # a blank cell (NaN): no record of the options
+            continue
+        if isinstance(options, dict):
+            out[(str(case), str(label))] = options
+    return out
+
+
+def ladder_rungs(
+    meta: dict[str, Any], ran: dict[tuple[str, str], dict[str, Any]] | None = None
+) -> dict[tuple[str, str], tuple[str, int]]:
     """(case id, model label) -> (kinematics, shapes) of every run of the full model but the
-    reference's in the study described by ``meta`` (study.json): the model's options,
-    overridden by the case's grid values (``models.LABEL.kinematics``, ``.shapes``),
-    the paper's rung where neither says."""
-    labels = meta.get("labels", {})
+    reference's in the study described by ``meta`` (study.json): the options the run
+    recorded (``ran``, ``ran_options``: the kinematics that ran, "auto" resolved for the
+    case's scene), else the model's options overridden by the case's grid values
+    (``models.LABEL.kinematics``, ``.shapes``; one shape per rod where neither says). A run
+    whose kinematics is left to "auto" (the default, ``auto_kinematics``: it depends on the
+    case's scene) and has no record is no rung."""
+    labels, ran = meta.get("labels", {}), ran or {}
     out = {}
     for m in meta["models"]:
         label = m["label"]
@@ -188,17 +211,21 @@ def ladder_rungs(meta: dict[str, Any]) -> dict[tuple[str, str], tuple[str, int]]
             params = case.get("params", {})
             kin = params.get(labels.get(f"models.{label}.kinematics"), opts.get("kinematics"))
             p = params.get(labels.get(f"models.{label}.shapes"), opts.get("shapes"))
-            out[(case["id"], label)] = (
-                str(kin if kin is not None else PAPER_RUNG[1]),
-                int(p if p is not None else PAPER_RUNG[0]),
-            )
+            record = ran.get((str(case["id"]), label), {})
+            kin, p = record.get("kinematics", kin), record.get("shapes", p)
+            if kin in KINEMATICS:
+                out[(str(case["id"]), label)] = (
+                    str(kin),
+                    int(p if p is not None else PAPER_RUNG[0]),
+                )
     return out
 
 
-def has_ladder(meta: dict[str, Any]) -> bool:
-    """Whether the study described by ``meta`` runs the rungs the split needs (first-order
-    p = 1, exact p = 1 and an exact p > 1 of the full model, the reference aside)."""
-    return ladder_p_max(set(ladder_rungs(meta).values())) is not None
+def has_ladder(meta: dict[str, Any], runtime: pd.DataFrame | None = None) -> bool:
+    """Whether the study described by ``meta`` (and its runs' records, ``runtime``) runs the
+    rungs the split needs (first-order p = 1, exact p = 1 and an exact p > 1 of the full
+    model, the reference aside)."""
+    return ladder_p_max(set(ladder_rungs(meta, ran_options(runtime)).values())) is not None
 
 
 def _base_paths(meta: dict[str, Any]) -> list[str]:
@@ -219,16 +246,19 @@ def _base_kind(params: dict[str, Any], meta: dict[str, Any]) -> str | None:
     return None
 
 
-def error_budget(disc: pd.DataFrame, meta: dict[str, Any]) -> pd.DataFrame | None:
+def error_budget(
+    disc: pd.DataFrame, meta: dict[str, Any], runtime: pd.DataFrame | None = None
+) -> pd.DataFrame | None:
     """The error budget of a study (``split_gaps``) from its discrepancies table ``disc``
     (``discrepancies.csv``: the gap of a run is its ``max_abs`` against the reference, over
     all output times and rods, where ``status`` is "ok") and its description ``meta``
-    (study.json: which run is which rung, ``ladder_rungs``). The group of a case is its n,
+    (study.json) and the options each run recorded (``runtime``: runtime.csv; which run is
+    which rung, ``ladder_rungs``). The group of a case is its n,
     horizon and grid values, the rungs' own axes aside; its base kind (column ``base_kind``,
     when some case sets it) is read from the grid (``scene.base.kind`` or a ``scene.base``
     table). None when the study does not run the
     rungs the split needs (``has_ladder``)."""
-    rungs = ladder_rungs(meta)
+    rungs = ladder_rungs(meta, ran_options(runtime))
     if ladder_p_max(set(rungs.values())) is None:
         return None
     axes = axis_columns(meta)

@@ -229,7 +229,7 @@ def _error_budget_section(
     """The Error budget section and ``out/error_budget.csv``, ``.md`` when the study runs the
     rungs the split needs (``rodval.report.error_budget``); nothing otherwise (and a stale
     budget of an earlier report of the folder is removed)."""
-    budget = error_budget(tables["discrepancies"], meta)
+    budget = error_budget(tables["discrepancies"], meta, tables["runtime"])
     files = [out / f"{ERROR_BUDGET}.{ext}" for ext in ("csv", "md")]
     if budget is None:
         for path in files:

@@ -4,7 +4,8 @@
 * ``trajectories``: tidy case, model, t (s), quantity, k, value (rad, rad/s, m or J).
 * ``discrepancies``: case, n, horizon, axes, model, reference, quantity, max_abs, rms,
   final_abs, max_rel, k_at_max, t_at_max (see ``rodval.analysis.metrics``), status.
-* ``runtime``: case, n, horizon, axes, model, method, rtol, atol, max_step, wall_s
+* ``runtime``: case, n, horizon, axes, model, options (JSON: the model options the run ran
+  with, an "auto" resolved, e.g. the full model's kinematics), method, rtol, atol, max_step, wall_s
   (integration, s), setup_s (model set-up, s), nfev, njev, nlu, nsteps, t_reached (s),
   status, message.
 
@@ -114,6 +115,7 @@ def runtime_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFra
                 {
                     **_case_columns(rec, axes),
                     "model": run.label,
+                    "options": json.dumps(run.trajectory.options, sort_keys=True),
                     "method": se.get("method"),
                     "rtol": se.get("rtol"),
                     "atol": se.get("atol"),
