@@ -58,7 +58,7 @@ def test_a_paper_run_is_not_audited():
 @pytest.mark.parametrize("name", ["latch3", "wing, free root"])
 def test_first_order_drift_is_invalid_and_the_exact_rung_keeps_it(name):
     scene = scenes()[name]
-    first = simulate(scene, "full").stats
+    first = simulate(scene, "full", kinematics="first-order").stats
     assert first.momentum_residual > MOMENTUM_RESIDUAL_BOUND
     assert first.valid is False
     (reason,) = [c["reason"] for c in first.validity if c["assumption"] == "momentum balance"]
@@ -76,7 +76,7 @@ def test_the_free_body_wing_of_the_first_order_model_is_invalid_and_its_fix_is_v
     kinematics (issue 37); on a free base that rung is built (issue 40) and keeps H to the
     integration's tolerance."""
     scene = scenes()["wing on a body"]
-    stats = simulate(scene, "full").stats
+    stats = simulate(scene, "full", kinematics="first-order").stats
     assert stats.momentum_residual > MOMENTUM_RESIDUAL_BOUND
     (check,) = [c for c in stats.validity if c["assumption"] == "momentum balance"]
     assert not check["holds"] and stats.valid is False
@@ -105,7 +105,9 @@ def test_the_residual_is_read_between_the_output_times_the_same_on_any_grid():
     the output grid (equal to round-off: the same states at the same grid times)."""
     wing = latch3_scene().with_(base=BODY, outputs=("phi", "base"))
     runs = [
-        simulate(wing.with_(times=np.linspace(0.0, wing.t_end, num)), "full").stats
+        simulate(
+            wing.with_(times=np.linspace(0.0, wing.t_end, num)), "full", kinematics="first-order"
+        ).stats
         for num in (11, 201)
     ]
     assert runs[0].nsteps == runs[1].nsteps
