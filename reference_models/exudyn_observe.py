@@ -19,6 +19,7 @@ from reference_models.exudyn_beam import (
 from rodval.core.base import Base
 from rodval.core.bounds import MIN_POSITIVE
 from rodval.core.scene import QUANTITIES, Scene, hinge_angles
+from rodval.solvers.audit import audit_times
 
 #: The mass (kg) and inertia (kg m^2) the beam quadratures (``exudyn_beam``, which read a
 #: moving body's from ``scene.base.inertial()``) give a prescribed base's body: massless as in
@@ -57,10 +58,13 @@ def _states_at(times: np.ndarray, t_rec: np.ndarray, records: dict) -> dict:
 
 
 def momentum_audit(
-    scene: Scene, E: int, times: np.ndarray, t_rec: np.ndarray, records: dict
+    scene: Scene, E: int, reached: float, t_rec: np.ndarray, records: dict
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(H, G) (N m s) at ``times`` for the angular-momentum audit (``momentum_audit_rows``)."""
-    return momentum_audit_rows(scene, E, _states_at(times, t_rec, records))
+    """(H, G) (N m s) for the angular-momentum audit (``momentum_audit_rows``) on the audit
+    grid's times up to ``reached`` (s): ``rodval.solvers.audit.audit_times``, the grid every
+    model reads, whatever the output times."""
+    grid = audit_times(scene.t_end)
+    return momentum_audit_rows(scene, E, _states_at(grid[grid <= reached], t_rec, records))
 
 
 def observe(

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib import animation
@@ -222,19 +223,7 @@ def animate_runs(
     # every frame time is an output time of every run (within 1e-12 s): its own row
     index = {k: np.searchsorted(t.times, times - 1e-12) for k, t in runs.items()}
     marks = {k: _event_marks(t) for k, t in runs.items()}
-    fig = Figure(figsize=(6.4, 5.2))
-    ax = fig.add_subplot()
-    allx = np.concatenate([x.ravel() for x, _ in [*nodes.values(), *bodies.values()]])
-    ally = np.concatenate([y.ravel() for _, y in [*nodes.values(), *bodies.values()]])
-    pad = 0.05 * max(float(np.ptp(allx)), float(np.ptp(ally)), 1e-9)
-    ax.set_xlim(allx.min() - pad, allx.max() + pad)
-    ax.set_ylim(ally.min() - pad, ally.max() + pad)
-    ax.set_aspect("equal", adjustable="box")
-    ax.set_xlabel("x, m")
-    ax.set_ylabel("y, m")
-    ax.grid(alpha=0.3)
-    if any(not b.moving for b in base.values()):
-        ax.plot([0], [0], "k^", ms=9)  # the pin of the pinned runs
+    fig, ax = _frame_axes([*nodes.values(), *bodies.values()], base)
     lines = {
         k: ax.plot(
             [], [], "-o", color=MODEL_COLOURS[i % len(MODEL_COLOURS)], ms=3, lw=1.6, label=k
@@ -275,6 +264,26 @@ def animate_runs(
     write_with(path, produce)
     events = tuple((k, te, lab) for k in runs for te, _, lab in marks[k] if te <= times[-1])
     return Animated(path, int(times.size), times, events, tuple(notes))
+
+
+def _frame_axes(paths: list, base: Mapping[str, Base]) -> tuple[Figure, Any]:
+    """The animation's figure and axes: equal scales holding every node and body outline of
+    ``paths`` ((x, y) histories) with a 5 % margin, and the pin at the origin when a run is
+    pinned."""
+    fig = Figure(figsize=(6.4, 5.2))
+    ax = fig.add_subplot()
+    allx = np.concatenate([x.ravel() for x, _ in paths])
+    ally = np.concatenate([y.ravel() for _, y in paths])
+    pad = 0.05 * max(float(np.ptp(allx)), float(np.ptp(ally)), 1e-9)
+    ax.set_xlim(allx.min() - pad, allx.max() + pad)
+    ax.set_ylim(ally.min() - pad, ally.max() + pad)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x, m")
+    ax.set_ylabel("y, m")
+    ax.grid(alpha=0.3)
+    if any(not b.moving for b in base.values()):
+        ax.plot([0], [0], "k^", ms=9)  # the pin of the pinned runs
+    return fig, ax
 
 
 def _bodies(

@@ -128,6 +128,7 @@ from rodval.models.kinematics.rungs import (
     check_shapes,
     resolve_kinematics,
 )
+from rodval.models.observation.held import held_reduced
 from rodval.models.observation.statics import (
     balance_residual,
     body_rest_angles,
@@ -554,42 +555,6 @@ def _held_pencil(
     full = linear_system(scene.chain, FullModel.name, q0, *variant)
     M_r, C_r, K_r, gamma = held_reduced(full, hinge_matrix(n)[held], n)
     return M_r, C_r, K_r, None, gamma
-
-
-def held_reduced(
-    MCK: tuple[np.ndarray, ...], A: np.ndarray, n: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, Callable[[np.ndarray, float], np.ndarray]]:
-    """The reduced model's (M_r, C_r, K_r) (n, n) with held hinges, from the full model's
-    linear (M, C, K) = ``MCK`` (3n) and the held hinges' rows A (m, 3n): the reduced model
-    holds them as equations of its quasi-static bending (``ReducedSystem.solve_locked``, the
-    kappa -> infinity limit), so with S = [[B, A_g^T], [A_g, 0]] (B = K_gg) and
-    E = [K_pg, A_p^T] the bending and the latches' multipliers are condensed out exactly:
-
-        M_r = M_pp - E S^-1 [M_gp; 0],  C_r = C_pp - E S^-1 [C_gp; 0],
-        K_r = K_pp - E S^-1 [K_gp; A_p]
-
-    (without held hinges S = B and these are the reduced model's own). Also returns
-    gamma(dphi, lam): a mode's bending coordinates (2n) from its chord angles at eigenvalue
-    lam = omega^2. O(n^3) (dense)."""
-    M, C, K = MCK
-    p, g = slice(0, n), slice(n, 3 * n)
-    m = A.shape[0]
-    S = np.zeros((2 * n + m, 2 * n + m))
-    S[: 2 * n, : 2 * n] = K[g, g]
-    S[: 2 * n, 2 * n :] = A[:, g].T
-    S[2 * n :, : 2 * n] = A[:, g]
-    E = np.hstack([K[p, g], A[:, p].T])
-    lu = scipy.linalg.lu_factor(S)
-    none = np.zeros((m, n))
-
-    def condense(B: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        return B[p, p] - E @ scipy.linalg.lu_solve(lu, np.vstack([B[g, p], rows]))
-
-    def gamma(dphi: np.ndarray, lam: float) -> np.ndarray:
-        rhs = np.concatenate([(K[g, p] - lam * M[g, p]) @ dphi, A[:, p] @ dphi])
-        return -scipy.linalg.lu_solve(lu, rhs)[: 2 * n]
-
-    return condense(M, none), condense(C, none), condense(K, A[:, p]), gamma
 
 
 def check_configuration(
