@@ -63,7 +63,7 @@ def test_the_ratio_gives_that_mode_the_stated_damping_ratio():
     [
         ({"ratio": 1.0}, ">= 0 and < 1"),
         ({"ratio": -0.01}, ">= 0 and < 1"),
-        ({"ratio": True}, "damping ratio"),
+        ({"ratio": True}, "key 'chain.bending_damping.ratio': must be a number"),
         ({"ratio": [0.01, 0.02]}, "one per rod (3), got 2"),
         ({"ratio": 0.01, "c": 3.0}, "takes no other key"),
     ],

@@ -260,7 +260,7 @@ def doc_example() -> tuple[str, list[str]]:
     section = text[text.index("## Loaded equilibrium") :]
     section = section[: section.index("\n## ", 5)]
     toml = re.search(r"```toml\n# tip.toml\n(.*?)```", section, re.S)
-    command = re.search(r"\n    (rodval modes tip\.toml[^\n]*)\n", section)
+    command = re.search(r"```bash\n(rodval modes tip\.toml[^\n]*)\n```", section)
     assert toml and command, "docs/modes.md's tip.toml example not found"
     return toml.group(1), command.group(1).split()[1:]
 
