@@ -14,7 +14,17 @@ import warnings
 from collections.abc import Collection, Sequence
 
 #: Subcommand modules, in the order ``rodval --help`` lists them.
-COMMANDS = ("reproduce", "simulate", "compare", "study", "report", "bench", "modes", "animate")
+COMMANDS = (
+    "reproduce",
+    "simulate",
+    "reference",
+    "compare",
+    "study",
+    "report",
+    "bench",
+    "modes",
+    "animate",
+)
 #: Each subcommand's line in ``rodval --help``, the ``help`` its module's ``register`` gives
 #: (tests/test_startup.py checks they agree): ``rodval --help`` and ``--version`` list the
 #: subcommands without importing their modules, whose options name constants of the heavy
@@ -22,6 +32,7 @@ COMMANDS = ("reproduce", "simulate", "compare", "study", "report", "bench", "mod
 SUMMARIES = {
     "reproduce": "reproduce the paper's example (Table 1, Fig. 3, cross-check)",
     "simulate": "run one scene with one model",
+    "reference": "refine the exudyn reference until it converges, with its error bar",
     "compare": "compare two runs of the same scene",
     "study": "run a study (grid of scenes x models) and write tables and a report",
     "report": "rebuild a study's report from its saved tables",
