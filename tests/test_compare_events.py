@@ -192,7 +192,9 @@ def test_a_lock_without_a_finite_impulse_says_why_its_cells_are_blank(side):
     row = event_discrepancies(events, "ref").iloc[0]
     assert math.isnan(row["impulse_rel"])
     who = "its" if side == "model" else "the reference's"
-    assert row["not_comparable"] == f"{who} record has no finite lock impulse (a damaged run record)"
+    assert (
+        row["not_comparable"] == f"{who} record has no finite lock impulse (a damaged run record)"
+    )
 
 
 def test_the_root_jump_is_blank_once_hinge_0_is_held(tmp_path):

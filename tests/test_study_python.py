@@ -108,7 +108,7 @@ def test_study_text_holds_any_unicode_and_refuses_a_lone_surrogate():
     """A study's name in any script round-trips through study.toml; a lone surrogate (JSON
     writes it as an escape TOML readers refuse: the study could not be read back) is refused
     naming the key."""
-    doc = {"study": {"name": "café \\ \"q\" \t \u0001 \U0001f600", "description": "a\nb"}}
+    doc = {"study": {"name": 'café \\ "q" \t \u0001 \U0001f600', "description": "a\nb"}}
     assert tomllib.loads(toml_text(doc)) == doc
     with pytest.raises(ValueError, match=r"^study.name: text .* holds a lone surrogate"):
         toml_text({"study": {"name": "a\ud800"}})

@@ -146,7 +146,8 @@ def test_unhashable_names_in_files_are_refused_in_one_line(tmp_path):
     from rodval.core.scene_file import scene_from_dict
     from rodval.study.sampling import check_distribution
 
-    with pytest.raises(ValueError, match=r"key 'loads\.0\.type': must be a string \(`pulse`, .*got list \[\]"):
+    wrong_type = r"key 'loads\.0\.type': must be a string \(`pulse`, .*got list \[\]"
+    with pytest.raises(ValueError, match=wrong_type):
         scene_from_dict(
             {"based_on": "paper", "n": 2, "loads": [{"type": [], "node": 1}]}, where="s"
         )
