@@ -23,7 +23,7 @@ from rodval import Base, simulate
 from rodval.core.base import Motion
 from rodval.core.hinges import Latch, Stop
 from rodval.core.loads import NodalForce
-from rodval.core.scene import UNITS, Chain, InitialState, Scene
+from rodval.core.scene import QUANTITIES, UNITS, Chain, InitialState, Scene
 from rodval.core.settings import COMPILED_METHODS, METHODS, SCIPY_METHODS
 from rodval.study.spec import StudySpec
 
@@ -39,19 +39,10 @@ BASES = {
         },
     ),
 }
-PINNED_OUTPUTS = (
-    "phi",
-    "dphi",
-    "alpha",
-    "beta",
-    "x",
-    "y",
-    "energy",
-    "hinge_angle",
-    "hinge_moment",
-    "angular_momentum",
-    "momentum",
-)
+#: the outputs every base has: every quantity (``QUANTITIES``, the one list) but the moving
+#: bases' own, so a quantity added to rodval joins the matrix by itself
+MOVING_OUTPUTS = ("base", "drive")
+PINNED_OUTPUTS = tuple(q for q in QUANTITIES if q not in MOVING_OUTPUTS)
 #: every output each base has
 OUTPUTS = {
     "pinned": PINNED_OUTPUTS,
