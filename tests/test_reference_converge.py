@@ -22,6 +22,7 @@ from rodval.analysis.convergence import (
     quantities_of_interest,
     successive_changes,
     unconverged,
+    worst_error,
 )
 from rodval.cli import main
 
@@ -70,6 +71,9 @@ def test_order_not_shown_falls_back_to_the_last_change(changes):
     assert error == abs(changes[-1])
 
 
+TIMES = np.array([0.0, 1.0])
+
+
 def test_impulses_are_relative_to_the_finest_and_locks_matched_by_label_and_order():
     def level(t1, s1, t2):
         events = [
@@ -77,7 +81,7 @@ def test_impulses_are_relative_to_the_finest_and_locks_matched_by_label_and_orde
             {"t": 0.5, "label": "stop hinge 2", "impulse": 9.0},  # not a lock
             {"t": t2, "label": "latch hinge 1", "impulse": 1.0},
         ]
-        return quantities_of_interest(events, np.array([[0.0, 0.1], [0.2, -0.4]]))
+        return quantities_of_interest(events, TIMES, np.array([[0.0, 0.1], [0.2, -0.4]]))
 
     levels = [level(0.30, -10.0, 0.80), level(0.34, -12.0, 0.84), level(0.35, -12.5, 0.85)]
     assert set(levels[0]) == {
@@ -86,8 +90,8 @@ def test_impulses_are_relative_to_the_finest_and_locks_matched_by_label_and_orde
         "lock_t[latch hinge 1#2]",
         "lock_impulse[latch hinge 1#2]",
         "phi_times",
-        "phi_final[1]",
-        "phi_final[2]",
+        "phi_deployed[1]",
+        "phi_deployed[2]",
     }
     found = {e.name: e for e in estimates(levels)}
     assert found["lock_impulse[latch hinge 1#1]"].changes == pytest.approx((-2 / 12.5, -0.5 / 12.5))
@@ -103,9 +107,9 @@ def test_impulses_are_relative_to_the_finest_and_locks_matched_by_label_and_orde
 
 def test_a_lock_one_level_misses_is_named():
     a = quantities_of_interest(
-        [{"t": 0.3, "label": "latch hinge 1", "impulse": 1.0}], np.zeros((2, 1))
+        [{"t": 0.3, "label": "latch hinge 1", "impulse": 1.0}], TIMES, np.zeros((2, 1))
     )
-    b = quantities_of_interest([], np.zeros((2, 1)))
+    b = quantities_of_interest([], TIMES, np.zeros((2, 1)))
     assert missing_quantity([a, b]) == "lock_t[latch hinge 1#1] (not at level 1)"
     assert missing_quantity([a, a]) is None
 
@@ -210,3 +214,37 @@ def test_a_level_the_model_refuses_is_named_before_any_level_runs(tiny, tmp_path
     assert err.err.startswith("rodval reference: error: level 0 (elements ")
     assert len(err.err.strip().splitlines()) == 1
     assert not (out / "levels.csv").exists()
+
+
+def test_the_deployed_state_is_the_mean_after_the_last_lock_not_the_vibrations_phase():
+    """Two levels that ring about the same deployed angle 0.5 rad after a lock at 1 s, with a
+    phase 1 rad apart: their final angles differ by up to 2 x 0.1 sin(0.5) ~ 0.096 rad, their
+    deployed means over 0 .. 20 whole periods by round-off of the trapezoid sum (the mean of a
+    sine over whole periods sampled 400 times a period: its trapezoid error is ~1e-15 rad)."""
+    t = np.arange(8401) / 400.0  # 0 .. 21 s, 400 samples a period, 1 s on the grid
+    omega = 2 * np.pi
+
+    def level(phase):
+        ring = np.where(t >= 1.0, 0.5 + 0.1 * np.sin(omega * (t - 1.0) + phase), 3.0 - 2.5 * t)
+        events = [{"t": 1.0, "label": "latch hinge 1", "impulse": 2.0}]
+        return quantities_of_interest(events, t, ring[:, None], attitude=0.01 * ring)
+
+    a, b = level(0.0), level(1.0)
+    assert abs(a["phi_times"][-1, 0] - b["phi_times"][-1, 0]) > 0.05
+    assert a["phi_deployed[1]"] == pytest.approx(0.5, abs=1e-12)
+    assert abs(a["phi_deployed[1]"] - b["phi_deployed[1]"]) < 1e-12
+    assert a["attitude_deployed"] == pytest.approx(0.005, abs=1e-14)
+    assert a["attitude_times"].shape == (t.size,)
+    found = {e.name: e for e in estimates([a, b, b])}
+    assert found["attitude_times"].unit == found["attitude_deployed"].unit == "rad"
+    bar = error_bar(list(found.values()), phi_scale=3.0)
+    assert bar["rel"] == 0.0  # the finest two levels agree: last change 0, no order
+    assert worst_error(list(found.values()), "attitude") == 0.0
+    assert worst_error(list(found.values()), "nothing") == 0.0
+
+
+def test_without_a_lock_the_deployed_state_is_the_whole_horizons_mean():
+    t = np.linspace(0.0, 2.0, 5)
+    q = quantities_of_interest([], t, np.array([[0.0], [1.0], [2.0], [3.0], [4.0]]))
+    assert q["phi_deployed[1]"] == pytest.approx(2.0)
+    assert "attitude_times" not in q

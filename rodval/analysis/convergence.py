@@ -13,7 +13,13 @@ The quantities of interest (``quantities_of_interest``), each with its unit:
   |impulse|;
 - ``phi_times``: the chord angles at the scene's output times, rad: the change between levels
   is the largest |phi_i - phi_{i-1}| over times and rods (a norm, >= 0);
-- ``phi_final[k]``: rod k's chord angle at the last output time, rad.
+- ``phi_deployed[k]``: rod k's deployed chord angle, rad: its time mean (trapezoid) over the
+  output times from the last lock to the end (the whole horizon without a lock), the state the
+  residual vibration rings about. The instantaneous angle at the end is in ``phi_times``; its
+  change between levels mostly measures that vibration's phase, which a lock-time error of a
+  few ms shifts by a large fraction of a period (docs/reference_model.md);
+- with a free base, ``attitude_times``: the body's attitude at the output times (the change: the
+  largest over times) and ``attitude_deployed``: its time mean after the last lock, rad.
 
 Per quantity (``estimate``): the changes between successive levels; the observed order
 p = log2(|d_{i-1}| / |d_i|) where it shows (``observed_order``: at least three levels, the last
@@ -40,7 +46,14 @@ MAX_ORDER = 6.0
 #: With four or more levels, the two last ratios' orders must agree within this.
 ORDER_SPREAD = 0.5
 #: The units of the quantity groups (``quantities_of_interest``'s name prefixes).
-UNITS = {"lock_t": "s", "lock_impulse": "relative", "phi_times": "rad", "phi_final": "rad"}
+UNITS = {
+    "lock_t": "s",
+    "lock_impulse": "relative",
+    "phi_times": "rad",
+    "phi_deployed": "rad",
+    "attitude_times": "rad",
+    "attitude_deployed": "rad",
+}
 RICHARDSON = "richardson"
 LAST_CHANGE = "last change"
 
@@ -135,17 +148,42 @@ def lock_keys(events: Sequence[Mapping[str, Any]]) -> dict[str, Mapping[str, Any
     return out
 
 
-def quantities_of_interest(events: Sequence[Mapping[str, Any]], phi: np.ndarray) -> dict[str, Any]:
-    """One level's quantities of interest (module docstring) from its lock events and its
-    chord angles ``phi`` (times x rods, at the scene's output times): name -> value."""
+def deployed_mean(times: np.ndarray, values: np.ndarray, since: float) -> np.ndarray:
+    """The time mean (trapezoid) of ``values`` (times x columns) over the output times at or
+    after ``since`` (s): the deployed state after the last lock. With fewer than two such
+    times, the values at the last time."""
+    times, values = np.asarray(times, float), np.asarray(values, float)
+    keep = times >= since
+    if keep.sum() < 2:
+        return values[-1]
+    t, v = times[keep], values[keep]
+    dt = np.diff(t).reshape(-1, *([1] * (v.ndim - 1)))
+    return np.sum(0.5 * (v[1:] + v[:-1]) * dt, axis=0) / (t[-1] - t[0])
+
+
+def quantities_of_interest(
+    events: Sequence[Mapping[str, Any]],
+    times: np.ndarray,
+    phi: np.ndarray,
+    attitude: np.ndarray | None = None,
+) -> dict[str, Any]:
+    """One level's quantities of interest (module docstring) from its lock events, its output
+    ``times`` (s), chord angles ``phi`` (times x rods, rad) and, with a free base, the body's
+    ``attitude`` (rad, one per time): name -> value."""
     out: dict[str, Any] = {}
-    for key, ev in lock_keys(events).items():
+    locks = lock_keys(events)
+    for key, ev in locks.items():
         out[f"lock_t[{key}]"] = float(ev["t"])
         out[f"lock_impulse[{key}]"] = float(ev["impulse"])
+    since = max((float(ev["t"]) for ev in locks.values()), default=float(times[0]))
     phi = np.asarray(phi, float)
     out["phi_times"] = phi
-    for k, value in enumerate(phi[-1], start=1):
-        out[f"phi_final[{k}]"] = float(value)
+    for k, value in enumerate(deployed_mean(times, phi, since), start=1):
+        out[f"phi_deployed[{k}]"] = float(value)
+    if attitude is not None:
+        theta = np.asarray(attitude, float).reshape(-1)
+        out["attitude_times"] = theta
+        out["attitude_deployed"] = float(deployed_mean(times, theta[:, None], since)[0])
     return out
 
 
@@ -182,16 +220,18 @@ def unconverged(found: Sequence[Estimate], tol: float) -> Estimate | None:
 def error_bar(found: Sequence[Estimate], phi_scale: float) -> dict[str, float]:
     """The reference's error bar with the keys of a study's ``[agreement] reference_error``
     (``rodval.study.case.agreement_spec``): ``rel``: the largest angle error (phi_times,
-    phi_final; rad) over ``phi_scale`` (max |phi| of the finest level, the scale of
+    phi_deployed; rad) over ``phi_scale`` (max |phi| of the finest level, the scale of
     ``rodval.analysis.agreement.gap_series``); ``lock_dt``: the largest lock-time error, s;
     ``impulse_rel``: the largest relative impulse error. 0 for a group with no quantity."""
-
-    def worst(prefix: str) -> float:
-        return max((e.error for e in found if e.name.startswith(prefix)), default=0.0)
-
-    angle = max(worst("phi_times"), worst("phi_final"))
+    angle = max(worst_error(found, "phi_times"), worst_error(found, "phi_deployed"))
     return {
         "rel": angle / phi_scale if phi_scale > 0 else 0.0,
-        "lock_dt": worst("lock_t["),
-        "impulse_rel": worst("lock_impulse["),
+        "lock_dt": worst_error(found, "lock_t["),
+        "impulse_rel": worst_error(found, "lock_impulse["),
     }
+
+
+def worst_error(found: Sequence[Estimate], prefix: str) -> float:
+    """The largest estimated error among the quantities whose name starts with ``prefix`` (in
+    their unit), 0 when there is none."""
+    return max((e.error for e in found if e.name.startswith(prefix)), default=0.0)

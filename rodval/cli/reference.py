@@ -39,14 +39,16 @@ def register(sub) -> None:
         description="Run SCENE ('paper' or a TOML scene file) with the exudyn model at levels "
         "i = 0, 1, ...: elements E0 * 2**i per rod and step H0 / 2**i, until every quantity "
         "of interest (each lock's time, s, and impulse, relative; the chord angles at the "
-        "scene's output times and at its end, rad) has an estimated error below TOL after at "
+        "scene's output times and their mean after the last lock, the deployed state, rad; on "
+        "a free base the body's attitude the same way) has an estimated error below TOL after at "
         "least three levels, or --levels levels ran. The error of the finest level is "
         "Richardson's |d| / (2**p - 1) where the observed order p shows, else the last change "
         "|d| (rodval.analysis.convergence). Writes DIR/levels.csv (one row per level) and "
         "DIR/reference.json (the finest level's settings and its error bar, whose "
         "reference_error a study's [agreement] takes as it is). Exit 0 converged, 1 not "
         "converged (naming the quantity), 2 bad input. DIR must be new, empty or an output "
-        "folder of rodval reference (refused before any work otherwise).",
+        "folder of rodval reference (refused before any work otherwise). The levels record the "
+        "outputs phi, energy (its audit is part of the verdict) and base only.",
     )
     p.add_argument("scene", metavar="SCENE", help="'paper' or a TOML scene file")
     p.add_argument(
@@ -78,6 +80,15 @@ def register(sub) -> None:
     )
     # DIR is claimed before any work and marked rodval's (rodval.cli._run, out_paths)
     p.set_defaults(func=run, out_folder="reference")
+
+
+def with_qoi_outputs(scene: Any) -> Any:
+    """``scene`` with the outputs the levels need and no others: "phi" (the quantities of
+    interest), "energy" (its audit, part of every level's verdict) and, on a free base, "base"
+    (the body's attitude). The command writes no trajectory, so the scene's other outputs
+    would only cost memory (exudyn records every step of each)."""
+    need = ("phi", "energy", "base") if scene.base.kind == "free" else ("phi", "energy")
+    return scene.with_(outputs=need)
 
 
 def plan(scene: Any, levels: int, elements: int | None, step: float | None) -> list[Any]:
@@ -127,7 +138,8 @@ def run_level(scene: Any, model: Any) -> dict[str, Any]:
             f"the run failed at t = {tr.times[-1] if tr.times.size else 0:g} s: {tr.stats.message}"
         )
         return row
-    row["qoi"] = quantities_of_interest(tr.events, tr["phi"])
+    attitude = tr["base_attitude"] if scene.base.kind == "free" else None
+    row["qoi"] = quantities_of_interest(tr.events, tr.times, tr["phi"], attitude)
     return row
 
 
@@ -184,15 +196,17 @@ def level_line(i: int, row: dict[str, Any]) -> str:
 
 def levels_table(rows: list[dict[str, Any]]) -> str:
     """levels.csv: level, elements, step, wall_s, verdict, then every scalar quantity's value
-    and phi_times_change (rad: largest change of the chord angles from the level before)."""
+    and phi_times_change (rad: largest change of the chord angles from the level before; with
+    a free base attitude_times_change, the body's attitude's)."""
     import pandas as pd
 
     records = []
     for i, row in enumerate(rows):
         rec = {"level": i, **{k: row[k] for k in ("elements", "step", "wall_s", "verdict")}}
         qoi = row.get("qoi", {})
-        rec.update({k: v for k, v in qoi.items() if k != "phi_times"})
-        rec["phi_times_change"] = row.get("changes", {}).get("phi_times")
+        rec.update({k: v for k, v in qoi.items() if not k.endswith("_times")})
+        for name in (k for k in qoi if k.endswith("_times")):
+            rec[f"{name}_change"] = row.get("changes", {}).get(name)
         records.append(rec)
     return pd.DataFrame.from_records(records).to_csv(index=False, float_format="%.10g")
 
@@ -202,7 +216,7 @@ def reference_record(scene_name: str, tol: float, rows: list, found: list, why: 
     the error bar as a study's [agreement] reference_error."""
     import numpy as np
 
-    from rodval.analysis.convergence import error_bar
+    from rodval.analysis.convergence import error_bar, worst_error
 
     done = [r for r in rows if "qoi" in r]
     finest = done[-1] if done else rows[-1]
@@ -218,6 +232,11 @@ def reference_record(scene_name: str, tol: float, rows: list, found: list, why: 
         "finest": {"elements": finest["elements"], "step": finest["step"]},
         "phi_scale_rad": scale,
         "reference_error": bar,
+        "attitude_error_rad": (
+            max(worst_error(found, "attitude_times"), worst_error(found, "attitude_deployed"))
+            if any(e.name.startswith("attitude") for e in found)
+            else None
+        ),
         "agreement_toml": "reference_error = { "
         + ", ".join(f"{k} = {v:.3g}" for k, v in bar.items())
         + " }",
@@ -239,7 +258,7 @@ def run(args) -> int:
     from rodval.core.out_paths import clear_previous, write_file
     from rodval.core.scene_file import load_scene
 
-    scene = load_scene(args.scene)
+    scene = with_qoi_outputs(load_scene(args.scene))
     models = plan(scene, args.levels, args.elements, args.step)
     rows, found, why = refine(scene, models, args.converge)
     record = reference_record(str(args.scene), args.converge, rows, found, why)
@@ -251,5 +270,7 @@ def run(args) -> int:
         f"error bar ({verdict}): {record['agreement_toml']} (levels {len(rows)}, finest "
         f"elements {record['finest']['elements']}, step {record['finest']['step']:g} s)"
     )
+    if record["attitude_error_rad"] is not None:
+        print(f"the body's attitude: error {record['attitude_error_rad']:.3g} rad")
     print(f"-> {args.out / 'reference.json'}")
     return 0 if why is None else 1
