@@ -232,3 +232,22 @@ def test_a_sampled_study_report_does_not_grow_with_its_samples(tmp_path):
         sizes[count] = len(reports[count].splitlines())
     assert sizes[16] <= sizes[4] + 2, sizes
     assert "## Answer" in reports[16] and "valid in" in reports[16]
+
+
+def test_a_long_value_table_is_a_link_a_short_one_is_printed(study_dir):
+    """The report cases' values at the report times: printed when short, else linked to
+    trajectories.md (the same table) and trajectories.csv, both in the study folder."""
+    import pandas as pd
+
+    from rodval.report.study_figures import INLINE_VALUE_ROWS, values_at_report_times
+
+    short = pd.DataFrame({"quantity": ["phi"] * 3, "k": [1, 1, 1], "t": [0.0, 0.1, 0.2]})
+    assert "| phi" in "\n".join(values_at_report_times(short))
+    long = pd.concat([short] * (INLINE_VALUE_ROWS // 3 + 1), ignore_index=True)
+    (line,) = values_at_report_times(long)
+    assert f"{len(long)} rows" in line and "(trajectories.md)" in line
+    assert "(trajectories.csv)" in line and "| phi" not in line
+    assert values_at_report_times(short.iloc[:0]) == []
+    report = (study_dir / "report.md").read_text()
+    for name in re.findall(r"\]\((trajectories\.(?:md|csv))\)", report):
+        assert (study_dir / name).is_file(), name

@@ -111,10 +111,27 @@ def case_figures(fig_dir: Path, meta: dict[str, Any], tables: dict[str, pd.DataF
     for cid in meta["report"]["cases"]:
         row = cases[cases["case"] == cid].iloc[0]
         lines += _one_case_figures(fig_dir, meta, traj[traj["case"] == cid], row, cid)
-    samples = trajectory_samples(traj, meta, cases)
-    if not samples.empty:
-        lines += ["Values at the report times (rad, rad/s):\n", to_markdown(samples, ".6g")]
-    return lines
+    return [*lines, *values_at_report_times(trajectory_samples(traj, meta, cases))]
+
+
+#: A value table of at most this many rows is printed in the report; a longer one is linked.
+INLINE_VALUE_ROWS = 24
+
+
+def values_at_report_times(samples: pd.DataFrame) -> list[str]:
+    """The report cases' values at the report times (``trajectory_samples``): the table itself
+    when it has at most INLINE_VALUE_ROWS rows, else a link to ``trajectories.md``, where the
+    study writes the same table (``rodval.study.tables.write_tables``), and to
+    ``trajectories.csv`` (markdown lines)."""
+    if samples.empty:
+        return []
+    if len(samples) <= INLINE_VALUE_ROWS:
+        return ["Values at the report times (rad, rad/s):\n", to_markdown(samples, ".6g")]
+    return [
+        f"Values at the report times (rad, rad/s; {len(samples)} rows, one column per model): "
+        "[`trajectories.md`](trajectories.md); every output time in "
+        "[`trajectories.csv`](trajectories.csv).\n"
+    ]
 
 
 def _one_case_figures(
