@@ -92,6 +92,20 @@ def ladder_constants(chain: Chain, p: int, exact: bool) -> np.ndarray:
     return np.ascontiguousarray(V)
 
 
+def rigid_constants(chain: Chain) -> np.ndarray:
+    """The kernels' V of the rigid chain: the paper's rung (``ladder_constants(chain, 1,
+    False)``) with zero bending mobility, the limit EI -> inf of every rung. The bending
+    blocks (a, b, P, P^-1, K, C) and the Schur constants (V_EPS .. V_TAU) are zero, so
+    ``ladder_solve`` leaves the Schur complement M_pp(phi) (the rigid rods' mass matrix with
+    their far nodes) and gives every bending acceleration exactly 0: bending coordinates at
+    rest stay at rest, D_k = phi_k - phi_{k-1} and the kernels are the rigid chain's.
+    ``rigid_kernels`` runs them on the rigid state [phi; phi']. O(n)."""
+    V = ladder_constants(chain, 1, False)
+    V[[V_EPS, V_PI, V_RHO, V_TAU]] = 0.0
+    V[LV_SHAPES:] = 0.0
+    return V
+
+
 def ladder_mass_matrix(chain: Chain, p: int, exact: bool, q: np.ndarray) -> np.ndarray:
     """M(q) (N, N) of a rung, dense (for the modal analysis; O(N^2)): the paper's M(phi) on
     [phi; alpha; beta], the bubbles' couplings (l_j c_kj a_k to the inboard phi_j, b_k to

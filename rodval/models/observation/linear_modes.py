@@ -342,7 +342,7 @@ def natural_frequencies(
 
 
 # -- modes --------------------------------------------------------------------------------------
-def _shapes(
+def node_shapes(
     chain: Chain,
     model: str,
     phi0: np.ndarray,
@@ -474,7 +474,7 @@ def modes_about(
     zeta = damping_ratios(M, C, K, X, omega)
     X = X if Z is None else Z @ X
     # node displacements and hinge angles need phi, alpha, beta only (bubbles: zero at the ends)
-    dx, dy, hinge = _shapes(
+    dx, dy, hinge = node_shapes(
         chain, model, q0[:n], X[: 3 * n], lam, coefficients=coefficients, recover=recover
     )
     return Modes(

@@ -1,6 +1,6 @@
 """Models by name, and the entry point: scene + model + integrator settings -> Trajectory.
 
-Native models: ``full``, ``reduced``; reference models (``reference_models``) are imported by
+Native models: ``full``, ``reduced``, ``rigid``; reference models (``reference_models``) are imported by
 name only when asked for, so the models layer does not depend on them.
 """
 
@@ -19,6 +19,7 @@ from rodval.core.trajectory import Trajectory
 REGISTRY: dict[str, str] = {
     "full": "rodval.models.presets.full:FullModel",
     "reduced": "rodval.models.presets.reduced:ReducedModel",
+    "rigid": "rodval.models.presets.rigid:RigidModel",
     "exudyn": "reference_models.exudyn_chain:ExudynModel",
 }
 

@@ -1,0 +1,131 @@
+"""Compiled kernels of the rigid chain (``rodval.models.kinematics.rigid``): the ladder's kernels
+(``ladder_kernels``) on the rigid constants (``ladder.rigid_constants``: zero bending mobility,
+the limit EI -> inf of every rung), run on the rigid state.
+
+The rigid state is y = [phi (n); body (b); phi' (n); body' (b)] (b = 0 on a pinned base, the
+free body's x_c, y_c, theta otherwise): n + b coordinates, the ODE the integrator sees. Each
+kernel here places it into the ladder's layout [phi; alpha; beta; body; rates] with the
+bending coordinates zero (``to_ladder``), runs the ladder's kernel, and takes the rigid
+coordinates back (``from_ladder``). With zero mobility the ladder's bending accelerations are
+exactly 0, so the bending coordinates the ladder sees stay zero, and nothing of the rigid
+chain's equations is written twice: M_pp(phi) phi'' = Q - G_pp phi'^2 - A^T (kappa (D - rest)
++ nu D'), D_k = phi_k - phi_{k-1}, with every lock, stop and base of the ladder.
+Cost: the ladder's O(n) evaluation on 3 n coordinates plus two copies of the state.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from rodval.models.assembly.kernels import rhs_head
+from rodval.models.hinge_items.deployment import hinge_events, locked_head
+from rodval.models.kinematics.ladder_kernels import (
+    ladder_accel,
+    ladder_accel_locked,
+    ladder_mechanics,
+    ladder_unit_responses,
+)
+
+
+@njit(cache=True)
+def to_ladder(y, n):
+    """The ladder's state [phi; 0 (2 n); body; phi'; 0 (2 n); body'] of a rigid state y =
+    [phi; body; phi'; body'] (``n`` rods, ``b`` = len(y) / 2 - n body coordinates)."""
+    half = y.shape[0] // 2
+    N = half + 2 * n
+    z = np.zeros(2 * N)
+    z[:n] = y[:n]
+    z[3 * n : N] = y[n:half]
+    z[N : N + n] = y[half : half + n]
+    z[N + 3 * n :] = y[half + n :]
+    return z
+
+
+@njit(cache=True)
+def positions_to_ladder(q, n):
+    """The ladder's coordinates [phi; 0 (2 n); body] of rigid coordinates q = [phi; body]."""
+    z = np.zeros(q.shape[0] + 2 * n)
+    z[:n] = q[:n]
+    z[3 * n :] = q[n:]
+    return z
+
+
+@njit(cache=True)
+def from_ladder(z, n, out):
+    """out = [z_phi; z_body] (rigid coordinates) of a ladder coordinate vector z = [phi;
+    alpha; beta; body] (its bending part dropped: zero for the rigid constants)."""
+    out[:n] = z[:n]
+    out[n:] = z[3 * n :]
+
+
+@njit(cache=True)
+def state_from_ladder(z, n, out):
+    """out = the rigid state of a ladder state (``from_ladder`` on each half)."""
+    N = z.shape[0] // 2
+    half = out.shape[0] // 2
+    from_ladder(z[:N], n, out[:half])
+    from_ladder(z[N:], n, out[half:])
+
+
+@njit(cache=True)
+def rigid_accel(V, y, has_load, SX, SY, damped, out):
+    """phi'' (n) of the pinned rigid chain at y = [phi; phi'] into ``out`` (``ladder_accel``
+    on ``rigid_constants``); O(n)."""
+    n = V.shape[1]
+    acc = np.empty(3 * n)
+    ladder_accel(V, to_ladder(y, n), has_load, SX, SY, damped, acc)
+    out[:] = acc[:n]
+
+
+@njit(cache=True)
+def rigid_unit_responses(V, q, locks, U):
+    """U[j] = M_pp(phi)^-1 a_{locks[j]} (n each, a_k = dD_k/dphi); only phi = q[:n] is read.
+    O(n) per hinge."""
+    n = V.shape[1]
+    Uz = np.empty((locks.shape[0], 3 * n))
+    ladder_unit_responses(V, positions_to_ladder(q[:n], n), locks, Uz)
+    for j in range(locks.shape[0]):
+        U[j, :] = Uz[j, :n]
+
+
+@njit(cache=True)
+def rigid_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
+    """phi'' (n) with the hinges ``locks`` held (D_k'' = 0) into ``out``, their multipliers
+    (N m) into ``lam`` (``ladder_accel_locked``); O(n m)."""
+    n = V.shape[1]
+    acc = np.empty(3 * n)
+    ladder_accel_locked(V, to_ladder(y, n), has_load, SX, SY, damped, locks, acc, lam)
+    out[:] = acc[:n]
+
+
+@njit(cache=True)
+def rigid_rhs(t, y, P, S, M, L, out):
+    """y' of the pinned rigid chain (compiled integrators' right-hand side)."""
+    n = P.shape[1]
+    SX = np.empty(n)
+    SY = np.empty(n)
+    has_load = rhs_head(t, y, L, SX, SY, out)
+    rigid_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[n:])
+
+
+@njit(cache=True)
+def rigid_rhs_locked(t, y, P, S, M, L, out):
+    """y' of the pinned rigid chain with the hinges of S held (``deployment.lock_scalars``)."""
+    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
+    rigid_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[P.shape[1] :], lam)
+
+
+@njit(cache=True)
+def rigid_mechanics(t, y, P, S, M, L, out):
+    """(T, P_ext, P_diss) of the pinned rigid chain into out[:3] (``ladder_mechanics``): T =
+    1/2 phi'^T M_pp phi' (J), the loads' power (W), the hinge dampers' sum nu (dD/dt)^2 (W)."""
+    ladder_mechanics(t, to_ladder(y, P.shape[1]), P, S, M, L, out)
+
+
+@njit(cache=True)
+def rigid_hinge_events(t, y, P, S, M, L, E, out):
+    """Latch and stop events g = D_k - angle, D_k = phi_k - phi_{k-1} (rad); O(rows)."""
+    n = P.shape[1]
+    zero = np.zeros(n)
+    hinge_events(y[:n], zero, zero, E, out)
