@@ -14,7 +14,10 @@ from rodval.analysis.agreement import (
     agreement_horizon,
     agreement_table,
     cause,
+    deployed_gap,
     gap_series,
+    lock_order,
+    locks_within,
     parting_lock,
     twin_parts_as_much,
 )
@@ -226,3 +229,42 @@ def test_a_study_with_a_twin_runs_it_and_its_report_opens_with_the_answer(tmp_pa
     assert list(runtime["model"]) == ["full", "reduced", "full twin"]
     answer = report.split("## Study")[0]
     assert "`reduced`" in answer and "agrees with `full` until" in answer
+
+
+def test_beyond_the_horizon_lock_order_locks_within_and_the_deployed_state():
+    """Past its horizon a model is still judged lock by lock and on its deployed state: the
+    model of ``_tables`` keeps the reference's lock order, misses hinge 1's bound by 0.3 s and
+    ends 0.9 rad off on rod 2 (b = 2 + 3 (t - 1 - shift) after t = 1 s: 3 x 0.3 rad at every
+    time after the later last lock); the twin (1e-7 s) is within 3e-7 rad."""
+    ref = [("latch hinge 2", 0.4), ("latch hinge 1", 1.0)]
+    assert lock_order(ref, ref) == "same"
+    assert (
+        lock_order(ref[::-1], ref) == "lock 1: latch hinge 1 where the reference has latch hinge 2"
+    )
+    assert lock_order(ref[:1], ref) == "1 locks, the reference 2"
+    assert locks_within([("latch hinge 2", 0.4005), ("latch hinge 1", 1.3)], ref, 1e-3) == "1/2"
+    assert locks_within(ref[::-1], ref, 1.0) == "0/2"
+    traj, events, runtime = _tables(twin_shift=1e-7)
+    settings = AgreementSettings(reference_rel=0.01)
+    table = agreement_table(traj, events, runtime, "ref", settings).set_index("model")
+    m, twin = table.loc["m"], table.loc["ref twin"]
+    assert (m["lock_order"], m["locks_within"]) == ("same", f"{len(REF) - 1}/{len(REF)}")
+    assert m["deployed_gap"] == pytest.approx(0.9, rel=1e-9)
+    assert twin["deployed_gap"] == pytest.approx(3e-7, rel=1e-6)
+    scale = np.max(np.abs(_phi()))
+    assert m["deployed_band"] == pytest.approx(0.01 * scale)
+    assert math.isnan(m["attitude_gap"])  # no free base
+
+
+def test_deployed_gap_needs_output_after_the_last_lock():
+    t = np.linspace(0.0, 1.0, 11)
+    v = np.zeros((11, 1))
+    assert math.isnan(deployed_gap((t, t), (v, v + 1.0), since=2.0))
+    assert deployed_gap((t, t), (v, v + 1.0), since=0.5) == pytest.approx(1.0)
+
+
+def test_the_reference_error_bar_takes_a_free_bases_attitude():
+    from rodval.study.case import agreement_spec
+
+    spec = agreement_spec({"reference_error": {"attitude": 2e-3, "lock_dt": 1e-3}}, "s.toml")
+    assert AgreementSettings.from_dict(spec).reference_attitude == 2e-3

@@ -20,6 +20,15 @@ Definitions (one place; the report and docs/deployment.md quote them):
 * **predictability horizon**: the agreement horizon of the reference's twin (the reference
   run again on the scene with one initial chord angle moved by a perturbation far below the
   tolerance) against the reference.
+* **beyond the horizon** (what stays meaningful once the trajectories part): the lock order
+  (``lock_order``: "same", or the first lock where the model's sequence of lock labels
+  differs from the reference's); how many of the reference's locks the model reaches in
+  order within lock_dt + e_dt (``locks_within``, "k/N"); the **deployed state**: each run's
+  chord angles (and a free base's attitude) averaged over the output times after the later
+  of the two runs' last locks (``rodval.analysis.convergence.deployed_mean``, the definition
+  ``rodval reference`` converges), and their largest difference, rad (``deployed_gap``;
+  ``attitude_gap``), against the reference's band: e_ref x the scale for the angles, the
+  reference's ``attitude`` error bar for the attitude.
 * **cause** of a model's parting, measured: (a) ``out of domain``: the model's own verdict
   on its run broke one of its checks (its ``invalid_because``); (b) ``unpredictable``: the
   twin parts as much: at the model's parting lock the twin's |dt| is at least
@@ -42,6 +51,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from rodval.analysis.convergence import deployed_mean
 from rodval.analysis.events import COMPARABLE_DT_S, is_lock, lock_comparison
 
 #: Default tolerance of the agreement horizon: a fraction of each watched quantity's scale.
@@ -64,8 +74,8 @@ class AgreementSettings:
     """A study's [agreement] settings (``tol``: fraction of the scale; ``quantities``: the
     watched ones; ``lock_dt``: s; ``reference_rel``, ``reference_dt``, ``reference_impulse``:
     the reference's own error bars (fraction of the scale, s, fraction of |S_ref|), 0 when
-    the study gives none; ``twin``: the twin's perturbation {"rod": k, "angle": rad} or
-    None)."""
+    the study gives none; ``reference_attitude``: rad, a free base's attitude; ``twin``: the
+    twin's perturbation {"rod": k, "angle": rad} or None)."""
 
     tol: float = DEFAULT_TOL
     quantities: tuple[str, ...] = DEFAULT_QUANTITIES
@@ -73,6 +83,7 @@ class AgreementSettings:
     reference_rel: float = 0.0
     reference_dt: float = 0.0
     reference_impulse: float = 0.0
+    reference_attitude: float = 0.0
     twin: Mapping[str, Any] | None = None
 
     @classmethod
@@ -87,6 +98,7 @@ class AgreementSettings:
             reference_rel=float(ref.get("rel", 0.0)),
             reference_dt=float(ref.get("lock_dt", 0.0)),
             reference_impulse=float(ref.get("impulse_rel", 0.0)),
+            reference_attitude=float(ref.get("attitude", 0.0)),
             twin=d.get("twin"),
         )
 
@@ -146,6 +158,44 @@ def parting_lock(
         label, _ = model[len(ref)]
         return {"label": label, "dt": math.nan, "why": "a lock the reference lacks"}
     return None
+
+
+def lock_order(model: Sequence[tuple[str, float]], ref: Sequence[tuple[str, float]]) -> str:
+    """ "same" when the model's locks carry the reference's labels in the reference's order
+    (both (label, t) in time order), else the first differing position in words."""
+    for i, ((label, _), (own, _)) in enumerate(zip(ref, model)):
+        if own != label:
+            return f"lock {i + 1}: {own} where the reference has {label}"
+    if len(model) != len(ref):
+        return f"{len(model)} locks, the reference {len(ref)}"
+    return "same"
+
+
+def locks_within(
+    model: Sequence[tuple[str, float]], ref: Sequence[tuple[str, float]], tol_dt: float
+) -> str:
+    """ "k/N": of the reference's N locks, how many the model reaches at the same position in
+    its lock order and within ``tol_dt`` s."""
+    hits = sum(
+        1
+        for (label, t_ref), (own, t) in zip(ref, model)
+        if own == label and abs(t - t_ref) <= tol_dt
+    )
+    return f"{hits}/{len(ref)}"
+
+
+def deployed_gap(
+    times: tuple[np.ndarray, np.ndarray],
+    values: tuple[np.ndarray, np.ndarray],
+    since: float,
+) -> float:
+    """The largest difference (the values' unit) between the model's and the reference's
+    deployed states: ``deployed_mean`` of each run's (nt, nk) ``values`` over its output
+    ``times`` at or after ``since`` (s); nan when either run has no output time there."""
+    (t_m, t_r), (v_m, v_r) = times, values
+    if not (t_m >= since).any() or not (t_r >= since).any():
+        return math.nan
+    return float(np.max(np.abs(deployed_mean(t_m, v_m, since) - deployed_mean(t_r, v_r, since))))
 
 
 def twin_parts_as_much(
@@ -294,6 +344,12 @@ AGREEMENT_COLUMNS = (
     "worst_dt_lock",
     "worst_impulse_rel",
     "worst_impulse_lock",
+    "lock_order",
+    "locks_within",
+    "deployed_gap",
+    "deployed_band",
+    "attitude_gap",
+    "attitude_band",
     "wall_s",
 )
 
@@ -366,9 +422,9 @@ def _pair_columns(
     model, case = row["model"], row["case"]
     t_h, q, t_end = pair_horizon(runs[model], runs[reference], settings)
     ref_locks = lock_list(events, case, reference)
-    part = parting_lock(
-        lock_list(events, case, model), ref_locks, settings.lock_dt + settings.reference_dt
-    )
+    own_locks = lock_list(events, case, model)
+    tol_dt = settings.lock_dt + settings.reference_dt
+    part = parting_lock(own_locks, ref_locks, tol_dt)
     return {
         "horizon": math.nan if t_h is None else t_h,
         "horizon_quantity": q or "",
@@ -378,7 +434,37 @@ def _pair_columns(
         "part_why": "" if part is None else part["why"],
         "_part": part,
         **worst_gaps(events, model, reference, case),
+        "lock_order": lock_order(own_locks, ref_locks) if ref_locks or own_locks else "",
+        "locks_within": locks_within(own_locks, ref_locks, tol_dt) if ref_locks else "",
+        **_deployed_columns(runs[model], runs[reference], own_locks, ref_locks, settings),
     }
+
+
+def _deployed_columns(
+    run: pd.DataFrame,
+    ref: pd.DataFrame,
+    own_locks: Sequence[tuple[str, float]],
+    ref_locks: Sequence[tuple[str, float]],
+    settings: AgreementSettings,
+) -> dict[str, float]:
+    """``deployed_gap`` (chord angles, rad) and ``attitude_gap`` (a free base's attitude,
+    rad; nan without it) of one run against the reference's, after the later last lock, and
+    the reference's bands: ``deployed_band`` = reference_rel x max |phi_ref| (rad; the scale
+    of ``gap_series``), ``attitude_band`` = reference_attitude (rad)."""
+    since = max((t for _, t in [*own_locks, *ref_locks]), default=0.0)
+    _, phi_ref = run_arrays(ref, ("phi",))
+    scale = float(np.max(np.abs(phi_ref["phi"]))) if "phi" in phi_ref else math.nan
+    out = {
+        "deployed_band": settings.reference_rel * scale,
+        "attitude_band": settings.reference_attitude,
+    }
+    for column, q in (("deployed_gap", "phi"), ("attitude_gap", "base_attitude")):
+        t_m, v_m = run_arrays(run, (q,))
+        t_r, v_r = run_arrays(ref, (q,))
+        out[column] = (
+            deployed_gap((t_m, t_r), (v_m[q], v_r[q]), since) if q in v_m and q in v_r else math.nan
+        )
+    return out
 
 
 def agreement_table(

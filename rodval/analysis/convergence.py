@@ -222,13 +222,18 @@ def error_bar(found: Sequence[Estimate], phi_scale: float) -> dict[str, float]:
     (``rodval.study.case.agreement_spec``): ``rel``: the largest angle error (phi_times,
     phi_deployed; rad) over ``phi_scale`` (max |phi| of the finest level, the scale of
     ``rodval.analysis.agreement.gap_series``); ``lock_dt``: the largest lock-time error, s;
-    ``impulse_rel``: the largest relative impulse error. 0 for a group with no quantity."""
+    ``impulse_rel``: the largest relative impulse error; with a free base's quantities,
+    ``attitude``: the largest error of the body's attitude (attitude_times,
+    attitude_deployed; rad). 0 for a group with no quantity."""
     angle = max(worst_error(found, "phi_times"), worst_error(found, "phi_deployed"))
-    return {
+    bar = {
         "rel": angle / phi_scale if phi_scale > 0 else 0.0,
         "lock_dt": worst_error(found, "lock_t["),
         "impulse_rel": worst_error(found, "lock_impulse["),
     }
+    if any(e.name.startswith("attitude") for e in found):
+        bar["attitude"] = worst_error(found, "attitude")
+    return bar
 
 
 def worst_error(found: Sequence[Estimate], prefix: str) -> float:

@@ -216,7 +216,7 @@ def reference_record(scene_name: str, tol: float, rows: list, found: list, why: 
     the error bar as a study's [agreement] reference_error."""
     import numpy as np
 
-    from rodval.analysis.convergence import error_bar, worst_error
+    from rodval.analysis.convergence import error_bar
 
     done = [r for r in rows if "qoi" in r]
     finest = done[-1] if done else rows[-1]
@@ -232,11 +232,6 @@ def reference_record(scene_name: str, tol: float, rows: list, found: list, why: 
         "finest": {"elements": finest["elements"], "step": finest["step"]},
         "phi_scale_rad": scale,
         "reference_error": bar,
-        "attitude_error_rad": (
-            max(worst_error(found, "attitude_times"), worst_error(found, "attitude_deployed"))
-            if any(e.name.startswith("attitude") for e in found)
-            else None
-        ),
         "agreement_toml": "reference_error = { "
         + ", ".join(f"{k} = {v:.3g}" for k, v in bar.items())
         + " }",
@@ -270,7 +265,5 @@ def run(args) -> int:
         f"error bar ({verdict}): {record['agreement_toml']} (levels {len(rows)}, finest "
         f"elements {record['finest']['elements']}, step {record['finest']['step']:g} s)"
     )
-    if record["attitude_error_rad"] is not None:
-        print(f"the body's attitude: error {record['attitude_error_rad']:.3g} rad")
     print(f"-> {args.out / 'reference.json'}")
     return 0 if why is None else 1

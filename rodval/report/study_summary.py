@@ -371,6 +371,34 @@ def _worst(row: pd.Series) -> tuple[str, str]:
     return dt, imp
 
 
+def _beyond(row: pd.Series) -> str:
+    """What stays meaningful beyond the horizon, in words: the lock order, the locks within
+    the lock-time bound, the deployed state's gaps against the reference's bands (rad)."""
+    parts = []
+    order = row.get("lock_order")
+    if _filled(order):
+        parts.append("lock order the same" if order == "same" else f"lock order differs ({order})")
+    if _filled(row.get("locks_within")):
+        parts.append(f"{row['locks_within']} locks within the lock-time bound")
+    for gap, band, name in (
+        ("deployed_gap", "deployed_band", "deployed angles"),
+        ("attitude_gap", "attitude_band", "deployed attitude"),
+    ):
+        if pd.notna(row.get(gap)):
+            within = (
+                f" (band {row[band]:.2g} rad: {'within' if row[gap] <= row[band] else 'outside'})"
+                if pd.notna(row.get(band)) and row[band] > 0
+                else ""
+            )
+            parts.append(f"{name} {row[gap]:.2g} rad off{within}")
+    return "; ".join(parts)
+
+
+def _filled(value: Any) -> bool:
+    """Whether a text cell holds text."""
+    return isinstance(value, str) and bool(value)
+
+
 def _answer_rows(table: pd.DataFrame, settings: AgreementSettings) -> pd.DataFrame:
     """The short table: one row per case and run."""
     rows = []
@@ -386,6 +414,7 @@ def _answer_rows(table: pd.DataFrame, settings: AgreementSettings) -> pd.DataFra
                 "cause": row["cause"] if isinstance(row["cause"], str) else "",
                 "worst lock dt": dt,
                 "worst impulse gap": imp,
+                "beyond the horizon": "" if row["role"] == "reference" else _beyond(row),
                 "run time": f"{row['wall_s']:.3g} s",
             }
         )
@@ -426,6 +455,9 @@ def _sentences(table: pd.DataFrame, ref: str, settings: AgreementSettings) -> li
         dt, imp = _worst(row)
         if dt:
             text += f"; worst lock-time gap {dt}, impulse gap {imp or 'n/a'}"
+        beyond = _beyond(row)
+        if beyond and (parts != "none" or not pd.isna(row["horizon"])):
+            text += f"; beyond: {beyond}"
         out.append(f"{text}; run time {row['wall_s']:.3g} s.")
     return out
 

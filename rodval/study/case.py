@@ -24,7 +24,7 @@ from rodval.study.model_specs import ModelSpec, model_specs
 
 MODES_KEYS = {"count", "about", "load_at", "allow_unbalanced"}
 AGREEMENT_KEYS = {"tol", "quantities", "lock_dt", "reference_error", "twin"}
-REFERENCE_ERROR_KEYS = {"rel", "lock_dt", "impulse_rel"}
+REFERENCE_ERROR_KEYS = {"rel", "lock_dt", "impulse_rel", "attitude"}
 TWIN_KEYS = {"rod", "angle"}
 #: Largest twin perturbation (rad): far below any tolerance of the agreement horizon.
 MAX_TWIN_ANGLE = 1e-3
@@ -215,7 +215,8 @@ def agreement_spec(table: Any, where: str) -> dict[str, Any]:
     docs/deployment.md): ``tol`` in (0, 1) (fraction of each watched quantity's scale,
     default DEFAULT_TOL), ``quantities`` (non-empty list of output quantities, default
     DEFAULT_QUANTITIES), ``lock_dt`` > 0 s (default COMPARABLE_DT_S), ``reference_error``
-    (the reference's own error bars, each >= 0: ``rel``, ``lock_dt`` s, ``impulse_rel``) and
+    (the reference's own error bars, each >= 0: ``rel``, ``lock_dt`` s, ``impulse_rel``,
+    ``attitude`` rad: a free base's attitude) and
     ``twin`` ({rod, angle}: the reference's twin run; none by default)."""
     table = {} if table is None else table
     if not isinstance(table, dict):
