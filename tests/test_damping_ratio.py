@@ -104,3 +104,25 @@ def test_a_budget_spent_on_a_stiff_vibration_names_it_and_the_fixes():
     assert "more evaluations to t_end" in stats.message
     assert "fix: damp the rods' bending ([chain] bending_damping = { ratio" in stats.message
     assert "the reduced model" in stats.message
+
+
+def test_a_held_budget_names_the_budget_that_would_finish_and_only_fixes_the_scene_takes():
+    """The message gives the max_evaluations that would reach t_end (used plus the predicted
+    rest, a quarter more for the rate's change), and reaching for it finishes; on a free base
+    it does not propose the reduced model, which refuses one (issue 49: it did)."""
+    import re
+
+    from rodval.bench.stiffness import rigid_latch
+    from rodval.core.base import Base
+    from rodval.core.status import STATUS_BUDGET
+    from rodval.models import simulate
+
+    scene = rigid_latch(1e9)
+    stats = simulate(scene, "full", max_evaluations=100_000).stats
+    budget = float(re.search(r"max_evaluations = ([0-9.e+]+) would reach it", stats.message)[1])
+    assert budget > 100_000
+    assert simulate(scene, "full", max_evaluations=int(budget)).stats.success
+    free = scene.with_(base=Base(kind="free", mass=800.0, inertia=533.0))
+    held = simulate(free, "full", max_evaluations=100_000).stats
+    assert held.status == STATUS_BUDGET and "would reach it" in held.message
+    assert "reduced model" not in held.message and "the rigid model" in held.message

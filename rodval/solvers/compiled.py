@@ -91,19 +91,23 @@ def switch_record(sw: np.ndarray) -> dict[str, Any] | None:
     }
 
 
-def held_by(switch: dict[str, Any] | None, remaining: float) -> str:
+def held_by(switch: dict[str, Any] | None, remaining: float, used: int) -> str:
     """ "; its steps were held by a vibration of ... rad/s (... Hz) ..." for a run whose steps
     the stiffness test found limited by its fastest mode (``switch``: ``switch_record``), with
-    the evaluations the ``remaining`` horizon (s) would take at the cheaper method's rate;
-    "" otherwise."""
+    the evaluations the ``remaining`` horizon (s) would take at the cheaper method's rate and
+    the budget that would reach t_end: the ``used`` evaluations plus those, with a quarter
+    more for the rate's change along the way, in two significant digits; "" otherwise."""
     if switch is None:
         return ""
     rho = switch["spectral_radius"]
     rates = [r for r in (switch["explicit_cost_per_s"], switch["implicit_cost_per_s"]) if r]
+    more = min(rates) * remaining
     return (
         f"; its steps were held by a vibration of {rho:.4g} rad/s ({rho / (2 * np.pi):.4g} Hz, "
-        f"the spectral radius at t = {switch['t']:.6g} s): about {min(rates) * remaining:.2g} "
-        f"more evaluations to t_end at {min(rates):.3g} per simulated second"
+        f"the spectral radius at t = {switch['t']:.6g} s): about {more:.2g} more evaluations "
+        f"to t_end at {min(rates):.3g} per simulated second (max_evaluations = "
+        f"{float(f'{used + 1.25 * more:.2g}'):.2g} would reach it, command line "
+        "--max-evaluations)"
     )
 
 
@@ -209,7 +213,7 @@ def _ending(
     if res.code in _BUDGETS:
         stats.status, setting = _BUDGETS[res.code]
         stats.message = settings.budget_message(setting, res.t) + held_by(
-            stats.switch, t_end - res.t
+            stats.switch, t_end - res.t, stats.nfev
         )
     elif res.code != budget.OK:
         stats.status, stats.message = verdict_message(res.code, res.monitor, res.t, guard)

@@ -237,12 +237,18 @@ class FullModel(PaperModel):
         return "a tighter rtol (integration error)"
 
     def stiffness_fix(self, scene: Scene) -> str:
-        """Stiff vibrations of the full model are its rods' bending modes."""
+        """Stiff vibrations of the full model are its rods' bending modes: damp them, or
+        drop them (the reduced model, on a pinned base only; the rigid model)."""
+        drop = (
+            "the rigid model (no bending)"
+            if scene.base.moving
+            else "the reduced model (quasi-static bending, no bending vibrations) or the rigid "
+            "model (no bending)"
+        )
         return (
             f"damp the rods' bending ({DAMPING_FIX}; a ratio of each "
-            "rod's first mode damps a locked segment's slower modes less, docs/model.md), the "
-            "reduced model (quasi-static bending, no bending vibrations), or a looser rtol and "
-            "atol"
+            f"rod's first mode damps a locked segment's slower modes less, docs/model.md), {drop}, "
+            "or a looser rtol and atol"
         )
 
     def check_base(self, scene: Scene) -> None:
