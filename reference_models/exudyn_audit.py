@@ -28,7 +28,11 @@ the node states exudyn recorded at every step.
   records ``numerical_dissipation`` = -R(t_end) (J) in its settings, and max |R| over the
   energy scale (``rodval.solvers.audit.balance``) as its ``energy_residual``, which the
   validity verdict bounds as every model's (docs/deployment.md, "Where the lock energy
-  goes").
+  goes"). That scalar is read on every recorded step (``account``: E of each recorded state,
+  W and D there), not at the output times, so it is the run's whatever its output grid
+  (issue 47; the native models read theirs on the audit grid,
+  ``rodval.solvers.audit.audit_times``); the quantities "work", "dissipated" and
+  "energy_residual" are W, D and R at the output times.
 
 Cost: O(steps x n x elements) array operations, once after the run.
 """
@@ -137,20 +141,25 @@ def ledger(
 
 
 def audit_quantities(
-    times: np.ndarray, energy: np.ndarray, t_rec: np.ndarray, W: np.ndarray, D: np.ndarray
-) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], float, float]:
+    times: np.ndarray,
+    energy: np.ndarray,
+    E0: float,
+    t_rec: np.ndarray,
+    W: np.ndarray,
+    D: np.ndarray,
+) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], float]:
     """ "work", "dissipated" and "energy_residual" at the output ``times`` (``energy``: E
-    there; W, D at the recorded steps, interpolated linearly), the scalar residual of
-    ``rodval.solvers.audit.balance`` and the numerical dissipation -R(t_end) (J)."""
+    there, E0 (J) at t = 0; W, D at the recorded steps, interpolated linearly) and the
+    numerical dissipation -R(t_end) (J)."""
     W_out, D_out = np.interp(times, t_rec, W), np.interp(times, t_rec, D)
-    R, scalar = balance(energy, float(energy[0]), W_out, D_out)
+    R = balance(energy, E0, W_out, D_out)[0]
     k = np.zeros(1, dtype=int)
     quantities = {
         "work": (W_out[:, None], k),
         "dissipated": (D_out[:, None], k),
         "energy_residual": (R[:, None], k),
     }
-    return quantities, scalar, float(-R[-1])
+    return quantities, float(-R[-1])
 
 
 def account(
@@ -159,7 +168,12 @@ def account(
     """The audit of a run that reached ``times``: the lock records completed (``ledger``)
     and, where the scene asks for "energy", the audit quantities added to ``observed``;
     returns the scalar residual (None without the audit) and the settings entry
-    {"numerical_dissipation": J} (empty without the audit)."""
+    {"numerical_dissipation": J} (empty without the audit).
+
+    The scalar is read on every recorded step (``rodval.solvers.audit.balance`` of E, the
+    energy ``observe`` reports, of each recorded state, ``energy_parts``, and W, D there),
+    not at the output times; E0 is the recorded state's at t = 0 (the first output time
+    need not be 0)."""
     n = int(np.searchsorted(t_rec, times[-1], side="right")) if times.size else 0
     if n < 2 or not (scene.latches or "energy" in observed):  # nothing to account for
         return None, {}
@@ -167,7 +181,8 @@ def account(
     W, D = ledger(scene, E, EA, t_rec[:n], reached, events)
     if "energy" not in observed:
         return None, {}
+    steps = energy_parts(scene, E, EA, t_rec[:n], t_rec[:n], reached).sum(axis=0)
     energy = observed["energy"][0][:, 0]
-    quantities, scalar, lost = audit_quantities(times, energy, t_rec[:n], W, D)
+    quantities, lost = audit_quantities(times, energy, float(steps[0]), t_rec[:n], W, D)
     observed.update(quantities)
-    return scalar, {"numerical_dissipation": lost}
+    return balance(steps, float(steps[0]), W, D)[1], {"numerical_dissipation": lost}

@@ -14,7 +14,8 @@ Small parts, each in its own place:
   the attempts stay non-finite down to the smallest step; the other methods stop at once;
 * events (``rodval.solvers.events``): crossing located, state jump applied, step restarted;
 * divergence guard (``rodval.solvers.guard``) after every accepted step;
-* energy audit (``rodval.solvers.audit``) on the dense output of every accepted step;
+* energy audit (``rodval.solvers.audit``) on the dense output of every accepted step, its
+  residual read on the audit grid (``audit.audit_times``), as the momentum audit's;
 * observation at the output times reached.
 
 Dense output is formed only on steps that contain output times, events, or when the scene asks
@@ -44,7 +45,12 @@ from rodval.core.status import (
 )
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.core.validity import SMALL_BENDING_RAD, momentum_point
-from rodval.solvers.audit import PowerLedger, audit_quantities, momentum_residual
+from rodval.solvers.audit import (
+    PowerLedger,
+    audit_quantities,
+    energy_residual,
+    momentum_residual,
+)
 from rodval.solvers.events import EventMonitor, apply_hit
 from rodval.solvers.guard import DivergenceGuard
 from rodval.solvers.limits import MAX_IMPLICIT_SIZE
@@ -376,6 +382,50 @@ def _momentum_audit(system: OdeSystem, Y: np.ndarray, stats: SolverStats) -> Non
         stats.momentum_residual = None
 
 
+def _energy_audit(
+    system: OdeSystem, times: np.ndarray, Y: np.ndarray, W: np.ndarray, D: np.ndarray
+) -> float:
+    """The scalar energy residual (``audit.energy_residual``) on the audit grid reached:
+    E, the energy ``observe`` reports (in the mode in effect at each time), at its ``times``
+    (s) and states ``Y`` (``energy_history`` where the system has it: one pass per mode;
+    else ``energy`` per state), W, D (J) the ledger's there; the same whatever the output
+    times. O(n) per grid time, after the run."""
+    history = getattr(system, "energy_history", None)  # the paper systems' batched form
+    if history is not None:
+        E = np.asarray(history(times, Y), float)
+    else:
+        E = np.array([system.energy(float(t), y) for t, y in zip(times, Y)])
+    return energy_residual(E, system.energy(0.0, system.y0), W, D)
+
+
+def _observe(
+    system: OdeSystem, out: Outputs, ledger: PowerLedger | None, stats: SolverStats
+) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
+    """The output times the run reached, their states and the observed quantities (the
+    energy audit's at the output times with a ``ledger``, and its residual into ``stats``,
+    read on the audit grid); a failed observation sets the run's status and message and
+    observes nothing."""
+    rows, on_grid = out.scene_rows(), out.audit_rows()
+    reached, Y = out.times[rows], out.Y[rows]
+    try:
+        observed = system.observe(reached, Y) if rows.size else {}
+        if ledger and rows.size:
+            W, D = ledger.series()
+            observed.update(
+                audit_quantities(
+                    observed["energy"][0][:, 0], system.energy(0.0, system.y0), W[rows], D[rows]
+                )
+            )
+            stats.energy_residual = _energy_audit(
+                system, out.times[on_grid], out.Y[on_grid], W[on_grid], D[on_grid]
+            )
+    except Exception as exc:  # noqa: BLE001
+        observed = {}
+        status, message = _failure(exc, stats.t_reached)
+        stats.status, stats.message = status, f"observation failed: {message}"
+    return reached, Y, observed
+
+
 def integrate(
     system: OdeSystem,
     scene: Scene,
@@ -398,11 +448,13 @@ def integrate(
         from rodval.solvers.compiled import run_compiled  # loads the compiled loop once
     times = np.asarray(scene.times)
     windows = LockWindows(system)
-    grid = AuditGrid(scene.t_end, system.y0.size) if _audits_momentum(system, scene) else None
+    audit = scene.wants("energy") and system.has_energy
+    momentum = _audits_momentum(system, scene)
+    # the audits' fixed grid, recorded beside the output times
+    grid = AuditGrid(scene.t_end) if audit or momentum else None
     out = Outputs(times, system.y0.size, windows, grid)
     stats = SolverStats()
     y = system.y0.astype(float).copy()
-    audit = scene.wants("energy") and system.has_energy
     ledger = PowerLedger(system.power) if audit else None
     start = time.perf_counter()
     t_now = 0.0
@@ -412,7 +464,7 @@ def integrate(
         guard = DivergenceGuard(system, settings, scene.t_end, y)
         at_zero = out.upto(0.0)
         own = out.write(np.repeat(y[None, :], at_zero.size, axis=0))
-        if ledger:  # one record per output time at t = 0 (not per probe there)
+        if ledger:  # one record per recorded time at t = 0 (not per probe there)
             for _ in range(int(np.count_nonzero(own))):
                 ledger.record()
         if form is not None:
@@ -428,22 +480,11 @@ def integrate(
     windows.close()
     if stats.status == 0:
         stats.message = "reached t_end"
-    reached = times[: out.n]
-    try:
-        observed = system.observe(reached, out.Y[: out.n]) if out.n else {}
-        if ledger and out.n:
-            audited, stats.energy_residual = audit_quantities(
-                observed["energy"][0][:, 0], system.energy(0.0, system.y0), ledger
-            )
-            observed.update(audited)
-    except Exception as exc:  # noqa: BLE001
-        observed = {}
-        status, message = _failure(exc, stats.t_reached)
-        stats.status, stats.message = status, f"observation failed: {message}"
+    reached, Y, observed = _observe(system, out, ledger, stats)
     reached, observed = _finite_prefix(reached, observed, stats)
-    _bending_validity(system, reached, out.Y[: reached.size], observed, stats)
-    if grid is not None:
-        _momentum_audit(system, grid.states(), stats)
+    _bending_validity(system, reached, Y[: reached.size], observed, stats)
+    if momentum:
+        _momentum_audit(system, out.Y[out.audit_rows()], stats)
     stats.wall_s = time.perf_counter() - start
     return Trajectory(
         model=model,

@@ -5,9 +5,10 @@ the lock, ``rodval.core.lock_window``).
 Probe times are output times the integrators interpolate on their dense output like the
 scene's own (every path: scipy's steps and the compiled loop): they never change a step, so a
 run's trajectory is the same with or without them. A probe's state goes to its window at once,
-while the system is still in the mode of that time. The audit grid (``AuditGrid``) is a second
-kind of probe: a fixed grid of [0, t_end] on which the momentum audit is read, so that its
-residual is the run's and not the output grid's.
+while the system is still in the mode of that time. The audit grid (``AuditGrid``: a fixed
+grid of [0, t_end]) is recorded beside the output times, on the same dense output: the
+momentum and energy audits are read there, so that their residuals are the run's and not the
+output grid's.
 """
 
 from __future__ import annotations
@@ -124,35 +125,32 @@ class LockWindows:
 
 
 class AuditGrid:
-    """States at the audit grid's times (``audit.audit_times``: evenly spaced in [0, t_end]),
-    probed like the lock windows (the dense output: no step changes). The momentum audit
-    reads them (``states``), so that a run's residual does not depend on its output grid:
-    read at the output times, one run gave 0.067 with 11 output times and 0.052 with 201."""
+    """The audit grid (``audit.audit_times``: evenly spaced in [0, t_end]): times at which
+    ``Outputs`` records a state like an output time (from the dense output: no step
+    changes), and the energy audit's running [W_ext, D] with it (``audit.PowerLedger``). The
+    momentum and energy audits read their residuals there (``Outputs.audit_rows``), so that
+    a run's residuals do not depend on its output grid: read at the output times, one run's
+    momentum residual was 0.067 with 11 output times and 0.052 with 201, its energy
+    residual 0.0486 and 0.0510 (issue 47)."""
 
-    def __init__(self, t_end: float, size: int):
+    def __init__(self, t_end: float):
         self.times = audit_times(t_end)
-        self.Y = np.empty((self.times.size, size))
-        self.i = 0
 
-    def pending(self) -> np.ndarray:
-        """The grid's times not yet taken."""
-        return self.times[self.i :]
 
-    def take(self, t: float, y: np.ndarray) -> None:
-        """The state y at time t, when t is the grid's next time."""
-        if self.i < self.times.size and self.times[self.i] == t:
-            self.Y[self.i] = y
-            self.i += 1
-
-    def states(self) -> np.ndarray:
-        """The states taken, (taken, N), in time order."""
-        return self.Y[: self.i]
+def _recorded(scene: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(times, is-scene, is-grid) of the recorded rows: the scene's output times and the
+    grid's, sorted, a time in both once."""
+    times, inverse = np.unique(np.concatenate([scene, grid]), return_inverse=True)
+    is_scene, is_grid = np.zeros(times.size, bool), np.zeros(times.size, bool)
+    is_scene[inverse[: scene.size]] = True
+    is_grid[inverse[scene.size :]] = True
+    return times, is_scene, is_grid
 
 
 class Outputs:
-    """States at the scene's output times ``times`` (rows of Y, filled in time order), at
-    the lock windows' probe times (handed to ``windows``) and at the audit grid's (handed to
-    ``audit``)."""
+    """States at the recorded times ``times``, rows of Y filled in time order: the scene's
+    output times and the audit grid's (``audit``; ``scene_rows``, ``audit_rows`` split
+    them), and at the lock windows' probe times (handed to ``windows``, not recorded)."""
 
     def __init__(
         self,
@@ -161,29 +159,37 @@ class Outputs:
         windows: LockWindows | None = None,
         audit: AuditGrid | None = None,
     ):
-        self.times = times
-        self.Y = np.empty((times.size, size))
+        grid = audit.times if audit is not None else np.zeros(0)
+        if grid.size:
+            self.times, self.is_scene, self.is_grid = _recorded(np.asarray(times, float), grid)
+        else:
+            self.times = times
+            self.is_scene = np.ones(times.size, bool)
+            self.is_grid = np.zeros(times.size, bool)
+        self.Y = np.empty((self.times.size, size))
         self.n = 0
         self.windows = windows
-        self.audit = audit
 
-    def _probes(self) -> np.ndarray:
-        """The probe times not yet taken (lock windows and audit grid), sorted."""
-        parts = [p.pending() for p in (self.windows, self.audit) if p is not None]
-        return np.sort(np.concatenate(parts)) if parts else np.zeros(0)
+    def scene_rows(self) -> np.ndarray:
+        """Indices of the recorded rows reached that are scene output times."""
+        return np.flatnonzero(self.is_scene[: self.n])
 
-    def _merged(self, scene: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(times, is-scene mask) of ``scene`` times and the probes up to their last one."""
-        probes = self._probes()
+    def audit_rows(self) -> np.ndarray:
+        """Indices of the recorded rows reached that are audit-grid times."""
+        return np.flatnonzero(self.is_grid[: self.n])
+
+    def _merged(self, recorded: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(times, is-recorded mask) of ``recorded`` times and the lock windows' probes."""
+        probes = self.windows.pending() if self.windows is not None else np.zeros(0)
         if not probes.size:
-            return scene, np.ones(scene.size, bool)
-        times = np.concatenate([scene, probes])
-        is_scene = np.concatenate([np.ones(scene.size, bool), np.zeros(probes.size, bool)])
+            return recorded, np.ones(recorded.size, bool)
+        times = np.concatenate([recorded, probes])
+        mask = np.concatenate([np.ones(recorded.size, bool), np.zeros(probes.size, bool)])
         order = np.argsort(times, kind="stable")
-        return times[order], is_scene[order]
+        return times[order], mask[order]
 
     def upto(self, t: float) -> np.ndarray:
-        """The output and probe times not yet written that are <= t, sorted."""
+        """The recorded and probe times not yet written that are <= t, sorted."""
         end = int(np.searchsorted(self.times, t, side="right"))
         times, mask = self._merged(self.times[self.n : end])
         keep = times <= t
@@ -191,21 +197,20 @@ class Outputs:
         return self._plan[0]
 
     def remaining(self) -> np.ndarray:
-        """All output and probe times not yet written, sorted (for a loop that writes them
+        """All recorded and probe times not yet written, sorted (for a loop that writes them
         in order, ``write`` after it)."""
         self._plan = self._merged(self.times[self.n :])
         return self._plan[0]
 
     def write(self, values: np.ndarray) -> np.ndarray:
         """values (k, N) for the first k times of the last ``upto`` / ``remaining``; returns
-        the mask of those that are scene output times."""
+        the mask of those that are recorded times (output or audit grid: the rows an audit's
+        ledger records)."""
         times, mask = self._plan[0][: len(values)], self._plan[1][: len(values)]
-        scene = values[mask]
-        self.Y[self.n : self.n + len(scene)] = scene
-        self.n += len(scene)
-        for t, y in zip(times[~mask], values[~mask]):
-            if self.windows is not None:
+        kept = values[mask]
+        self.Y[self.n : self.n + len(kept)] = kept
+        self.n += len(kept)
+        if self.windows is not None:
+            for t, y in zip(times[~mask], values[~mask]):
                 self.windows.take(float(t), y)
-            if self.audit is not None:
-                self.audit.take(float(t), y)
         return mask

@@ -5,6 +5,8 @@ coordinates (``energy_rows``, ``bending_energy_at``, ``rod_momenta_at``, ``kinet
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from contextlib import AbstractContextManager
 from typing import Any
 
 import numpy as np
@@ -39,6 +41,9 @@ class PaperEnergy:
     base_chain: Any
     stops: tuple
     stop_active: tuple[bool, ...]
+    #: the mode in effect at a time, and a context in a mode (``PaperSystem``)
+    _mode_for: Callable[[float], tuple]
+    _mode: Callable[[tuple], AbstractContextManager]
 
     def rigid(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """phi, phi' from a state history Y (nt, N)."""
@@ -107,6 +112,24 @@ class PaperEnergy:
     def energy_rows(self, times: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(T, Pi) (J) per state of a history Y in the current mode; O(n) each."""
         return self.energies(*self.rigid(Y), *self.bending(times, Y))
+
+    def energy_history(self, times: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        """E = T + Pi (J) per state of a history Y at ``times`` (s), each in the mode in effect
+        at its time (``_mode_for``: an event's time is in the mode before it), as ``observe``
+        reports it: the energy audit's E on its grid (``rodval.solvers.audit``). One
+        ``energy_rows`` per run of states in one mode; O(n) per state."""
+        times = np.asarray(times, float)
+        E = np.empty(times.size)
+        modes = [self._mode_for(float(t)) for t in times]
+        start = 0
+        for i in range(1, times.size + 1):
+            if i < times.size and modes[i] == modes[start]:
+                continue
+            with self._mode(modes[start]):
+                kin, pot = self.energy_rows(times[start:i], Y[start:i])
+            E[start:i] = kin + pot
+            start = i
+        return E
 
     def bending_energy_at(self, t: float, y: np.ndarray) -> float:
         """The rods' bending energy (J) at one state."""
