@@ -12,6 +12,10 @@ records (exudyn stores every step of the sensors the outputs need).
   every step computed; the run then ends with the wall-clock status (``STATUS_WALL``, the
   message of ``IntegratorSettings.budget_message``) or as ``STATUS_FAILED`` at the memory
   bound.
+* Between the attempts of ``step = "auto"`` (``refinement_refusal``): a further attempt at a
+  smaller step is refused before it starts when it would not fit the memory, the steps of a
+  run without a wall-clock budget, or what the attempts before it left of the wall-clock
+  budget, which covers them all (every attempt's ``RunBudget`` starts from the run's start).
 """
 
 from __future__ import annotations
@@ -81,6 +85,40 @@ def check_plan(t_end: float, step: float, doubles_per_step: int, max_wall_s: flo
             f"at the memory bound), or raise {ENV_LIMIT}"
         )
     return steps
+
+
+def refinement_refusal(
+    t_end: float,
+    step: float,
+    doubles_per_step: int,
+    max_wall_s: float,
+    left_s: float,
+    predicted_s: float,
+) -> str | None:
+    """Why a further attempt of ``step = "auto"`` at ``step`` (s) over ``t_end`` (s) would not
+    fit the run's budgets, decided before it starts (None: it fits): more recorded steps than
+    the memory limit allows, or, without a wall-clock budget (``max_wall_s`` = inf), more
+    than ``MAX_STEPS_UNBOUNDED`` steps (``check_plan``'s message); with one, a predicted wall
+    time ``predicted_s`` (s) beyond the ``left_s`` (s) the attempts before it left of it."""
+    steps = planned_steps(t_end, step)
+    if steps > memory_bound_steps(doubles_per_step):
+        return (
+            f"its {steps} recorded steps would need about "
+            f"{steps * record_bytes(doubles_per_step) / 1e9:.3g} GB of memory, more than the "
+            f"limit of {memory_limit_bytes() / 1e9:.3g} GB ({ENV_LIMIT})"
+        )
+    if not math.isfinite(max_wall_s):
+        try:
+            check_plan(t_end, step, doubles_per_step, max_wall_s)
+        except ValueError as exc:
+            return str(exc).removeprefix("exudyn: ")
+        return None
+    if predicted_s > left_s:
+        return (
+            f"it would take about {predicted_s:.3g} s and the wall-clock budget (max_wall_s "
+            f"{max_wall_s:g} s, every attempt's together) leaves {max(left_s, 0.0):.3g} s"
+        )
+    return None
 
 
 class RunBudget:

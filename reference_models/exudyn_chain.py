@@ -38,16 +38,12 @@ length with unit slopes: unstretched at the nodes (``_bent_rod``). Velocities fo
 curve (dphi, dalpha, dbeta).
 
 Solver: exudyn's implicit generalized-alpha (or trapezoidal index-2) integrator with a fixed
-step (halved, down to step/64, only if Newton fails), sparse linear solver (EigenSparse), no
-solution files, no graphics and no console output. Newton's absolute tolerance is
-``newton_atol_per_EA * EA`` (N): the default absolute tolerance lies below the round-off of the
-stiff axial forces. With latches the (modified) Newton Jacobian is renewed every step
-(``JAC_PER_STEP``; renewing it only in the step a latch switches on, through exudyn's
-``solver.conv.jacobianUpdateRequested``, keeps the lock times to 1e-7 ms but moves phi by
-1.3e-6 rad on the 6-panel wing and is not faster: docs/reference_model.md, "Speed"): a
-Jacobian kept from before a latch's joint was switched on leaves the joint without effect
-until Newton restarts (0.17 ms late on the two-rod scene of tests/test_rigid_lock.py, the
-hinge passing its latch angle by 3.7 mrad).
+step (halved, down to step/64, only if Newton fails): the option ``step``'s, or by default
+(``step = "auto"``) the one the run needs (``exudyn_step``), sparse linear solver
+(EigenSparse), no files, graphics or console output. Newton's absolute tolerance is
+``newton_atol_per_EA * EA`` (N): the default lies below the round-off of the stiff axial
+forces. With latches the Newton Jacobian is renewed every step (``JAC_PER_STEP``; why:
+docs/reference_model.md, "Speed").
 rodval's native integrator settings are refused unless at their defaults (``check_settings``;
 ``blowup_factor`` and ``max_wall_s`` apply). Before every step ``Guard`` checks the state:
 non-finite (STATUS_DIVERGED), kinetic energy above blowup_factor x (E(0) + W+ + 1e-6 J)
@@ -60,28 +56,36 @@ a run without a wall-clock budget is refused before any work when it plans more 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any
 
 import numpy as np
 
+from reference_models import exudyn_step
 from reference_models.exudyn_audit import account
 from reference_models.exudyn_beam import positive
-from reference_models.exudyn_budget import RunBudget, check_plan
+from reference_models.exudyn_budget import RunBudget, check_plan, refinement_refusal
 from reference_models.exudyn_build import BuiltSystem, build, recorded_doubles
-from reference_models.exudyn_guard import Guard
+from reference_models.exudyn_ending import (
+    ended,
+    lock_records,
+    run_guard,
+    solver_message,
+    unaudited_drive,
+)
 from reference_models.exudyn_latches import Latches
 from reference_models.exudyn_observe import body_view, momentum_audit, observe, stop_events
 from reference_models.exudyn_settings import (
     newton_record,
     simulation_settings,
 )
+from reference_models.exudyn_step import AUTO, check_step, run_auto
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import (
-    STATUS_DIVERGED,
     STATUS_ERROR,
     STATUS_FAILED,
     numerical_failure,
@@ -93,10 +97,12 @@ from rodval.solvers.audit import momentum_residual
 ELEMENTS = ("cable2d",)
 SOLVERS = ("generalized-alpha", "trapezoidal")
 
-#: Converged defaults, chosen by benchmarks/exudyn_convergence.py (docs/reference_model.md).
+#: Converged defaults, chosen by benchmarks/exudyn_convergence.py (docs/reference_model.md);
+#: the step by the run's needs ("auto": ``exudyn_step``, from at most 2e-4 s, the converged
+#: fixed default before it).
 DEFAULTS: dict[str, Any] = {
     "elements": 2,
-    "step": 2e-4,
+    "step": AUTO,
     "EA": 1e10,
     "element": "cable2d",
     "solver": "generalized-alpha",
@@ -109,14 +115,7 @@ DEFAULTS: dict[str, Any] = {
 #: IntegratorSettings fields that belong to rodval's ODE integrators: exudyn cannot honour
 #: them (its integrator is set by this model's options), so any non-default value is refused.
 #: (``max_wall_s`` and ``blowup_factor`` are honoured: ``exudyn_budget``, ``exudyn_guard``.)
-NATIVE_INTEGRATOR_FIELDS = (
-    "method",
-    "rtol",
-    "atol",
-    "max_step",
-    "first_step",
-    "max_evaluations",
-)
+NATIVE_INTEGRATOR_FIELDS = ("method", "rtol", "atol", "max_step", "first_step", "max_evaluations")
 
 
 class ExudynModel(Model):
@@ -126,8 +125,15 @@ class ExudynModel(Model):
 
     elements : int >= 1
         ANCF cable elements per rod.
-    step : float in (0, 0.1] s
-        Fixed time step (the run uses ceil(t_end / step) equal steps).
+    step : "auto" or float in (0, 0.1] s
+        The time step. A float: the fixed step (the run uses ceil(t_end / step) equal
+        steps). "auto" (the default): the fixed step the run needs, by attempts
+        (``exudyn_step``): an a-priori step (the shortest lock window over 20 steps, at most
+        2e-4 s), halved (at most 4 times) while a lock window holds fewer than 20 steps, the
+        energy residual exceeds its bound or a rod turns by more than
+        ``max_rotation_per_step`` in a step; the last attempt is the run, its settings record
+        every attempt (``step_auto``) and its notes why that step was chosen, or that none
+        within the limits met the checks. ``max_wall_s`` covers every attempt together.
     EA : float in (0, 1e14] N
         Axial stiffness standing in for inextensibility.
     element : "cable2d"
@@ -171,7 +177,7 @@ class ExudynModel(Model):
         self,
         *,
         elements: int = DEFAULTS["elements"],
-        step: float = DEFAULTS["step"],
+        step: float | str = DEFAULTS["step"],
         EA: float = DEFAULTS["EA"],
         element: str = DEFAULTS["element"],
         solver: str = DEFAULTS["solver"],
@@ -184,7 +190,7 @@ class ExudynModel(Model):
         if unknown:
             raise ValueError(_unknown_options_message(unknown))
         self.elements = positive("elements", elements, integer=True)
-        self.step = positive("step", step, upper=0.1)
+        self.step: float | str = check_step(step)
         self.EA = positive("EA", EA, upper=1e14)
         if element not in ELEMENTS:
             raise ValueError(f"element must be one of {ELEMENTS}, got {element!r}")
@@ -249,10 +255,11 @@ class ExudynModel(Model):
         return build(scene, self.elements, self.EA)
 
     def _settings(self, scene: Scene):
-        """exudyn's simulation settings of a run of ``scene`` (``simulation_settings``)."""
+        """exudyn's simulation settings of a run of ``scene`` (``simulation_settings``) at the
+        fixed step (a float: ``_run_at``)."""
         return simulation_settings(
             scene,
-            self.step,
+            float(self.step),
             (self.newton_rtol, self.newton_atol_per_EA * self.EA),
             self.spectral_radius_for(scene),
         )
@@ -314,24 +321,84 @@ class ExudynModel(Model):
                 "the lock"
             )
 
+    def first_step(self, scene: Scene) -> float:
+        """The step (s) of the first run of ``scene``: the option's, or for "auto" the
+        a-priori step (``exudyn_step.a_priori_step``)."""
+        return self.step if isinstance(self.step, float) else exudyn_step.a_priori_step(scene)[0]
+
     def check_plan(self, scene: Scene, settings: IntegratorSettings) -> int:
-        """The run's planned steps, or ValueError before any work when a run without a
-        wall-clock budget plans too many steps or records (``exudyn_budget.check_plan``)."""
+        """The (first) run's planned steps, or ValueError before any work when a run without
+        a wall-clock budget plans too many steps or records (``exudyn_budget.check_plan``)."""
         doubles = recorded_doubles(scene, self.elements)
-        return check_plan(scene.t_end, self.step, doubles, settings.max_wall_s)
+        return check_plan(scene.t_end, self.first_step(scene), doubles, settings.max_wall_s)
+
+    def simulate(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
+        """``Model.simulate``, with the note of a ``step = "auto"`` run (why its step was
+        chosen, or that none met the checks) first in ``stats.notes``."""
+        trajectory = super().simulate(scene, settings)
+        auto = trajectory.settings.get("step_auto")
+        if auto is not None:
+            trajectory.stats.notes = [auto["note"], *trajectory.stats.notes]
+        return trajectory
 
     def run(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
         """Run the scene. Of the native integrator ``settings`` ``blowup_factor`` and
-        ``max_wall_s`` (s, from this call: the set-up counts) apply; any other non-default
-        field raises ValueError before any work (``check_settings``), as does a run without a
-        wall-clock budget that plans too many steps (``check_plan``): the exudyn integrator is
-        set by this model's options, recorded in ``trajectory.settings`` with the steps
-        actually taken."""
+        ``max_wall_s`` (s, from this call: the set-up counts, and with ``step = "auto"`` every
+        attempt) apply; any other non-default field raises ValueError before any work
+        (``check_settings``), as does a run without a wall-clock budget that plans too many
+        steps (``check_plan``): the exudyn integrator is set by this model's options, recorded
+        in ``trajectory.settings`` with the steps actually taken."""
         start = time.perf_counter()
         settings = settings or IntegratorSettings()
         self.check_settings(settings)
         self.check_scene(scene)
         planned = self.check_plan(scene, settings)
+        if isinstance(self.step, float):
+            return self._run_at(scene, settings, (planned, start))
+        return self._run_auto(scene, settings, start)
+
+    def with_step(self, step: float) -> ExudynModel:
+        """This model with the fixed ``step`` (s), every other option the same."""
+        return ExudynModel(**{**self.options(), "step": step})
+
+    def _run_auto(self, scene: Scene, settings: IntegratorSettings, start: float) -> Trajectory:
+        """The ``step = "auto"`` run (``exudyn_step.run_auto``): fixed-step attempts from
+        ``start`` (``time.perf_counter()`` s, the run's start: one wall-clock budget for them
+        all), each further one refused before it starts when it would not fit
+        (``refinement_refusal``). The last attempt's trajectory, its settings recording
+        ``requested_step`` "auto" and ``step_auto`` (the attempts), its stats' wall time and
+        counters summed over the attempts, its options this model's."""
+        doubles = recorded_doubles(scene, self.elements)
+        totals = {"wall_s": 0.0, "nsteps": 0, "nfev": 0, "njev": 0}
+
+        def run_at(step: float) -> Trajectory:
+            planned = check_plan(scene.t_end, step, doubles, settings.max_wall_s)
+            trajectory = self.with_step(step)._run_at(scene, settings, (planned, start))
+            for key in totals:
+                totals[key] += getattr(trajectory.stats, key)
+            return trajectory
+
+        def refusal(step: float, predicted_s: float) -> str | None:
+            left = settings.max_wall_s - (time.perf_counter() - start)
+            return refinement_refusal(
+                scene.t_end, step, doubles, settings.max_wall_s, left, predicted_s
+            )
+
+        bounds = (self.energy_residual_bound, self.max_rotation_per_step)
+        trajectory, auto = run_auto(scene, run_at, refusal, bounds)
+        for key, value in totals.items():
+            setattr(trajectory.stats, key, value)
+        trajectory.settings.update(requested_step=AUTO, step_auto=auto.record())
+        trajectory.options = self.options()
+        return trajectory
+
+    def _run_at(
+        self, scene: Scene, settings: IntegratorSettings, plan: tuple[int, float]
+    ) -> Trajectory:
+        """One run of ``scene`` at this model's fixed step (a float); ``plan`` = (its planned
+        steps, the run's start in ``time.perf_counter()`` s, from which ``max_wall_s``
+        counts)."""
+        planned, start = plan
         budget = RunBudget(settings, start, recorded_doubles(scene, self.elements))
         factor = settings.blowup_factor
         stats = SolverStats()
@@ -343,7 +410,9 @@ class ExudynModel(Model):
         try:
             built = self._build(scene)
             sim = self._settings(scene)
-            guard = _guard(built, scene, self.elements, self.EA, factor, self.max_rotation_per_step)
+            guard = run_guard(
+                built, scene, self.elements, self.EA, factor, self.max_rotation_per_step
+            )
         except Exception as exc:  # noqa: BLE001 - a failed build is data
             status, message = numerical_failure(exc, 0.0) or (
                 STATUS_ERROR,
@@ -367,8 +436,8 @@ class ExudynModel(Model):
         except Exception as exc:  # noqa: BLE001
             stats.status, stats.message = STATUS_ERROR, f"reading sensors failed: {exc}"
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
-        times = _ended(scene, stats, (guard, budget), t_rec, diverged)
-        events, lock_steps = _lock_records(latches)
+        times = ended(scene, stats, (guard, budget), t_rec, diverged)
+        events, lock_steps = lock_records(latches)
         reached = t_rec[t_rec <= times[-1]] if times.size else t_rec[:0]
         stops = stop_events(scene, self.elements, reached, records, lock_steps)
         events = sorted(events + stops, key=lambda ev: ev["t"])
@@ -382,7 +451,7 @@ class ExudynModel(Model):
                 body_view(scene), self.elements, self.EA, times, t_rec, records, events, observed
             )
             if scene.base.prescribed:
-                stats.energy_residual, audit = _unaudited_drive(observed, events)
+                stats.energy_residual, audit = unaudited_drive(observed, events)
             if times.size and momentum_point(scene) is not None:
                 stats.momentum_residual = momentum_residual(
                     *momentum_audit(scene, self.elements, times[-1], t_rec, records)
@@ -434,7 +503,7 @@ class ExudynModel(Model):
             if not ok:
                 stats.status, stats.message = (
                     STATUS_FAILED,
-                    _solver_message(solver, "solver failed"),
+                    solver_message(solver, "solver failed"),
                 )
             elif guard.verdict is None:  # the last step's end state has had no pre-step check
                 guard.check(scene.t_end if budget.stop is None else built.mbs.systemData.GetTime())
@@ -452,9 +521,17 @@ class ExudynModel(Model):
     def validity_checks(self, scene: Scene, trajectory: Trajectory) -> list[Check]:
         """The energy balance (where audited) and the time-step resolution: the largest rod
         rotation per step seen against ``max_rotation_per_step`` (the beam itself is
-        geometrically exact: no small-bending assumption)."""
+        geometrically exact: no small-bending assumption). A ``step = "auto"`` run whose
+        energy residual did not fall with the step names more elements as the energy fix."""
         seen = trajectory.settings.get("max_rotation_per_step_seen")
-        return super().validity_checks(scene, trajectory) + step_resolution(
+        checks = super().validity_checks(scene, trajectory)
+        fix = trajectory.settings.get("step_auto", {}).get("energy_fix")
+        if fix:  # "auto" found the residual does not fall with the step: not the step's fix
+            checks = [
+                dataclasses.replace(c, fix=fix) if c.assumption == "energy balance" else c
+                for c in checks
+            ]
+        return checks + step_resolution(
             seen, self.max_rotation_per_step, trajectory.settings.get("step_used")
         )
 
@@ -511,90 +588,9 @@ class ExudynModel(Model):
         )
 
 
-#: What a prescribed base's run leaves unaudited: the drive's work is not measured.
-DRIVE_UNAUDITED = ("work", "dissipated", "energy_residual")
-#: A lock window's accounts that need the work done on the chain (the drive's included).
-DRIVE_WINDOW_KEYS = ("work_window_end", "dissipated_window_end", "energy_residual_window_end")
-
-
-def _guard(built: BuiltSystem, scene: Scene, E: int, EA: float, factor: float, rotation: float):
-    """The run's ``Guard``. On a prescribed base it sees the massless body (``body_view``:
-    the lock records' kinetic energies are the chain's, as the native models') and checks no
-    energy budget: its drive's work, which the budget would need, is not measured (the
-    non-finite and rotation-per-step checks stay)."""
-    return Guard(
-        built, body_view(scene), E, EA, factor, rotation, checks_energy=not scene.base.prescribed
-    )
-
-
-def _unaudited_drive(observed: dict, events: list[dict]) -> tuple[None, dict]:
-    """A prescribed base's run is not audited for energy: its drive's power (the imposed
-    coordinates' constraint forces on the chain) is not measured, so the balance's work would
-    miss it. The audit's quantities are dropped from ``observed``, and the lock windows' work,
-    dissipation and residual from their records (their energies at the window's end stay);
-    returns (no residual, no settings entry) as for any unaudited run."""
-    for name in DRIVE_UNAUDITED:
-        observed.pop(name, None)
-    for ev in events:
-        for key in DRIVE_WINDOW_KEYS:
-            ev.pop(key, None)
-    return None, {}
-
-
-def _ended(
-    scene: Scene, stats: SolverStats, checks: tuple[Guard, RunBudget], t_rec, diverged: bool
-) -> np.ndarray:
-    """How the run ended (status, message, time reached into ``stats``; the guard's verdict
-    explains a solver failure that may follow it, the budget's stop (``checks`` = (guard,
-    budget)) a run that ended early) and the output times it kept."""
-    guard, budget = checks
-    stats.t_reached = float(t_rec[-1]) if t_rec.size else 0.0
-    keep_detected = True
-    if guard.verdict is not None and stats.status != STATUS_ERROR:
-        stats.status, stats.message, t_detected, keep_detected = guard.verdict
-        stats.t_reached = min(stats.t_reached, t_detected) if t_rec.size else 0.0
-    stopped = budget.outcome(stats.t_reached)
-    if stats.status == 0 and stopped is not None and stats.t_reached < scene.t_end * (1 - 1e-9):
-        stats.status, stats.message = stopped
-    if stats.status == 0 and stats.t_reached < scene.t_end * (1 - 1e-9):
-        stats.status, stats.message = STATUS_FAILED, "solver stopped before t_end"
-    if stats.status == STATUS_FAILED and diverged and guard.verdict is None:
-        stats.status = STATUS_DIVERGED
-        stats.message = f"non-finite state after t = {stats.t_reached:.6g} s"
-    if stats.status == 0:
-        stats.message = "reached t_end"
-    times = np.asarray(scene.times)
-    tol = 1e-9 * max(1.0, scene.t_end)
-    if not t_rec.size:
-        return t_rec
-    if keep_detected:
-        return times[times <= stats.t_reached + tol]
-    return times[times < stats.t_reached - tol]  # the state at the detection time is bad
-
-
-def _lock_records(latches: Latches | None) -> tuple[list[dict], dict[int, float]]:
-    """The lock events in time order and hinge -> lock time (s), pending locks closed."""
-    if latches is None:
-        return [], {}
-    try:
-        latches.close()
-    except Exception:  # noqa: BLE001 - the pending locks stay unrecorded
-        pass
-    events = sorted(latches.events, key=lambda ev: ev["t"])
-    return events, dict(latches.lock_times.items())
-
-
 def _unknown_options_message(unknown: dict) -> str:
     names = ", ".join(repr(k) for k in sorted(unknown))
     return (
         f"unknown exudyn model option(s) {names}; allowed options: {', '.join(DEFAULTS)} "
         f"(defaults {DEFAULTS})"
     )
-
-
-def _solver_message(solver, default: str) -> str:
-    try:
-        msg = solver.GetErrorString()
-    except Exception:  # noqa: BLE001
-        msg = ""
-    return msg.strip() or default

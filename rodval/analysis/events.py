@@ -19,6 +19,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from rodval.core.lock_window import MIN_WINDOW_STEPS
+
 #: The leading columns of an events table (after the columns that name the run: case columns
 #: and model); the keys the native and exudyn latch records share.
 EVENT_COLUMNS = (
@@ -53,12 +55,6 @@ COMPARABLE_ENERGY = 0.05
 #: approaches the latch angle so slowly that its time and impulse hang on small differences
 #: of state, and a model may not lock at all.
 GRAZING_LOSS = 0.01
-#: The fewest steps of exudyn's fixed step that a lock window must hold (its record's
-#: ``window_steps`` = impulse_window / step) for the window mean to be resolved: the impulse
-#: is the trapezoid rule of S(tau) on the steps (1.8-2.6 % off the rigid-panel limit with 23
-#: steps, docs/deployment.md). The native models integrate the window on their dense output
-#: under error control and record no ``window_steps``.
-MIN_WINDOW_STEPS = 20
 
 
 def event_row(lead: Mapping[str, Any], ev: Mapping[str, Any]) -> dict[str, Any]:

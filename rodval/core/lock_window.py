@@ -47,6 +47,13 @@ ELEMENTS_PER_ROD = 8
 MIN_ELEMENTS = 2 * ELEMENTS_PER_ROD
 #: A longer locked segment is cut into this many uniform sections (``_sections``).
 MAX_SECTIONS = 128
+#: The fewest steps of a fixed-step model (exudyn) that a lock window must hold (its record's
+#: ``window_steps`` = impulse_window / step) for the window mean to be resolved: the impulse
+#: is the trapezoid rule of S(tau) on the steps (1.8-2.6 % off the rigid-panel limit with 23
+#: steps, docs/deployment.md). The native models integrate the window on their dense output
+#: under error control and record no ``window_steps``. Used by the lock comparison
+#: (``rodval.analysis.events``) and by exudyn's ``step = "auto"`` (``exudyn_step``).
+MIN_WINDOW_STEPS = 20
 #: The window's quadrature: Gauss-Legendre on equal panels (degree 2 * NODES - 1 per panel).
 WINDOW_PANELS = 64
 WINDOW_NODES = 4
