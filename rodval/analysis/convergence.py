@@ -223,8 +223,9 @@ def error_bar(found: Sequence[Estimate], phi_scale: float) -> dict[str, float]:
     phi_deployed; rad) over ``phi_scale`` (max |phi| of the finest level, the scale of
     ``rodval.analysis.agreement.gap_series``); ``lock_dt``: the largest lock-time error, s;
     ``impulse_rel``: the largest relative impulse error; with a free base's quantities,
-    ``attitude``: the largest error of the body's attitude (attitude_times,
-    attitude_deployed; rad). 0 for a group with no quantity."""
+    ``attitude``: the error of the body's deployed attitude (attitude_deployed, rad: the
+    band of ``rodval.analysis.agreement``'s ``attitude_gap``; the attitude at the output
+    times is in ``group_errors``). 0 for a group with no quantity."""
     angle = max(worst_error(found, "phi_times"), worst_error(found, "phi_deployed"))
     bar = {
         "rel": angle / phi_scale if phi_scale > 0 else 0.0,
@@ -232,8 +233,18 @@ def error_bar(found: Sequence[Estimate], phi_scale: float) -> dict[str, float]:
         "impulse_rel": worst_error(found, "lock_impulse["),
     }
     if any(e.name.startswith("attitude") for e in found):
-        bar["attitude"] = worst_error(found, "attitude")
+        bar["attitude"] = worst_error(found, "attitude_deployed")
     return bar
+
+
+def group_errors(found: Sequence[Estimate]) -> dict[str, float]:
+    """The largest estimated error of each group of quantities present (UNITS' names: lock
+    times s, impulses relative, angles rad), the figures ``rodval reference`` prints."""
+    return {
+        group: worst_error(found, group)
+        for group in UNITS
+        if any(e.name.split("[")[0] == group for e in found)
+    }
 
 
 def worst_error(found: Sequence[Estimate], prefix: str) -> float:

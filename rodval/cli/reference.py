@@ -216,7 +216,7 @@ def reference_record(scene_name: str, tol: float, rows: list, found: list, why: 
     the error bar as a study's [agreement] reference_error."""
     import numpy as np
 
-    from rodval.analysis.convergence import error_bar
+    from rodval.analysis.convergence import UNITS, error_bar, group_errors
 
     done = [r for r in rows if "qoi" in r]
     finest = done[-1] if done else rows[-1]
@@ -232,6 +232,10 @@ def reference_record(scene_name: str, tol: float, rows: list, found: list, why: 
         "finest": {"elements": finest["elements"], "step": finest["step"]},
         "phi_scale_rad": scale,
         "reference_error": bar,
+        "errors": {
+            group: {"error": error, "unit": UNITS[group]}
+            for group, error in group_errors(found).items()
+        },
         "agreement_toml": "reference_error = { "
         + ", ".join(f"{k} = {v:.3g}" for k, v in bar.items())
         + " }",
@@ -264,6 +268,10 @@ def run(args) -> int:
     print(
         f"error bar ({verdict}): {record['agreement_toml']} (levels {len(rows)}, finest "
         f"elements {record['finest']['elements']}, step {record['finest']['step']:g} s)"
+    )
+    print(
+        "errors by group: "
+        + ", ".join(f"{g} {e['error']:.3g} {e['unit']}" for g, e in record["errors"].items())
     )
     print(f"-> {args.out / 'reference.json'}")
     return 0 if why is None else 1
