@@ -119,9 +119,10 @@ def test_initial_rates_follow_the_curve():
 
 def test_energy_blowup_is_detected_during_the_run():
     """A real blow-up: the bent rod (a = 0.1) under the trapezoidal rule at a fixed step of
-    2e-4 s (the default "auto" would refine the looser run below until it is resolved) gains energy without bound (the old code reported such runs as success). The
-    per-step check stops it as STATUS_BLOWUP at the detection time (measured t = 0.4635 s, T =
-    1.3e5 J > 100 x 1001 J), well before t_end, keeping the output times before it."""
+    2e-4 s (the default "auto" would refine the looser run below until it is resolved) gains
+    energy without bound (the old code reported such runs as success). The per-step check
+    stops it as STATUS_BLOWUP at the detection time (measured t = 0.4635 s, T = 1.3e5 J >
+    100 x 1001 J), well before t_end, keeping the output times before it."""
     scene = one_rod(0.1, t_end=1.0, times=np.linspace(0.0, 1.0, 201))
     tr = simulate(scene, "exudyn", solver="trapezoidal", step=2e-4)
     print(tr.stats.status, tr.stats.message, tr.stats.t_reached, tr.settings["steps"])
