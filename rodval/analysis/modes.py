@@ -24,6 +24,7 @@ from scipy.optimize import linear_sum_assignment
 
 from rodval.core.modal import Modes
 from rodval.core.scene import Scene
+from rodval.models.observation.deployed_damping import resolve_damping
 from rodval.models.observation.linear_modes import check_arguments, check_configuration, mac_matrix
 from rodval.models.presets.registry import MODEL_NAMES, modal_options, model_class
 
@@ -41,9 +42,11 @@ def model_modes(
     """The modes of ``model`` (a registered name) about the scene's initial state or its
     static equilibrium, every model about the same configuration, checked here once
     (``check_configuration``); ``options``: the model's own (``Model.modes``; e.g. the paper
-    models' ``coefficients``, exudyn's discretization)."""
+    models' ``coefficients``, exudyn's discretization). A bending damping stated for the
+    deployed structure is converted first (``resolve_damping``), as for a run."""
     check_arguments(scene, count)
     cls = model_class(model)
+    scene = resolve_damping(scene)
     balance = check_configuration(scene, about, load_at, allow_unbalanced)
     m = cls.modes(scene, about=about, count=count, load_at=load_at, **options)
     m.info.update(balance)

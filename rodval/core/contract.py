@@ -14,6 +14,7 @@ from abc import ABC, abstractmethod
 from typing import Any, ClassVar
 
 from rodval.core.checks import check_keys
+from rodval.core.damping import check_resolved
 from rodval.core.modal import Modes
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
@@ -52,6 +53,7 @@ class Model(ABC):
             return trajectory
         settings.check_horizon(scene.t_end)
         self.check_base(scene)
+        check_resolved(scene, f"model {self.name!r}")  # a deployed damping request, converted
         trajectory = self.run(scene, settings)
         trajectory.scene = scene
         stats = trajectory.stats
@@ -139,6 +141,7 @@ class Model(ABC):
         )
         if cls.MODAL_ANALYSIS is None:
             raise ValueError(f"model {cls.name!r} has no modal analysis")
+        check_resolved(scene, f"model {cls.name!r} modes")
         if scene.base.prescribed:
             raise ValueError(
                 f"model {cls.name!r}: modes of a chain on a prescribed base (a motion that is a "

@@ -29,6 +29,7 @@ import numpy as np
 from rodval.core.base import PINNED, Base
 from rodval.core.bounds import as_rod_array
 from rodval.core.checks import check_keys, check_number
+from rodval.core.damping import DampingRequest
 from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
 from rodval.core.hinges import Stop as Stop
 from rodval.core.hinges import check_acting_stops, check_latches, hinge_items
@@ -365,6 +366,11 @@ class Scene:
     base : Base
         The body node 0 belongs to: pinned at the origin (default) or a free rigid body.
     name : str
+    damping : DampingRequest or None
+        The bending damping as a scene file stated it, ``{ ratio, of }``
+        (``rodval.core.damping``), recorded with the run; the chain holds the c it gives. A
+        deployed request's c is 0 until the models layer converts it
+        (``DampingRequest.pending``). None: c as given.
     """
 
     chain: Chain
@@ -379,6 +385,7 @@ class Scene:
     latches: tuple[Latch, ...] = ()
     stops: tuple[Stop, ...] = ()
     base: Base = PINNED
+    damping: DampingRequest | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -424,6 +431,11 @@ class Scene:
                 "output 'drive' needs a prescribed base (Base(kind='prescribed', ...))"
             )
         check_latches(self.latches, self.initial_hinge_angles(), self.initial_hinge_rates())
+        if self.damping is not None and not isinstance(self.damping, DampingRequest):
+            raise ValueError(
+                "damping must be a rodval.core.damping.DampingRequest or None, got "
+                f"{type(self.damping).__name__}"
+            )
 
     @property
     def n(self) -> int:

@@ -21,7 +21,7 @@ import numpy as np
 
 from rodval.core.base import BASE_KINDS, PINNED, Base
 from rodval.core.checks import check_keys, check_number
-from rodval.core.damping import bending_damping_for_ratio
+from rodval.core.damping import PANEL, DampingRequest, bending_damping_for_ratio, damping_request
 from rodval.core.loads import LOAD_FACTORIES, pulse
 from rodval.core.profiles import resolve_profiles
 from rodval.core.resources import check_rods
@@ -226,38 +226,39 @@ def _horizon(d: dict, based_on: str | None) -> float:
     )
 
 
-def _chain(d: dict, n: int, based_on: str | None, where: str) -> Chain:
+def _chain(
+    d: dict, n: int, based_on: str | None, where: str
+) -> tuple[Chain, DampingRequest | None]:
     """The ``[chain]`` table over the paper's values (``based_on``) or the neutral ones; a rod
-    field without a neutral value (``REQUIRED_CHAIN``) must be given."""
+    field without a neutral value (``REQUIRED_CHAIN``) must be given. With the damping's
+    ratio form, also its request (``rodval.core.damping``): a panel ratio is converted here;
+    a deployed one leaves c = 0 for the models layer to convert (``DampingRequest.pending``)."""
     spec = dict(d.get("chain", {}))
     check_keys(spec, CHAIN_KEYS, f"{where} [chain]")
-    ratio = _damping_ratio(spec, where)
+    request = _damping_request(spec, where)
     spec = resolve_profiles(spec, n, f"{where} [chain]")
     defaults = UNIFORM_DEFAULTS if based_on == "paper" else NEUTRAL_CHAIN
     for key, what in REQUIRED_CHAIN.items():
         if key not in spec and key not in defaults:
             raise _missing(f"chain.{key}", what)
     chain = Chain(**{**defaults, **spec}, _n=n)
-    if ratio is None:
-        return chain
+    if request is None or request.of != PANEL:
+        return chain, request
+    ratio = list(request.ratio) if isinstance(request.ratio, tuple) else request.ratio
     c = bending_damping_for_ratio(ratio, chain.l, chain.m, chain.EI)
-    return chain.with_(bending_damping=c)
+    return chain.with_(bending_damping=c), request
 
 
-def _damping_ratio(spec: dict, where: str) -> Any:
-    """The ratio of ``[chain] bending_damping = { ratio = ... }`` (removed from ``spec``; the
-    chain gets the converted N m^2 s, ``rodval.core.damping``), or None when the damping is
-    given in N m^2 s (a number, a list or a profile)."""
+def _damping_request(spec: dict, where: str) -> DampingRequest | None:
+    """The request of ``[chain] bending_damping = { ratio = ..., of = ... }`` (removed from
+    ``spec``: the chain gets the converted N m^2 s, ``rodval.core.damping``), or None when
+    the damping is given in N m^2 s (a number, a list or a profile)."""
     value = spec.get("bending_damping")
     if not isinstance(value, dict) or "ratio" not in value:
         return None
-    if set(value) != {"ratio"}:
-        raise ValueError(
-            f"{where} [chain] bending_damping: a table with 'ratio' takes no other key "
-            f"(got {sorted(value)}); give {{ ratio = 0.01 }} for 1 % of critical damping"
-        )
+    request = damping_request(value, where)
     del spec["bending_damping"]
-    return value["ratio"]
+    return request
 
 
 def _loads(d: dict, n: int, based_on: str | None, where: str) -> tuple:
@@ -288,7 +289,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
     try:
         n = _count(d, based_on)
         t_end = _horizon(d, based_on)
-        chain = _chain(d, n, based_on, where)
+        chain, damping = _chain(d, n, based_on, where)
         loads = _loads(d, n, based_on, where)
         init_spec = d.get("initial", {})
         check_keys(init_spec, INITIAL_KEYS, f"{where} [initial]")
@@ -309,6 +310,7 @@ def scene_from_dict(d: dict, where: str = "scene") -> Scene:
             initial=InitialState(**init_spec),
             name=d.get("name", f"paper-n{n}" if based_on == "paper" else "scene"),
             base=body,
+            damping=damping,
         )
     except ValueError as exc:
         msg = str(exc)
@@ -427,15 +429,21 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     with their parameters, initial state, output times, outputs; a free base): it is based on
     nothing, and ``scene_from_dict`` rebuilds the same scene from it, bit for bit. A load
     that is a plain Python callable has no such form: it is recorded as
-    ``{"type": "callable", "node": k}``, which ``scene_from_dict`` refuses."""
+    ``{"type": "callable", "node": k}``, which ``scene_from_dict`` refuses. A deployed
+    damping request not yet converted (``DampingRequest.pending``) is recorded as the request
+    ``{ ratio, of = "deployed" }`` in place of its placeholder c, so that the scene rebuilt
+    from the dict converts it again; a converted one as its c (N m^2 s)."""
     init = scene.initial.resolve(scene.n)
+    chain = scene.chain.as_dict()
+    if scene.damping is not None and scene.damping.pending:
+        chain["bending_damping"] = scene.damping.as_dict()  # type: ignore[assignment]
     return {
         "name": scene.name,
         "n": scene.n,
         "t_end": scene.t_end,
         "times": [float(t) for t in scene.times],
         "outputs": list(scene.outputs),
-        "chain": scene.chain.as_dict(),
+        "chain": chain,
         "loads": [{"type": f.name, "node": f.node, **f.params} for f in scene.loads],
         "initial": {k: v.tolist() for k, v in init.items()},
         "latches": [latch_dict(latch) for latch in scene.latches],

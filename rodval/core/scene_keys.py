@@ -159,8 +159,13 @@ SCENE_KEYS: dict[str, Key] = {
             "bending_damping": Key(
                 ROD,
                 "N m^2 s",
-                ">= 0; or `{ ratio = ... }`",
-                {"ratio": Key(NUMBER_OR_NUMBERS, "", ">= 0 and < 1")},
+                ">= 0; or `{ ratio = ..., of = ... }`",
+                {
+                    "ratio": Key(
+                        NUMBER_OR_NUMBERS, "", '>= 0 and < 1 (one per rod: `of = "panel"` only)'
+                    ),
+                    "of": Key(STRING, "", '`"panel"` (default), `"deployed"`'),
+                },
             ),
         },
         section=True,

@@ -13,6 +13,8 @@ Files:
   (``table="auto"``, more than ``CSV_MAX_VALUES`` values) ``trajectory.npz`` (the times, each
   quantity's values and k labels as float64 / int64 arrays: written in a fraction of the
   time of the text table);
+  A bending damping stated as a ratio is recorded under ``bending_damping`` (the request and,
+  for the deployed structure, its conversion: ``DAMPING_KEY``) beside the scene's c;
 * ``trajectory_wide.csv`` on request (one row per output time);
 * ``scene_arrays.npz`` when the scene has lists of more than ``INLINE_MAX`` numbers (a large
   chain's per-rod fields and initial state): run.json then holds, in their place,
@@ -56,6 +58,7 @@ from rodval.core.provenance import provenance
 from rodval.core.scene import Scene
 from rodval.core.scene_file import scene_to_dict
 from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.models.observation.deployed_damping import resolve_damping
 
 RUN_JSON = "run.json"
 TABLE_CSV, TABLE_NPZ = "trajectory.csv", "trajectory.npz"
@@ -74,6 +77,11 @@ NPZ_DIGEST_KEY = "trajectory_npz"
 ARRAYS_KEY = "scene_arrays"
 #: run.json's list of the files its run wrote (besides run.json).
 FILES_KEY = "files"
+#: run.json's record of a bending damping stated as a ratio (``rodval.core.damping``): the
+#: request ``ratio``, ``of`` and, for the deployed structure, its conversion (``c_N_m2_s``
+#: per rod, ``beta_s``, the mode's ``mode_omega_rad_s`` and ``zeta``, ``iterations``,
+#: ``model``); the scene holds the c that ran.
+DAMPING_KEY = "bending_damping"
 #: The keys a run.json may hold besides ``RUN_KEYS``.
 OPTIONAL_KEYS = (
     "events",
@@ -82,6 +90,7 @@ OPTIONAL_KEYS = (
     NPZ_DIGEST_KEY,
     ARRAYS_KEY,
     FILES_KEY,
+    DAMPING_KEY,
     SCHEMA_KEY,
     CHECKSUM_KEY,
 )
@@ -414,6 +423,7 @@ def write_run(
     ``out`` holds files rodval did not write. Returns the files written besides run.json."""
     out = Path(out)
     claim_run_folder(out)
+    scene = resolve_damping(scene)  # the c the models ran (converted once per process)
     doc, arrays = scene_record(scene)
     name = table_file(table, value_count(traj))
     files = [name, *([WIDE_CSV] if wide else []), *([ARRAYS_NPZ] if arrays else [])]
@@ -433,6 +443,8 @@ def write_run(
         DIGEST_KEY if name == TABLE_CSV else NPZ_DIGEST_KEY: file_digest(data),
         FILES_KEY: files,
     }
+    if scene.damping is not None:
+        record[DAMPING_KEY] = scene.damping.record()
     if wide:
         write_file(out / WIDE_CSV, traj.to_frame(wide=True).to_csv(index=False))
     if arrays:

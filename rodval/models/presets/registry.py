@@ -14,6 +14,7 @@ from rodval.core.resources import check_run_memory, dense_path
 from rodval.core.scene import Scene, trajectory_quantities
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.core.trajectory import Trajectory
+from rodval.models.observation.deployed_damping import resolve_damping
 
 #: name -> "module:Class". Each class lists its option names in ``OPTIONS``.
 REGISTRY: dict[str, str] = {
@@ -81,14 +82,18 @@ def get_model(name: str | Model, **options: Any) -> Model:
     return cls(**options)
 
 
-def check_scene(model: Model, scene: Scene, settings: IntegratorSettings) -> None:
+def check_scene(model: Model, scene: Scene, settings: IntegratorSettings) -> Scene:
     """What ``model`` (with its options) refuses for ``scene`` with ``settings``, before any
     work: a ValueError naming the reason. The settings against the scene's horizon
-    (``IntegratorSettings.check_horizon``) and the base and outputs the model has
-    (``Model.check_base``: a moving base on the reduced model, the output "drive" on exudyn).
-    The one definition ``simulate`` and a study's plan (``rodval.study.case``) both ask."""
+    (``IntegratorSettings.check_horizon``), the base and outputs the model has
+    (``Model.check_base``: a moving base on the reduced model, the output "drive" on exudyn)
+    and a bending damping stated for the deployed structure, converted to the rods' c
+    (``deployed_damping.resolve_damping``: the same c for every model). Returns the scene
+    the model runs (``scene`` itself unless converted). The one definition ``simulate`` and
+    a study's plan (``rodval.study.case``) both ask."""
     settings.check_horizon(scene.t_end)
     model.check_base(scene)
+    return resolve_damping(scene)
 
 
 def _unknown_keyword(model: str, key: str, allowed: tuple[str, ...]) -> str:
@@ -142,7 +147,7 @@ def simulate(
             f"both (got settings= and {', '.join(sorted(integ))})"
         )
     m = get_model(model, **options)
-    check_scene(m, scene, settings)
+    scene = check_scene(m, scene, settings)
     check_run_memory(
         scene.n,
         scene.times.size,
