@@ -213,3 +213,16 @@ def test_modes_refuse_an_option_and_a_free_base_in_one_line():
     with pytest.raises(ValueError, match="free base") as err:
         rodval.modes(straight.with_(base=BODY), "rigid")
     assert "\n" not in str(err.value)
+
+
+def test_modes_of_a_rigid_chain_with_every_hinge_held_are_refused_in_one_line():
+    """Every hinge held: nothing moves, so no modes; one line naming why (it crashed with
+    numpy's zero-size error)."""
+    from rodval.core.hinges import Latch
+    from rodval.core.scene import Chain, Scene
+
+    chain = Chain.uniform(2, l=1.0, m=1.0, EI=1e4)
+    scene = Scene(chain=chain, latches=(Latch(0, 0.0, held=True), Latch(1, 0.0, held=True)))
+    with pytest.raises(ValueError, match="every hinge is held") as info:
+        rodval.modes(scene, "rigid")
+    assert "\n" not in str(info.value)

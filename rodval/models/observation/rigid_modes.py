@@ -51,6 +51,12 @@ def rigid_modes(
     (``Model.modes`` refuses the others: ``rigid_modes`` has no ``FREE_BASE``)."""
     chain, n = scene.chain, scene.n
     Z = rigid_basis(scene)
+    if not Z.shape[1]:
+        raise ValueError(
+            "rigid model: every hinge is held (latches held from t = 0), so the rigid chain "
+            "has no motion and no modes; the full model or exudyn has the held chain's bending "
+            "modes"
+        )
     q0 = np.zeros(3 * n)
     q0[:n] = scene.initial.resolve(n)["phi"]
     eq, SX, SY = None, None, None
