@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from scenes import latch3_toml
 
 from rodval.analysis.events import events_frame
 from rodval.cli import main
@@ -135,37 +136,13 @@ def test_a_final_state_the_run_did_not_reach_breaks_the_requirement():
 
 
 # a latched three-rod study read (never run) for the read-time checks
+SCENE = latch3_toml("scene", outputs=("phi", "energy"))
 STUDY = """
 [study]
 name = "latched"
 reference = "full"
 
-[scene]
-n = 3
-t_end = 0.8
-times = {{ num = 81 }}
-outputs = ["phi", "energy"]
-loads = []
-
-[scene.chain]
-l = 1.5
-m = 3.0
-EI = 1e5
-mu = 0.5
-kappa = [0.0, 50.0, 50.0]
-nu = 0.0
-
-[scene.initial]
-phi = [0.0, 3.0915926535897933, 0.0]
-
-[[scene.latches]]
-hinge = 1
-angle = 0.0
-
-[[scene.latches]]
-hinge = 2
-angle = 0.0
-
+{scene}
 [models.full]
 [models.reduced]
 
@@ -176,10 +153,10 @@ angle = 0.0
 
 def _spec(acceptance: str):
     """acceptance_spec on STUDY's [acceptance] with its labels, outputs and scene."""
-    doc = tomllib.loads(STUDY.format(acceptance=acceptance))
+    doc = tomllib.loads(STUDY.format(scene=SCENE, acceptance=acceptance))
     from rodval.study import study_from_dict
 
-    base = tomllib.loads(STUDY.format(acceptance="valid = true"))
+    base = tomllib.loads(STUDY.format(scene=SCENE, acceptance="valid = true"))
     spec = study_from_dict(base, "s.toml")
     quantities = {"phi", "kinetic", "potential", "energy"}
     return acceptance_spec(
@@ -257,7 +234,9 @@ def test_the_study_file_reader_checks_requirements_before_any_work(tmp_path):
     """Through load_study: a requirement on an output the cases lack is refused."""
     path = tmp_path / "s.toml"
     path.write_text(
-        STUDY.format(acceptance=REQ.format(model="reduced", items="peak_hinge_moment = 1.0"))
+        STUDY.format(
+            scene=SCENE, acceptance=REQ.format(model="reduced", items="peak_hinge_moment = 1.0")
+        )
     )
     with pytest.raises(ValueError, match=r"add it there"):
         load_study(path)

@@ -9,6 +9,7 @@ import xml.etree.ElementTree as ET
 
 import pandas as pd
 import pytest
+from scenes import latch3_toml
 
 from rodval.analysis.events import events_frame, lock_comparison
 from rodval.cli import main
@@ -16,37 +17,13 @@ from rodval.report.acceptance import acceptance_checks
 from rodval.study import load_study
 
 # the three-rod latched deployment (benchmarks/exudyn_speed.py latch3_scene), two cases
+SCENE = latch3_toml("scene", outputs=("phi", "energy"))
 STUDY = """
 [study]
 name = "latched"
 reference = "full"
 
-[scene]
-n = 3
-t_end = 0.8
-times = {{ num = 81 }}
-outputs = ["phi", "energy"]
-loads = []
-
-[scene.chain]
-l = 1.5
-m = 3.0
-EI = 1e5
-mu = 0.5
-kappa = [0.0, 50.0, 50.0]
-nu = 0.0
-
-[scene.initial]
-phi = [0.0, 3.0915926535897933, 0.0]
-
-[[scene.latches]]
-hinge = 1
-angle = 0.0
-
-[[scene.latches]]
-hinge = 2
-angle = 0.0
-
+{scene}
 [models.full]
 [models.reduced]
 
@@ -60,7 +37,7 @@ angle = 0.0
 
 def _study(tmp_path, name: str, acceptance: str):
     path = tmp_path / f"{name}.toml"
-    path.write_text(STUDY.format(acceptance=acceptance))
+    path.write_text(STUDY.format(scene=SCENE, acceptance=acceptance))
     return path
 
 

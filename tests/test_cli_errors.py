@@ -11,8 +11,7 @@ import sys
 from pathlib import Path
 
 import pytest
-
-from rodval.cli import main
+from checks import assert_refused, run_main
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -53,24 +52,6 @@ CASES = [
     (["--t-end", "0"], ["--t-end", "> 0"]),
     (["--set", "foo=1"], ["option", "foo"]),
 ]
-
-
-def run_main(capsys, *args: str) -> subprocess.CompletedProcess:
-    try:
-        code = main(list(args))
-    except SystemExit as exc:
-        code = exc.code
-    out = capsys.readouterr()
-    return subprocess.CompletedProcess(args, code, out.out, out.err)
-
-
-def assert_refused(proc: subprocess.CompletedProcess, words: list[str]) -> None:
-    assert proc.returncode == 2, proc.stderr
-    assert "Traceback" not in proc.stderr
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1, proc.stderr
-    for w in words:
-        assert w in lines[0], (w, lines[0])
 
 
 @pytest.mark.parametrize("options, words", CASES, ids=[" ".join(c[0]) for c in CASES])

@@ -10,38 +10,15 @@ import math
 
 import pandas as pd
 import pytest
+from scenes import latch3_toml
 
 from rodval.analysis.events import MIN_WINDOW_STEPS, event_discrepancies, events_frame
 from rodval.cli import main
 from rodval.report.markdown import to_markdown
 
 # the three-rod latched deployment (benchmarks/exudyn_speed.py latch3_scene)
-LATCH3 = """
-n = 3
-t_end = 0.8
-times = { num = 81 }
-outputs = ["phi"]
-
-[chain]
-l = 1.5
-m = 3.0
-EI = 1e5
-mu = 0.5
-kappa = [0.0, 50.0, 50.0]
-nu = 0.0
-
-[initial]
-phi = [0.0, 3.0915926535897933, 0.0]
-"""
-LATCHES = """
-[[latches]]
-hinge = 1
-angle = 0.0
-
-[[latches]]
-hinge = 2
-angle = 0.0
-"""
+LATCH3 = latch3_toml(latches=())
+LATCHES = latch3_toml(latches=(1, 2))[len(LATCH3) :]
 # two rods whose root hinge latches too (after hinge 1): its record's root jump means nothing
 ROOT = """
 n = 2

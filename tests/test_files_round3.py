@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_cli_errors import assert_refused, run_main
+from checks import assert_refused, run_main
 
 from rodval.cli import main
 from rodval.core.out_paths import (

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from scenes import latch3_toml
 
 from rodval.cli import main
 from rodval.core.base import Base
@@ -160,30 +161,7 @@ def test_modes_accept_auto():
     assert plain.info["kinematics"] == "first-order"
 
 
-LATCH3 = """n = 3
-t_end = 0.8
-times = { start = 0.0, stop = 0.8, num = 81 }
-outputs = ["phi"]
-
-[chain]
-l = 1.5
-m = 3.0
-EI = 1e5
-mu = 0.5
-kappa = [0.0, 50.0, 50.0]
-nu = 0.0
-
-[initial]
-phi = [0.0, 3.0915926535897933, 0.0]
-
-[[latches]]
-hinge = 1
-angle = 0.0
-
-[[latches]]
-hinge = 2
-angle = 0.0
-"""
+LATCH3 = latch3_toml()
 
 
 def test_run_json_records_the_kinematics_that_ran_and_a_rerun_reproduces(tmp_path, capsys):

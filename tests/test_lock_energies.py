@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 import pytest
-from test_lock_impulse import stiff_damped_latch
+from scenes import stiff_damped_latch
 
 from rodval import paper_scene, simulate
 

@@ -9,22 +9,12 @@ import math
 
 import numpy as np
 import pytest
-from test_rigid_lock import two_rod_latch
+from scenes import stiff_damped_latch, two_rod_latch
 
 from rodval import simulate
 from rodval.core.lock_window import first_bending_period, locked_segment, window_nodes
 from rodval.core.scene import Chain, Latch
 from rodval.core.scene_file import scene_from_dict, scene_to_dict
-
-#: Kelvin-Voigt bending damping (N m^2 s) of the stiff damped two-rod scene: zeta = c omega /
-#: (2 EI) = 0.1 on the locked pair's first bending mode (2756 rad/s at EI = 1e7).
-DAMPING = 700.0
-
-
-def stiff_damped_latch():
-    scene = two_rod_latch(1e7)
-    chain = scene.chain.with_(bending_damping=DAMPING)
-    return dataclasses.replace(scene, chain=chain, outputs=("phi", "dphi", "angular_momentum"))
 
 
 @pytest.mark.parametrize(

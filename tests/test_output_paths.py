@@ -10,8 +10,8 @@ import subprocess
 import sys
 
 import pytest
+from checks import one_line
 from study_helpers import write_study
-from test_trust_study import one_line
 
 from rodval.cli import main
 

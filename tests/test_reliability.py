@@ -7,11 +7,10 @@ what is wrong, before any work where it can be; never a traceback, a hang or a s
 from __future__ import annotations
 
 import math
-import signal
-import time
 
 import numpy as np
 import pytest
+from checks import TimeLimit, one_line
 
 from rodval import (
     Chain,
@@ -35,37 +34,6 @@ from rodval.core.status import (
 )
 
 SMALL = paper_scene(4, t_end=0.5, times=np.linspace(0, 0.5, 6))
-
-
-class TimeLimit:
-    """Fails the test when the block takes longer than ``seconds``: a SIGALRM for Python code,
-    and the elapsed time afterwards for compiled loops (which a signal cannot interrupt)."""
-
-    def __init__(self, seconds: float):
-        self.seconds = seconds
-
-    def __enter__(self):
-        def alarm(signum, frame):
-            raise AssertionError(f"hang: more than {self.seconds:g} s")
-
-        self.old = signal.signal(signal.SIGALRM, alarm)
-        signal.setitimer(signal.ITIMER_REAL, self.seconds)
-        self.start = time.perf_counter()
-        return self
-
-    def __exit__(self, *exc):
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, self.old)
-        assert time.perf_counter() - self.start < self.seconds, "hang"
-        return False
-
-
-def one_line_error(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = [line for line in err.splitlines() if line.strip()]
-    assert len(lines) == 1, err
-    assert "Traceback" not in err and "internal error" not in err, err
-    return lines[0]
 
 
 # --------------------------------------------------------------- huge initial values: no hang
@@ -193,7 +161,7 @@ def test_scene_file_too_large_on_the_cli(tmp_path, capsys):
     path = tmp_path / "big.toml"
     path.write_text('based_on = "paper"\nn = 50000\ntimes = {num = 100000}\n')
     assert main(["simulate", str(path), "--out", str(tmp_path / "o")]) == 2
-    line = one_line_error(capsys)
+    line = one_line(capsys)
     assert "big.toml" in line and "GB of memory" in line
 
 

@@ -7,10 +7,11 @@ import math
 
 import numpy as np
 import pytest
+from scenes import two_rod_latch
 
 from rodval import simulate
 from rodval.core.rigid import node_velocities, rigid_lock
-from rodval.core.scene import Chain, InitialState, Latch, Scene
+from rodval.core.scene import Chain
 
 
 def two_link_closed_form(l, m, mu, w):
@@ -91,21 +92,6 @@ def test_node_velocities_are_the_chords_turning_about_the_root():
 def test_a_hinge_not_held_is_refused():
     with pytest.raises(ValueError, match="hinge 2 must be among the held hinges"):
         rigid_lock(Chain.uniform(3), np.zeros(3), np.ones(3), [1], 2)
-
-
-def two_rod_latch(EI: float) -> Scene:
-    """The exudyn deployment tests' two-rod scene (tests/test_exudyn_deployment.py): l = 1.5
-    m, m = 3 kg/m, mu = 0.5 kg, hinge 0 free, hinge 1 stowed at pi - 0.05 rad unfolding on a
-    50 N m/rad spring, latch at 0; the lock comes at t = 0.404 s."""
-    chain = Chain.uniform(2, l=1.5, m=3.0, EI=EI, mu=0.5, kappa=[0.0, 50.0], nu=0.0)
-    return Scene(
-        chain=chain,
-        t_end=0.42,
-        times=np.linspace(0.0, 0.42, 43),
-        outputs=("phi", "dphi"),
-        initial=InitialState(phi=[0.0, math.pi - 0.05], dphi=[1.0, 1.0]),
-        latches=(Latch(1, 0.0),),
-    )
 
 
 def test_every_native_lock_record_carries_the_rigid_impulse():

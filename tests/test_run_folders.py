@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from test_cli_errors import assert_refused, run_main
+from checks import assert_refused, run_main
 
 import rodval.cli.simulate as simulate_cli
 from rodval import paper_scene, simulate

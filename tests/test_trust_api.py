@@ -9,7 +9,7 @@ import json
 
 import numpy as np
 import pytest
-from test_cli_errors import assert_refused, run_main
+from checks import assert_refused, run_main
 
 import rodval
 from rodval import Chain, paper_scene

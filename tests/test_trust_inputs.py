@@ -7,8 +7,8 @@ import json
 import shutil
 
 import pytest
+from checks import assert_refused, run_main
 from study_helpers import write_study
-from test_cli_errors import assert_refused, run_main
 
 import rodval
 from rodval import IntegratorSettings, Latch, paper_scene, tabulated

@@ -9,7 +9,7 @@ import re
 
 import numpy as np
 import pytest
-from test_reliability import TimeLimit, one_line_error
+from checks import TimeLimit, one_line
 
 from rodval import InitialState, Scene, paper_scene, simulate
 from rodval.cli import main
@@ -169,7 +169,7 @@ def test_an_acting_stop_keeps_its_hinge_within_the_chain_bounds(tmp_path, capsys
     with TimeLimit(30):
         code = main(["simulate", str(scene_file), "--out", str(tmp_path / "o")])
     assert code == 2
-    line = one_line_error(capsys)
+    line = one_line(capsys)
     assert "stop stiffness (N m/rad) must lie in [1e-12, 1e+12]" in line and "kappa" not in line
     assert not (tmp_path / "o").exists()
 
@@ -215,12 +215,12 @@ def test_a_chain_too_large_for_memory_is_refused_before_any_rod_array(tmp_path, 
     assert "RODVAL_MAX_MEMORY_GB" in str(info.value)
     path = _scene_file(tmp_path, 'based_on = "paper"\nn = 100000000\n')
     assert main(["simulate", str(path), "--model", "reduced", "--out", str(tmp_path / "o")]) == 2
-    assert "n = 100000000 rods" in one_line_error(capsys)
+    assert "n = 100000000 rods" in one_line(capsys)
 
 
 def test_a_count_beyond_int64_is_refused_by_the_parser_and_the_settings(tmp_path, capsys):
     """A huge --max-evaluations passed the parser and failed at run time in numba."""
-    from test_cli_errors import assert_refused, run_main
+    from checks import assert_refused, run_main
 
     from rodval.core.settings import IntegratorSettings
 
@@ -252,7 +252,7 @@ def test_a_damaged_load_history_is_named_with_its_row_and_column(tmp_path, capsy
         tmp_path, 'based_on = "paper"\n[[loads]]\ntype = "tabulated"\nnode = 8\nfile = "bad.csv"\n'
     )
     assert main(["simulate", str(path), "--out", str(tmp_path / "o")]) == 2
-    assert re.search(words, one_line_error(capsys))
+    assert re.search(words, one_line(capsys))
 
 
 def test_a_load_file_is_found_beside_the_scene_file_from_any_folder(tmp_path, monkeypatch):

@@ -5,19 +5,12 @@ from __future__ import annotations
 
 import pandas as pd
 import pytest
+from checks import one_line
 from study_helpers import write_study
 
 from rodval.cli import main
 
 ONE_MODEL = "[models.reduced]\n"
-
-
-def one_line(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = [line for line in err.splitlines() if line.strip()]
-    assert len(lines) == 1, err
-    assert "Traceback" not in err and "internal error" not in err, err
-    return lines[0]
 
 
 @pytest.fixture(scope="module")
