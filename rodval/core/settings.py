@@ -36,6 +36,9 @@ RTOL_RANGE = (
     f"a number in (0, 1), at least {MIN_RTOL:.3g} (> 0 is not enough: the integrators cannot "
     "honour less than 100 machine epsilons)"
 )
+#: How the compiled loop's error norm weighs the state (``IntegratorSettings.error_control``).
+ERROR_CONTROLS = ("uniform", "per-block")
+
 #: Largest count (evaluations, steps) a setting may ask for: 2**53, exact as a double and far
 #: inside the compiled loop's int64 counters (a larger one failed at run time with numba's
 #: "No matching definition" or OverflowError).
@@ -68,6 +71,21 @@ class IntegratorSettings:
     min_step_fraction, stall_steps : the run stops as "step size collapse" when
         ``stall_steps`` consecutive accepted steps are all shorter than
         ``min_step_fraction * t_end``.
+
+    Error control per coordinate block (the compiled methods and "auto";
+    ``rodval.solvers.compiled.atol_vector``):
+
+    error_control : "uniform": every component's absolute tolerance is ``atol``;
+        "per-block": a system that names its bending coordinates (``OdeSystem.bending_mask``:
+        the full model) has every angle judged on the scale of 1 rad, atol_i = max(atol,
+        rtol x 1 rad) (a panel at phi = 0 no stricter than one at pi), and every rate on
+        the scale 1 rad x ``block_frequency``, atol_i = max(atol, rtol x block_frequency x
+        1 rad/s): a vibration faster than ``block_frequency`` whose angle stays below rtol x
+        1 rad is not resolved, and Radau IIA (L-stable) steps over it; the bending block
+        (alpha, beta, a rung's bubbles and their rates) on a scale ``bending_scale`` times
+        larger. Systems without bending coordinates (reduced, rigid) run as "uniform".
+    block_frequency : rad/s, > 0, finite: the per-block rates' frequency scale.
+    bending_scale : >= 1, finite: how much larger the bending block's scale is.
     """
 
     method: str = AUTO
@@ -80,10 +98,28 @@ class IntegratorSettings:
     blowup_factor: float = 100.0
     min_step_fraction: float = 1e-9
     stall_steps: int = 1000
+    error_control: str = "uniform"
+    block_frequency: float = 1e4
+    bending_scale: float = 1e4
 
     def __post_init__(self) -> None:
         if not isinstance(self.method, str) or self.method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
+        if not isinstance(self.error_control, str) or self.error_control not in ERROR_CONTROLS:
+            raise ValueError(
+                f"error_control must be one of {ERROR_CONTROLS}, got {self.error_control!r}"
+            )
+        check_number(
+            "block_frequency",
+            self.block_frequency,
+            low=0,
+            low_open=True,
+            finite=True,
+            allowed="a finite frequency > 0 (rad/s)",
+        )
+        check_number(
+            "bending_scale", self.bending_scale, low=1, finite=True, allowed="a finite number >= 1"
+        )
         for name in (
             "rtol",
             "atol",

@@ -111,6 +111,21 @@ def held_by(switch: dict[str, Any] | None, remaining: float, used: int) -> str:
     )
 
 
+def atol_vector(system: OdeSystem, settings: IntegratorSettings) -> float | np.ndarray:
+    """The absolute tolerance of each state component (rad, rad/s, m, m/s): ``settings.atol``
+    (a float) for "uniform" error control or a system without bending coordinates
+    (``OdeSystem.bending_mask`` None or empty); for "per-block" (``IntegratorSettings``) the
+    coordinates (the first half of [q; q']) max(atol, rtol x 1) and their rates max(atol,
+    rtol x block_frequency), the bending block's (``bending_mask``) times bending_scale."""
+    mask = system.bending_mask()
+    if settings.error_control == "uniform" or mask is None or not mask.any():
+        return settings.atol
+    half = mask.size // 2
+    scale = np.where(mask, settings.bending_scale, 1.0)
+    scale[half:] *= settings.block_frequency
+    return np.maximum(settings.atol, settings.rtol * scale)
+
+
 def run_compiled(
     system: OdeSystem,
     y0: np.ndarray,
@@ -139,6 +154,7 @@ def run_compiled(
     monitor = None
     stepper = _STEPPERS[settings.method]
     switch = stiffness.new_state()
+    atol = atol_vector(system, settings)
     while True:
         form = system.compiled()
         assert form is not None  # choose_method took the compiled path for this system
@@ -151,7 +167,7 @@ def run_compiled(
                 np.concatenate([[t], edges[edges > t]]),
                 times,
                 settings.rtol,
-                settings.atol,
+                atol,
                 settings.max_step,
                 settings.first_step,
                 settings.max_evaluations - stats.nfev,

@@ -80,8 +80,8 @@ def _rms(x):
 
 @njit(cache=True, error_model="numpy")
 def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, order, tmp, f1):
-    """scipy's select_initial_step (Hairer, Sec. II.4) for a method of the given order; uses
-    one evaluation."""
+    """scipy's select_initial_step (Hairer, Sec. II.4) for a method of the given order (``atol``:
+    one per coordinate); uses one evaluation."""
     scale = atol + np.abs(y0) * rtol
     d0 = _rms(y0 / scale)
     d1 = _rms(f0 / scale)
@@ -100,7 +100,8 @@ def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, or
 @njit(cache=True, inline="always", error_model="numpy")
 def _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol):
     """One DOP853 step from (t, y) to t_new (s): the stages into K, the solution into y_new;
-    returns Hairer's error norm (< 1: accepted). 12 evaluations, O(N) each combination."""
+    returns Hairer's error norm (< 1: accepted) with the scale atol[i] + rtol max(|y_i|,
+    |y_new_i|) (``atol``: one per coordinate). 12 evaluations, O(N) each combination."""
     N = y.shape[0]
     h = t_new - t
     for s in range(1, N_STAGES):
@@ -111,7 +112,7 @@ def _attempt(rhs, P, S, M, L, t, t_new, y, K, y_new, tmp, rtol, atol):
     err5 = 0.0
     err3 = 0.0
     for i in range(N):
-        sc = atol + max(abs(y[i]), abs(y_new[i])) * rtol
+        sc = atol[i] + max(abs(y[i]), abs(y_new[i])) * rtol
         e5 = 0.0
         e3 = 0.0
         for j in range(N_STAGES + 1):
@@ -215,9 +216,11 @@ def _audit_step(mechanics, P, S, M, L, F, y, t, t_new, t_cut, times, n_out, tmp,
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, reporting, cnt):
+def _step_control(
+    rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, atol, reporting, cnt
+):
     """Step attempts from (t, y) towards t_bound with Hairer's step-size control until one is
-    accepted (its stages in K, its solution in y_new). ``controls`` as in ``run``; ``cnt``:
+    accepted (its stages in K, its solution in y_new). ``controls``, ``atol`` as in ``run``; ``cnt``:
     [evaluations used, evaluation count at the next clock read], updated. Returns (code, t
     of the accepted step's end, the next step size): ``OK``, or ``STEP_TOO_SMALL``,
     ``BUDGET``, ``WALL`` or ``NON_FINITE`` with t unchanged.
@@ -226,7 +229,7 @@ def _step_control(rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls
     transient, e.g. just after a lock) is rejected and the step cut by MIN_FACTOR, as scipy's
     DOP853 does with its infinite error norm; a state whose attempts stay non-finite down to
     the smallest step is ``NON_FINITE`` (diverged), not ``STEP_TOO_SMALL``."""
-    rtol, atol, max_step = controls[0], controls[1], controls[2]
+    rtol, max_step = controls[0], controls[2]
     min_step = smallest_step(t)
     h_abs = min(max(h_abs, min_step), max_step)
     rejected = False
@@ -302,7 +305,7 @@ def _buffers(y0, total, n_events):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper, mode):
+def _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, atol, cnt, stepper, mode):
     """The derivative at a segment's start into K[0] and the first step size (s): the given
     one (controls[3] > 0) or ``_initial_step``'s for the stepper's order; 1 or 2
     evaluations, counted in cnt[0]. ``stepper``: (Radau's work, its scalars, the switching
@@ -326,7 +329,7 @@ def _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper,
     if controls[3] > 0:
         return min(controls[3], t_bound - t)
     cnt[0] += 1
-    rtol, atol, max_step = controls[0], controls[1], controls[2]
+    rtol, max_step = controls[0], controls[2]
     order = radau.ERROR_ORDER if implicit else 7
     return _initial_step(
         rhs, P, S, M, L, t, y, K[0], t_bound, rtol, atol, max_step, order, tmp, np.empty(y.shape[0])
@@ -337,16 +340,16 @@ def _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper,
 def _advance(rhs, P, S, M, L, args):
     """One accepted step from (t, y) by the stepper in use (Radau IIA when ``implicit``,
     which also writes the dense output F): ``_step_control``'s or ``radau.step``'s return.
-    ``args``: (t, t_bound, h_abs, buffers, controls, reporting, cnt, rw, sc, implicit)."""
-    t, t_bound, h_abs, buffers, controls, reporting, cnt, rw, sc, implicit = args
+    ``args``: (t, t_bound, h_abs, buffers, controls, atol, reporting, cnt, rw, sc, implicit)."""
+    t, t_bound, h_abs, buffers, controls, atol, reporting, cnt, rw, sc, implicit = args
     y, y_new, K, F, tmp = buffers[0], buffers[1], buffers[2], buffers[3], buffers[4]
     if implicit:
         return radau.step(
             rhs, P, S, M, L, t, t_bound, h_abs, y, K[0], y_new, K[N_STAGES], F,
-            controls, reporting, cnt, rw, sc,
+            controls, atol, reporting, cnt, rw, sc,
         )  # fmt: skip
     return _step_control(
-        rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, reporting, cnt
+        rhs, P, S, M, L, t, t_bound, h_abs, y, K, y_new, tmp, controls, atol, reporting, cnt
     )
 
 
@@ -364,6 +367,7 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
     _F1,
     _F1,
     _F1,
+    _F1,
     types.boolean,
     _F2,
     _F2,
@@ -372,14 +376,17 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
 
 
 @njit(_RUN_SIGNATURE, cache=True, error_model="numpy")
-def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, reporting, Y, W, carry):
+def run(
+    rhs, mechanics, events, arrays, y0, edges, times, controls, atol, guard, reporting, Y, W, carry
+):
     """Integrate from edges[0] to edges[-1], restarting at each interior edge (breakpoint),
     writing the state at ``times`` into Y, until the end or the first event. ``rhs``,
     ``mechanics``, ``events`` and ``arrays`` (P, S, M, L, E, directions): a
     ``CompiledForm``'s functions and arrays. ``controls``: [rtol, atol, max_step (s),
     first_step (s; <= 0 selects it), max_nfev, deadline (a ``time.perf_counter()`` value, s;
     inf: none), stepper (``DOP853_STEPPER``, or ``RADAU_STEPPER``: ``rodval.solvers.radau``,
-    which writes its own dense output)]: the budgets' codes (``budget.exhausted``: ``BUDGET``,
+    which writes its own dense output)]; ``atol``: the absolute tolerance of each coordinate
+    (N,; controls[1] is not read): the budgets' codes (``budget.exhausted``: ``BUDGET``,
     ``WALL``; the time reached goes to the progress reporter if ``reporting``).
 
     ``carry``: (mon, total, hit, switch), carried over restarts. ``guard``: ``GuardSpec.as_array()``,
@@ -419,11 +426,13 @@ def run(rhs, mechanics, events, arrays, y0, edges, times, controls, guard, repor
     for seg in range(edges.shape[0] - 1):
         t, t_bound = edges[seg], edges[seg + 1]
         stepper, mode = (rw, sc, switch), (implicit, switching)
-        h_abs = _segment_start(rhs, P, S, M, L, t, t_bound, buffers, controls, cnt, stepper, mode)
+        h_abs = _segment_start(
+            rhs, P, S, M, L, t, t_bound, buffers, controls, atol, cnt, stepper, mode
+        )
         if not np.all(np.isfinite(K[0])):  # the derivative at an accepted state
             return n_out, cnt[0], nsteps, NON_FINITE, t
         while t < t_bound:
-            args = (t, t_bound, h_abs, buffers, controls, reporting, cnt, rw, sc, implicit)
+            args = (t, t_bound, h_abs, buffers, controls, atol, reporting, cnt, rw, sc, implicit)
             code, t_new, h_abs = _advance(rhs, P, S, M, L, args)
             nsteps += code == OK
             if code == OK:
@@ -484,7 +493,7 @@ def integrate_compiled(
     edges: np.ndarray,
     times: np.ndarray,
     rtol: float,
-    atol: float,
+    atol: float | np.ndarray,
     max_step: float,
     first_step: float | None,
     max_nfev: int,
@@ -502,7 +511,9 @@ def integrate_compiled(
     blow-up check and no audit; ``deadline``: a ``time.perf_counter()`` value, s;
     ``reporting``: report progress; ``audit``: integrate the load and damper powers;
     ``stepper``: ``DOP853_STEPPER``, ``RADAU_STEPPER`` or ``SWITCHING_STEPPER``, see ``run``;
-    ``switch``: the switching state, carried on like ``monitor``).
+    ``switch``: the switching state, carried on like ``monitor``; ``atol``: one absolute
+    tolerance for every coordinate, or one per coordinate (N,), e.g.
+    ``rodval.solvers.compiled.atol_vector``'s).
     A run continued after an event passes the guard's ``monitor`` and the audit's running
     ``total`` [W_ext, D] (J) on (both updated in place); new ones start from (edges[0], y0)."""
     g = guard.as_array()
@@ -513,8 +524,9 @@ def integrate_compiled(
     mechanics = form.mechanics if form.mechanics is not None else form.rhs
     events = form.events if form.events is not None else no_events
     first = -1.0 if first_step is None else first_step
-    controls = np.array([rtol, atol, max_step, first, max_nfev, deadline, stepper], float)
     y0 = np.array(y0, float)
+    atol_v = np.array(np.broadcast_to(np.asarray(atol, float), y0.shape))
+    controls = np.array([rtol, atol_v.max(), max_step, first, max_nfev, deadline, stepper], float)
     mon = start_monitor(form, float(edges[0]), y0, guard) if monitor is None else monitor
     total = np.zeros(2) if total is None else total
     W = np.zeros((len(times) if audit else 0, 2))
@@ -529,6 +541,7 @@ def integrate_compiled(
         np.array(edges, float),
         np.array(times, float),
         controls,
+        atol_v,
         g,
         bool(reporting),
         Y,

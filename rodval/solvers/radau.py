@@ -305,18 +305,19 @@ def _predict(t, h, y, F, rw, sc):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _error(rhs, P_, S, M, L, t, y, y_new, f, h, rw, controls, again, cnt):
+def _error(rhs, P_, S, M, L, t, y, y_new, f, h, rw, controls, atol, again, cnt):
     """Hairer's error estimate of the step (its norm): (MU_REAL/h I - J)^-1 (f + Z^T E / h),
     filtered once more through the right-hand side when ``again`` (after a rejection; one
-    evaluation)."""
+    evaluation); scaled by atol[i] + rtol max(|y_i|, |y_new_i|) (``atol``: one per
+    coordinate)."""
     LUr, pr, Z, tmp, f1, err = rw[1], rw[2], rw[5], rw[11], rw[12], rw[15]
-    rtol, atol = controls[0], controls[1]
+    rtol = controls[0]
     N = y.shape[0]
     for i in range(N):
         err[i] = f[i] + (E[0] * Z[0, i] + E[1] * Z[1, i] + E[2] * Z[2, i]) / h
     lu_solve(LUr, pr, err)
     for i in range(N):
-        tmp[i] = atol + max(abs(y[i]), abs(y_new[i])) * rtol
+        tmp[i] = atol[i] + max(abs(y[i]), abs(y_new[i])) * rtol
     norm = _norm(err, tmp)
     if again and norm > 1.0:
         for i in range(N):
@@ -357,17 +358,36 @@ def _newton(rhs, P_, S, M, L, t, y, f, h, F, tol, rw, sc, cnt):
 
 @njit(cache=True, error_model="numpy")
 def step(
-    rhs, P_, S, M, L, t, t_bound, h_abs, y, f, y_new, f_new, F, controls, reporting, cnt, rw, sc
+    rhs,
+    P_,
+    S,
+    M,
+    L,
+    t,
+    t_bound,
+    h_abs,
+    y,
+    f,
+    y_new,
+    f_new,
+    F,
+    controls,
+    atol,
+    reporting,
+    cnt,
+    rw,
+    sc,
 ):
     """Step attempts from (t, y) (f = rhs(t, y)) towards t_bound until one is accepted
     (scipy's ``Radau._step_impl``): its state into y_new, the derivative there into f_new,
-    its dense output into F (``dense_coefficients``). ``controls``, ``cnt`` as in
-    ``dop853.run``; ``rw``: ``work``; ``sc``: the scalars (H_OLD, ...), updated. Returns
+    its dense output into F (``dense_coefficients``). ``controls``, ``atol`` (one per
+    coordinate), ``cnt`` as in ``dop853.run``; ``rw``: ``work``; ``sc``: the scalars (H_OLD,
+    ...), updated. Returns
     (code, t of the step's end, the next step size): ``OK``, or ``STEP_TOO_SMALL``,
     ``BUDGET``, ``WALL`` or ``NON_FINITE`` (attempts non-finite down to the smallest step)
     with t unchanged."""
     J, Z, tmp, f1, scale = rw[0], rw[5], rw[11], rw[12], rw[14]
-    rtol, atol, max_step = controls[0], controls[1], controls[2]
+    rtol, max_step = controls[0], controls[2]
     N = y.shape[0]
     tol = max(10.0 * _EPS / rtol, min(0.03, rtol**0.5))
     min_step = smallest_step(t)
@@ -384,7 +404,7 @@ def step(
         h = t_new - t
         h_abs = h
         for i in range(N):
-            scale[i] = atol + abs(y[i]) * rtol
+            scale[i] = atol[i] + abs(y[i]) * rtol
         converged, n_iter, rate = _newton(rhs, P_, S, M, L, t, y, f, h, F, tol, rw, sc, cnt)
         finite = rate < np.inf
         if not converged:
@@ -393,7 +413,7 @@ def step(
             continue
         for i in range(N):
             y_new[i] = y[i] + Z[2, i]
-        error_norm = _error(rhs, P_, S, M, L, t, y, y_new, f, h, rw, controls, rejected, cnt)
+        error_norm = _error(rhs, P_, S, M, L, t, y, y_new, f, h, rw, controls, atol, rejected, cnt)
         safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter)
         if error_norm > 1.0 or not np.isfinite(error_norm):
             finite = np.isfinite(error_norm)

@@ -160,6 +160,12 @@ class OdeSystem(ABC):
         coordinates (the driver's small-bending check)."""
         return None
 
+    def bending_mask(self) -> np.ndarray | None:
+        """Which state components are bending coordinates or their rates (bool, (N,)), the
+        block that per-block error control (``IntegratorSettings.bending_atol``) judges on a
+        scale of its own; None (default): the system has no bending coordinates."""
+        return None
+
     def event_functions(self) -> tuple[EventSpec, ...]:
         """The system's state events in its current mode (none by default)."""
         return ()
@@ -175,6 +181,12 @@ class OdeSystem(ABC):
         at one state: the integrands of a lock window (``rodval.solvers.outputs.LockWindows``);
         a system whose lock records declare an ``impulse_window`` implements it."""
         raise NotImplementedError
+
+    def window_rows(self, times: np.ndarray, Y: np.ndarray, hinge: int) -> np.ndarray:
+        """``window_terms`` at the states Y (nt, N) at ``times`` (s), all in the current mode,
+        as rows (nt, 5); state by state unless the system evaluates them on whole arrays."""
+        rows = [self.window_terms(float(t), y, hinge) for t, y in zip(times, Y)]
+        return np.array(rows, dtype=float).reshape(-1, 5)
 
     def energy_parts(self, t: float, y: np.ndarray) -> tuple[float, float, float]:
         """(kinetic, hinge, bending) energy (J) at one state, summing to ``energy``: a lock

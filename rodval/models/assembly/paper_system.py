@@ -206,6 +206,16 @@ class PaperSystem(PaperEnergy, OdeSystem):
             largest = max(largest, float(np.max(np.abs(alpha))), float(np.max(np.abs(beta))))
         return largest
 
+    def bending_mask(self) -> np.ndarray | None:
+        """The full model's bending coordinates (alpha, beta, a rung's bubbles: q[n:Nc]) and
+        their rates in [q; q'] (a body's coordinates after Nc are not); None when reduced."""
+        if not self.full:
+            return None
+        N = self.y0.size // 2
+        q = np.zeros(N, dtype=bool)
+        q[self.n : getattr(self, "Nc", 3 * self.n)] = True
+        return np.concatenate([q, q])
+
     def energy(self, t: float, y: np.ndarray) -> float:
         """E = T + Pi (J) at one state (the same energy ``observe`` reports)."""
         with self._mode_at(t):
