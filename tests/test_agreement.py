@@ -268,3 +268,21 @@ def test_the_reference_error_bar_takes_a_free_bases_attitude():
 
     spec = agreement_spec({"reference_error": {"attitude": 2e-3, "lock_dt": 1e-3}}, "s.toml")
     assert AgreementSettings.from_dict(spec).reference_attitude == 2e-3
+
+
+def test_a_free_bases_deployed_attitude_is_compared_against_its_band():
+    """The body's attitude (quantity base_attitude, k = 0) of the model 0.01 rad off the
+    reference's after the later last lock: attitude_gap 0.01 rad, judged against the
+    reference's attitude bar."""
+    traj, events, runtime = _tables(twin_shift=1e-7)
+    extra = [
+        {"case": "c", "model": m, "t": t, "quantity": "base_attitude", "k": 0, "value": v}
+        for m, off in (("ref", 0.0), ("ref twin", 0.0), ("m", 0.01))
+        for t, v in zip(T, 0.1 * np.sin(T) + off)
+    ]
+    traj = pd.concat([traj, pd.DataFrame(extra)], ignore_index=True)
+    settings = AgreementSettings(reference_attitude=2e-3)
+    table = agreement_table(traj, events, runtime, "ref", settings).set_index("model")
+    assert table.loc["m", "attitude_gap"] == pytest.approx(0.01, rel=1e-9)
+    assert table.loc["m", "attitude_band"] == 2e-3
+    assert table.loc["ref twin", "attitude_gap"] == pytest.approx(0.0, abs=1e-15)

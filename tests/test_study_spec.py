@@ -105,6 +105,7 @@ def test_shipped_studies_and_the_readme_example_are_valid():
         "deployment_stiff": 1,
         "deployment_stiff_panels": 1,
         "deployment_sample": 256,
+        "deployment_spacecraft": 1,
         "exudyn_convergence": 80,
         "model_error_budget": 8,
         "n_sweep": 20,
