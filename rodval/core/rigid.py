@@ -27,6 +27,7 @@ of every model's ``impulse``.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import numpy as np
@@ -46,9 +47,25 @@ def node_velocities(l: np.ndarray, phi: np.ndarray, dphi: np.ndarray) -> np.ndar
 def _mass_matrix(chain: Chain) -> scipy.sparse.csr_matrix:
     """The rigid chain's mass matrix in the node velocities v_1..v_n (kg, 2n x 2n, banded):
     rod k adds m l / 3 on nodes k-1 and k and m l / 6 between them; node k its point mass."""
+    rows, cols, vals = _mass_entries(*_mass_key(chain))
     n = chain.n
-    ml = chain.m * chain.l
-    diag = ml / 3.0 + np.concatenate([ml[1:] / 3.0, [0.0]]) + chain.mu  # node k = 1..n
+    return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(2 * n, 2 * n))
+
+
+def _mass_key(chain: Chain) -> tuple[bytes, bytes, bytes]:
+    """The chain's m, l, mu as bytes: ``_mass_entries``' cache key."""
+    m, l, mu = (np.ascontiguousarray(a, float).tobytes() for a in (chain.m, chain.l, chain.mu))
+    return m, l, mu
+
+
+@functools.lru_cache(maxsize=16)
+def _mass_entries(m: bytes, l: bytes, mu: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(rows, cols, values) of ``_mass_matrix`` from the chain's m, l, mu (as bytes, the
+    cache's key: they do not change between the locks of a run). O(n)."""
+    ml = np.frombuffer(m) * np.frombuffer(l)
+    mu_ = np.frombuffer(mu)
+    n = ml.size
+    diag = ml / 3.0 + np.concatenate([ml[1:] / 3.0, [0.0]]) + mu_  # node k = 1..n
     rows, cols, vals = [], [], []
     for c in range(2):
         idx = 2 * np.arange(n) + c
@@ -59,14 +76,18 @@ def _mass_matrix(chain: Chain) -> scipy.sparse.csr_matrix:
             rows += [idx[:-1], idx[1:]]
             cols += [idx[1:], idx[:-1]]
             vals += [ml[1:] / 6.0, ml[1:] / 6.0]
-    return scipy.sparse.csr_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(2 * n, 2 * n)
-    )
+    out = (np.concatenate(rows), np.concatenate(cols), np.concatenate(vals))
+    for a in out:
+        a.flags.writeable = False
+    return out
 
 
-def _constraints(chain: Chain, phi: np.ndarray, held: Sequence[int]) -> scipy.sparse.csr_matrix:
-    """G (n + m, 2n): rows 0..n-1 the rods' rigidity d_k . (v_k - v_{k-1}); then one row per
-    held hinge h, omega_{h+1} - omega_h (omega_k = n_k . (v_k - v_{k-1}) / l_k; no omega_0)."""
+def _constraint_entries(
+    chain: Chain, phi: np.ndarray, held: Sequence[int]
+) -> tuple[list[int], list[int], list[float]]:
+    """(rows, cols, values) of G (n + m, 2n), duplicates not yet summed: rows 0..n-1 the rods'
+    rigidity d_k . (v_k - v_{k-1}); then one row per held hinge h, omega_{h+1} - omega_h
+    (omega_k = n_k . (v_k - v_{k-1}) / l_k; no omega_0)."""
     n = chain.n
     d = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
     nrm = np.stack([-np.sin(phi), np.cos(phi)], axis=-1) / chain.l[:, None]
@@ -90,7 +111,27 @@ def _constraints(chain: Chain, phi: np.ndarray, held: Sequence[int]) -> scipy.sp
         rod(n + j, h, nrm[h], 1.0)
         if h > 0:
             rod(n + j, h - 1, nrm[h - 1], -1.0)
-    return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(n + len(held), 2 * n))
+    return rows, cols, vals
+
+
+def _constraints(chain: Chain, phi: np.ndarray, held: Sequence[int]) -> scipy.sparse.csr_matrix:
+    """G (n + m, 2n) (``_constraint_entries``; a node's two entries in a hinge row summed)."""
+    rows, cols, vals = _constraint_entries(chain, phi, held)
+    return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(chain.n + len(held), 2 * chain.n))
+
+
+def _kkt(chain: Chain, phi: np.ndarray, held: Sequence[int]) -> scipy.sparse.csc_matrix:
+    """[[M, -G^T], [G, 0]] in one assembly (the entries of ``_mass_matrix`` and
+    ``_constraints``; a duplicate is two terms of one hinge row, so its sum is the same in
+    any order). O(n + m)."""
+    n = chain.n
+    mr, mc, mv = _mass_entries(*_mass_key(chain))
+    gr, gc, gv = (np.asarray(a) for a in _constraint_entries(chain, phi, held))
+    size = 2 * n + n + len(held)
+    rows = np.concatenate([mr, gc, 2 * n + gr])
+    cols = np.concatenate([mc, 2 * n + gr, gc])
+    vals = np.concatenate([mv, -gv.astype(float), gv.astype(float)])
+    return scipy.sparse.csc_matrix((vals, (rows, cols)), shape=(size, size))
 
 
 def rigid_lock(
@@ -107,10 +148,9 @@ def rigid_lock(
         raise ValueError(f"hinge {hinge} must be among the held hinges {held}")
     n = chain.n
     M = _mass_matrix(chain)
-    G = _constraints(chain, np.asarray(phi, float), held)
+    kkt = _kkt(chain, np.asarray(phi, float), held)
     v0 = node_velocities(chain.l, np.asarray(phi, float), np.asarray(dphi, float)).ravel()
-    kkt = scipy.sparse.bmat([[M, -G.T], [G, None]], format="csc")
-    rhs = np.concatenate([M @ v0, np.zeros(G.shape[0])])
+    rhs = np.concatenate([M @ v0, np.zeros(n + len(held))])
     z = scipy.sparse.linalg.spsolve(kkt, rhs)
     v1, lam = z[: 2 * n], z[2 * n :]
     return {

@@ -22,6 +22,14 @@ from rodval.solvers.audit import audit_times
 from rodval.solvers.system import OdeSystem
 
 
+def _add(total: float, terms: np.ndarray) -> float:
+    """total + terms[0] + terms[1] + ... added left to right (a cumulative sum is
+    sequential), as a loop of ``+=`` over the terms would."""
+    if not terms.size:
+        return total
+    return float(np.cumsum(np.concatenate([[total], terms]))[-1])
+
+
 class _Window:
     """One lock's window: its probes (the quadrature nodes of ``window_nodes`` and its end),
     the running sums of the lock record's impulses and the energy accounts at its end."""
@@ -58,18 +66,25 @@ class _Window:
             mu = record["angular_impulses"][held.index(self.hinge)]
             self.impulse += float(mu) * (1.0 - s / self.w)
 
-    def take(self, system: OdeSystem, y: np.ndarray) -> None:
-        t = float(self.times[self.i])
-        lam, H, finite, p_ext, p_diss = system.window_terms(t, y, self.hinge)
-        self.impulse += self.taper[self.i] * lam
-        self.H += self.mean[self.i] * H
-        self.finite += self.taper[self.i] * finite
-        self.taken += self.mean[self.i]
-        self.work += self.w * self.mean[self.i] * p_ext
-        self.dissipated += self.w * self.mean[self.i] * p_diss
-        self.i += 1
+    def take(self, system: OdeSystem, Y: np.ndarray) -> None:
+        """The states Y (m, N) at the window's next m probes, all in the system's current
+        mode: their integrands in one ``window_rows`` call, added to the running sums in
+        probe order (``_add``: the same sums, term by term, as one probe at a time)."""
+        m = len(Y)
+        if not m:
+            return
+        probes = slice(self.i, self.i + m)
+        terms = system.window_rows(self.times[probes], Y, self.hinge)
+        taper, mean = self.taper[probes], self.mean[probes]
+        self.impulse = _add(self.impulse, taper * terms[:, 0])
+        self.H = _add(self.H, mean * terms[:, 1])
+        self.finite = _add(self.finite, taper * terms[:, 2])
+        self.taken = _add(self.taken, mean)
+        self.work = _add(self.work, self.w * mean * terms[:, 3])
+        self.dissipated = _add(self.dissipated, self.w * mean * terms[:, 4])
+        self.i += m
         if self.i == self.times.size:  # the window's end
-            self.energies = system.energy_parts(t, y)
+            self.energies = system.energy_parts(float(self.times[-1]), Y[-1])
 
     def finish(self) -> None:
         """Write the window's measures into the lock record (a window the run did not reach
@@ -107,14 +122,22 @@ class LockWindows:
             return np.zeros(0)
         return np.sort(np.concatenate([w.times[w.i :] for w in self.open]))
 
-    def take(self, t: float, y: np.ndarray) -> None:
-        """The state y at probe time t to every window probing there."""
+    def take(self, times: np.ndarray, Y: np.ndarray) -> None:
+        """The states Y (m, N) at probe times ``times`` (sorted, all in the system's current
+        mode) to every window probing there: each window takes the run of its next probes
+        found among ``times`` (a probe two windows share is one state for both)."""
+        if not len(times):
+            return
         for win in list(self.open):
-            if win.i < win.times.size and win.times[win.i] == t:
-                win.take(self.system, y)
-                if win.i == win.times.size:
-                    win.finish()
-                    self.open.remove(win)
+            pending = win.times[win.i :]
+            at = np.searchsorted(times, pending)
+            found = at < len(times)
+            found[found] = times[at[found]] == pending[found]
+            m = int(np.argmin(found)) if not found.all() else found.size  # leading run
+            win.take(self.system, Y[at[:m]])
+            if win.i == win.times.size:
+                win.finish()
+                self.open.remove(win)
 
     def close(self) -> None:
         """At the end of the run: the windows not completed are written over the part
@@ -211,6 +234,5 @@ class Outputs:
         self.Y[self.n : self.n + len(kept)] = kept
         self.n += len(kept)
         if self.windows is not None:
-            for t, y in zip(times[~mask], values[~mask]):
-                self.windows.take(float(t), y)
+            self.windows.take(times[~mask], values[~mask])
         return mask

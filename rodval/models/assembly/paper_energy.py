@@ -160,7 +160,14 @@ class PaperEnergy:
         (``rodval.core.validity.momentum_balance``): the angular momentum about node 0 and the
         gross, sum_k |h_k| of the rods with their far nodes (``rod_momenta_at``). O(n) per
         state."""
-        h = np.array([self.rod_momenta_at(y)[1] for y in Y]).reshape(len(Y), -1)
+        if len(Y) and type(self).rod_momenta_at is PaperEnergy.rod_momenta_at:
+            # the paper's velocity field (``rod_momenta_at``) on the whole history at once
+            n = self.n
+            V = np.array([self.generalized_rates(y) for y in Y])
+            phi = self.rigid(Y)[0]
+            h = rod_momenta(self.base_chain, phi, V[:, :n], V[:, n : 2 * n], V[:, 2 * n : 3 * n])[1]
+        else:
+            h = np.array([self.rod_momenta_at(y)[1] for y in Y]).reshape(len(Y), -1)
         return h.sum(axis=1), np.abs(h).sum(axis=1)
 
     def angular_momentum_rows(self, times: np.ndarray, Y: np.ndarray) -> np.ndarray:

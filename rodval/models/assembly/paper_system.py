@@ -11,6 +11,7 @@ import numpy as np
 
 from rodval.core.checks import check_choice
 from rodval.core.loads import LoadSet, load_table
+from rodval.core.quantities import tip_deflection
 from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
@@ -282,13 +283,16 @@ class PaperSystem(PaperEnergy, OdeSystem):
                 out["alpha"] = (alpha, rods)
             if scene.wants("beta"):
                 out["beta"] = (beta, rods)
-        if scene.wants("x", "y"):
+        if scene.wants("x", "y", "tip_deflection"):
             x, y = node_positions(self.l, phi)
             nodes = np.arange(0, n + 1)
             if scene.wants("x"):
                 out["x"] = (x, nodes)
             if scene.wants("y"):
                 out["y"] = (y, nodes)
+            if scene.wants("tip_deflection"):
+                tip = tip_deflection(x, y, self.attitude(Y))
+                out["tip_deflection"] = (tip[:, None], np.zeros(1, dtype=int))
         if scene.wants("hinge_angle", "hinge_moment"):
             D = hinge_angles(phi, alpha, beta, self.attitude(Y))
             hinges = np.arange(n)
@@ -503,6 +507,10 @@ class PaperSystem(PaperEnergy, OdeSystem):
         """The lock window's integrands at one state (``lock_records.window_terms``)."""
         return lock_records.window_terms(self, t, y, hinge)
 
+    def window_rows(self, times: np.ndarray, Y: np.ndarray, hinge: int) -> np.ndarray:
+        """The integrands at many states in the current mode (``lock_records.window_rows``)."""
+        return lock_records.window_rows(self, times, Y, hinge)
+
     def energy_parts(self, t: float, y: np.ndarray) -> tuple[float, float, float]:
         """(kinetic, hinge, bending) energy (J) in the current mode (``lock_records``)."""
         return lock_records.energy_parts(self, t, y)
@@ -526,59 +534,6 @@ class PaperSystem(PaperEnergy, OdeSystem):
     def accel_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(accelerations, multipliers lambda (N m)) with the locked hinges held."""
         raise NotImplementedError
-
-
-class StackedSystem(PaperSystem):
-    """A full-model system whose state is [Q; Q'] with N = len(Q) coordinates, the chain's
-    phi, alpha, beta first and more after them (a ladder rung's bubbles, a free base's body),
-    on compiled kernels: ``locked_kernel(V, y, has_load, SX, SY, damped, locks, out, lam)``
-    and ``unit_kernel(V, q, locks, U)`` (U[j] = M^-1 a_{locks[j]})."""
-
-    full = True
-    N: int
-    locked_kernel: Any
-    unit_kernel: Any
-
-    def chain_initial_state(self) -> np.ndarray:
-        """The chain's [q; q'] at t = 0 (a ladder rung adds its bubbles, at rest)."""
-        i = self.initial
-        return np.concatenate([i["phi"], i["alpha"], i["beta"], i["dphi"], i["dalpha"], i["dbeta"]])
-
-    def bubble_energies(self, Y: np.ndarray) -> np.ndarray:
-        """The bending energy (J) of shapes beyond the paper's cubic, per state: none."""
-        return np.zeros(len(Y))
-
-    def generalized_rates(self, y):
-        return y[self.N :]
-
-    def rigid(self, Y):
-        n, N = self.n, self.N
-        return Y[:, :n], Y[:, N : N + n]
-
-    def bending(self, times, Y):
-        n, N = self.n, self.N
-        return (
-            Y[:, n : 2 * n],
-            Y[:, 2 * n : 3 * n],
-            Y[:, N + n : N + 2 * n],
-            Y[:, N + 2 * n : N + 3 * n],
-        )
-
-    def accel_locked(self, t, y):
-        sums = self.loads.suffix_sums(t)
-        SX, SY = (self._no_load, self._no_load) if sums is None else sums
-        out = np.empty(self.N)
-        lam = np.empty(self._lock_h.size)
-        self.locked_kernel(self.V, y, sums is not None, SX, SY, self.damped, self._lock_h, out, lam)
-        return out, lam
-
-    def unit_responses(self, q, hinges) -> np.ndarray:
-        U = np.empty((len(hinges), self.N))
-        self.unit_kernel(self.V, q, np.asarray(hinges, np.int64), U)
-        return U
-
-    def plastic_jump(self, y, hinges, angles):
-        return lock_records.plastic_jump(self, y, hinges, angles)
 
 
 class PaperModel(OdeModel):

@@ -18,7 +18,7 @@ from rodval.core.base import root_state
 from rodval.core.scene import Scene
 from rodval.models.assembly.kernels import full_constants
 from rodval.models.assembly.paper_energy import NO_LOADS, NO_MATRICES
-from rodval.models.assembly.paper_system import StackedSystem
+from rodval.models.assembly.stacked_system import StackedSystem
 from rodval.models.base import free_base as fb
 
 

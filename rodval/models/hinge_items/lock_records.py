@@ -20,6 +20,7 @@ model's equations are the Newton-Euler equations of that field, and the gap is r
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -27,7 +28,8 @@ import numpy as np
 from rodval.core.lock_window import lock_window
 from rodval.core.rigid import node_velocities, rigid_lock
 from rodval.core.root_momentum import root_momentum_fields
-from rodval.models.assembly.paper_matrices import node_positions
+from rodval.core.scene import hinge_angles
+from rodval.models.assembly.paper_matrices import generalized_forces, node_positions, rod_momenta
 
 #: The systems these functions read: ``rodval.models.assembly.paper_system.PaperSystem`` (which imports
 #: this module, so it is not imported here).
@@ -81,6 +83,100 @@ def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[
         arm = r[k + 1 :] - r[k]
         finite += float(np.sum(arm[:, 0] * Y[k:] - arm[:, 1] * X[k:]))
     return (float(lam[held.index(k)]), H, float(finite), *system.power(t, y))
+
+
+def _cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b (z-component) per row of (..., 2) arrays."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+@functools.cache
+def _batched(cls: type) -> bool:
+    """Whether ``window_rows`` may evaluate a system of class ``cls`` on whole arrays: its
+    momenta, root motion, attitude and powers are the paper system's own (a ladder rung's,
+    a free or prescribed base's are not; those go state by state through ``window_terms``)."""
+    hooks = {
+        "rod_momenta_at": "PaperEnergy",
+        "root_motion": "PaperEnergy",
+        "attitude": "PaperEnergy",
+        "attitude_rate": "PaperEnergy",
+        "power": "PaperSystem",
+        "damper_power_at": "PaperSystem",
+        "window_terms": "PaperSystem",
+    }
+    # by name: paper_system imports this module (an import back would be a cycle)
+    return all(
+        getattr(getattr(cls, name, None), "__qualname__", "") == f"{owner}.{name}"
+        and getattr(cls, name).__module__.startswith("rodval.models.assembly.paper_")
+        for name, owner in hooks.items()
+    )
+
+
+def window_rows(system: PaperSystem, times: np.ndarray, Y: np.ndarray, k: int) -> np.ndarray:
+    """``window_terms`` (lambda, H_out, M_fin, P_ext, P_diss) at the states Y (nt, N) at
+    ``times`` (s), all in the current mode, as rows (nt, 5): the same arithmetic on whole
+    arrays (one compiled constrained solve per state; the momenta, hinge angles and rates,
+    dampers' power vectorized), equal to the per-state values to round-off (the sums over
+    rods in another order for n >= 8: a few ulp of the largest term). A system whose
+    momenta or powers are its own (``_batched``) is evaluated state by state."""
+    times = np.asarray(times, float)
+    if not times.size:
+        return np.zeros((0, 5))
+    if not system.scene.base.moving and _batched(system.__class__):
+        return _window_rows(system, times, np.asarray(Y, float), k)
+    return np.array([window_terms(system, float(t), y, k) for t, y in zip(times, Y)])
+
+
+def _window_rows(system: PaperSystem, times: np.ndarray, Y: np.ndarray, k: int) -> np.ndarray:
+    """``window_rows`` of a pinned paper system (its ``_batched`` hooks)."""
+    n = system.n
+    j = [int(h) for h in system._lock_h].index(k)
+    solve = getattr(system, "solve_locked", None)  # the reduced model: lambda and gamma at once
+    if solve is not None and system.locked:
+        solved = [solve(float(t), y) for t, y in zip(times, Y)]
+        lam = np.array([s[2][j] for s in solved])
+        gamma = np.array([s[1] for s in solved]).reshape(-1, 2 * n)
+        alpha, beta = gamma[:, :n], gamma[:, n:]
+    else:
+        lam = np.array([system.accel_locked(float(t), y)[1][j] for t, y in zip(times, Y)])
+        alpha, beta = system.bending(times, Y)[:2]
+    V = np.array([system.generalized_rates(y) for y in Y])
+    dphi_r, dalpha, dbeta = V[:, :n], V[:, n : 2 * n], V[:, 2 * n : 3 * n]
+    phi, dphi = system.rigid(Y)
+    chain = system.base_chain
+    # outboard_momentum, per row
+    p, h, _ = rod_momenta(chain, phi, dphi_r, dalpha, dbeta)
+    x, yy = node_positions(chain.l, phi)
+    r = np.stack([x, yy], axis=-1)
+    p_out = p[:, k:].sum(axis=1)
+    H = h[:, k:].sum(axis=1) - _cross_rows(r[:, k], p_out)
+    if k > 0:
+        nodes = np.stack([-np.sin(phi), np.cos(phi)], axis=-1)
+        v_k = np.cumsum((chain.l * dphi_r)[..., None] * nodes, axis=-2)[:, k - 1]
+        finite_v = _cross_rows(v_k, p_out)
+    else:
+        finite_v = np.zeros(times.size)  # node 0 is pinned
+    ch = system.chain  # the mode's effective chain (acting stops in its kappa, nu, rest)
+    D = hinge_angles(phi, alpha, beta, None)[:, k]
+    rates = hinge_angles(dphi_r, dalpha, dbeta, None)
+    finite = -(ch.kappa[k] * (D - ch.rest_angle[k]) + ch.nu[k] * rates[:, k]) - finite_v
+    p_ext = np.zeros(times.size)
+    for i, t in enumerate(times):
+        forces = system.loads.nodal(float(t))
+        if forces is None:
+            continue
+        X, Yf = forces  # at nodes 1..n
+        arm = r[i, k + 1 :] - r[i, k]
+        finite[i] += float(np.sum(arm[:, 0] * Yf[k:] - arm[:, 1] * X[k:]))
+        sums = system.loads.suffix_sums(float(t))
+        p_ext[i] = float(generalized_forces(system.l, phi[i], *sums) @ dphi[i])
+    if system.damped:
+        cb = 4.0 * ch.bending_damping / ch.l
+        bending = cb * (dalpha * dalpha + dalpha * dbeta + dbeta * dbeta)
+        p_diss = np.sum(ch.nu * rates * rates, axis=-1) + np.sum(bending, axis=-1)
+    else:
+        p_diss = np.zeros(times.size)
+    return np.stack([lam, H, finite, p_ext, p_diss], axis=-1)
 
 
 def lock_record(

@@ -28,7 +28,7 @@ from rodval.models.assembly.paper_matrices import (
 from rodval.models.assembly.paper_matrices import (
     angular_momentum_rows as momentum_rows,
 )
-from rodval.models.assembly.paper_system import StackedSystem
+from rodval.models.assembly.stacked_system import StackedSystem
 from rodval.models.hinge_items import deployment
 from rodval.models.kinematics.ladder_kernels import (
     BLOCK_A,

@@ -17,7 +17,7 @@ import numpy as np
 from rodval.core.scene import Scene
 from rodval.models.assembly.paper_energy import NO_LOADS, NO_MATRICES
 from rodval.models.assembly.paper_matrices import hinge_matrix
-from rodval.models.assembly.paper_system import StackedSystem
+from rodval.models.assembly.stacked_system import StackedSystem
 from rodval.models.kinematics.ladder import rigid_constants
 from rodval.models.kinematics.rigid_kernels import (
     rigid_accel,
