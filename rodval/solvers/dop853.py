@@ -384,14 +384,12 @@ def run(
     ``mechanics``, ``events`` and ``arrays`` (P, S, M, L, E, directions): a
     ``CompiledForm``'s functions and arrays. ``controls``: [rtol, atol, max_step (s),
     first_step (s; <= 0 selects it), max_nfev, deadline (a ``time.perf_counter()`` value, s;
-    inf: none), stepper (``DOP853_STEPPER``, or ``RADAU_STEPPER``: ``rodval.solvers.radau``,
-    which writes its own dense output)]; ``atol``: the absolute tolerance of each coordinate
-    (N,; controls[1] is not read): the budgets' codes (``budget.exhausted``: ``BUDGET``,
-    ``WALL``; the time reached goes to the progress reporter if ``reporting``).
-
-    ``carry``: (mon, total, hit, switch), carried over restarts. ``guard``: ``GuardSpec.as_array()``,
-    checked by ``guard_step`` after every accepted step (``mon``: its monitor);
-    ``mechanics(t, y, ...)`` writes (T, P_ext, P_diss), for the guard when guard[2] is finite.
+    inf: none), stepper (``DOP853_STEPPER``, or ``RADAU_STEPPER``, its own dense output)];
+    ``atol`` (N,): each coordinate's absolute tolerance (controls[1] is not read); the budgets'
+    codes: ``budget.exhausted``; the time reached goes to the progress reporter if ``reporting``.
+    ``carry``: (mon, total, hit, switch), over restarts. ``guard``: ``GuardSpec.as_array()``,
+    checked by ``guard_step`` after every accepted step (``mon``: its monitor); ``mechanics(t,
+    y, ...)`` writes (T, P_ext, P_diss), for the guard when guard[2] is finite.
     ``W`` (nt, 2), or (0, 2) for no audit: the audit's running [W_ext, D] (J) at the output
     times from the running ``total`` (``_audit_step``: 3 evaluations for the dense output on
     every step, GAUSS_NODES evaluations of ``mechanics`` per step and per output time).
@@ -403,8 +401,7 @@ def run(
     IIA when its steps are limited by stability and back when Radau IIA proves dearer
     (``rodval.solvers.stiffness``; ``switch``: its state, ``stiffness.new_state``).
 
-    Returns (number of output times written, nfev, accepted steps, code, t reached).
-    """
+    Returns (number of output times written, nfev, accepted steps, code, t reached)."""
     P, S, M, L, E, directions = arrays
     N = y0.shape[0]
     mon, total, hit, switch = carry

@@ -378,14 +378,10 @@ def step(
     rw,
     sc,
 ):
-    """Step attempts from (t, y) (f = rhs(t, y)) towards t_bound until one is accepted
-    (scipy's ``Radau._step_impl``): its state into y_new, the derivative there into f_new,
-    its dense output into F (``dense_coefficients``). ``controls``, ``atol`` (one per
-    coordinate), ``cnt`` as in ``dop853.run``; ``rw``: ``work``; ``sc``: the scalars (H_OLD,
-    ...), updated. Returns
-    (code, t of the step's end, the next step size): ``OK``, or ``STEP_TOO_SMALL``,
-    ``BUDGET``, ``WALL`` or ``NON_FINITE`` (attempts non-finite down to the smallest step)
-    with t unchanged."""
+    """Attempts from (t, y) (f = rhs(t, y)) to t_bound until one is accepted (scipy's
+    ``Radau._step_impl``): y_new, f_new there, the dense output into F; ``controls``, ``atol``
+    (per coordinate), ``cnt`` as in ``dop853.run``, ``rw``: ``work``, ``sc``: the scalars.
+    Returns (code, t, next step): OK, or STEP_TOO_SMALL, BUDGET, WALL, NON_FINITE, t kept."""
     J, Z, tmp, f1, scale = rw[0], rw[5], rw[11], rw[12], rw[14]
     rtol, max_step = controls[0], controls[2]
     N = y.shape[0]
