@@ -15,8 +15,9 @@ matrix is banded with kl = 4 sub- and ku = 6 super-diagonals. It is solved by Ga
 elimination with partial pivoting on the band (LAPACK gbtf2/gbtrs style, the right-hand side
 eliminated on the fly; U then has kl + ku super-diagonals). Rows and columns are equilibrated
 by constant powers of two (Ruiz scaling of the angle-independent coefficient magnitudes,
-computed once in ``banded_constants``), which changes no value in exact arithmetic and makes
-the pivot choice independent of units. Its determinant is +-det(B) det(M_r), so the
+computed once per ``Cst`` by ``equilibrate`` on the banded LU's first use: the sweep, the
+default, never reads them), which changes no value in exact arithmetic and makes the pivot
+choice independent of units. Its determinant is +-det(B) det(M_r), so the
 banded system is regular exactly when the dense reduced one is.
 """
 
@@ -42,10 +43,15 @@ from rodval.models.assembly.kernels import (
 #: number of Cst's leading rows laid out like kernels.V (rows 0 .. N_V_ROWS - 1)
 N_V_ROWS = max(V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB) + 1
 C_AP, C_BP = N_V_ROWS, N_V_ROWS + 1
+#: 1.0 once the scales below hold the equilibration (``equilibrate``), 0.0 while they are 1
+C_EQUIL = N_V_ROWS + 2
 #: first of 7 rows of row scales (one per local equation) and of 7 rows of column scales
-C_RSCALE = N_V_ROWS + 2
+C_RSCALE = N_V_ROWS + 3
 C_CSCALE = C_RSCALE + 7
 N_CST = C_CSCALE + 7
+#: Ruiz sweeps of the equilibration: the powers of two stop changing after 15-19 sweeps on the
+#: paper chain and on random chains with coefficients spread over 9 decades (n = 3000)
+RUIZ_SWEEPS = 20
 
 #: unknowns per rod and their local order
 NB = 7
@@ -189,9 +195,11 @@ def _eliminate(A, b, j, U):
 @njit(cache=True)
 def solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
     """The banded LU with partial pivoting (module docstring) of the 7n x 7n system. U (7n x
-    11), b (7n + 10), A (RING x W): work storage. False if a pivot column is exactly zero."""
+    11), b (7n + 10), A (RING x W): work storage. False if a pivot column is exactly zero.
+    Its first call on a ``Cst`` writes the equilibration into it (``equilibrate``)."""
     n = c.shape[0]
     N = NB * n
+    equilibrate(Cst)
     for k in range(n):
         r0 = NB * k
         for e in range(NB):
@@ -225,12 +233,6 @@ def solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
     return True
 
 
-#: Magnitudes below this are set to zero in the sweep (physical units: N, rad, rad/s^2). Far
-#: below any round-off of the values they are added to, and far above the subnormal range
-#: (< 2.2e-308): on a long chain the coefficients of the tail relation and the solution decay
-#: geometrically towards the root and would otherwise sit at subnormals, where every x86
-#: operation takes a ~100-cycle microcode assist (5x slower runs at n = 8192,
-#: benchmarks/subnormal_cost.py).
 @njit(cache=True)
 def band_size(n):
     """Length (float64 entries) of the banded LU's work storage for n rods: U (7n x (KL + KU +
@@ -241,22 +243,28 @@ def band_size(n):
 @njit(cache=True)
 def band_magnitudes(Cst):
     """Angle-independent coefficient magnitudes |A| of the banded matrix (c = s = 1,
-    unit scales), in band storage."""
+    unit scales), in band storage (7n x W). O(n)."""
     n = Cst.shape[1]
+    unit = Cst.copy()
+    unit[C_RSCALE:] = 1.0
     one = np.ones(n)
     A = np.empty((NB * n, W))
     for k in range(n):
-        _fill_rod(Cst, k, one, one, A, -1)
+        _fill_rod(unit, k, one, one, A, -1)
     return np.abs(A)
 
 
 @njit(cache=True)
 def ruiz_equilibrate(T, rs, cs, sweeps):
     """Ruiz equilibration of the band magnitudes T (modified in place): after the sweeps
-    every row and column of diag(rs) |A| diag(cs) has its largest entry close to 1."""
+    every row and column of diag(rs) |A| diag(cs) has its largest entry close to 1. Each
+    sweep: the row and column maxima, then every nonzero entry divided by the square roots
+    of its row's and its column's (one square root per row and column). O(n) per sweep."""
     N = T.shape[0]
     rmax = np.empty(N)
     cmax = np.empty(N)
+    rsq = np.empty(N)
+    csq = np.empty(N)
     for _ in range(sweeps):
         cmax[:] = 0.0
         for i in range(N):
@@ -268,13 +276,37 @@ def ruiz_equilibrate(T, rs, cs, sweeps):
                 if v > 0.0 and v > cmax[j]:
                     cmax[j] = v
         for i in range(N):
-            fr = 1.0 / np.sqrt(rmax[i]) if rmax[i] > 0.0 else 1.0
-            fc = 1.0 / np.sqrt(cmax[i]) if cmax[i] > 0.0 else 1.0
+            rsq[i] = np.sqrt(rmax[i])
+            csq[i] = np.sqrt(cmax[i])
+            fr = 1.0 / rsq[i] if rmax[i] > 0.0 else 1.0
+            fc = 1.0 / csq[i] if cmax[i] > 0.0 else 1.0
             rs[i] *= fr
             cs[i] *= fc
         for i in range(N):
-            fr = 1.0 / np.sqrt(rmax[i]) if rmax[i] > 0.0 else 1.0
+            fr = 1.0 / rsq[i] if rmax[i] > 0.0 else 1.0
             for o in range(T.shape[1]):
-                j = i - KL + o
                 if T[i, o] > 0.0:
-                    T[i, o] *= fr / np.sqrt(cmax[j])
+                    T[i, o] *= fr / csq[i - KL + o]
+
+
+@njit(cache=True)
+def equilibrate(Cst):
+    """Write the row and column scales of the banded LU into ``Cst`` (rows C_RSCALE ..,
+    C_CSCALE ..; C_EQUIL set to 1), unless done: RUIZ_SWEEPS sweeps of Ruiz equilibration of
+    the angle-independent magnitudes (``band_magnitudes``), each scale rounded to the nearest
+    power of two (exact scaling: no rounding in the solve). Called by ``solve_band`` on its
+    first use, so a run whose sweep never falls back pays nothing (``banded_constants``
+    leaves the scales at 1). O(n) time, ~120n doubles of work memory while it runs."""
+    if Cst[C_EQUIL, 0] != 0.0:
+        return
+    n = Cst.shape[1]
+    rs = np.ones(NB * n)
+    cs = np.ones(NB * n)
+    ruiz_equilibrate(band_magnitudes(Cst), rs, cs, RUIZ_SWEEPS)
+    rs = np.exp2(np.round(np.log2(rs)))
+    cs = np.exp2(np.round(np.log2(cs)))
+    for k in range(n):
+        for e in range(NB):
+            Cst[C_RSCALE + e, k] = rs[NB * k + e]
+            Cst[C_CSCALE + e, k] = cs[NB * k + e]
+    Cst[C_EQUIL, :] = 1.0

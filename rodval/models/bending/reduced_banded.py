@@ -51,7 +51,10 @@ Banded LU (METHOD_BAND): the fallback, in ``rodval.models.bending.reduced_band_l
 
 Cost: O(n) time and memory per evaluation, no n x n array anywhere: the sweep ~250 flops and
 19 doubles per rod, the banded LU ~800 flops and ~90 doubles per rod (U factor 7n x 11). phi''
-and gamma come out of the same solve, so the bending recovery is the same routine.
+and gamma come out of the same solve, so the bending recovery is the same routine. Rods at
+rest near the root cost only the forces and a comparison each: the sweep stops where the
+rest of the chain's solution is exactly 0 (``solve_sweep``), the usual case on a long chain
+driven near its tip (at n = 1e5, ~120 rods move within 2 s of the paper's pulse).
 """
 
 from __future__ import annotations
@@ -66,18 +69,16 @@ from rodval.models.assembly.kernels import (
     V_NU,
     V_OUTER,
     V_PPDIAG,
+    V_REST,
     V_W,
     constant_rows,
-    gpp_times,
-    hinge_forces,
     rhs_head,
-    upper_t_times,
 )
 from rodval.models.assembly.paper_matrices import DEFAULT_VARIANT, chain_constants
 from rodval.models.bending.reduced_band_lu import (
     C_AP,
     C_BP,
-    C_CSCALE,
+    C_EQUIL,
     C_RSCALE,
     KL,
     KU,
@@ -86,43 +87,72 @@ from rodval.models.bending.reduced_band_lu import (
     NB,
     RING,
     W,
-    band_magnitudes,
     band_size,
-    ruiz_equilibrate,
     solve_band,
 )
 
 
 @njit(cache=True)
 def reduced_forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec):
-    """Right-hand sides (N m) into vec (scratch of 5n): vec[:n] = r_p = Q - G_pp phi'^2
+    """Right-hand sides (N m) into vec (length >= 3n): vec[:n] = r_p = Q - G_pp phi'^2
     - C_pp phi' - K_pp phi, vec[n:2n] = r_alpha, vec[2n:3n] = r_beta, with
-    r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi) (C only when ``damped``)."""
+    r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi) (C only when ``damped``).
+
+    One pass root to tip (the hinge springs and dampers, kernels.hinge_forces with alpha =
+    beta = 0; the prefix sums of G_pp and G_pa^T, kernels.gpp_times and upper_t_times) and
+    one back (the suffix sums of G_pp, the load), each sum in the order of those kernels.
+    O(n)."""
     n = phi.shape[0]
-    vec[: 4 * n] = 0.0
     fp = vec[:n]
     fa = vec[n : 2 * n]
     fb = vec[2 * n : 3 * n]
-    zero = vec[3 * n : 4 * n]
-    w2 = vec[4 * n : 5 * n]
+    l, outer, w = Cst[V_L], Cst[V_OUTER], Cst[V_W]
+    kap, nu, rest = Cst[V_KAPPA], Cst[V_NU], Cst[V_REST]
+    # hinge k: D_k = phi_k - phi_{k-1} - rest_k, torque T_k = kappa_k D_k (Tv: nu_k D_k')
+    T_next = kap[0] * (phi[0] - rest[0])
+    Tv_next = nu[0] * dphi[0] if damped else 0.0
+    pc = 0.0  # sum_{j<k} l_j c_j phi_j'^2 (G_pp's and G_pa^T's prefix sums alike)
+    ps = 0.0
     for k in range(n):
-        w2[k] = dphi[k] * dphi[k]
-    hinge_forces(Cst, phi, zero, zero, V_KAPPA, fp, fa, fb)  # K_qp phi
-    if damped:
-        hinge_forces(Cst, dphi, zero, zero, V_NU, fp, fa, fb)  # C_qp phi'
-    for k in range(n):
-        fp[k] = -fp[k]
-        fa[k] = -fa[k]
-        fb[k] = -fb[k]
-    gpp_times(Cst, c, s, w2, fp)  # - G_pp phi'^2
-    upper_t_times(Cst, c, s, w2, False, fa, 1.0)  # - G_ap phi'^2 = + G_pa^T phi'^2
-    upper_t_times(Cst, c, s, w2, False, fb, -1.0)  # - G_bp phi'^2 = - G_pa^T phi'^2
-    if has_load:
-        l = Cst[V_L]
-        for k in range(n):
+        T, Tv = T_next, Tv_next
+        p = T
+        a = T
+        b = 0.0
+        if k + 1 < n:
+            T_next = kap[k + 1] * ((phi[k + 1] - phi[k]) - rest[k + 1])
+            p -= T_next
+            b -= T_next
+        if damped:
+            p += Tv
+            a += Tv
+            if k + 1 < n:
+                Tv_next = nu[k + 1] * (dphi[k + 1] - dphi[k])
+                p -= Tv_next
+                b -= Tv_next
+        x = dphi[k] * dphi[k]
+        fp[k] = -p - l[k] * outer[k] * (s[k] * pc - c[k] * ps)  # - G_pp phi'^2, j < k
+        g = w[k] * (c[k] * ps - s[k] * pc)
+        fa[k] = -a + g  # - G_ap phi'^2 = + G_pa^T phi'^2
+        fb[k] = -b + -g  # - G_bp phi'^2 = - G_pa^T phi'^2
+        pc += l[k] * c[k] * x
+        ps += l[k] * s[k] * x
+    sc = 0.0
+    ss = 0.0
+    for k in range(n - 1, -1, -1):  # - G_pp phi'^2, j > k (weight M_j); then the load
+        fp[k] -= l[k] * (s[k] * sc - c[k] * ss)
+        x = dphi[k] * dphi[k]
+        sc += outer[k] * l[k] * c[k] * x
+        ss += outer[k] * l[k] * s[k] * x
+        if has_load:
             fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
 
 
+#: Magnitudes below this are set to zero in the sweep (physical units: N, rad, rad/s^2). Far
+#: below any round-off of the values they are added to, and far above the subnormal range
+#: (< 2.2e-308): on a long chain the coefficients of the tail relation and the solution decay
+#: geometrically towards the root and would otherwise sit at subnormals, where every x86
+#: operation takes a ~100-cycle microcode assist (5x slower runs at n = 8192,
+#: benchmarks/subnormal_cost.py).
 TINY = 1e-250
 
 
@@ -227,14 +257,34 @@ def _tail_relation(Cst, k, c, s, Tk, F, G):
 
 
 @njit(cache=True, inline="always")
-def _root_to_tip(Cst, c, s, T, ddphi_out, gamma_out):
-    """z_0 = 0, u_k = T_k [z_k; 1], z_{k+1} = (P_k + l_k e_k x_k, beta_k), rod by rod into
-    the outputs; False if a value is not finite. O(n)."""
+def _quiet_below(Cst, k, c, s, fp, fa, fb, f0, f1):
+    """The highest rod j <= k whose local system has a nonzero constant column R[:, 3] when
+    the tail's constant part is f = (f0, f1) (N) and its alpha part G[3] is 0, or -1 when rods
+    0..k have none (_local_system: R[:, 3] = (fp - l e.f, fa, fb); the same expression, so the
+    test is exact). O(k - j)."""
+    l = Cst[V_L]
+    j = k
+    while j >= 0:
+        if fa[j] != 0.0 or fb[j] != 0.0 or fp[j] != l[j] * (c[j] * f0 + s[j] * f1):
+            return j
+        j -= 1
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _root_to_tip(Cst, c, s, T, quiet, ddphi_out, gamma_out):
+    """u_k = 0 for the quiet rods k <= ``quiet`` (solve_sweep); then z = 0, u_k = T_k [z_k;
+    1], z_{k+1} = (P_k + l_k e_k x_k, beta_k), rod by rod into the outputs; False if a value
+    is not finite. O(n)."""
     n = c.shape[0]
+    for k in range(quiet + 1):
+        ddphi_out[k] = 0.0
+        gamma_out[k] = 0.0
+        gamma_out[n + k] = 0.0
     P0 = 0.0
     P1 = 0.0
     bprev = 0.0
-    for k in range(n):
+    for k in range(quiet + 1, n):
         x = _flush(T[k, 0, 0] * P0 + T[k, 0, 1] * P1 + T[k, 0, 2] * bprev + T[k, 0, 3])
         a = _flush(T[k, 1, 0] * P0 + T[k, 1, 1] * P1 + T[k, 1, 2] * bprev + T[k, 1, 3])
         bb = _flush(T[k, 2, 0] * P0 + T[k, 2, 1] * P1 + T[k, 2, 2] * bprev + T[k, 2, 3])
@@ -254,18 +304,35 @@ def _root_to_tip(Cst, c, s, T, ddphi_out, gamma_out):
 def solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
     """The tip-to-root elimination (module docstring, "sweep"), then root to tip. T (n x 3 x
     4): work storage for u_k = T_k[:, :3] z_k + T_k[:, 3]. False if a local pivot is zero or
-    a result is not finite. O(n): ~250 flops per rod."""
+    a result is not finite. O(n): ~250 flops per rod.
+
+    The quiet root part: once the constant parts of rods 0..k (T_k[:, 3], from R[:, 3]) are
+    all exactly zero, z_0 = 0 gives u_j = 0 and z_{j+1} = 0 rod by rod up to k, whatever the
+    T_j[:, :3]; the tip-to-root pass stops there (``_quiet_below`` checks the rods below it,
+    each rod at most once per evaluation) and rods 0..k get 0. This is the same result as the
+    full pass to the last bit (up to the sign of zeros): on a long chain driven near its tip
+    the motion decays geometrically towards the root (the sweep flushes values below TINY),
+    and the rods at rest there cost nothing. Not checked for them: a zero local pivot, which
+    the full pass would hand to the banded LU (a singular sub-chain at rest)."""
     n = c.shape[0]
     F = np.zeros((2, 4))  # tail relation of rod k+1: S_{k+1} = F[:, :3] z_{k+1} + F[:, 3]
     G = np.zeros(4)  #                           alpha_{k+1} = G[:3] . z_{k+1} + G[3]
     L = np.empty((3, 3))
     R = np.empty((3, 4))
+    quiet = -1
+    unchecked = n  # rods >= unchecked were checked for the current (F[:, 3], G[3])
     for k in range(n - 1, -1, -1):
+        if k < unchecked and G[3] == 0.0:
+            j = _quiet_below(Cst, k, c, s, fp, fa, fb, F[0, 3], F[1, 3])
+            if j < 0:
+                quiet = k
+                break
+            unchecked = j  # rods j+1..k keep F[:, 3], G[3]: no check until rod j is passed
         _local_system(Cst, k, n, c, s, fp, fa, fb, F, G, L, R)
         if not _solve_local(L, R, T[k]):
             return False
         _tail_relation(Cst, k, c, s, T[k], F, G)
-    return _root_to_tip(Cst, c, s, T, ddphi_out, gamma_out)
+    return _root_to_tip(Cst, c, s, T, quiet, ddphi_out, gamma_out)
 
 
 #: ``method`` of reduced_solve_work
@@ -315,8 +382,13 @@ def reduced_solve_work(
     c = work[:n]
     s = work[n : 2 * n]
     for k in range(n):
-        c[k] = np.cos(phi[k])
-        s[k] = np.sin(phi[k])
+        p = phi[k]
+        if p == 0.0:  # cos(+-0) = 1, sin(+-0) = +-0 exactly: the rods at rest cost no call
+            c[k] = 1.0
+            s[k] = p
+        else:
+            c[k] = np.cos(p)
+            s[k] = np.sin(p)
     vec = work[2 * n : 7 * n]
     reduced_forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
     fp, fa, fb = vec[:n], vec[n : 2 * n], vec[2 * n : 3 * n]
@@ -353,30 +425,26 @@ def reduced_accel_banded(Cst, phi, dphi, has_load, SX, SY, damped, out):
 def banded_constants(cc, chain, variant: str = DEFAULT_VARIANT) -> np.ndarray:
     """Every angle-independent per-rod constant of ``reduced_solve`` as a float64 array
     (N_CST, n); ``cc = paper_matrices.chain_constants(chain, variant)``, or None to compute
-    the per-rod constants here for ``variant`` (O(n) memory; chain_constants is O(n^2)). O(n).
+    the per-rod constants here for ``variant``. O(n) time and memory.
 
     Rows: the kernels.V layout (l (m), outer mass M_k (kg), M_pp diagonal (kg m^2),
     w = m l^2/12 (kg m), kappa (N m/rad), nu (N m s/rad), 4 EI/l (N m)), then the bending-row
     diagonals ap, bp (kg m^2; the only difference between the "printed" and "published"
-    variants), then 7 row and 7 column equilibration scales (powers of two, per rod)."""
+    variants), then the banded LU's equilibration: its flag (C_EQUIL) and 7 row and 7 column
+    scales per rod, left at 1 here; the banded LU writes them on its first use
+    (``reduced_band_lu.equilibrate``), since the sweep, the default, does not read them."""
     n = chain.n
     if cc is None:
         cc = chain_constants(chain, variant)
-    Cst = np.zeros((N_CST, n))
-    Cst[:N_V_ROWS] = np.vstack(constant_rows(cc, chain))
+    Cst = np.empty((N_CST, n))
+    rows = constant_rows(cc, chain)
+    for i in range(N_V_ROWS):  # row by row: no (N_V_ROWS, n) temporary
+        Cst[i] = rows[i]
     Cst[C_AP] = cc.ap_diag
     Cst[C_BP] = cc.bp_diag
+    Cst[C_EQUIL] = 0.0
     Cst[C_RSCALE:] = 1.0
-    rs = np.ones(NB * n)
-    cs = np.ones(NB * n)
-    ruiz_equilibrate(band_magnitudes(Cst), rs, cs, 20)
-
-    def pow2(v):
-        return np.exp2(np.round(np.log2(v)))  # exact scaling: no rounding
-
-    Cst[C_RSCALE : C_RSCALE + NB] = pow2(rs).reshape(n, NB).T
-    Cst[C_CSCALE : C_CSCALE + NB] = pow2(cs).reshape(n, NB).T
-    return np.ascontiguousarray(Cst)
+    return Cst
 
 
 def bending_at(
