@@ -286,3 +286,21 @@ def test_a_free_bases_deployed_attitude_is_compared_against_its_band():
     assert table.loc["m", "attitude_gap"] == pytest.approx(0.01, rel=1e-9)
     assert table.loc["m", "attitude_band"] == 2e-3
     assert table.loc["ref twin", "attitude_gap"] == pytest.approx(0.0, abs=1e-15)
+
+
+def test_the_answer_states_the_references_error_bar_or_that_it_is_not_given():
+    """The reference's sentence carries the error bar the study gives (measured by refining
+    the reference, `rodval reference`), each figure in its unit; without one, it says so."""
+    from rodval.report.study_summary import _sentences
+
+    traj, events, runtime = _tables(twin_shift=1e-7)
+    bar = {"lock_dt": 0.00787, "impulse_rel": 0.00842, "rel": 0.00648, "attitude": 4.5e-4}
+    settings = AgreementSettings.from_dict({"reference_error": bar})
+    table = agreement_table(traj, events, runtime, "ref", settings)
+    first = _sentences(table, "ref", settings)[0]
+    assert first.startswith("The reference `ref` is valid, its error bar measured by refining")
+    for text in ("locks to 7.87 ms", "impulses to 0.84%", "angles to 0.65% of their scale"):
+        assert text in first
+    assert "deployed attitude to 0.00045 rad" in first
+    plain = _sentences(table, "ref", AgreementSettings())[0]
+    assert "its error bar not given ([agreement] reference_error)" in plain

@@ -435,7 +435,10 @@ def _sentences(table: pd.DataFrame, ref: str, settings: AgreementSettings) -> li
         )
         verdict = _verdict(row)
         if row["role"] == "reference":
-            out.append(f"The reference {name} is {verdict} (run time {row['wall_s']:.3g} s).")
+            out.append(
+                f"The reference {name} is {verdict}{_error_bar(settings)} (run time "
+                f"{row['wall_s']:.3g} s)."
+            )
             continue
         head = f"{name} is {verdict}; it agrees with `{ref}` until {_until(row)}"
         if row["role"] == "twin":
@@ -460,6 +463,29 @@ def _sentences(table: pd.DataFrame, ref: str, settings: AgreementSettings) -> li
             text += f"; beyond: {beyond}"
         out.append(f"{text}; run time {row['wall_s']:.3g} s.")
     return out
+
+
+def _error_bar(settings: AgreementSettings) -> str:
+    """The reference's measured error bar in words (the study's ``[agreement]
+    reference_error``), "" when the study gives none."""
+    parts = [
+        text
+        for value, text in (
+            (settings.reference_dt, f"its locks to {settings.reference_dt * 1e3:.3g} ms"),
+            (settings.reference_impulse, f"their impulses to {settings.reference_impulse:.2%}"),
+            (settings.reference_rel, f"the angles to {settings.reference_rel:.2%} of their scale"),
+            (
+                settings.reference_attitude,
+                f"the deployed attitude to {settings.reference_attitude:.2g} rad",
+            ),
+        )
+        if value > 0
+    ]
+    if not parts:
+        return ", its error bar not given ([agreement] reference_error)"
+    return ", its error bar measured by refining it ([agreement] reference_error): " + ", ".join(
+        parts
+    )
 
 
 def _answer_over_cases(table: pd.DataFrame, ref: str) -> list[str]:
