@@ -89,8 +89,9 @@ from rodval.core.status import (
     STATUS_ERROR,
     STATUS_FAILED,
     numerical_failure,
+    update_status,
 )
-from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.core.trajectory import SolverStats, Trajectory, finish
 from rodval.core.validity import Check, momentum_point, step_resolution
 from rodval.solvers.audit import momentum_residual
 
@@ -418,7 +419,7 @@ class ExudynModel(Model):
                 STATUS_ERROR,
                 f"{type(exc).__name__}: {exc}",
             )
-            stats.status, stats.message = status, f"build failed: {message}"
+            update_status(stats, status, f"build failed: {message}")
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         run_info.update(
             step_used=float(sim.timeIntegration.initialStepSize),
@@ -434,7 +435,7 @@ class ExudynModel(Model):
         try:
             t_rec, records, diverged = self._records(built)
         except Exception as exc:  # noqa: BLE001
-            stats.status, stats.message = STATUS_ERROR, f"reading sensors failed: {exc}"
+            update_status(stats, STATUS_ERROR, f"reading sensors failed: {exc}")
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         times = ended(scene, stats, (guard, budget), t_rec, diverged)
         events, lock_steps = lock_records(latches)
@@ -457,10 +458,8 @@ class ExudynModel(Model):
                     *momentum_audit(scene, self.elements, times[-1], t_rec, records)
                 )
         except Exception as exc:  # noqa: BLE001
-            stats.status, stats.message = (
-                STATUS_ERROR,
-                f"observation failed: {type(exc).__name__}: {exc}",
-            )
+            message = f"observation failed: {type(exc).__name__}: {exc}"
+            update_status(stats, STATUS_ERROR, message)
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         run_info.update(audit)
         return self._trajectory(scene, times, observed, stats, run_info, events)
@@ -500,17 +499,13 @@ class ExudynModel(Model):
         start = time.perf_counter()
         try:
             ok = solver.SolveSystem(built.mbs, sim)
-            if not ok:
-                stats.status, stats.message = (
-                    STATUS_FAILED,
-                    solver_message(solver, "solver failed"),
-                )
+            if not ok and guard.verdict is None:  # a verdict says why it stopped (``ended``)
+                update_status(stats, STATUS_FAILED, solver_message(solver, "solver failed"))
             elif guard.verdict is None:  # the last step's end state has had no pre-step check
                 guard.check(scene.t_end if budget.stop is None else built.mbs.systemData.GetTime())
         except Exception as exc:  # noqa: BLE001 - exudyn errors come back as data
-            stats.status = STATUS_ERROR
             cause = built.load_errors[0] if built.load_errors else exc
-            stats.message = f"{type(cause).__name__}: {cause}"
+            update_status(stats, STATUS_ERROR, f"{type(cause).__name__}: {cause}")
         finally:
             stats.wall_s = time.perf_counter() - start
             exu.config.printToConsole = console
@@ -570,13 +565,12 @@ class ExudynModel(Model):
         steps_planned, step_used (s, the fixed step), steps (taken), min_step_used (s, smaller
         than step_used only if Newton failures halved it), max_rotation_per_step_seen (rad),
         blowup_factor) and ``spectral_radius`` (the value used, ``spectral_radius_for``)."""
-        return Trajectory(
+        return finish(
+            stats,
             model=self.name,
             scene_name=scene.name,
             times=times,
-            values={q: v for q, (v, _) in observed.items()},
-            k_index={q: k for q, (_, k) in observed.items()},
-            stats=stats,
+            observed=observed,
             settings={
                 "method": f"exudyn {self.solver}",
                 "step": self.step,

@@ -11,7 +11,7 @@ from reference_models.exudyn_guard import Guard
 from reference_models.exudyn_latches import Latches
 from reference_models.exudyn_observe import body_view
 from rodval.core.scene import Scene
-from rodval.core.status import STATUS_DIVERGED, STATUS_ERROR, STATUS_FAILED
+from rodval.core.status import STATUS_DIVERGED, STATUS_FAILED, update_status
 from rodval.core.trajectory import SolverStats
 
 #: What a prescribed base's run leaves unaudited: the drive's work is not measured.
@@ -47,25 +47,24 @@ def unaudited_drive(observed: dict, events: list[dict]) -> tuple[None, dict]:
 def ended(
     scene: Scene, stats: SolverStats, checks: tuple[Guard, RunBudget], t_rec, diverged: bool
 ) -> np.ndarray:
-    """How the run ended (status, message, time reached into ``stats``; the guard's verdict
-    explains a solver failure that may follow it, the budget's stop (``checks`` = (guard,
-    budget)) a run that ended early) and the output times it kept."""
+    """How the run ended (status, message, time reached into ``stats``, each ending through
+    ``update_status``'s precedence: the guard's verdict, which stopped the solver and says
+    why; a state cut off as non-finite; the budget's stop (``checks`` = (guard, budget)) of
+    a run that ended early, or else a plain failure) and the output times it kept."""
     guard, budget = checks
     stats.t_reached = float(t_rec[-1]) if t_rec.size else 0.0
     keep_detected = True
-    if guard.verdict is not None and stats.status != STATUS_ERROR:
-        stats.status, stats.message, t_detected, keep_detected = guard.verdict
-        stats.t_reached = min(stats.t_reached, t_detected) if t_rec.size else 0.0
-    stopped = budget.outcome(stats.t_reached)
-    if stats.status == 0 and stopped is not None and stats.t_reached < scene.t_end * (1 - 1e-9):
-        stats.status, stats.message = stopped
-    if stats.status == 0 and stats.t_reached < scene.t_end * (1 - 1e-9):
-        stats.status, stats.message = STATUS_FAILED, "solver stopped before t_end"
-    if stats.status == STATUS_FAILED and diverged and guard.verdict is None:
-        stats.status = STATUS_DIVERGED
-        stats.message = f"non-finite state after t = {stats.t_reached:.6g} s"
-    if stats.status == 0:
-        stats.message = "reached t_end"
+    if guard.verdict is not None:
+        status, message, t_detected, keep = guard.verdict
+        t = min(stats.t_reached, t_detected) if t_rec.size else 0.0
+        if update_status(stats, status, message, t):
+            keep_detected = keep
+    short = stats.t_reached < scene.t_end * (1 - 1e-9)
+    if diverged and guard.verdict is None:
+        update_status(stats, STATUS_DIVERGED, f"non-finite state after t = {stats.t_reached:.6g} s")
+    if short:
+        stopped = budget.outcome(stats.t_reached)
+        update_status(stats, *(stopped or (STATUS_FAILED, "solver stopped before t_end")))
     times = np.asarray(scene.times)
     tol = 1e-9 * max(1.0, scene.t_end)
     if not t_rec.size:

@@ -7,6 +7,7 @@ raises for a failed integration, it ends with one of these codes, a message and 
 from __future__ import annotations
 
 from enum import IntEnum
+from typing import Protocol
 
 import numpy as np
 
@@ -59,6 +60,57 @@ STATUS_BLOWUP = Status.BLOWUP
 STATUS_STALLED = Status.STALLED
 STATUS_BUDGET = Status.BUDGET
 STATUS_WALL = Status.WALL
+
+
+#: Which ending wins when two apply to one run, defined once (diffrax's ``update_result``):
+#: a status is replaced only by one of higher rank, never by one of equal or lower rank, so
+#: among equals the first stays. Ranks, from how little the ending says is wrong with the
+#: model to how much: 0 success; 1 a budget spent (wall clock, evaluations, a study's time
+#: limit: the run was stopped from outside, its state fine); 2 the integrator gave up; 3 its
+#: steps collapsed; 4 the energy blew up; 5 the state left float64 (non-finite); 6 the model
+#: (or the process running it) broke. So the guard's verdict replaces the solver failure it
+#: caused, a non-finite state replaces a plain failure, and nothing replaces a model error.
+PRECEDENCE: dict[Status, int] = {
+    Status.SUCCESS: 0,
+    Status.WALL: 1,
+    Status.BUDGET: 1,
+    Status.TIMEOUT: 1,
+    Status.FAILED: 2,
+    Status.STALLED: 3,
+    Status.BLOWUP: 4,
+    Status.DIVERGED: 5,
+    Status.ERROR: 6,
+    Status.CRASHED: 6,
+}
+
+
+def update_result(old: int, new: int) -> Status:
+    """The status of a run that ended ``old`` when ``new`` applies too: ``new`` if it ranks
+    above ``old`` in ``PRECEDENCE``, else ``old`` (ValueError for a number that is no
+    status)."""
+    old_s, new_s = Status(old), Status(new)
+    return new_s if PRECEDENCE[new_s] > PRECEDENCE[old_s] else old_s
+
+
+class Outcome(Protocol):
+    """What ``update_status`` writes: a run's status, message and time reached (s)."""
+
+    status: int
+    message: str
+    t_reached: float
+
+
+def update_status(result: Outcome, code: int, message: str, t: float | None = None) -> bool:
+    """Apply the ending ``code`` with its one-line ``message`` (and ``t``, the time reached
+    in s, when given) to ``result`` (a ``SolverStats``) when it wins by ``update_result``;
+    returns whether it did. The one place a run's status is written."""
+    old = Status(result.status)
+    if update_result(old, code) == old:
+        return False
+    result.status, result.message = Status(code), message
+    if t is not None:
+        result.t_reached = float(t)
+    return True
 
 
 def numerical_failure(exc: BaseException, t: float) -> tuple[int, str] | None:

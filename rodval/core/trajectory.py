@@ -7,83 +7,22 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rodval.core.status import STATUS_SUCCESS, Status
+from rodval.core.run_result import SolverStats
+from rodval.core.status import STATUS_SUCCESS
 
 if TYPE_CHECKING:
     import pandas as pd
 
-
-@dataclass
-class SolverStats:
-    """Cost and outcome of one run. ``wall_s`` is the integration's own wall time (s), without
-    imports, model set-up or one-time compilation. ``status`` is always a ``Status`` (an int
-    given to it is converted; ValueError for a number that is no status)."""
-
-    status: int = STATUS_SUCCESS  # always a Status at run time (see __setattr__)
-    message: str = ""
-    t_reached: float = 0.0
-    nfev: int = 0
-    njev: int = 0
-    nlu: int = 0
-    nsteps: int = 0
-    wall_s: float = 0.0
-    #: max |E - E(0) - W_ext + D| / max(max E, max |W_ext|) over the output times, when the
-    #: scene asks for "energy" (see rodval.solvers.audit); None otherwise.
-    energy_residual: float | None = None
-    #: max |H - H(0)| / max G over the output times, where angular momentum is conserved
-    #: (``rodval.core.validity.momentum_point``: a free base or a free root, no loads); None
-    #: otherwise.
-    momentum_residual: float | None = None
-    #: Largest |alpha|, |beta| (rad) over the output times reached, for models with bending
-    #: angles; None otherwise.
-    max_bending: float | None = None
-    #: Whether ``max_bending`` stayed within ``rodval.core.validity.SMALL_BENDING_RAD``, the
-    #: small-bending assumption both paper models rest on (None when not measured).
-    small_bending: bool | None = None
-    #: The model's verdict on its own assumptions (``rodval.core.validity``): whether every
-    #: check held (None: nothing could be checked), independent of ``status``: a run can reach
-    #: t_end and be invalid.
-    valid: bool | None = None
-    #: Every check made: assumption, figure, bound, unit, holds, reason.
-    validity: list[dict[str, Any]] = field(default_factory=list)
-    #: Where "auto"'s compiled DOP853 found its steps limited by stability and went on with
-    #: Radau IIA (``rodval.solvers.dop853.SWITCHING_STEPPER``): {"to", "t" (s), "h_lambda",
-    #: "h" (s), "reason"}; None when it did not switch.
-    switch: dict[str, Any] | None = None
-    #: What the model did not take from the scene, one sentence each with the reason (e.g. the
-    #: reduced model's quasi-static bending has no bending rates for the rods' bending
-    #: damping to act on): ``rodval.core.contract.Model.scene_notes``.
-    notes: list[str] = field(default_factory=list)
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        if name == "status":
-            value = Status(value)
-        object.__setattr__(self, name, value)
-
-    @property
-    def success(self) -> bool:
-        return self.status == STATUS_SUCCESS
-
-    def as_dict(self) -> dict:
-        return {
-            "status": int(self.status),
-            "success": self.success,
-            "message": self.message,
-            "t_reached": self.t_reached,
-            "nfev": self.nfev,
-            "njev": self.njev,
-            "nlu": self.nlu,
-            "nsteps": self.nsteps,
-            "wall_s": self.wall_s,
-            "energy_residual": self.energy_residual,
-            "momentum_residual": self.momentum_residual,
-            "max_bending": self.max_bending,
-            "small_bending": self.small_bending,
-            "valid": self.valid,
-            "validity": [dict(c) for c in self.validity],
-            "switch": None if self.switch is None else dict(self.switch),
-            "notes": list(self.notes),
-        }
+#: ``SolverStats`` (the run's result, ``rodval.core.run_result``) is named here too, where a
+#: trajectory's readers have always imported it.
+__all__ = [
+    "RESULT_KEYS",
+    "SolverStats",
+    "Trajectory",
+    "UnknownQuantity",
+    "finish",
+    "result_fields",
+]
 
 
 class UnknownQuantity(KeyError, ValueError):
@@ -112,12 +51,12 @@ class Trajectory:
     stats: SolverStats
     #: The integrator settings as the run used them (for "auto": the method that ran, and
     #: ``requested_method``); a reference model's own integrator (method, step).
-    settings: dict = field(default_factory=dict)
+    settings: dict[str, Any] = field(default_factory=dict)
     #: The model's options (e.g. coefficients, kernel; exudyn's discretization).
-    options: dict = field(default_factory=dict)
+    options: dict[str, Any] = field(default_factory=dict)
     #: State events in time order (e.g. latches locking), each a plain dict with "t" (s),
     #: "label" and the model's own measures.
-    events: list = field(default_factory=list)
+    events: list[Any] = field(default_factory=list)
     #: The rodval.Scene the run simulated (set by ``Model.simulate``; None for trajectories
     #: read from files or records, whose scene is in run.json / the case record). ``compare``
     #: refuses two runs of different scenes. Not part of equality or of ``to_dict``.
@@ -130,22 +69,14 @@ class Trajectory:
         scene_name: str,
         stats: SolverStats,
         *,
-        settings: dict | None = None,
-        options: dict | None = None,
+        settings: dict[str, Any] | None = None,
+        options: dict[str, Any] | None = None,
     ) -> Trajectory:
         """The trajectory of a run that produced no output time (a set-up error, a timeout, a
         crashed worker): no times, no values; ``stats`` says how it ended. The one
-        constructor of a failed run, for every model and the study runner."""
-        return cls(
-            model=model,
-            scene_name=scene_name,
-            times=np.zeros(0),
-            values={},
-            k_index={},
-            stats=stats,
-            settings=dict(settings or {}),
-            options=dict(options or {}),
-        )
+        constructor of a failed run, for every model and the study runner (through
+        ``finish``)."""
+        return finish(stats, model=model, scene_name=scene_name, settings=settings, options=options)
 
     @property
     def success(self) -> bool:
@@ -185,24 +116,31 @@ class Trajectory:
             )
         return float(values[i[0], j[0]])
 
-    def to_dict(self) -> dict:
-        """Plain JSON-ready form (lists and numbers); inverse of ``from_dict``."""
+    def result_dict(self) -> dict[str, Any]:
+        """The run's result (``RESULT_KEYS``: model, options, settings, stats, events), plain
+        and JSON-ready: what ``to_dict`` (a study's case record) and run.json
+        (``rodval.report.run_files.write_run``) hold alike; read back by ``result_fields``."""
         return {
             "model": self.model,
+            "options": self.options,
+            "settings": self.settings,
+            "stats": self.stats.to_dict(),
+            "events": self.events,
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-ready form (lists and numbers); inverse of ``from_dict``."""
+        return {
             "scene_name": self.scene_name,
             "times": self.times.tolist(),
             "values": {q: v.tolist() for q, v in self.values.items()},
             "k_index": {q: k.tolist() for q, k in self.k_index.items()},
-            "stats": self.stats.as_dict(),
-            "settings": self.settings,
-            "options": self.options,
-            "events": self.events,
+            **self.result_dict(),
         }
 
     @classmethod
-    def from_dict(cls, d: dict) -> Trajectory:
+    def from_dict(cls, d: dict[str, Any]) -> Trajectory:
         times = np.asarray(d["times"], dtype=float)
-        stats = {k: v for k, v in d["stats"].items() if k != "success"}
         k_index = {q: np.asarray(k, dtype=int) for q, k in d["k_index"].items()}
         return cls(
             model=d["model"],
@@ -213,10 +151,7 @@ class Trajectory:
                 for q, v in d["values"].items()
             },
             k_index=k_index,
-            stats=SolverStats(**stats),
-            settings=dict(d.get("settings", {})),
-            options=dict(d.get("options", {})),
-            events=list(d.get("events", [])),
+            **result_fields(d),
         )
 
     @classmethod
@@ -270,3 +205,52 @@ class Trajectory:
         if not parts:
             return pd.DataFrame(columns=["t", "quantity", "k", "value"])
         return pd.concat(parts, ignore_index=True)
+
+
+#: The fields of a run's result, the same in memory, in a case record and in run.json.
+RESULT_KEYS = ("model", "options", "settings", "stats", "events")
+
+
+def result_fields(d: dict[str, Any]) -> dict[str, Any]:
+    """The result fields ``Trajectory.result_dict`` wrote (a case record's trajectory or a
+    run.json), as ``Trajectory`` fields: stats (``SolverStats.from_dict``), settings, options
+    and events (the model is read with the outputs it names)."""
+    return {
+        "stats": SolverStats.from_dict(d["stats"]),
+        "settings": dict(d.get("settings", {})),
+        "options": dict(d.get("options", {})),
+        "events": list(d.get("events", [])),
+    }
+
+
+def finish(
+    stats: SolverStats,
+    *,
+    model: str,
+    scene_name: str,
+    times: np.ndarray | None = None,
+    observed: dict[str, tuple[np.ndarray, np.ndarray]] | None = None,
+    settings: dict[str, Any] | None = None,
+    options: dict[str, Any] | None = None,
+    events: list[Any] | None = None,
+) -> Trajectory:
+    """The one end of every run, native (``rodval.solvers.driver.integrate``), exudyn
+    (``reference_models.exudyn_chain``) and failed (``Trajectory.failed``): the trajectory of
+    the output ``times`` (s) reached and the ``observed`` quantities (name -> (values
+    (nt, nk), k labels)), with ``stats`` as the run left it. Its status was set on the way by
+    ``rodval.core.status.update_status`` alone; a run still at success here reached t_end,
+    and its message says so."""
+    if stats.status == STATUS_SUCCESS:
+        stats.message = "reached t_end"
+    observed = observed or {}
+    return Trajectory(
+        model=model,
+        scene_name=scene_name,
+        times=np.zeros(0) if times is None else times,
+        values={q: v for q, (v, _) in observed.items()},
+        k_index={q: k for q, (_, k) in observed.items()},
+        stats=stats,
+        settings=dict(settings or {}),
+        options=dict(options or {}),
+        events=list(events or []),
+    )

@@ -32,6 +32,7 @@ is written through ``rodval.core.out_paths.write_file`` (never through a link).
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import io
 import json
@@ -57,7 +58,7 @@ from rodval.core.out_paths import (
 from rodval.core.provenance import provenance
 from rodval.core.scene import Scene
 from rodval.core.scene_file import scene_to_dict
-from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.core.trajectory import SolverStats, Trajectory, result_fields
 from rodval.models.observation.deployed_damping import resolve_damping
 
 RUN_JSON = "run.json"
@@ -434,11 +435,7 @@ def write_run(
     write_file(out / name, data)
     record: dict[str, Any] = {
         "scene": doc,
-        "model": traj.model,
-        "options": traj.options,
-        "settings": traj.settings,
-        "stats": traj.stats.as_dict(),
-        "events": traj.events,
+        **traj.result_dict(),  # the same fields as a case record's (model ... events)
         "provenance": provenance(),
         DIGEST_KEY if name == TABLE_CSV else NPZ_DIGEST_KEY: file_digest(data),
         FILES_KEY: files,
@@ -564,11 +561,8 @@ def read_run(folder: Path) -> Trajectory:
             raise _no_digest(folder)
         check_digest(path, rec[DIGEST_KEY])
         traj = _read_csv(path, rec)
-    stats = {k: v for k, v in rec["stats"].items() if k != "success"}
     try:
-        traj.stats = SolverStats(**stats)
+        fields = result_fields(rec)
     except TypeError as exc:
         raise ValueError(f"{folder / RUN_JSON}: key 'stats': {exc}") from None
-    traj.settings, traj.options = dict(rec["settings"]), dict(rec["options"])
-    traj.events = list(rec.get("events", []))
-    return traj
+    return dataclasses.replace(traj, **fields)

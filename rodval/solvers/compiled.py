@@ -21,6 +21,7 @@ from rodval.core.status import (
     STATUS_WALL,
     exception_line,
     numerical_failure,
+    update_status,
 )
 from rodval.core.trajectory import SolverStats
 from rodval.solvers import budget, dop853, progress, stiffness
@@ -183,9 +184,8 @@ def run_compiled(
             )
         except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
             # raised by a model's kernel: the loop's time is lost, t_reached stays at its start
-            stats.status, stats.message = numerical_failure(exc, t) or (
-                STATUS_ERROR,
-                exception_line(exc),
+            update_status(
+                stats, *(numerical_failure(exc, t) or (STATUS_ERROR, exception_line(exc)))
             )
             stats.t_reached = t
             break
@@ -227,9 +227,8 @@ def _ending(
     budget spent on a stiff vibration (``stats.switch``) says which and what the rest of the
     horizon would cost (``held_by``)."""
     if res.code in _BUDGETS:
-        stats.status, setting = _BUDGETS[res.code]
-        stats.message = settings.budget_message(setting, res.t) + held_by(
-            stats.switch, t_end - res.t, stats.nfev
-        )
+        code, setting = _BUDGETS[res.code]
+        held = held_by(stats.switch, t_end - res.t, stats.nfev)
+        update_status(stats, code, settings.budget_message(setting, res.t) + held)
     elif res.code != budget.OK:
-        stats.status, stats.message = verdict_message(res.code, res.monitor, res.t, guard)
+        update_status(stats, *verdict_message(res.code, res.monitor, res.t, guard))

@@ -42,8 +42,9 @@ from rodval.core.status import (
     STATUS_WALL,
     exception_line,
     numerical_failure,
+    update_status,
 )
-from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.core.trajectory import SolverStats, Trajectory, finish
 from rodval.core.validity import SMALL_BENDING_RAD, momentum_point
 from rodval.solvers.audit import (
     PowerLedger,
@@ -82,11 +83,11 @@ def _contiguous_states(dense: Callable[[Any], np.ndarray]) -> Callable[[Any], np
 
 
 class _Stop(Exception):
-    """Ends a scipy run from inside the right-hand side (status, message)."""
+    """Ends a scipy run from inside the right-hand side: ``code`` (a status), message."""
 
-    def __init__(self, status: int, message: str):
+    def __init__(self, code: int, message: str):
         super().__init__(message)
-        self.status = status
+        self.code = code
 
 
 def choose_method(system: OdeSystem, scene: Scene, settings: IntegratorSettings) -> str:
@@ -240,11 +241,11 @@ class _ScipyRun:
                 self.fun, a, y, b, rtol=s.rtol, atol=s.atol, max_step=s.max_step, **self.extra
             )
         except _Stop as stop:
-            self.stats.status, self.stats.message = stop.status, str(stop)
+            update_status(self.stats, stop.code, str(stop))
             self.stats.nfev = self.nfev
             return y, a, b
         except Exception as exc:  # e.g. a singular iteration matrix while scipy sets up
-            self.stats.status, self.stats.message = _numerical_or_raise(exc, a)
+            update_status(self.stats, *_numerical_or_raise(exc, a))
             self.stats.nfev = self.nfev
             return y, a, b
         t_now = a
@@ -255,14 +256,13 @@ class _ScipyRun:
                 self.stats.nsteps += 1
                 if solver.status == "failed":
                     if self.non_finite:  # non-finite at every step size: diverged
-                        self.stats.status, self.stats.message = STATUS_DIVERGED, self.non_finite
+                        update_status(self.stats, STATUS_DIVERGED, self.non_finite)
                     else:
-                        self.stats.status = STATUS_FAILED
-                        self.stats.message = f"{msg} (t = {solver.t:.6g} s)"
+                        update_status(self.stats, STATUS_FAILED, f"{msg} (t = {solver.t:.6g} s)")
                     break
                 verdict = self.guard.check(solver.t_old, solver.t, solver.y)
                 if verdict:
-                    self.stats.status, self.stats.message = verdict
+                    update_status(self.stats, *verdict)
                     break
                 t0, t1 = solver.t_old, solver.t
                 hit = (
@@ -292,9 +292,9 @@ class _ScipyRun:
                     self._count(solver)
                     return y_new, t_event, t_event
         except _Stop as stop:
-            self.stats.status, self.stats.message = stop.status, str(stop)
+            update_status(self.stats, stop.code, str(stop))
         except Exception as exc:  # e.g. a singular iteration matrix inside scipy's step
-            self.stats.status, self.stats.message = _numerical_or_raise(exc, solver.t)
+            update_status(self.stats, *_numerical_or_raise(exc, solver.t))
         self._count(solver)
         return solver.y.copy(), t_now, b
 
@@ -330,7 +330,8 @@ def _numerical_or_raise(exc: Exception, t: float) -> tuple[int, str]:
 
 def _finite_prefix(times: np.ndarray, observed: dict, stats: SolverStats):
     """The output times up to the first one where an observed value is not finite: a run
-    never returns NaN; if it had reported success, it is a divergence."""
+    never returns NaN; it is a divergence, where that ending wins (``update_status``: over a
+    success, a budget or a plain failure; the time reached is then the last finite one)."""
     bad = [
         int(np.argmax(~np.isfinite(v).all(axis=1)))
         for v, _ in observed.values()
@@ -339,10 +340,8 @@ def _finite_prefix(times: np.ndarray, observed: dict, stats: SolverStats):
     if not bad:
         return times, observed
     cut = min(bad)
-    if stats.status == 0:
-        stats.status = STATUS_DIVERGED
-        stats.message = f"diverged: non-finite outputs at t = {times[cut]:.6g} s"
-        stats.t_reached = float(times[cut - 1]) if cut else 0.0
+    message = f"diverged: non-finite outputs at t = {times[cut]:.6g} s"
+    update_status(stats, STATUS_DIVERGED, message, float(times[cut - 1]) if cut else 0.0)
     return times[:cut], {q: (v[:cut], k) for q, (v, k) in observed.items()}
 
 
@@ -422,7 +421,7 @@ def _observe(
     except Exception as exc:  # noqa: BLE001
         observed = {}
         status, message = _failure(exc, stats.t_reached)
-        stats.status, stats.message = status, f"observation failed: {message}"
+        update_status(stats, status, f"observation failed: {message}")
     return reached, Y, observed
 
 
@@ -475,25 +474,22 @@ def integrate(
             t_now = scipy_run.run(y, edges)
             events = scipy_run.events
     except Exception as exc:  # noqa: BLE001 - e.g. the model's energy at y0: a run never raises
-        stats.status, stats.message = _failure(exc, t_now)
+        update_status(stats, *_failure(exc, t_now))
     stats.t_reached = float(t_now)
     windows.close()
-    if stats.status == 0:
-        stats.message = "reached t_end"
     reached, Y, observed = _observe(system, out, ledger, stats)
     reached, observed = _finite_prefix(reached, observed, stats)
     _bending_validity(system, reached, Y[: reached.size], observed, stats)
     if momentum:
         _momentum_audit(system, out.Y[out.audit_rows()], stats)
     stats.wall_s = time.perf_counter() - start
-    return Trajectory(
+    return finish(
+        stats,
         model=model,
         scene_name=scene.name,
         times=reached,
-        values={q: v for q, (v, _) in observed.items()},
-        k_index={q: k for q, (_, k) in observed.items()},
-        stats=stats,
+        observed=observed,
         settings=ran,
-        options=dict(options or {}),
+        options=options,
         events=events,
     )

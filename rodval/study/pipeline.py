@@ -23,7 +23,7 @@ from rodval.analysis.metrics import compare_runs
 from rodval.core.checks import as_path, check_choice, check_type
 from rodval.core.provenance import provenance
 from rodval.core.scene_file import scene_to_dict
-from rodval.core.status import STATUS_CRASHED, STATUS_DIVERGED, STATUS_TIMEOUT
+from rodval.core.status import STATUS_CRASHED, STATUS_DIVERGED, STATUS_TIMEOUT, update_status
 from rodval.core.trajectory import Trajectory
 from rodval.study.case import Case
 from rodval.study.records import CaseRecord, DamagedRecord, RunRecord, read_case
@@ -98,10 +98,8 @@ def _no_silent_nonfinite(traj: Trajectory) -> None:
         return
     for q, v in traj.values.items():
         if not np.all(np.isfinite(v)):
-            traj.stats.status = STATUS_DIVERGED
-            traj.stats.message = (
-                f"diverged: the model reported success with non-finite values of {q!r}"
-            )
+            message = f"diverged: the model reported success with non-finite values of {q!r}"
+            update_status(traj.stats, STATUS_DIVERGED, message)
             if traj.stats.valid:  # no verdict on a run that failed (rodval.core.validity)
                 traj.stats.valid = None
             return

@@ -1,0 +1,95 @@
+"""The result of one run, the same in memory, in a study's case record and in run.json:
+how it ended (``status``, ``message``, ``t_reached``), what it cost and what the model said
+of its own validity. Its status changes only through ``rodval.core.status.update_status``
+(the precedence rule); a run is finished by ``rodval.core.trajectory.finish``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from rodval.core.status import STATUS_SUCCESS, Status
+
+
+@dataclass
+class SolverStats:
+    """Cost and outcome of one run. ``wall_s`` is the integration's own wall time (s), without
+    imports, model set-up or one-time compilation. ``status`` is always a ``Status`` (an int
+    given to it is converted; ValueError for a number that is no status)."""
+
+    status: int = STATUS_SUCCESS  # always a Status at run time (see __setattr__)
+    message: str = ""
+    t_reached: float = 0.0
+    nfev: int = 0
+    njev: int = 0
+    nlu: int = 0
+    nsteps: int = 0
+    wall_s: float = 0.0
+    #: max |E - E(0) - W_ext + D| / max(max E, max |W_ext|) over the output times, when the
+    #: scene asks for "energy" (see rodval.solvers.audit); None otherwise.
+    energy_residual: float | None = None
+    #: max |H - H(0)| / max G over the output times, where angular momentum is conserved
+    #: (``rodval.core.validity.momentum_point``: a free base or a free root, no loads); None
+    #: otherwise.
+    momentum_residual: float | None = None
+    #: Largest |alpha|, |beta| (rad) over the output times reached, for models with bending
+    #: angles; None otherwise.
+    max_bending: float | None = None
+    #: Whether ``max_bending`` stayed within ``rodval.core.validity.SMALL_BENDING_RAD``, the
+    #: small-bending assumption both paper models rest on (None when not measured).
+    small_bending: bool | None = None
+    #: The model's verdict on its own assumptions (``rodval.core.validity``): whether every
+    #: check held (None: nothing could be checked), independent of ``status``: a run can reach
+    #: t_end and be invalid.
+    valid: bool | None = None
+    #: Every check made: assumption, figure, bound, unit, holds, reason.
+    validity: list[dict[str, Any]] = field(default_factory=list)
+    #: Where "auto"'s compiled DOP853 found its steps limited by stability and went on with
+    #: Radau IIA (``rodval.solvers.dop853.SWITCHING_STEPPER``): {"to", "t" (s), "h_lambda",
+    #: "h" (s), "reason"}; None when it did not switch.
+    switch: dict[str, Any] | None = None
+    #: What the model did not take from the scene, one sentence each with the reason (e.g. the
+    #: reduced model's quasi-static bending has no bending rates for the rods' bending
+    #: damping to act on): ``rodval.core.contract.Model.scene_notes``.
+    notes: list[str] = field(default_factory=list)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name == "status":
+            value = Status(value)
+        object.__setattr__(self, name, value)
+
+    @property
+    def success(self) -> bool:
+        return self.status == STATUS_SUCCESS
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-ready form, the same in a study's case record and in run.json (with
+        ``success``, derived from ``status``); inverse of ``from_dict``."""
+        return {
+            "status": int(self.status),
+            "success": self.success,
+            "message": self.message,
+            "t_reached": self.t_reached,
+            "nfev": self.nfev,
+            "njev": self.njev,
+            "nlu": self.nlu,
+            "nsteps": self.nsteps,
+            "wall_s": self.wall_s,
+            "energy_residual": self.energy_residual,
+            "momentum_residual": self.momentum_residual,
+            "max_bending": self.max_bending,
+            "small_bending": self.small_bending,
+            "valid": self.valid,
+            "validity": [dict(c) for c in self.validity],
+            "switch": None if self.switch is None else dict(self.switch),
+            "notes": list(self.notes),
+        }
+
+    #: The name callers used before ``to_dict``.
+    as_dict = to_dict
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> SolverStats:
+        """The result ``to_dict`` wrote (``success`` is derived, not read); TypeError naming
+        a key that is no field, ValueError for a status that is no ``Status``."""
+        return cls(**{k: v for k, v in d.items() if k != "success"})
