@@ -44,6 +44,7 @@ def register(sub) -> None:
 def run(args) -> int:
     from rodval.analysis.metrics import discrepancies
     from rodval.core.out_paths import clear_previous, write_file, write_with
+    from rodval.core.quantities import ROD_QUANTITIES
     from rodval.core.scene_file import scene_differences
     from rodval.report.figures import plot_time_histories
     from rodval.report.markdown import to_markdown
@@ -67,7 +68,7 @@ def run(args) -> int:
         args.out / "discrepancies.md",
         f"# {args.a} ({a.model}) against {args.b} ({b.model})\n\n" + to_markdown(table),
     )
-    quantities = [q for q in ("phi", "dphi", "alpha", "beta") if q in table["quantity"].values]
+    quantities = [q for q in ROD_QUANTITIES if q in table["quantity"].values]
     if quantities:
         n = int(max(b.k_index[quantities[0]]))
         histories = {f"A: {a.model}": a, f"B: {b.model}": b}

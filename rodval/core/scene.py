@@ -34,73 +34,28 @@ from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
 from rodval.core.hinges import Stop as Stop
 from rodval.core.hinges import check_acting_stops, check_latches, hinge_items
 from rodval.core.loads import NodalForce
+from rodval.core.quantities import GROUPS, OUTPUTS, UNIT, check_output_bases, quantities_of
 from rodval.core.resources import check_rods, check_run_memory
 
-#: Quantities a scene may ask for. "x"/"y" are node positions (k = 0..n); "energy" yields
-#: kinetic, potential and total energy (k = 0); "angular_momentum" (N m s, counter-clockwise
-#: positive) has k = 0: H about the root node, sum int (r - r_0) x v dm over rods and point
-#: masses, and k = 1: H about the chain's centre of mass, H_0 - (S x P) / M (S first mass
-#: moment about the root, P linear momentum, M total mass); with a free base (``Base``) k = 1
-#: is about the whole system's centre of mass, body included. "momentum" (N s): the whole
-#: system's linear momentum (k = 0, 1: x, y). "base" (a free base only) yields the body's
-#: base_position, base_velocity (k = 0, 1: x, y), base_attitude and base_rate (k = 0); "drive"
-#: (a prescribed base only) the base's force on the chain at node 0, drive_force (N, k = 0, 1:
-#: x, y), and its moment about the body's centre, drive_moment (N m, k = 0); docs/quantities.md.
-QUANTITIES = (
-    "phi",
-    "dphi",
-    "alpha",
-    "beta",
-    "x",
-    "y",
-    "energy",
-    "hinge_angle",
-    "hinge_moment",
-    "angular_momentum",
-    "momentum",
-    "base",
-    "drive",
-)
-#: What the quantities "energy", "base" and "drive" yield in a trajectory.
-EXPANDS = {
-    "energy": ("kinetic", "potential", "energy"),
-    "base": ("base_position", "base_velocity", "base_attitude", "base_rate"),
-    "drive": ("drive_force", "drive_moment"),
-}
+#: Quantities a scene may ask for (the outputs of ``rodval.core.quantities.QUANTITY_TABLE``,
+#: where each is declared once: unit, k, definition, bases, models). "x"/"y" are node
+#: positions (k = 0..n); "energy" yields kinetic, potential and total energy (k = 0);
+#: "angular_momentum" (N m s, counter-clockwise positive) has k = 0: H about the root node and
+#: k = 1: H about the centre of mass (the whole system's, a free base's body included);
+#: "momentum" (N s): the whole system's linear momentum (k = 0, 1: x, y). "base" (a moving
+#: base only) yields base_position, base_velocity, base_attitude and base_rate; "drive" (a
+#: prescribed base only) drive_force and drive_moment; docs/quantities.md.
+QUANTITIES: tuple[str, ...] = OUTPUTS
+#: What the group outputs ("energy", "base", "drive") yield in a trajectory.
+EXPANDS: dict[str, tuple[str, ...]] = GROUPS
 #: Units of every trajectory quantity (the energy audit adds work, dissipated, residual).
-UNITS = {
-    "phi": "rad",
-    "dphi": "rad/s",
-    "alpha": "rad",
-    "beta": "rad",
-    "x": "m",
-    "y": "m",
-    "kinetic": "J",
-    "potential": "J",
-    "energy": "J",
-    "work": "J",
-    "dissipated": "J",
-    "energy_residual": "J",
-    "hinge_angle": "rad",
-    "hinge_moment": "N m",
-    "angular_momentum": "N m s",
-    "momentum": "N s",
-    "base_position": "m",
-    "base_velocity": "m/s",
-    "base_attitude": "rad",
-    "base_rate": "rad/s",
-    "drive_force": "N",
-    "drive_moment": "N m",
-}
+UNITS: dict[str, str] = UNIT
 
 
 def trajectory_quantities(outputs: Iterable[str]) -> tuple[str, ...]:
     """The trajectory quantities a scene's ``outputs`` produce: "energy" and "base" yield
     their parts (``EXPANDS``); the others themselves."""
-    out: list[str] = []
-    for q in outputs:
-        out.extend(EXPANDS.get(q, (q,)))
-    return tuple(out)
+    return quantities_of(outputs)
 
 
 #: ``Chain.uniform``'s values where a field is not given (the paper's example, SI units).
@@ -421,15 +376,7 @@ class Scene:
         check_acting_stops(self.chain, self.stops)
         if not isinstance(self.base, Base):
             raise ValueError(f"base must be a rodval.Base, got {type(self.base).__name__}")
-        if not self.base.moving and self.wants("base"):
-            raise ValueError(
-                "output 'base' needs a free or prescribed base (Base(kind='free', ...) or "
-                "Base(kind='prescribed', ...))"
-            )
-        if not self.base.prescribed and self.wants("drive"):
-            raise ValueError(
-                "output 'drive' needs a prescribed base (Base(kind='prescribed', ...))"
-            )
+        check_output_bases(self.outputs, self.base.kind)
         check_latches(self.latches, self.initial_hinge_angles(), self.initial_hinge_rates())
         if self.damping is not None and not isinstance(self.damping, DampingRequest):
             raise ValueError(

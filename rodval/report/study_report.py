@@ -34,6 +34,7 @@ from rodval.analysis.events import (
     event_discrepancies,
 )
 from rodval.core.out_paths import STUDY_SCHEMA, is_stamped, write_file
+from rodval.core.quantities import models_with
 from rodval.models import get_model
 from rodval.models.presets.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
@@ -111,19 +112,44 @@ def residual_vibration(
     return pd.DataFrame(rows)
 
 
-def peak_hinge_moments(traj: pd.DataFrame, events: pd.DataFrame) -> pd.DataFrame:
-    """Largest |hinge moment| (N m) per case, model and hinge: from the "hinge_moment"
-    trajectories when recorded, else the events' peak_moment (the lock window's peak)."""
+def peak_hinge_moments(
+    traj: pd.DataFrame, events: pd.DataFrame, models: list[dict[str, Any]] | None = None
+) -> pd.DataFrame:
+    """Largest |hinge moment| (N m) per case, model and hinge, one row each: ``peak_moment``
+    over the output times of the "hinge_moment" trajectories of every model that outputs it
+    (``rodval.core.quantities.models_with``; ``models``: the study's ``[{"label", "model"}]``,
+    None: every model in ``traj``), ``source`` "hinge_moment"; beside it ``window_peak``, the
+    lock windows' peak where the model's lock records carry one (``peak_moment`` of
+    events.csv: exudyn's, over every step of the window, so it can exceed the output times'
+    peak). A model with only the lock records gives their peak (``source`` "lock window")."""
+    keys = ["case", "model", "hinge"]
     hm = traj[traj["quantity"] == "hinge_moment"]
+    if models is not None:
+        labels = {m["label"] for m in models if models_with("hinge_moment", [m["model"]])}
+        hm = hm[hm["model"].isin(labels)]
+    peaks = pd.DataFrame(columns=[*keys, "peak_moment"])
     if not hm.empty:
         g = hm.assign(abs_value=hm["value"].abs()).groupby(["case", "model", "k"], sort=False)
-        out = g["abs_value"].max().reset_index().rename(columns={"k": "hinge"})
-        return out.rename(columns={"abs_value": "peak_moment"}).assign(source="hinge_moment")
+        peaks = g["abs_value"].max().reset_index()
+        peaks = peaks.rename(columns={"k": "hinge", "abs_value": "peak_moment"})
+        peaks["hinge"] = peaks["hinge"].astype(int)
+    window = pd.DataFrame(columns=[*keys, "window_peak"])
     if "peak_moment" in events and events["peak_moment"].notna().any():
-        cols = ["case", "model", "hinge", "peak_moment"]
-        part = events.dropna(subset=["peak_moment"])[[c for c in cols if c in events]]
-        return part.assign(source="lock window")
-    return pd.DataFrame()
+        part = events.dropna(subset=["peak_moment"])
+        window = part.groupby(keys, sort=False)["peak_moment"].max().reset_index()
+        window = window.rename(columns={"peak_moment": "window_peak"})
+        window["hinge"] = window["hinge"].astype(int)
+    if window.empty:
+        return peaks.assign(source="hinge_moment") if not peaks.empty else pd.DataFrame()
+    if peaks.empty:
+        return window.assign(peak_moment=window["window_peak"], source="lock window")[
+            [*keys, "peak_moment", "source", "window_peak"]
+        ]
+    out = peaks.assign(source="hinge_moment").merge(window, on=keys, how="outer")
+    only = out["peak_moment"].isna()
+    out["source"] = out["source"].where(~only, "lock window")
+    out["peak_moment"] = out["peak_moment"].where(~only, out["window_peak"])
+    return out[[*keys, "peak_moment", "source", "window_peak"]]
 
 
 def _blanks(df: pd.DataFrame) -> pd.DataFrame:
@@ -205,9 +231,7 @@ def _deployment_section(
             "\n",
             to_markdown(keep(disc), ".3g"),
         ]
-    peaks = peak_hinge_moments(tables["trajectories"], events)
-    if not peaks.empty:
-        lines += ["Peak hinge moments (N m):\n", to_markdown(keep(peaks), ".4g")]
+    lines += peak_moment_lines(tables["trajectories"], events, meta["models"], keep)
     resid = residual_vibration(tables["trajectories"], events, tables["cases"])
     if not resid.empty:
         lines += [
@@ -216,6 +240,35 @@ def _deployment_section(
             to_markdown(keep(resid), ".4g"),
         ]
     return [*lines, *deployment_figures(fig_dir, meta, tables, events)]
+
+
+def peak_moment_lines(
+    traj: pd.DataFrame, events: pd.DataFrame, models: list[dict[str, Any]], keep: Any
+) -> list[str]:
+    """The peak hinge moments' table (``peak_hinge_moments``) as markdown lines; none when
+    no model recorded a hinge moment."""
+    peaks = peak_hinge_moments(traj, events, models)
+    if peaks.empty:
+        return []
+    lines = [
+        "Peak hinge moments (N m): `peak_moment` over the output times from every model that "
+        "outputs `hinge_moment`; `window_peak` over every step of a lock window where the "
+        "model's lock records carry it:\n",
+        to_markdown(_blanks(keep(peaks)), ".4g"),
+    ]
+    recorded = set(traj.loc[traj["quantity"] == "hinge_moment", "model"])
+    unrecorded = [
+        m["label"]
+        for m in models
+        if models_with("hinge_moment", [m["model"]]) and m["label"] not in recorded
+    ]
+    if unrecorded:
+        lines.append(
+            "Without `hinge_moment` among the [scene] outputs the output times' peaks of "
+            + ", ".join(f"`{label}`" for label in unrecorded)
+            + " are not recorded: add it there to compare every model's.\n"
+        )
+    return lines
 
 
 def _keep(constants: dict[str, Any]) -> Any:

@@ -42,9 +42,9 @@ Absolute requirements bound a model's own results, not its gap to the reference:
 quantity); each has ``min``, ``max`` or both (finite, min <= max; a lock time and an impulse
 >= 0). The hinge is a latched hinge of every case (not a held one), the final quantity one
 the cases output (a scene's ``"energy"`` yields ``kinetic``, ``potential`` and ``energy``)
-and its k one that quantity has (``quantity_k``), ``peak_hinge_moment`` needs
-``"hinge_moment"`` among the outputs: each refused when the file is read, naming the key and
-what is allowed. Evaluated by ``rodval.report.acceptance``.
+and its k one that quantity has (``rodval.core.quantities.quantity_k``),
+``peak_hinge_moment`` needs ``"hinge_moment"`` among the outputs: each refused when the file
+is read, naming the key and what is allowed. Evaluated by ``rodval.report.acceptance``.
 """
 
 from __future__ import annotations
@@ -55,6 +55,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from rodval.core.checks import check_keys
+from rodval.core.quantities import quantity_k
 from rodval.core.scene import EXPANDS, QUANTITIES, Scene
 from rodval.report.acceptance import BOUND_METRICS, EVENT_METRICS, REQUIRE_ITEMS, SCALAR_KEYS
 
@@ -320,16 +321,3 @@ def _latched_hinge(v: Any, key: str, scenes: Sequence[Scene], err: Any) -> int:
             allowed = ", ".join(map(str, sorted(common))) or "none"
             raise err(key, f"must be a hinge every case latches ({allowed}), got {v!r}")
     return hinge
-
-
-def quantity_k(quantity: str, n: int) -> range:
-    """The k a trajectory quantity has on an n-rod chain (docs/quantities.md): rods 1..n,
-    nodes 0..n, hinges 0..n-1, two components (k = 0, 1) or one (k = 0)."""
-    if quantity in ("phi", "dphi", "alpha", "beta"):
-        return range(1, n + 1)
-    if quantity in ("x", "y"):
-        return range(n + 1)
-    if quantity in ("hinge_angle", "hinge_moment"):
-        return range(n)
-    pairs = ("angular_momentum", "momentum", "base_position", "base_velocity", "drive_force")
-    return range(2) if quantity in pairs else range(1)
