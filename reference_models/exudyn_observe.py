@@ -18,6 +18,7 @@ from reference_models.exudyn_beam import (
 )
 from rodval.core.base import Base
 from rodval.core.bounds import MIN_POSITIVE
+from rodval.core.quantities import tip_deflection
 from rodval.core.scene import QUANTITIES, Scene, hinge_angles
 from rodval.solvers.audit import audit_times
 
@@ -100,7 +101,7 @@ def observe(
     for name, val in (("phi", phi), ("dphi", dphi), ("alpha", alpha), ("beta", beta)):
         if scene.wants(name):
             out[name] = (val, rods)
-    if scene.wants("x", "y"):
+    if scene.wants("x", "y", "tip_deflection"):
         nodes = np.arange(0, n + 1)
         x = np.concatenate([qL[:, :1, 0], qR[..., 0]], 1)
         y = np.concatenate([qL[:, :1, 1], qR[..., 1]], 1)
@@ -108,6 +109,9 @@ def observe(
             out["x"] = (x, nodes)
         if scene.wants("y"):
             out["y"] = (y, nodes)
+        if scene.wants("tip_deflection"):
+            tip = tip_deflection(x, y, body_attitude(at)[0])
+            out["tip_deflection"] = (tip[:, None], np.zeros(1, dtype=int))
     if scene.wants("hinge_angle", "hinge_moment"):
         _hinge_quantities(
             scene, E, times, at, (phi, alpha, beta), (qL, vL, qR, vR), lock_steps, out

@@ -45,12 +45,13 @@ BASES = {
 
 def test_scene_names_and_units_are_the_registry():
     """QUANTITIES, EXPANDS, UNITS (rodval.core.scene) are read from the registry, in the order
-    they had; every trajectory quantity has a unit."""
+    they had, with tip_deflection added; every trajectory quantity has a unit."""
     assert QUANTITIES == OUTPUTS
     assert QUANTITIES[:13] == (
         "phi", "dphi", "alpha", "beta", "x", "y", "energy", "hinge_angle", "hinge_moment",
         "angular_momentum", "momentum", "base", "drive",
     )  # fmt: skip
+    assert "tip_deflection" in QUANTITIES
     assert EXPANDS is GROUPS and UNITS is UNIT
     assert EXPANDS["energy"] == ("kinetic", "potential", "energy")
     assert EXPANDS["base"] == ("base_position", "base_velocity", "base_attitude", "base_rate")
@@ -75,6 +76,7 @@ def test_docs_quantity_table_is_the_generated_one():
     rodval.core.quantities --write docs/quantities.md)."""
     text = (ROOT / "docs" / "quantities.md").read_text()
     assert with_doc_table(text) == text
+    assert "| `tip_deflection` |" in text
 
 
 @pytest.mark.parametrize(
@@ -85,6 +87,7 @@ def test_docs_quantity_table_is_the_generated_one():
         ("hinge_moment", 3, range(3)),
         ("momentum", 3, range(2)),
         ("angular_momentum", 3, range(2)),
+        ("tip_deflection", 3, range(1)),
         ("drive_moment", 3, range(1)),
     ],
 )
@@ -99,6 +102,7 @@ def test_unknown_quantity_is_one_line():
 
 def test_every_model_outputs_hinge_moment_and_exudyn_no_drive():
     assert models_with("hinge_moment", MODEL_NAMES) == MODEL_NAMES
+    assert models_with("tip_deflection", MODEL_NAMES, "free") == MODEL_NAMES
     assert "exudyn" not in models_with("drive_force", MODEL_NAMES, "prescribed")
     assert models_with("base_attitude", MODEL_NAMES, "pinned") == ()
 
@@ -109,7 +113,7 @@ def test_output_bases_messages():
         paper_scene(2, outputs=("phi", "base"))
     with pytest.raises(ValueError, match=r"^output 'drive' needs a prescribed base \("):
         paper_scene(2, outputs=("phi", "drive")).with_(base=BASES["free"])
-    check_output_bases(("phi", "x"), "pinned")  # every base has them
+    check_output_bases(("phi", "tip_deflection"), "pinned")  # every base has them
 
 
 @pytest.mark.parametrize("model", MODEL_NAMES)

@@ -11,6 +11,7 @@ import numpy as np
 
 from rodval.core.checks import check_choice
 from rodval.core.loads import LoadSet, load_table
+from rodval.core.quantities import tip_deflection
 from rodval.core.scene import Scene, hinge_angles
 from rodval.core.trajectory import Trajectory
 from rodval.core.validity import Check, small_bending
@@ -282,13 +283,16 @@ class PaperSystem(PaperEnergy, OdeSystem):
                 out["alpha"] = (alpha, rods)
             if scene.wants("beta"):
                 out["beta"] = (beta, rods)
-        if scene.wants("x", "y"):
+        if scene.wants("x", "y", "tip_deflection"):
             x, y = node_positions(self.l, phi)
             nodes = np.arange(0, n + 1)
             if scene.wants("x"):
                 out["x"] = (x, nodes)
             if scene.wants("y"):
                 out["y"] = (y, nodes)
+            if scene.wants("tip_deflection"):
+                tip = tip_deflection(x, y, self.attitude(Y))
+                out["tip_deflection"] = (tip[:, None], np.zeros(1, dtype=int))
         if scene.wants("hinge_angle", "hinge_moment"):
             D = hinge_angles(phi, alpha, beta, self.attitude(Y))
             hinges = np.arange(n)
