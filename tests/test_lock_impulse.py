@@ -133,12 +133,16 @@ def test_exudyn_measures_the_same_impulse():
 @pytest.mark.slow
 @pytest.mark.exudyn
 def test_the_shipped_flexible_deployment_compares_like_with_like(tmp_path):
-    """studies/deployment.toml (four panels, EI = 5e3, exudyn reference: 4 elements per rod,
-    h = 1e-4 s): the first lock (hinge 3) within 1 ms and its lock impulse within 10 % in both
-    native models (measured full 0.20 ms / 0.04 %, reduced 0.98 ms / 5.7 %); the later locks
-    the models reach in different states are marked not comparable in the discrepancies and
-    the report says why (measured: the reduced model's hinge 2 and 1 by their kinetic energy
-    before the lock, 28 % and 53 % off; the full model's hinge 1 after hinge 2's 3.3 ms)."""
+    """studies/deployment.toml (four panels, EI = 5e3; its reference exudyn at 8 elements per
+    rod and 2.5e-5 s since issue 47, hinge 3's lock time to 0.16 ms by `rodval reference`):
+    the first lock (hinge 3) compares like with like: the full model within 0.3 ms (measured
+    -0.19 ms, about the reference's error bar) and 1 % in impulse (0.63 %), the reduced model
+    within 1.2 ms (measured +1.07 ms: its quasi-static bending lags; it is out of its domain on
+    this scene by its energy balance) and 10 % (5.4 %). (Against the earlier reference, exudyn
+    at 4 elements and 1e-4 s, the reduced model's gap was 0.98 ms and a 1 ms bound held both.)
+    The later locks the models reach in other states are marked not comparable, with the
+    earlier lock's gap as the reason (reduced: hinge 3's 1.07 ms; full at hinge 1: hinge 2's
+    1.41 ms), and the report says why."""
     pytest.importorskip("exudyn")
     from pathlib import Path
 
@@ -149,13 +153,14 @@ def test_the_shipped_flexible_deployment_compares_like_with_like(tmp_path):
     out = tmp_path / "out"
     run_study(load_study(study), out, workers=1, progress=False)
     disc = event_discrepancies(read_events(out), "exudyn").set_index(["model", "label"])
-    for model in ("full", "reduced"):
+    for model, dt, impulse in (("full", 3e-4, 0.01), ("reduced", 1.2e-3, 0.1)):
         first = disc.loc[(model, "latch hinge 3")]
-        assert abs(first["dt"]) < 1e-3
-        assert first["impulse_rel"] < 0.1
+        assert abs(first["dt"]) < dt
+        assert first["impulse_rel"] < impulse
         assert first["not_comparable"] == ""
         assert disc.loc[(model, "latch hinge 1"), "not_comparable"] != ""
-    assert "kinetic energy" in disc.loc[("reduced", "latch hinge 2"), "not_comparable"]
+    assert "after latch hinge 3" in disc.loc[("reduced", "latch hinge 2"), "not_comparable"]
+    assert "after latch hinge 2" in disc.loc[("full", "latch hinge 1"), "not_comparable"]
     assert "not_comparable" in build_report(out).read_text()
 
 
