@@ -220,7 +220,9 @@ def rotate(theta: Any, v: np.ndarray) -> np.ndarray:
     return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
 
 
-def root_state(base: Base, position, velocity, attitude, rate) -> tuple[np.ndarray, np.ndarray]:
+def root_state(
+    base: Base, position: Any, velocity: Any, attitude: Any, rate: Any
+) -> tuple[np.ndarray, np.ndarray]:
     """Node 0's position r_0 = r_c + rho (m) and velocity v_0 = v_c + theta' k x rho (m/s),
     rho = R(theta) hinge_offset, from the body's centre of mass r_c, v_c (..., 2), attitude
     theta (rad) and rate theta' (rad/s) (...); each (..., 2)."""

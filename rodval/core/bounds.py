@@ -20,7 +20,7 @@ MAX_MAGNITUDE = 1e12
 MIN_POSITIVE = 1e-12
 
 
-def as_rod_array(name: str, value, n: int, *, positive: bool | None) -> np.ndarray:
+def as_rod_array(name: str, value: Any, n: int, *, positive: bool | None) -> np.ndarray:
     """A length-n float array from a scalar or sequence of real numbers; ``positive``: True
     for > 0, False for >= 0 (both with bounded magnitudes: ``MAX_MAGNITUDE``,
     ``MIN_POSITIVE``), None for any finite value (angles, initial state)."""

@@ -156,4 +156,5 @@ class Model(ABC):
                 f"model {cls.name!r}: modes of a chain on a free base (the free spacecraft) are "
                 "not built for this model (docs/base.md; the full and exudyn models have them)"
             )
-        return analysis(scene, about=about, count=count, load_at=load_at, **options)
+        modes: Modes = analysis(scene, about=about, count=count, load_at=load_at, **options)
+        return modes

@@ -142,7 +142,8 @@ def first_free_free_frequency(l: Any, m: Any, EI: Any) -> np.ndarray:
     """omega_1 (rad/s) of each rod's first free-free bending mode: l (m), m (kg/m), EI (N m^2),
     scalars or arrays (broadcast). O(n)."""
     l, m, EI = (np.asarray(v, dtype=float) for v in (l, m, EI))
-    return (FREE_FREE_BETA_L / l) ** 2 * np.sqrt(EI / m)
+    omega: np.ndarray = (FREE_FREE_BETA_L / l) ** 2 * np.sqrt(EI / m)
+    return omega
 
 
 def bending_damping_for_ratio(ratio: Any, l: Any, m: Any, EI: Any) -> np.ndarray:
@@ -158,4 +159,5 @@ def bending_damping_for_ratio(ratio: Any, l: Any, m: Any, EI: Any) -> np.ndarray
             f"got {zeta.size}"
         )
     zeta = zeta if zeta.size > 1 else zeta[0]
-    return 2.0 * zeta * EI / first_free_free_frequency(l, m, EI)
+    c: np.ndarray = 2.0 * zeta * EI / first_free_free_frequency(l, m, EI)
+    return c

@@ -134,7 +134,8 @@ def _zero_floor(lam: np.ndarray, sigma: float) -> np.ndarray:
 def angular_frequencies(lam: np.ndarray) -> np.ndarray:
     """omega (rad/s) of eigenvalues lam = omega^2 (1/s^2): sqrt(lam), and -sqrt(-lam) for a
     negative lam (an unstable, e.g. buckled, configuration)."""
-    return np.sign(lam) * np.sqrt(np.abs(lam))
+    omega: np.ndarray = np.sign(lam) * np.sqrt(np.abs(lam))
+    return omega
 
 
 def quadratic_eigenvalues(
@@ -215,7 +216,8 @@ def constraint_basis(A: np.ndarray) -> np.ndarray:
     for i in range(m):
         own = np.flatnonzero(nonzero[i] & (touched == 1))
         if own.size == 0:
-            return scipy.linalg.null_space(A)
+            basis: np.ndarray = scipy.linalg.null_space(A)
+            return basis
         pivots.append(int(own[np.argmax(np.abs(A[i, own]))]))
     keep = np.setdiff1d(np.arange(N), pivots)
     Z = np.zeros((N, keep.size))

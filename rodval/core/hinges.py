@@ -15,7 +15,7 @@ from rodval.core.bounds import bounded_number, check_bounds
 from rodval.core.checks import check_number
 
 
-def _index(name: str, value, n: int) -> int:
+def _index(name: str, value: Any, n: int) -> int:
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise ValueError(
             f"{name} must be an integer hinge index in 0..n-1 = 0..{n - 1}, got {value!r}"

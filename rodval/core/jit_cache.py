@@ -42,6 +42,7 @@ import hashlib
 import importlib.util
 import os
 import re
+from collections.abc import Callable
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -186,7 +187,7 @@ def install(root: Path = PACKAGE_ROOT) -> bool:
         from numba.core import caching
 
         mixin = caching._SourceFileBackedLocatorMixin
-        original_stamp = mixin.get_source_stamp
+        original_stamp: Callable[[Any], Any] = mixin.get_source_stamp  # numba: untyped
     except (ImportError, AttributeError):
         return False
     prefix = str(Path(root).resolve()) + os.sep

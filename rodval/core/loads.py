@@ -191,7 +191,7 @@ class NodalForce:
     support: tuple[float, float] = (0.0, math.inf)
     breakpoints: tuple[float, ...] = ()
     name: str = "callable"
-    params: dict = field(default_factory=dict, compare=False)
+    params: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
         if isinstance(self.node, bool) or not isinstance(self.node, numbers.Integral):
@@ -218,10 +218,10 @@ class NodalForce:
     def active(self, t: float) -> bool:
         return self.support[0] <= t <= self.support[1]
 
-    def rows(self) -> list[tuple] | None:
+    def rows(self) -> list[tuple[float, ...]] | None:
         """This force's rows of the compiled load table, or None when a component is a plain
         callable (no compiled form)."""
-        out = []
+        out: list[tuple[float, ...]] = []
         for comp, f in ((0, self.fx), (1, self.fy)):
             if f is None:
                 continue
@@ -469,7 +469,7 @@ LOAD_FACTORIES: dict[str, Callable[..., NodalForce]] = {
 def load_table(loads: Sequence[NodalForce]) -> np.ndarray | None:
     """The compiled load table (rows x ``LOAD_COLUMNS``) of ``loads``, or None when one of
     them is a plain callable."""
-    rows: list[tuple] = []
+    rows: list[tuple[float, ...]] = []
     for f in loads:
         r = f.rows()
         if r is None:
@@ -491,7 +491,7 @@ def _track_ends(table: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def _track_row(L, start, end, t):
+def _track_row(L: np.ndarray, start: int, end: int, t: float) -> int:
     """The row of the track ``start:end`` of ``L`` with the latest start t0 <= t (``start``
     when there is none): the only row of the track that may act at t. O(log(end - start))."""
     lo, hi = start, end
@@ -505,7 +505,7 @@ def _track_row(L, start, end, t):
 
 
 @njit(cache=True)
-def load_sums(L, t, SX, SY):
+def load_sums(L: np.ndarray, t: float, SX: np.ndarray, SY: np.ndarray) -> bool:
     """Suffix sums SX_k = sum_{j>=k} X_j, SY_k (N) at t from the load table ``L``; returns
     False (and leaves SX, SY untouched) when no row acts at t. O(tracks x log rows + n); the
     acting rows are summed in table order."""

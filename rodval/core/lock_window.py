@@ -152,7 +152,8 @@ def first_bending_period(chain: Chain, hinge: int, held: tuple[int, ...] | list[
     # pinned: the rigid rotation about the pin is the zero eigenvalue, the first bending
     # mode the next one; clamped: the first one
     lam = float(values[0] if clamped else values[1])
-    return 2.0 * np.pi / np.sqrt(lam)
+    period: float = 2.0 * np.pi / np.sqrt(lam)
+    return period
 
 
 def lock_window(chain: Chain, latch: Latch, held: tuple[int, ...] | list[int] = ()) -> float:

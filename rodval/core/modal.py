@@ -20,6 +20,8 @@ from rodval.core.scene import Scene
 if TYPE_CHECKING:
     import pandas as pd
 
+    from rodval.core.loads import NodalForce
+
 #: What a model is linearised about: its initial state at rest (free vibration, loads
 #: ignored; it must be an equilibrium, see ``rodval.models.observation.statics.check_at_rest``) or the
 #: static equilibrium under the scene's static loads (``static_loads``) and hinge rest angles.
@@ -49,7 +51,7 @@ class ConstantLoads:
         return bool(np.any(self.SX) or np.any(self.SY))
 
 
-def _force_at(f, t: float) -> tuple[float, float]:
+def _force_at(f: NodalForce, t: float) -> tuple[float, float]:
     return (float(f.fx(t)) if f.fx else 0.0, float(f.fy(t)) if f.fy else 0.0)
 
 
@@ -135,7 +137,7 @@ class Modes:
     phi0: np.ndarray
     l: np.ndarray
     equilibrium: Equilibrium | None = None
-    info: dict = field(default_factory=dict)
+    info: dict[str, Any] = field(default_factory=dict)
     rigid: int = 0
 
     @property
@@ -146,7 +148,7 @@ class Modes:
     def count(self) -> int:
         return self.omega.size
 
-    def rows(self, index) -> Modes:
+    def rows(self, index: Any) -> Modes:
         """The modes ``index`` (a slice or index array) of these, as a Modes (``rigid``
         counting the rigid ones kept)."""
         keep = np.arange(self.count)[index]
@@ -180,7 +182,7 @@ class Modes:
         y = np.concatenate([[0.0], np.cumsum(self.l * np.sin(self.phi0))])
         return x, y
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """Plain JSON-ready form (case records); inverse of ``from_dict``."""
         return {
             "model": self.model,
@@ -196,7 +198,7 @@ class Modes:
         }
 
     @classmethod
-    def from_dict(cls, d: dict) -> Modes:
+    def from_dict(cls, d: dict[str, Any]) -> Modes:
         damping = np.asarray(d["damping"], float)
         return cls(
             model=d["model"],
@@ -240,7 +242,9 @@ class Modes:
         )
 
 
-def normalize_shapes(dx: np.ndarray, dy: np.ndarray, hinge: np.ndarray):
+def normalize_shapes(
+    dx: np.ndarray, dy: np.ndarray, hinge: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Scale each mode (row) so that the largest node displacement magnitude is 1 (or, if the
     nodes do not move, the largest |hinge angle| is 1) and the largest node-displacement
     component (else hinge angle) is positive."""
@@ -316,7 +320,7 @@ def split_rigid(
     *,
     ratio: float = RIGID_RATIO,
     tol: float = RIGID_SHAPE_TOL,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
     """Separate the three rigid modes of a chain on a free base from its flexible modes, the
     same way for every model (native ``rodval.models.observation.free_modes``, exudyn's
     ``reference_models.exudyn_modes``).
@@ -423,7 +427,8 @@ def mac_matrix(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     A, B = np.asarray(A), np.asarray(B)
     num = np.abs(A.conj() @ B.T) ** 2
     den = np.outer(np.sum(np.abs(A) ** 2, 1), np.sum(np.abs(B) ** 2, 1))
-    return np.divide(num, den, out=np.zeros_like(num, dtype=float), where=den > 0)
+    mac: np.ndarray = np.divide(num, den, out=np.zeros_like(num, dtype=float), where=den > 0)
+    return mac
 
 
 def damping_ratios(

@@ -111,7 +111,7 @@ def motion_table(motion: tuple[Motion, ...]) -> np.ndarray:
 
 
 @njit(cache=True)
-def law_motion(L, r, t):
+def law_motion(L: np.ndarray, r: int, t: float) -> tuple[float, float, float]:
     """(f, f', f'') at t of row ``r`` of a law table (``LOAD_COLUMNS``), on its interval: the
     value in the law's unit and its first and second time derivatives (a prescribed base's
     motion, ``rodval.core.base.Motion``). The values are ``load_sums``' formulas."""
@@ -139,7 +139,7 @@ def law_motion(L, r, t):
 
 
 @njit(cache=True)
-def motion_at(table, t):
+def motion_at(table: np.ndarray, t: float) -> np.ndarray:
     """(3, 3) [[x, x', x''], [y, ...], [theta, ...]] (m, m/s, m/s^2; rad, rad/s, rad/s^2) at t
     >= 0 from a base-motion table (``rodval.core.base.motion_table``): each axis's row whose
     interval holds t (``law_motion``); O(rows)."""

@@ -70,7 +70,8 @@ def resolve_profile(name: str, spec: dict[str, Any], n: int) -> list[float]:
         if any(b <= a for a, b in zip(at, at[1:])) or at[0] < 0 or at[-1] > 1:
             raise ValueError(f"{name} profile: 'at' must increase within [0, 1], got {at}")
         x = (np.arange(n) + 0.5) / n
-        return np.interp(x, at, values).tolist()
+        profile: list[float] = np.interp(x, at, values).tolist()
+        return profile
     if "values" in spec:
         raise ValueError(f"{name} profile: 'values' goes with 'at'")
     first = _numbers(name, "first", spec["first"], scalar_ok=True) if "first" in spec else []

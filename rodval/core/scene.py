@@ -96,17 +96,17 @@ class Chain:
 
     def __init__(
         self,
-        l,
-        m,
-        EI,
-        mu,
-        kappa,
-        nu,
-        rest_angle=0.0,
-        bending_damping=0.0,
+        l: Any,
+        m: Any,
+        EI: Any,
+        mu: Any,
+        kappa: Any,
+        nu: Any,
+        rest_angle: Any = 0.0,
+        bending_damping: Any = 0.0,
         _n: int | None = None,
         **unknown: Any,
-    ):
+    ) -> None:
         check_keys(unknown, self.FIELDS, "Chain", noun="field")  # a ValueError, not TypeError
         n = _n
         if n is None:
@@ -139,7 +139,8 @@ class Chain:
 
     @property
     def n(self) -> int:
-        return self.l.shape[0]
+        n: int = self.l.shape[0]
+        return n
 
     @property
     def damped(self) -> bool:
@@ -150,19 +151,19 @@ class Chain:
     def as_dict(self) -> dict[str, list[float]]:
         return {k: getattr(self, k).tolist() for k in self.FIELDS}
 
-    def with_(self, **changes) -> Chain:
+    def with_(self, **changes: Any) -> Chain:
         """A copy with some fields replaced (scalars broadcast); an unknown field is refused."""
         check_keys(changes, self.FIELDS, "Chain.with_", noun="field")
         d = {k: getattr(self, k) for k in self.FIELDS}
         d.update(changes)
         return Chain(**d, _n=self.n)
 
-    def __eq__(self, other) -> bool:
+    def __eq__(self, other: object) -> bool:
         return isinstance(other, Chain) and all(
             np.array_equal(getattr(self, k), getattr(other, k)) for k in self.FIELDS
         )
 
-    def __hash__(self):  # pragma: no cover - frozen dataclass with arrays
+    def __hash__(self) -> int:  # pragma: no cover - frozen dataclass with arrays
         return hash(tuple(getattr(self, k).tobytes() for k in self.FIELDS))
 
 
@@ -222,7 +223,8 @@ def hinge_angles(
     left = np.concatenate([np.zeros(phi.shape[:-1] + (1,)), (phi + beta)[..., :-1]], axis=-1)
     if attitude is not None:
         left[..., 0] = attitude
-    return (phi + alpha) - left
+    angles: np.ndarray = (phi + alpha) - left
+    return angles
 
 
 #: Output times when a scene gives none, and the most a scene may ask for.
@@ -240,7 +242,7 @@ def output_times(start: float, stop: float, num: int) -> np.ndarray:
     return clean
 
 
-def _times_array(value) -> np.ndarray:
+def _times_array(value: Any) -> np.ndarray:
     """Output times as given: a 1-D sequence of real numbers (s), nothing converted."""
     if isinstance(value, (str, bytes, dict, set)) or np.ndim(value) != 1:
         raise ValueError(f"times (output times) must be a 1-D sequence of seconds, got {value!r}")
@@ -408,7 +410,7 @@ class Scene:
         bps |= {b for b in self.base.breakpoints if 0 < b < self.t_end}
         return np.array(sorted(bps))
 
-    def with_(self, **changes) -> Scene:
+    def with_(self, **changes: Any) -> Scene:
         """A copy with fields replaced (validated again); an unknown field is refused."""
         check_keys(changes, (f.name for f in fields(self)), "Scene.with_", noun="field")
         return replace(self, **changes)

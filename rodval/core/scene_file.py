@@ -15,14 +15,14 @@ import dataclasses
 import inspect
 import tomllib
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
 from rodval.core.base import BASE_KINDS, PINNED, Base
 from rodval.core.checks import check_keys, check_number
 from rodval.core.damping import PANEL, DampingRequest, bending_damping_for_ratio, damping_request
-from rodval.core.loads import LOAD_FACTORIES, pulse
+from rodval.core.loads import LOAD_FACTORIES, NodalForce, pulse
 from rodval.core.profiles import resolve_profiles
 from rodval.core.resources import check_rods
 from rodval.core.scene import (
@@ -38,6 +38,8 @@ from rodval.core.scene import (
     output_times,
 )
 from rodval.core.scene_keys import check_types, merge_documents, set_path
+
+_Item = TypeVar("_Item", Latch, Stop)
 
 #: The scenes a file may be ``based_on`` by name: what the file omits takes that scene's
 #: values. In a file, ``based_on`` may also be the path of another scene file
@@ -113,7 +115,7 @@ def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
     )
 
 
-def _load(spec: dict, n: int, where: str):
+def _load(spec: Any, n: int, where: str) -> NodalForce:
     if not isinstance(spec, dict) or "type" not in spec:
         raise ValueError(f"{where}: each load needs a 'type' (one of {', '.join(LOAD_FACTORIES)})")
     kind = spec["type"]
@@ -137,7 +139,7 @@ def _load(spec: dict, n: int, where: str):
     return factory(**args)
 
 
-def latch_dict(latch: Latch) -> dict:
+def latch_dict(latch: Latch) -> dict[str, Any]:
     """A latch's scene-file table (``held`` only when true: other scenes' records unchanged)."""
     d = dataclasses.asdict(latch)
     if not d["held"]:
@@ -145,12 +147,14 @@ def latch_dict(latch: Latch) -> dict:
     return d
 
 
-def _table_items(d: dict, key: str, cls: type, keys: tuple[str, ...], where: str) -> list:
+def _table_items(
+    d: dict[str, Any], key: str, cls: type[_Item], keys: tuple[str, ...], where: str
+) -> list[_Item]:
     """``[[latches]]`` / ``[[stops]]`` tables as Latch / Stop objects."""
     items = d.get(key, [])
     if not isinstance(items, list):
         raise ValueError(f"key '{key}' must be an array of tables [[{key}]]")
-    out = []
+    out: list[_Item] = []
     for i, spec in enumerate(items):
         place = f"{where} [[{key}]] #{i + 1}"
         check_keys(spec, set(keys), place)
@@ -170,7 +174,7 @@ def _missing(key: str, what: str) -> ValueError:
     )
 
 
-def _based_on(d: dict, where: str) -> str | None:
+def _based_on(d: dict[str, Any], where: str) -> str | None:
     """The document's ``based_on`` (one of ``BASED_ON``) or None."""
     based_on = d.get("based_on")
     if based_on is not None and (not isinstance(based_on, str) or based_on not in BASED_ON):
@@ -203,7 +207,7 @@ def _base_advice(base: str) -> str:
     )
 
 
-def _count(d: dict, based_on: str | None) -> int:
+def _count(d: dict[str, Any], based_on: str | None) -> int:
     """``n``, the number of rods: an integer >= 1 (the paper's 8 with ``based_on``)."""
     if "n" not in d and based_on is None:
         raise _missing("n", "number of rods")
@@ -214,7 +218,7 @@ def _count(d: dict, based_on: str | None) -> int:
     return n
 
 
-def _horizon(d: dict, based_on: str | None) -> float:
+def _horizon(d: dict[str, Any], based_on: str | None) -> float:
     """``t_end``, the horizon (s): a finite number > 0 (the paper's 2 s with ``based_on``)."""
     if "t_end" not in d and based_on is None:
         raise _missing("t_end", "horizon, s")
@@ -227,7 +231,7 @@ def _horizon(d: dict, based_on: str | None) -> float:
 
 
 def _chain(
-    d: dict, n: int, based_on: str | None, where: str
+    d: dict[str, Any], n: int, based_on: str | None, where: str
 ) -> tuple[Chain, DampingRequest | None]:
     """The ``[chain]`` table over the paper's values (``based_on``) or the neutral ones; a rod
     field without a neutral value (``REQUIRED_CHAIN``) must be given. With the damping's
@@ -249,7 +253,7 @@ def _chain(
     return chain.with_(bending_damping=c), request
 
 
-def _damping_request(spec: dict, where: str) -> DampingRequest | None:
+def _damping_request(spec: dict[str, Any], where: str) -> DampingRequest | None:
     """The request of ``[chain] bending_damping = { ratio = ..., of = ... }`` (removed from
     ``spec``: the chain gets the converted N m^2 s, ``rodval.core.damping``), or None when
     the damping is given in N m^2 s (a number, a list or a profile)."""
@@ -261,7 +265,7 @@ def _damping_request(spec: dict, where: str) -> DampingRequest | None:
     return request
 
 
-def _loads(d: dict, n: int, based_on: str | None, where: str) -> tuple:
+def _loads(d: dict[str, Any], n: int, based_on: str | None, where: str) -> tuple[NodalForce, ...]:
     """The ``[[loads]]`` tables; omitted: none (the paper's pulse at node n with
     ``based_on``)."""
     if "loads" not in d:
@@ -271,7 +275,7 @@ def _loads(d: dict, n: int, based_on: str | None, where: str) -> tuple:
     return tuple(_load(s, n, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"]))
 
 
-def scene_from_dict(d: dict, where: str = "scene") -> Scene:
+def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
     """Build and validate a Scene from the dict form (``docs/scene_file.md``).
 
     The scene holds what ``d`` says: an omitted key is neutral (no loads, no node masses,
@@ -466,7 +470,8 @@ def scene_to_file_table(scene: Scene, where: str = "scene") -> dict[str, Any]:
                 "which a scene or study file cannot hold; build it with a load law of "
                 f"rodval.core.loads ({', '.join(LOAD_FACTORIES)})"
             )
-    return _without_none(scene_to_dict(scene))
+    table: dict[str, Any] = _without_none(scene_to_dict(scene))
+    return table
 
 
 def _without_none(value: Any) -> Any:

@@ -157,7 +157,10 @@ def frame_times(runs: Mapping[str, Trajectory], frames: int) -> np.ndarray:
     shared = shared_times(runs)
     if shared.size <= frames:
         return shared
-    return shared[np.unique(np.linspace(0, shared.size - 1, frames).round().astype(int))]
+    picked: np.ndarray = shared[
+        np.unique(np.linspace(0, shared.size - 1, frames).round().astype(int))
+    ]
+    return picked
 
 
 def _event_marks(traj: Trajectory) -> list[tuple[float, int, str]]:
@@ -266,7 +269,9 @@ def animate_runs(
     return Animated(path, int(times.size), times, events, tuple(notes))
 
 
-def _frame_axes(paths: list, base: Mapping[str, Base]) -> tuple[Figure, Any]:
+def _frame_axes(
+    paths: list[tuple[np.ndarray, np.ndarray]], base: Mapping[str, Base]
+) -> tuple[Figure, Any]:
     """The animation's figure and axes: equal scales holding every node and body outline of
     ``paths`` ((x, y) histories) with a 5 % margin, and the pin at the origin when a run is
     pinned."""

@@ -15,6 +15,7 @@ from typing import Any, Literal
 import numpy as np
 import pandas as pd
 from matplotlib import colormaps, ticker
+from matplotlib.axes import Axes
 from matplotlib.colors import TABLEAU_COLORS
 from matplotlib.figure import Figure
 from matplotlib.typing import ColorType
@@ -75,7 +76,7 @@ def chain_nodes(traj: Trajectory, t: float, l: np.ndarray) -> tuple[np.ndarray, 
     )
 
 
-def _min_height(ax, ratio: float) -> None:
+def _min_height(ax: Axes, ratio: float) -> None:
     """Widen the y limits to at least ``ratio`` of the x span (a nearly straight chain would
     otherwise be drawn as a sliver)."""
     (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
@@ -134,7 +135,7 @@ def plot_configurations(
     return path
 
 
-def model_styles(labels: Sequence[str]) -> dict[str, dict]:
+def model_styles(labels: Sequence[str]) -> dict[str, dict[str, Any]]:
     """One colour and line style per model label, the same in every figure of a report."""
     return {
         lab: {
@@ -178,7 +179,7 @@ def plot_time_histories(
     return _save(fig, path, title)
 
 
-def _label(model: str, others: Sequence[str], key: tuple) -> str:
+def _label(model: str, others: Sequence[str], key: tuple[Any, ...]) -> str:
     parts = [
         f"{o}={v:g}" if isinstance(v, (int, float, np.number)) else f"{o}={v}"
         for o, v in zip(others, key)
@@ -187,12 +188,12 @@ def _label(model: str, others: Sequence[str], key: tuple) -> str:
 
 
 def _lines(
-    ax,
+    ax: Axes,
     df: pd.DataFrame,
     x: str,
     y: str,
     others: Sequence[str],
-    styles: dict,
+    styles: dict[str, dict[str, Any]],
     logx: bool,
     logy: bool = True,
 ) -> None:
@@ -241,7 +242,7 @@ def _save(fig: Figure, path: Path | str, title: str = "") -> Path:
     return path
 
 
-def _finish(fig, axes, path: Path, title: str) -> Path:
+def _finish(fig: Figure, axes: Sequence[Axes] | np.ndarray, path: Path, title: str) -> Path:
     handles, _ = axes[0].get_legend_handles_labels()
     axes[0].legend(fontsize=7, ncol=2 if len(handles) > 6 else 1)
     return _save(fig, path, title)

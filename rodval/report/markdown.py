@@ -19,4 +19,5 @@ def to_markdown(df: pd.DataFrame, floatfmt: str = ".3g") -> str:
                 dtype=object,
             )
     # None (a value that does not apply) is shown blank
-    return safe.to_markdown(index=False, tablefmt="pipe", floatfmt=floatfmt, missingval="") + "\n"
+    text: str = safe.to_markdown(index=False, tablefmt="pipe", floatfmt=floatfmt, missingval="")
+    return text + "\n"

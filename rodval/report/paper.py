@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
@@ -23,7 +24,7 @@ from rodval.report.markdown import to_markdown
 
 
 def table1_markdown(
-    table: pd.DataFrame, errors: pd.DataFrame, coefficients: str, stats: dict[str, dict]
+    table: pd.DataFrame, errors: pd.DataFrame, coefficients: str, stats: dict[str, dict[str, Any]]
 ) -> str:
     """Markdown: for each quantity and time, the published P/R values beside rodval's, the
     column errors and the runs."""

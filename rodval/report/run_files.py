@@ -504,7 +504,8 @@ def read_run_record(path: Path) -> dict[str, Any]:
         )
     if _references(rec["scene"]):
         rec["scene"] = join_arrays(rec["scene"], _scene_arrays(path, rec), str(path))
-    return rec
+    record: dict[str, Any] = rec
+    return record
 
 
 def _no_digest(folder: Path) -> ValueError:

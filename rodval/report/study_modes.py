@@ -37,7 +37,8 @@ def modes_from_tables(freq: pd.DataFrame, shapes: pd.DataFrame, case: str, model
     def arr(kind: str, mode: int) -> np.ndarray:
         """The values of ``kind`` (a mode_shapes kind) of ``mode``, by node or hinge k."""
         part = sh[(sh["kind"] == kind) & (sh["mode"] == mode)].sort_values("k")
-        return part["value"].to_numpy(float)
+        values: np.ndarray = part["value"].to_numpy(float)
+        return values
 
     x0, y0 = arr("node_x0", 0), arr("node_y0", 0)
     modes = [int(m) for m in f["mode"]]

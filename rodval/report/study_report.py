@@ -30,9 +30,9 @@ from rodval.analysis.events import (
     COMPARABLE_DT_S,
     COMPARABLE_ENERGY,
     GRAZING_LOSS,
-    MIN_WINDOW_STEPS,
     event_discrepancies,
 )
+from rodval.core.lock_window import MIN_WINDOW_STEPS
 from rodval.core.out_paths import STUDY_SCHEMA, is_stamped, write_file
 from rodval.core.quantities import models_with
 from rodval.models import get_model

@@ -309,7 +309,7 @@ def case_twin(
             "agreement.quantities",
             f"{missing[0]!r} is not an output of the scene ({sorted(outputs)})",
         )
-    twin = spec.get("twin")
+    twin: dict[str, Any] | None = spec.get("twin")
     if twin is None:
         return None
     if any(m.label == twin_label(reference) for m in models):

@@ -26,10 +26,10 @@ def plain_document(doc: Any, where: str) -> dict[str, Any]:
     (``scene_to_file_table``: ValueError naming ``scene.loads[i]`` for a callable load)."""
     if not isinstance(doc, dict):
         raise ValueError(f"{where}: a study document must be a dict, got {type(doc).__name__}")
-    doc = copy.deepcopy(doc)
-    if isinstance(doc.get("scene"), Scene):
-        doc["scene"] = scene_to_file_table(doc["scene"], where="scene")
-    return doc
+    plain: dict[str, Any] = copy.deepcopy(doc)
+    if isinstance(plain.get("scene"), Scene):
+        plain["scene"] = scene_to_file_table(plain["scene"], where="scene")
+    return plain
 
 
 def flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:

@@ -135,7 +135,7 @@ class StudyRun:
 
 
 def run_study(
-    spec: StudySpec | dict | str | Path,
+    spec: StudySpec | dict[str, Any] | str | Path,
     out: str | Path,
     *,
     workers: int | None = None,
@@ -216,6 +216,7 @@ def _as_study(spec: Any) -> StudySpec:
     elif isinstance(spec, dict):
         spec = StudySpec.from_dict(spec)
     check_type("spec", spec, StudySpec, "a study (rodval.load_study) or a study file's path")
+    assert isinstance(spec, StudySpec)  # check_type raised otherwise
     return spec
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -92,7 +93,9 @@ def quantiles(spec: dict[str, Any], u: np.ndarray) -> np.ndarray:
     from scipy.stats import norm
 
     if spec["dist"] == "uniform":
-        return spec["low"] + u * (spec["high"] - spec["low"])
+        uniform: np.ndarray = spec["low"] + u * (spec["high"] - spec["low"])
+        return uniform
+    to_z: Callable[[float], float]  # the bound's standard-normal coordinate
     if spec["dist"] == "normal":
         mean, scale = spec["mean"], spec["std"]
         to_z = lambda x: (x - mean) / scale  # noqa: E731 - a one-line change of variable
@@ -101,7 +104,7 @@ def quantiles(spec: dict[str, Any], u: np.ndarray) -> np.ndarray:
         to_z = lambda x: (math.log(x) - mean) / scale if x > 0 else -math.inf  # noqa: E731
     a = norm.cdf(to_z(spec["low"])) if "low" in spec else 0.0
     b = norm.cdf(to_z(spec["high"])) if "high" in spec else 1.0
-    z = mean + scale * norm.ppf(a + u * (b - a))
+    z: np.ndarray = mean + scale * norm.ppf(a + u * (b - a))
     return z if spec["dist"] == "normal" else np.exp(z)
 
 
@@ -109,14 +112,17 @@ def unit_design(design: str, count: int, dims: int, seed: int) -> np.ndarray:
     """(count, dims) points in [0, 1)^dims of the named design, reproducible from ``seed``."""
     from scipy.stats import qmc
 
+    points: np.ndarray
     if design == "sobol":
-        return qmc.Sobol(dims, scramble=True, seed=seed).random(count)
-    if design == "lhs":
-        return qmc.LatinHypercube(dims, seed=seed).random(count)
-    return np.random.default_rng(seed).random((count, dims))
+        points = qmc.Sobol(dims, scramble=True, seed=seed).random(count)
+    elif design == "lhs":
+        points = qmc.LatinHypercube(dims, seed=seed).random(count)
+    else:
+        points = np.random.default_rng(seed).random((count, dims))
+    return points
 
 
-def flatten_keys(d: dict, prefix: str = "") -> dict[str, Any]:
+def flatten_keys(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     """Dotted paths -> distribution tables (a table with ``dist`` ends a path)."""
     out: dict[str, Any] = {}
     for k, v in d.items():

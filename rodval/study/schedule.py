@@ -31,7 +31,9 @@ Payload = dict[str, Any]
 Done = Callable[[Payload, list[dict[str, Any]]], None]
 
 
-def complete_runs(payload: Payload, runs: list[dict], status: int, message: str) -> list[dict]:
+def complete_runs(
+    payload: Payload, runs: list[dict[str, Any]], status: int, message: str
+) -> list[dict[str, Any]]:
     """``runs`` plus a failed run (``status``, ``message``) for each model not in them."""
     done = {r["label"] for r in runs}
     name = payload["scene"].get("name", payload["case"])
@@ -47,7 +49,7 @@ class WarmWorker:
     _live_lock = threading.Lock()
 
     def __init__(self) -> None:
-        self.proc: subprocess.Popen | None = None
+        self.proc: subprocess.Popen[str] | None = None
         self.lines: queue.Queue[str | None] = queue.Queue()
         self.stderr = tempfile.TemporaryFile(mode="w+")
 
@@ -68,7 +70,7 @@ class WarmWorker:
             WarmWorker._live.add(self)
 
     @staticmethod
-    def _read(proc: subprocess.Popen, lines: queue.Queue) -> None:
+    def _read(proc: subprocess.Popen[str], lines: queue.Queue[str | None]) -> None:
         assert proc.stdout is not None
         for line in proc.stdout:
             lines.put(line)

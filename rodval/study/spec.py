@@ -252,7 +252,7 @@ def _resolve_scene(
 def _reference(study: dict[str, Any], models: tuple[ModelSpec, ...], where: str) -> str:
     """``study.reference``: one of the model labels (default: the first model's)."""
     labels = [m.label for m in models]
-    reference = study.get("reference", labels[0])
+    reference: str = study.get("reference", labels[0])
     if reference not in labels:
         raise key_error(
             where,

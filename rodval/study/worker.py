@@ -24,7 +24,7 @@ from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.models.presets.registry import modal_options, simulate
 
 
-def failed_run(model: dict, scene_name: str, status: int, message: str) -> dict[str, Any]:
+def failed_run(model: dict[str, Any], scene_name: str, status: int, message: str) -> dict[str, Any]:
     """A run record for a model that produced nothing (error before integration, timeout...)."""
     traj = Trajectory.failed(
         model["model"],
