@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from rodval.core.scene import Scene
 from rodval.models.assembly.paper_system import PaperSystem
 from rodval.models.hinge_items import lock_records
 
@@ -20,8 +21,17 @@ class StackedSystem(PaperSystem):
 
     full = True
     N: int
+    #: coordinates after the chain's (a moving base's body: ``rodval.models.base.moving_base``)
+    body_coordinates = 0
     locked_kernel: Any
     unit_kernel: Any
+
+    def setup_base(self, scene: Scene) -> None:
+        """What a base adds before the kernels are set up (``moving_base``): nothing on a pin."""
+
+    def initial_state(self) -> np.ndarray:
+        """The state at t = 0: the chain's (``chain_initial_state``)."""
+        return self.chain_initial_state()
 
     def chain_initial_state(self) -> np.ndarray:
         """The chain's [q; q'] at t = 0 (a ladder rung adds its bubbles, at rest)."""

@@ -198,9 +198,6 @@ class LadderSystem(StackedSystem):
     compiled_rhs_locked = staticmethod(ladder_rhs_locked)
     compiled_events = staticmethod(deployment.full_hinge_events)  # D from [phi; alpha; beta]
 
-    #: coordinates after the chain's (a free body's x_c, y_c, theta: ``moving_base``)
-    body_coordinates = 0
-
     def __init__(self, scene: Scene, coefficients: str, kernel: str, shapes: int, kinematics: str):
         check_rung_options(coefficients, kernel)
         self.p = check_shapes(shapes)
@@ -211,13 +208,6 @@ class LadderSystem(StackedSystem):
         self.setup_base(scene)
         self.y0 = self.initial_state()
         self.use_kernel()
-
-    def setup_base(self, scene: Scene) -> None:
-        """What a base adds before the kernels are set up (``moving_base``): nothing on a pin."""
-
-    def initial_state(self) -> np.ndarray:
-        """The state at t = 0: the chain's (``chain_initial_state``)."""
-        return self.chain_initial_state()
 
     def chain_initial_state(self) -> np.ndarray:
         """[q; q'] of the chain at t = 0: the paper's coordinates, the bubbles at rest."""

@@ -48,9 +48,6 @@ class RigidSystem(StackedSystem):
     compiled_rhs_locked = staticmethod(rigid_rhs_locked)
     compiled_events = staticmethod(rigid_hinge_events)
 
-    #: coordinates after the chain's (a free body's x_c, y_c, theta: ``moving_base``)
-    body_coordinates = 0
-
     def __init__(self, scene: Scene):
         super().__init__(scene, *RIGID_OPTIONS)
         self.Nc = self.n
@@ -58,13 +55,6 @@ class RigidSystem(StackedSystem):
         self.setup_base(scene)
         self.y0 = self.initial_state()
         self.use_kernel()
-
-    def setup_base(self, scene: Scene) -> None:
-        """What a base adds before the kernels are set up (``moving_base``): nothing on a pin."""
-
-    def initial_state(self) -> np.ndarray:
-        """The state at t = 0: the chain's (``chain_initial_state``)."""
-        return self.chain_initial_state()
 
     def chain_initial_state(self) -> np.ndarray:
         """[phi; phi'] at t = 0 (the scene's bending angles and rates have no place here)."""
