@@ -33,7 +33,14 @@ from rodval.solvers.budget import EVENT, NON_FINITE, OK, next_attempt, smallest_
 from rodval.solvers.dop853_events import any_crossing, interpolate, locate, no_events
 from rodval.solvers.guard import GuardSpec, guard_step, new_monitor
 from rodval.solvers.limits import MAX_IMPLICIT_SIZE
-from rodval.solvers.signature import EVENTS_TYPE, RHS_TYPE
+from rodval.solvers.signature import (
+    EVENTS_TYPE,
+    RHS_TYPE,
+    background_allowed,
+    compile_in_background,
+    in_cache,
+    wait_for,
+)
 from rodval.solvers.signature import F1 as _F1
 from rodval.solvers.signature import F2 as _F2
 from rodval.solvers.signature import F3 as _F3
@@ -87,7 +94,8 @@ def _initial_step(rhs, P, S, M, L, t0, y0, f0, t_bound, rtol, atol, max_step, or
     d1 = _rms(f0 / scale)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, t_bound - t0)
-    tmp[:] = y0 + h0 * f0
+    for i in range(y0.shape[0]):  # a loop: a slice assignment compiles numba's shape check
+        tmp[i] = y0[i] + h0 * f0[i]
     rhs(t0 + h0, tmp, P, S, M, L, f1)
     d2 = _rms((f1 - f0) / scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
@@ -375,7 +383,7 @@ _RUN_SIGNATURE = types.Tuple((types.int64, types.int64, types.int64, types.int64
 )
 
 
-@njit(_RUN_SIGNATURE, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")  # compiled for _RUN_SIGNATURE only: ``loop``
 def run(
     rhs, mechanics, events, arrays, y0, edges, times, controls, atol, guard, reporting, Y, W, carry
 ):
@@ -416,7 +424,7 @@ def run(
     nsteps = 0
     t = edges[0]
     while n_out < times.shape[0] and times[n_out] <= t:
-        Y[n_out] = y
+        radau.copy_into(Y[n_out], y)
         n_out += 1
     if E.shape[0] > 0:
         events(t, y, P, S, M, L, E, g_old)
@@ -449,13 +457,39 @@ def run(
             for i in range(N):
                 y[i] = y_new[i]
                 K[0, i] = K[N_STAGES, i]
-            g_old[:] = g_new
+            radau.copy_into(g_old, g_new)
             if flip:  # the other stepper from here on (see above)
                 implicit = not implicit
                 if implicit:
                     rw = radau.work(N, True)
                     radau.start(rhs, P, S, M, L, t, y, K[0], rw, sc, cnt)
     return n_out, cnt[0], nsteps, OK, t
+
+
+#: The key of the loop's background compilation (``signature.compile_in_background``).
+_LOOP_KEY = "dop853.run"
+
+
+def loop():
+    """``run`` compiled for ``_RUN_SIGNATURE``, its only signature: loaded from numba's
+    cache after the background compilation of ``warm_up`` if any (else compiled here)."""
+    if not run.signatures:
+        wait_for(_LOOP_KEY)
+        run.compile(_RUN_SIGNATURE)
+        run.disable_compile()
+    return run
+
+
+def warm_up() -> None:
+    """Compile ``run`` in a background process (once; ``background_allowed``) when numba's
+    cache lacks it, while this process builds the system and compiles its kernels."""
+    if run.signatures or not background_allowed() or in_cache(run, _RUN_SIGNATURE) is not False:
+        return
+    compile_in_background(_LOOP_KEY, "from rodval.solvers import dop853; dop853.loop()")
+
+
+if in_cache(run, _RUN_SIGNATURE):  # loaded on import, as a study worker's warm-up expects
+    loop()
 
 
 class CompiledRun(NamedTuple):
@@ -529,7 +563,7 @@ def integrate_compiled(
     W = np.zeros((len(times) if audit else 0, 2))
     hit = np.zeros(y0.size + 1)
     switch = stiffness.new_state() if switch is None else switch
-    n_out, nfev, nsteps, code, t = run(
+    n_out, nfev, nsteps, code, t = loop()(
         form.rhs,
         mechanics,
         events,

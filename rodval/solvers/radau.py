@@ -76,6 +76,14 @@ _EPS = np.finfo(float).eps
 H_OLD, ERR_OLD, CURRENT_JAC, LU_VALID, HAVE_SOL, NLU, NITER = range(7)
 
 
+@njit(cache=True, inline="always")
+def copy_into(dst, src):
+    """dst[:] = src (1-D, same size), as a loop: a slice assignment compiles numba's shape
+    check and its message (about 2 s on each first compile, ``benchmarks/first_run.py``)."""
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
 @njit(cache=True, error_model="numpy")
 def lu_factor(A, piv):
     """A = P L U in place (Doolittle, partial pivoting), row swaps in piv. O(N^3), real or
@@ -434,6 +442,6 @@ def step(
     else:
         sc[CURRENT_JAC] = 0.0
     sc[H_OLD], sc[ERR_OLD], sc[HAVE_SOL] = h_abs, error_norm, 1.0
-    rw[13][:] = y
+    copy_into(rw[13], y)
     dense_coefficients(Z, F)
     return OK, t_new, h_abs * factor

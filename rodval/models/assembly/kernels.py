@@ -322,7 +322,8 @@ def rhs_head(t, y, L, SX, SY, out):
     half = v, the load suffix sums at t (N) into SX, SY (``load_sums``); returns whether a
     load acts. O(N)."""
     half = y.shape[0] // 2
-    out[:half] = y[half:]
+    for i in range(half):  # a loop: a slice assignment compiles numba's shape check
+        out[i] = y[half + i]
     return load_sums(L, t, SX, SY)
 
 

@@ -176,8 +176,9 @@ def chain_state(y, N):
     """[q; q'] of the chain (2N) from a free body's state [Q; Q'] (2 (N + 3))."""
     NQ = N + 3
     yc = np.empty(2 * N)
-    yc[:N] = y[:N]
-    yc[N:] = y[NQ : NQ + N]
+    for i in range(N):  # loops: a slice assignment compiles numba's shape check
+        yc[i] = y[i]
+        yc[N + i] = y[NQ + i]
     return yc
 
 
@@ -215,7 +216,8 @@ def body_solve(V, parts, th, G, K, fp, fg, rb, out):
     g1 = xb[1] + xb[2] * rx
     for i in range(N):
         u[i] -= g0 * G[0, i] + g1 * G[1, i]
-    out[N : N + 3] = xb
+    for i in range(3):
+        out[N + i] = xb[i]
 
 
 @njit(cache=True)
@@ -403,7 +405,9 @@ def prescribed_unit_responses(V, q, locks, U):
     Uc = np.empty((locks.shape[0], N))
     ladder_unit_responses(V, q[:N], locks, Uc)
     U[:, :] = 0.0
-    U[:, :N] = Uc
+    for j in range(Uc.shape[0]):
+        for i in range(N):
+            U[j, i] = Uc[j, i]
 
 
 @njit(cache=True)

@@ -171,7 +171,8 @@ def base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out):
     g1 = xb[1] + xb[2] * rx
     for i in range(3 * n):
         u[i] -= g0 * G[0, i] + g1 * G[1, i]
-    out[3 * n : 3 * n + 3] = xb
+    for i in range(3):  # a loop: a slice assignment compiles numba's shape check
+        out[3 * n + i] = xb[i]
 
 
 @njit(cache=True)
@@ -179,8 +180,9 @@ def _chain_state(y, n):
     """[q; q'] of the chain (6n) from the free-base state [Q; Q'] (2 (3n + 3))."""
     N = 3 * n + 3
     yc = np.empty(6 * n)
-    yc[: 3 * n] = y[: 3 * n]
-    yc[3 * n :] = y[N : N + 3 * n]
+    for i in range(3 * n):
+        yc[i] = y[i]
+        yc[3 * n + i] = y[N + i]
     return yc
 
 

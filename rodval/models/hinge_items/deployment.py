@@ -330,7 +330,8 @@ def reduced_rhs_locked(t, y, P, S, M, L, out):
     )
     if not ok:
         ddphi[:] = np.nan
-    out[half:] = ddphi
+    for i in range(half):  # a loop: a slice assignment compiles numba's shape check
+        out[half + i] = ddphi[i]
     work[-1] = track_bending(gamma, work[-1])
 
 
