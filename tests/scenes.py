@@ -10,10 +10,12 @@ import numpy as np
 from rodval.core.scene import Chain, InitialState, Latch, Scene
 
 
-def two_rod_latch(EI: float) -> Scene:
+def two_rod_latch(EI: float, window: float | None = None) -> Scene:
     """The exudyn deployment tests' two-rod scene (tests/test_exudyn_deployment.py): l = 1.5
     m, m = 3 kg/m, mu = 0.5 kg, hinge 0 free, hinge 1 stowed at pi - 0.05 rad unfolding on a
-    50 N m/rad spring, latch at 0; the lock comes at t = 0.404 s."""
+    50 N m/rad spring, latch at 0 (its lock window ``window`` s, None: the latch's default,
+    the locked pair's first bending period, 2.28 ms at EI = 1e7); the lock comes at t =
+    0.404 s."""
     chain = Chain.uniform(2, l=1.5, m=3.0, EI=EI, mu=0.5, kappa=[0.0, 50.0], nu=0.0)
     return Scene(
         chain=chain,
@@ -21,7 +23,7 @@ def two_rod_latch(EI: float) -> Scene:
         times=np.linspace(0.0, 0.42, 43),
         outputs=("phi", "dphi"),
         initial=InitialState(phi=[0.0, math.pi - 0.05], dphi=[1.0, 1.0]),
-        latches=(Latch(1, 0.0),),
+        latches=(Latch(1, 0.0, window=window),),
     )
 
 

@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 import pytest
+import scenes
 
 from reference_models import exudyn_step
 from reference_models.exudyn_budget import record_bytes, refinement_refusal
@@ -38,19 +39,9 @@ BAD_STEP = r'^step must be "auto" or a number in \(0, 0\.1\] s, got '
 
 
 def two_rod_latch(EI: float = 1e7, window: float | None = None) -> Scene:
-    """tests/test_rigid_lock.py's two rods (l = 1.5 m, m = 3 kg/m, mu = 0.5 kg, hinge 0 free,
-    hinge 1 unfolding on a 50 N m/rad spring from pi - 0.05 rad, latch at 0, lock at 0.404 s).
-    At EI = 1e7 N m^2 the lock window (the locked pair's first bending period) is 2.28 ms:
-    11.4 steps of the former fixed default 2e-4 s."""
-    chain = Chain.uniform(2, l=1.5, m=3.0, EI=EI, mu=0.5, kappa=[0.0, 50.0], nu=0.0)
-    return Scene(
-        chain=chain,
-        t_end=0.42,
-        times=np.linspace(0.0, 0.42, 43),
-        outputs=("phi", "dphi"),
-        initial=InitialState(phi=[0.0, math.pi - 0.05], dphi=[1.0, 1.0]),
-        latches=(Latch(1, 0.0, window=window),),
-    )
+    """``scenes.two_rod_latch`` at EI = 1e7 N m^2 by default: its lock window (the locked
+    pair's first bending period) is 2.28 ms, 11.4 steps of the former fixed default 2e-4 s."""
+    return scenes.two_rod_latch(EI, window)
 
 
 SCENE_TOML = """
