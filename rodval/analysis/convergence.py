@@ -10,7 +10,8 @@ The quantities of interest (``quantities_of_interest``), each with its unit:
 - ``lock_t[LABEL#j]``: the j-th lock of that label (``Trajectory.events``, matched by label and
   order), its time, s;
 - ``lock_impulse[LABEL#j]``: its impulse, relative: changes divided by the finest level's
-  |impulse|;
+  |impulse|; only for a lock whose window closed before the run's end (``window_closed``: a
+  window the run ended inside holds the impulse over the part reached, not the lock's);
 - ``phi_times``: the chord angles at the scene's output times, rad: the change between levels
   is the largest |phi_i - phi_{i-1}| over times and rods (a norm, >= 0);
 - ``phi_deployed[k]``: rod k's deployed chord angle, rad: its time mean (trapezoid) over the
@@ -26,6 +27,11 @@ p = log2(|d_{i-1}| / |d_i|) where it shows (``observed_order``: at least three l
 changes of one sign and shrinking, p in [MIN_ORDER, MAX_ORDER], and with four or more levels
 the previous ratio's order within ORDER_SPREAD of it); the estimated error of the finest level:
 Richardson |d_last| / (2**p - 1) where the order shows, else |d_last| (``method`` says which).
+
+The levels compared (``compared_from``): the finest level and the levels just before it that
+finished, are valid by the model's own checks and hold the same quantities (lock alike); a
+level left out (failed, INVALID, locking otherwise) ends the run of compared levels, so an
+error bar never rests on a change from a level the model itself rejects.
 """
 
 from __future__ import annotations
@@ -169,12 +175,14 @@ def quantities_of_interest(
 ) -> dict[str, Any]:
     """One level's quantities of interest (module docstring) from its lock events, its output
     ``times`` (s), chord angles ``phi`` (times x rods, rad) and, with a free base, the body's
-    ``attitude`` (rad, one per time): name -> value."""
+    ``attitude`` (rad, one per time): name -> value (a float, or an array for the ``_times``
+    quantities). A lock whose window did not close has its time and no impulse."""
     out: dict[str, Any] = {}
     locks = lock_keys(events)
     for key, ev in locks.items():
         out[f"lock_t[{key}]"] = float(ev["t"])
-        out[f"lock_impulse[{key}]"] = float(ev["impulse"])
+        if impulse_measured(ev):
+            out[f"lock_impulse[{key}]"] = float(ev["impulse"])
     since = max((float(ev["t"]) for ev in locks.values()), default=float(times[0]))
     phi = np.asarray(phi, float)
     out["phi_times"] = phi
@@ -187,15 +195,69 @@ def quantities_of_interest(
     return out
 
 
-def missing_quantity(levels: Sequence[Mapping[str, Any]]) -> str | None:
+def qoi_record(qoi: Mapping[str, Any]) -> dict[str, Any]:
+    """``quantities_of_interest``'s values as JSON values (arrays as nested lists; JSON keeps
+    every digit of a float): the inverse of ``qoi_from_record``."""
+    return {name: np.asarray(v).tolist() if is_array(name) else float(v) for name, v in qoi.items()}
+
+
+def qoi_from_record(record: Mapping[str, Any]) -> dict[str, Any]:
+    """The quantities of interest of ``qoi_record``'s JSON values, bit for bit."""
+    return {
+        name: np.asarray(v, float) if is_array(name) else float(v) for name, v in record.items()
+    }
+
+
+def is_array(name: str) -> bool:
+    """Whether quantity ``name`` is an array over the output times (``phi_times``,
+    ``attitude_times``) rather than a number."""
+    return name.endswith("_times")
+
+
+def compared_from(levels: Sequence[Mapping[str, Any] | None]) -> int:
+    """The first of the levels the error bar compares (module docstring): the finest level and
+    those just before it with the same quantities, back to the first level that is None (left
+    out: failed or INVALID) or holds other quantities (``missing_quantity``). len(levels) when
+    the finest is None: nothing is compared."""
+    finest = levels[-1] if levels else None
+    if finest is None:
+        return len(levels)
+    start = len(levels) - 1
+    while start > 0:
+        level = levels[start - 1]
+        if level is None or missing_quantity([level, finest]) is not None:
+            break
+        start -= 1
+    return start
+
+
+def missing_quantity(
+    levels: Sequence[Mapping[str, Any]], numbers: Sequence[int] | None = None
+) -> str | None:
     """The first quantity that some level lacks and another holds (a lock one level does not
-    reach), as "NAME (not at level i)", or None when every level holds the same ones."""
+    reach, a lock window one level closes and another does not), as "NAME (not at level i)"
+    (i: the level's place in ``levels``, or its number in ``numbers``), or None when every
+    level holds the same ones."""
     names = list(dict.fromkeys(name for level in levels for name in level))
     for name in names:
         for i, level in enumerate(levels):
             if name not in level:
-                return f"{name} (not at level {i})"
+                return f"{name} (not at level {i if numbers is None else numbers[i]})"
     return None
+
+
+def unmeasured(events: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The lock impulses of a run that are no quantity of interest: "lock_impulse[LABEL#j]" of
+    each lock whose window the run ended inside (``window_closed`` False)."""
+    return [
+        f"lock_impulse[{key}]" for key, ev in lock_keys(events).items() if not impulse_measured(ev)
+    ]
+
+
+def impulse_measured(event: Mapping[str, Any]) -> bool:
+    """Whether a lock record's impulse is the lock's: its window closed before the run ended
+    (``window_closed``; taken as closed when the record has no such key)."""
+    return bool(event.get("window_closed", True))
 
 
 def estimates(levels: Sequence[Mapping[str, Any]]) -> list[Estimate]:

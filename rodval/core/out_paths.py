@@ -334,15 +334,16 @@ def claim_output_folder(folder: Path, flag: str = "--out", command: str | None =
         )
 
 
-def clear_previous(folder: Path, command: str) -> list[str]:
+def clear_previous(folder: Path, command: str, keep: Iterable[str] = ()) -> list[str]:
     """Remove the files the earlier run of ``command`` wrote into output folder ``folder``
-    (those its marker lists; nothing else): called by the command just before it writes its
-    own, so that the folder holds this run's files only (no events.csv of an earlier
-    compare whose runs locked). Returns the removed files."""
+    (those its marker lists; nothing else) but those in ``keep`` (paths relative to the
+    folder: the files this run takes over, ``rodval reference``'s finished levels): called by
+    the command just before it writes its own, so that the folder holds this run's files
+    only (no events.csv of an earlier compare whose runs locked). Returns the removed files."""
     record = _marker(folder)
     listed = listed_files(folder) if record and record.get("command") == command else None
-    removed = []
-    for name in listed or []:
+    removed, kept = [], set(keep)
+    for name in [f for f in listed or [] if f not in kept]:
         path = folder / name
         if path.is_file() and not path.is_symlink():
             path.unlink()
@@ -350,10 +351,13 @@ def clear_previous(folder: Path, command: str) -> list[str]:
     return removed
 
 
-def mark_output_folder(folder: Path, command: str) -> None:
+def mark_output_folder(folder: Path, command: str, coming: Iterable[str] = ()) -> None:
     """Mark ``folder`` (when the command made or wrote it) as the output folder of
-    ``command``, listing the files there (``claim_output_folder`` let in no other)."""
+    ``command``, listing the files there (``claim_output_folder`` let in no other) and the
+    files ``coming`` (paths relative to the folder) that the command will write: listed
+    before they are written, a file a killed command leaves is never one rodval disowns."""
     if not folder.is_dir() or folder.is_symlink():
         return
-    record = stamp({"command": command, FILES_KEY: folder_files(folder)}, OUTPUT_SCHEMA)
+    files = sorted({*folder_files(folder), *coming})
+    record = stamp({"command": command, FILES_KEY: files}, OUTPUT_SCHEMA)
     write_file(folder / OUTPUT_MARKER, json.dumps(record, indent=1))
