@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from rodval.cli.options import add_model_options, model_options, positive_int
+from rodval.cli.options import add_model_options, model_options, positive_int, with_scene_values
 from rodval.core.out_paths import clear_previous, write_file
 
 if TYPE_CHECKING:
@@ -65,7 +65,7 @@ def register(sub) -> None:
         help="linearize about an initial state that is not an equilibrium (refused otherwise; "
         "its static residual is recorded in modes.json)",
     )
-    add_model_options(p, coefficients_default=None)
+    add_model_options(p, coefficients_default=None, settings=False)
     p.add_argument(
         "--compare",
         nargs="?",
@@ -121,16 +121,23 @@ def run(args) -> int:
 def _given_options(args, model: str, compare: tuple[str, ...]) -> dict:
     """The model options of the command line (--set KEY=VALUE, --coefficients; the two for
     one key refused, ``model_options``), each one that the modes of ``model`` or of a
-    --compare model take (``MODES_OPTIONS``); any other --set is refused, naming it."""
+    --compare model take (``MODES_OPTIONS``); any other option is refused, naming it, and so
+    is an integrator setting (a --set of a scene value is the scene's, ``_scene_and_model``)."""
+    from rodval.core.settings import SETTING_NAMES
     from rodval.models.presets.registry import model_class
 
     given = model_options(args)
-    other = [k for k, _ in args.options if k not in given]  # --set of a scene value
+    settings = [k for k, _ in args.options if k in SETTING_NAMES]
+    if settings:
+        raise ValueError(
+            f"--set {settings[0]} is an integrator setting, which a modal analysis does not "
+            "use (rodval modes linearizes and integrates nothing); rodval simulate takes it"
+        )
     models = (model, *compare)
     accepted = sorted({k for name in models for k in model_class(name).MODES_OPTIONS})
     unknown = sorted(k for k in given if k not in accepted)
-    if other or unknown:
-        name = (other or unknown)[0]
+    if unknown:
+        name = unknown[0]
         flag = "--coefficients" if name == "coefficients" and args.coefficients else f"--set {name}"
         raise ValueError(
             f"{flag} does not apply to the modes of {', '.join(dict.fromkeys(models))} "
@@ -170,13 +177,15 @@ def _ran_options(m) -> dict:
 
 
 def _record(scene: Scene, m, args) -> dict:
-    """modes.json: what the modes are of and about (the options the analysis ran with, the
-    held hinges it held), the count of flexible modes written, a free base's rigid modes
-    (reported apart from them) and the equilibrium found."""
+    """modes.json: what the modes are of and about (the complete resolved scene, as run.json
+    records it: ``scene_to_dict``; the options the analysis ran with, the held hinges it
+    held), the count of flexible modes written, a free base's rigid modes (reported apart
+    from them) and the equilibrium found."""
     from rodval.core.modal import held_hinges
+    from rodval.core.scene_file import scene_to_dict
 
     record = {
-        "scene": scene.name,
+        "scene": scene_to_dict(scene),
         "model": m.model,
         "about": m.about,
         "coefficients": m.info.get("coefficients"),
@@ -269,18 +278,20 @@ def _comparison(
 
 
 def _scene_and_model(args) -> tuple[Scene, str, dict, dict]:
-    """The scene of SCENE ('paper', a TOML file, or a run.json: its recorded scene), the
+    """The scene of SCENE ('paper', a TOML file, or a run.json: its recorded scene) with the
+    scene values of --set (``with_scene_values``, as ``rodval simulate`` sets them), the
     model (--model, else a run.json's own model, else "full") and, for a run.json of the same
     model, its model options as ``rodval simulate`` reruns them (``rodval.cli.simulate``'s
     one reading of a run.json): (the ones the modes take, the ones that set only how the run
     was computed; ``rodval.analysis.modes.rerun_options``, which refuses any other)."""
     from rodval.analysis.modes import rerun_options
     from rodval.cli.simulate import rerun_request
-    from rodval.core.scene_file import load_scene, scene_from_dict
+    from rodval.core.scene_file import scene_from_dict
 
-    path = Path(args.scene)
-    if path.suffix != ".json":
-        return load_scene(args.scene), args.model or "full", {}, {}
     doc, model, _, options = rerun_request(args)
-    carried, computed = rerun_options(model, options, str(path))
-    return scene_from_dict(doc, where=str(path)), model, carried, computed
+    carried: dict = {}
+    computed: dict = {}
+    if Path(args.scene).suffix == ".json":
+        carried, computed = rerun_options(model, options, str(args.scene))
+    doc, where = with_scene_values(doc, args)
+    return scene_from_dict(doc, where=where), model, carried, computed

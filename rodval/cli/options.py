@@ -6,9 +6,18 @@ import argparse
 import math
 import tomllib
 from pathlib import Path
+from typing import Any
 
 from rodval.core.scene_keys import scene_path
-from rodval.core.settings import DEFAULTS, MAX_COUNT, METHODS, MIN_RTOL, RTOL_RANGE
+from rodval.core.settings import (
+    DEFAULTS,
+    MAX_COUNT,
+    METHODS,
+    MIN_RTOL,
+    RTOL_RANGE,
+    SETTING_NAMES,
+    IntegratorSettings,
+)
 
 
 def positive_float(
@@ -78,42 +87,67 @@ def time_list(text: str) -> list[float]:
     return values
 
 
-def scene_value(raw: str) -> object:
-    """The VALUE of ``--set PATH=VALUE`` for a scene key, read as a TOML value (``2e8``,
-    ``[1, 2]``, ``true``, ``{ ratio = 0.01 }``, ``"text"``), or the text itself when it is not
-    one (``kind=free``); the scene checks it like the file's value."""
+#: The integrator settings that have a flag of their own (``add_integrator_options``):
+#: setting name -> flag. Every setting (``SETTING_NAMES``) is also ``--set NAME=VALUE``.
+SETTING_FLAGS = {
+    "method": "--method",
+    "rtol": "--rtol",
+    "atol": "--atol",
+    "max_step": "--max-step",
+    "max_evaluations": "--max-evaluations",
+    "max_wall_s": "--max-wall",
+}
+#: The openings of a TOML string, array or table: a ``--set`` VALUE that starts with one
+#: must be that whole TOML value; a VALUE that is no TOML value is otherwise taken as text
+#: when it is one line (a bare word: ``kinematics=exact``, ``method=Radau-numba``).
+TOML_OPENERS = ('"', "'", "[", "{")
+
+
+def set_value(key: str, raw: str) -> object:
+    """The VALUE of ``--set KEY=VALUE`` (scene value, model option or integrator setting):
+    exactly one TOML value (``2e8``, ``[1, 2]``, ``true``, ``{ ratio = 0.01 }``,
+    ``"auto"``), or the text itself when it is a bare word (``kinematics=exact``); what it
+    sets checks it like the file's. ArgumentTypeError naming ``--set KEY`` for anything else:
+    more than one TOML value (``2e8`` and a newline with more TOML), a string, array or
+    table left open, text over several lines, or nothing."""
+    if not raw:
+        raise argparse.ArgumentTypeError(_not_one_value(key, raw, "empty"))
     try:
-        return tomllib.loads(f"value = {raw}")["value"]
-    except tomllib.TOMLDecodeError:
+        doc = tomllib.loads(f"value = {raw}")
+    except tomllib.TOMLDecodeError as exc:
+        if "\n" in raw or "\r" in raw or raw.startswith(TOML_OPENERS):
+            raise argparse.ArgumentTypeError(_not_one_value(key, raw, str(exc))) from None
         return raw
+    if set(doc) != {"value"}:
+        raise argparse.ArgumentTypeError(_not_one_value(key, raw, "more than one value"))
+    return doc["value"]
+
+
+def _not_one_value(key: str, raw: str, why: str) -> str:
+    """The one-line message of a --set VALUE that is not one TOML value."""
+    return (
+        f"--set {key}: VALUE must be one TOML value (2e8, [1, 2], true, {{ ratio = 0.01 }}, "
+        f'"text") or a bare word, got {raw!r} ({why})'
+    )
 
 
 def key_value(text: str) -> tuple[str, object]:
-    """KEY=VALUE: a scene key's dotted path (``scene_path``: ``chain.EI=2e8``) with a TOML
-    value (``scene_value``), or a model option with VALUE parsed as int, float or kept as
-    text."""
-    if "=" not in text:
+    """KEY=VALUE: a scene key's dotted path (``scene_path``: ``chain.EI=2e8``), a model
+    option or an integrator setting (``SETTING_NAMES``), with its VALUE read by
+    ``set_value``."""
+    key, equals, raw = text.partition("=")
+    if not equals or not key.strip():
         raise argparse.ArgumentTypeError(f"--set expects KEY=VALUE, got {text!r}")
-    key, raw = text.split("=", 1)
-    if scene_path(key.strip()) is not None:
-        return key.strip(), scene_value(raw.strip())
-    value: object = raw
-    for cast in (int, float):
-        try:
-            value = cast(raw)
-            break
-        except ValueError:
-            continue
-    return key.strip(), value
+    return key.strip(), set_value(key.strip(), raw.strip())
 
 
 def add_integrator_options(p: argparse.ArgumentParser) -> None:
-    """--method, --rtol, --atol, --max-step, --max-evaluations, --max-wall with the defaults of
+    """--method, --rtol, --atol, --max-step, --max-evaluations, --max-wall (``SETTING_FLAGS``),
+    each None when not given (``integrator_settings``); their defaults are
     ``rodval.core.settings.DEFAULTS`` (the same as the Python API and study files)."""
     d = DEFAULTS
     p.add_argument(
         "--method",
-        default=d["method"],
         choices=METHODS,
         help="auto (default: the compiled DOP853 where the model and scene have a "
         "compiled form, going on with the compiled Radau IIA when stiffness limits its "
@@ -123,58 +157,80 @@ def add_integrator_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--rtol",
         type=positive_float("--rtol", below=1.0, least=MIN_RTOL, allowed=RTOL_RANGE),
-        default=d["rtol"],
         help=f"relative tolerance: {RTOL_RANGE} (default {d['rtol']:g})",
     )
     p.add_argument(
         "--atol",
         type=positive_float("--atol"),
-        default=d["atol"],
         help=f"absolute tolerance > 0 (default {d['atol']:g})",
     )
     p.add_argument(
         "--max-step",
         type=positive_float("--max-step", finite=False),
-        default=d["max_step"],
         help="largest step, s (default unbounded)",
     )
     p.add_argument(
         "--max-evaluations",
         type=positive_int("--max-evaluations"),
-        default=d["max_evaluations"],
         help=f"right-hand-side evaluations a run may use (default {d['max_evaluations']})",
     )
     p.add_argument(
         "--max-wall",
         type=positive_float("--max-wall", finite=False),
-        default=d["max_wall_s"],
         help="wall-clock seconds a run may use (default: no limit)",
     )
 
 
-def integrator_settings(args: argparse.Namespace) -> dict:
-    """The integrator settings the user gave on the command line (only those that differ
-    from the defaults, so that a reference model with its own integrator is not handed
-    settings nobody asked for)."""
-    given = {
-        "method": args.method,
-        "rtol": args.rtol,
-        "atol": args.atol,
-        "max_step": args.max_step,
-        "max_evaluations": args.max_evaluations,
-        "max_wall_s": args.max_wall,
-    }
-    return {k: v for k, v in given.items() if v != DEFAULTS[k]}
+def integrator_settings(args: argparse.Namespace) -> dict[str, object]:
+    """The integrator settings given on the command line: the flags given
+    (``SETTING_FLAGS``; one given at its default value too) and ``--set NAME=VALUE`` of any
+    setting (``SETTING_NAMES``: ``error_control``, ``first_step``, ...), checked by
+    ``IntegratorSettings`` like a study file's [integrator]. A setting given both by its flag
+    and by --set is refused (ValueError naming both), never one of them winning silently, and
+    so is a --set value its setting refuses (ValueError naming ``--set NAME``)."""
+    given: dict[str, object] = {}
+    for name, flag in SETTING_FLAGS.items():
+        value = getattr(args, flag.removeprefix("--").replace("-", "_"))
+        if value is not None:
+            given[name] = value
+    for name, value in set_options(args.options).items():
+        if name in SETTING_NAMES:
+            if name in given:
+                raise ValueError(
+                    f"--set {name}={value!r} and {SETTING_FLAGS[name]} {given[name]!r} both "
+                    f"given; give {name} once"
+                )
+            try:
+                IntegratorSettings().with_(**{name: value})  # its check, as [integrator]'s
+            except ValueError as exc:
+                raise ValueError(f"--set {name}: {exc}") from None
+            given[name] = value
+    return given
 
 
-def add_model_options(p: argparse.ArgumentParser, *, coefficients_default: str | None) -> None:
-    """--coefficients (the native models' variant) and --set KEY=VALUE (any model option)."""
+def add_model_options(
+    p: argparse.ArgumentParser, *, coefficients_default: str | None, settings: bool = True
+) -> None:
+    """--coefficients (the native models' variant) and --set KEY=VALUE (a model option, a
+    scene value or, with ``settings``, an integrator setting)."""
     p.add_argument(
         "--coefficients",
         choices=("printed", "published"),
         default=coefficients_default,
         help="coefficient variant of the native models (default printed)",
     )
+    setting = ", an integrator setting, e.g. error_control=per-block" if settings else ""
+    add_set_option(
+        p,
+        "a model option, e.g. elements=8 for exudyn, a scene value by its dotted "
+        f"key, e.g. chain.EI=2e8 or latches.*.angle=0.4{setting}; the keys: "
+        "docs/scene_file.md",
+    )
+
+
+def add_set_option(p: argparse.ArgumentParser, what: str) -> None:
+    """--set KEY=VALUE (repeatable, ``key_value``; the pairs in ``args.options``), ``what``
+    saying what KEY may be."""
     p.add_argument(
         "--set",
         dest="options",
@@ -182,9 +238,7 @@ def add_model_options(p: argparse.ArgumentParser, *, coefficients_default: str |
         action="append",
         default=[],
         metavar="KEY=VALUE",
-        help="a model option, e.g. elements=8 for exudyn, or a scene value by its dotted "
-        "key, e.g. chain.EI=2e8 or latches.*.angle=0.4 (a TOML value, checked like the "
-        "scene file's; repeatable); the keys: docs/scene_file.md",
+        help=f"{what} (VALUE: one TOML value or a bare word, checked like the file's; repeatable)",
     )
 
 
@@ -202,9 +256,15 @@ def set_options(pairs: list[tuple[str, object]]) -> dict[str, object]:
 
 
 def model_options(args: argparse.Namespace) -> dict[str, object]:
-    """The model options of ``add_model_options``: the --set pairs and --coefficients (when
-    given); --coefficients together with --set coefficients=... is refused (ValueError)."""
-    options = {k: v for k, v in set_options(args.options).items() if scene_path(k) is None}
+    """The model options of ``add_model_options``: the --set pairs that are neither a scene
+    value (``scene_overrides``) nor an integrator setting (``integrator_settings``), and
+    --coefficients (when given); --coefficients together with --set coefficients=... is
+    refused (ValueError)."""
+    options = {
+        k: v
+        for k, v in set_options(args.options).items()
+        if scene_path(k) is None and k not in SETTING_NAMES
+    }
     if args.coefficients is not None:
         if "coefficients" in options:
             raise ValueError(
@@ -227,6 +287,18 @@ def scene_overrides(args: argparse.Namespace) -> dict[str, object]:
                 raise ValueError(f"--set {path} given twice (as {key} and {path}); give it once")
             out[path] = value
     return out
+
+
+def with_scene_values(doc: dict[str, Any], args: argparse.Namespace) -> tuple[dict[str, Any], str]:
+    """The scene document ``doc`` (of SCENE, ``args.scene``) with the scene values of ``--set
+    PATH=VALUE`` set (``scene_overrides``, ``with_overrides``: a study grid's paths), and the
+    name its errors go by: SCENE, with the --set keys. ``doc`` is not changed."""
+    from rodval.core.scene_file import with_overrides
+
+    overrides = scene_overrides(args)
+    if not overrides:
+        return doc, str(args.scene)
+    return with_overrides(doc, overrides), f"{args.scene} (with --set {', '.join(overrides)})"
 
 
 def add_junit_option(p) -> None:

@@ -10,9 +10,11 @@ from pathlib import Path
 from rodval.cli.options import (
     acceptance_exit,
     add_junit_option,
+    add_set_option,
     check_junit,
     positive_float,
     positive_int,
+    set_options,
 )
 
 
@@ -82,6 +84,12 @@ def register(sub) -> None:
         action="store_false",
         help="no progress bar and no announcement of the number of cases",
     )
+    add_set_option(
+        p,
+        "a value of the study file by its dotted path, as a [grid] key gives it, e.g. "
+        "integrator.rtol=1e-6 or models.full.shapes=2, or a scene value, e.g. chain.EI=2e8 "
+        "(scene. may be left out); the keys: studies/README.md",
+    )
     add_junit_option(p)
     p.set_defaults(func=run)
 
@@ -105,7 +113,12 @@ def run(args) -> int:
         )
     check_junit(args.junit, args.out, inputs=(args.file,))
     StudyStore(args.out).check_folder()
-    spec = load_study(args.file, max_cases=args.max_cases or MAX_CASES, announce=announce)
+    spec = load_study(
+        args.file,
+        max_cases=args.max_cases or MAX_CASES,
+        announce=announce,
+        overrides=set_options(args.options),
+    )
     signal.signal(signal.SIGTERM, signal.default_int_handler)
     try:
         res = run_study(

@@ -60,8 +60,12 @@ def resolve_profile(name: str, spec: dict[str, Any], n: int) -> list[float]:
     if forms[0] == "at":
         if "first" in spec:
             raise ValueError(f"{name} profile: 'first' goes with 'rest' or 'repeat', not 'at'")
+        if "values" not in spec:
+            raise ValueError(
+                f"{name} profile: 'at' needs 'values' (one per point of 'at'), missing"
+            )
         at = _numbers(name, "at", spec["at"], scalar_ok=False)
-        values = _numbers(name, "values", spec.get("values"), scalar_ok=False)
+        values = _numbers(name, "values", spec["values"], scalar_ok=False)
         if len(values) != len(at):
             raise ValueError(
                 f"{name} profile: 'at' and 'values' must have the same length, got {len(at)} "

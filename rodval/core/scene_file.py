@@ -21,7 +21,13 @@ import numpy as np
 
 from rodval.core.base import BASE_KINDS, PINNED, Base
 from rodval.core.checks import check_keys, check_number
-from rodval.core.damping import PANEL, DampingRequest, bending_damping_for_ratio, damping_request
+from rodval.core.damping import (
+    PANEL,
+    RATIO_KEYS,
+    DampingRequest,
+    bending_damping_for_ratio,
+    damping_request,
+)
 from rodval.core.loads import LOAD_FACTORIES, NodalForce, pulse
 from rodval.core.profiles import resolve_profiles
 from rodval.core.resources import check_rods
@@ -37,7 +43,8 @@ from rodval.core.scene import (
     Stop,
     output_times,
 )
-from rodval.core.scene_keys import check_types, merge_documents, set_path
+from rodval.core.scene_keys import check_types, merge_documents, missing_key, set_path
+from rodval.core.settings import SETTING_NAMES
 
 _Item = TypeVar("_Item", Latch, Stop)
 
@@ -256,10 +263,13 @@ def _chain(
 def _damping_request(spec: dict[str, Any], where: str) -> DampingRequest | None:
     """The request of ``[chain] bending_damping = { ratio = ..., of = ... }`` (removed from
     ``spec``: the chain gets the converted N m^2 s, ``rodval.core.damping``), or None when
-    the damping is given in N m^2 s (a number, a list or a profile)."""
+    the damping is given in N m^2 s (a number, a list or a profile: a table with neither
+    ``ratio`` nor ``of``). A table with ``of`` and no ``ratio`` is refused naming the ratio."""
     value = spec.get("bending_damping")
-    if not isinstance(value, dict) or "ratio" not in value:
+    if not isinstance(value, dict) or not set(value) & set(RATIO_KEYS):
         return None
+    if "ratio" not in value:
+        raise missing_key(where, "chain.bending_damping.ratio")
     request = damping_request(value, where)
     del spec["bending_damping"]
     return request
@@ -275,6 +285,19 @@ def _loads(d: dict[str, Any], n: int, based_on: str | None, where: str) -> tuple
     return tuple(_load(s, n, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"]))
 
 
+def _refuse_settings(d: dict[str, Any], where: str) -> None:
+    """An integrator setting written among a scene's keys (``rtol = 1e-6`` in a scene file or a
+    study's [scene]) is refused saying where it goes, before the keys' own check lists the
+    scene keys only."""
+    settings = sorted(set(d) & set(SETTING_NAMES)) if isinstance(d, dict) else []
+    if settings:
+        name = settings[0]
+        raise ValueError(
+            f"{where} key '{name}': an integrator setting, not a scene value; give it on the "
+            f"command line (--set {name}=...) or in a study's [integrator] or [models.LABEL]"
+        )
+
+
 def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
     """Build and validate a Scene from the dict form (``docs/scene_file.md``).
 
@@ -284,6 +307,7 @@ def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
     every omitted key takes the paper example's value (``paper_scene``). Every error is a
     ValueError that names ``where`` (a file name) and the offending key.
     """
+    _refuse_settings(d, where)
     check_keys(d, TOP_KEYS, where)
     if isinstance(d.get("base"), str):  # the old spelling of based_on, or a base kind
         raise ValueError(f"{where} key 'base': {_base_advice(d['base'])}")
@@ -369,9 +393,21 @@ def scene_file_document(
             f"another ({names})"
         )
     earlier, files = scene_file_document(target, here)
+    _check_earlier(earlier, target, path)
     earlier.pop("name", None)  # a file's name is its own (or its file name), never inherited
     later = {k: v for k, v in data.items() if k != "based_on"}
     return merge_documents(earlier, later), (path, *files)
+
+
+def _check_earlier(earlier: dict[str, Any], target: Path, path: Path) -> None:
+    """The scene of the file ``target`` (its document ``earlier``, its own ``based_on``
+    resolved), which ``path`` is based on, built once to check it: an error there is
+    ``target``'s, named so (a one-line ValueError starting with ``target``), never the error
+    of the file that names it."""
+    try:
+        scene_from_dict(earlier, where=str(target))
+    except ValueError as exc:
+        raise ValueError(f"{exc} ({path} is based on it)") from None
 
 
 def anchor_load_files(doc: dict[str, Any], folder: Path) -> dict[str, Any]:

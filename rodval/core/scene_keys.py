@@ -10,8 +10,9 @@ Dotted paths into a scene document (``set_path``: a study grid's ``scene.chain.E
 command line's ``--set chain.EI=2e8``; in a list ``*`` is every element, an integer one), and
 the merge of two documents (``merge_documents``: a scene file ``based_on`` another, a study's
 [scene] over the file it names): the sections (``[chain]``, ``[initial]``, ``[base]``,
-``[base.motion]``) merge key by key, every other value (numbers, lists, arrays of tables,
-inline tables such as profiles, motion laws or ``times``) replaces the earlier one whole.
+``[base.motion]``) merge key by key (a ``[base]`` of another ``kind`` replaces the earlier
+base whole), every other value (numbers, lists, arrays of tables, inline tables such as
+profiles, motion laws or ``times``) replaces the earlier one whole.
 """
 
 from __future__ import annotations
@@ -72,9 +73,10 @@ NODE = Kind('an integer or "last"', lambda v: _integer(v) or v == "last")
 class Key:
     """One key of a scene file: its type, unit and allowed values (words), and for a table
     its keys (``keys``: checked when the value is a table; for an array of tables, each
-    element's). ``section``: a table that ``merge_documents`` merges key by key;
-    ``required``: a key every table of its array must hold; ``none``: the dict form (a run
-    record) may hold None for "omitted"."""
+    element's). ``section``: a table that ``merge_documents`` merges key by key, unless the
+    later table names another ``variant`` (a key of the table and its default: [base]'s
+    ``kind``), which replaces the earlier table whole; ``required``: a key every table of its
+    array must hold; ``none``: the dict form (a run record) may hold None for "omitted"."""
 
     kind: Kind
     unit: str = ""
@@ -83,6 +85,7 @@ class Key:
     section: bool = False
     required: bool = False
     none: bool = False
+    variant: tuple[str, str] | None = None
 
 
 def _rod(unit: str, allowed: str) -> Key:
@@ -143,6 +146,7 @@ SCENE_KEYS: dict[str, Key] = {
             ),
         },
         section=True,
+        variant=("kind", "pinned"),
     ),
     "chain": Key(
         TABLE,
@@ -266,9 +270,29 @@ def _check_table(table: dict[str, Any], keys: dict[str, Key], prefix: str, where
                 _check_table(item, key.keys, f"{path}.{i}.", where)
                 missing = [k for k, sub in key.keys.items() if sub.required and k not in item]
                 if missing:
-                    raise ValueError(f"{where} key '{path}.{i}.{missing[0]}': is missing")
+                    raise missing_key(where, f"{path}.{i}.{missing[0]}")
         elif isinstance(value, dict) and key.keys:
             _check_table(value, key.keys, f"{path}.", where)
+
+
+def key_at(path: str) -> Key:
+    """The ``Key`` of the dotted scene ``path`` (an element of an array of tables by its
+    index or ``*``: ``latches.0.hinge``); KeyError when ``SCENE_KEYS`` has no such key."""
+    head, *rest = path.split(".")
+    key = SCENE_KEYS[head]
+    for part in rest:
+        if key.kind is not TABLES or not (part == "*" or part.isdigit()):
+            key = key.keys[part]
+    return key
+
+
+def missing_key(where: str, path: str) -> ValueError:
+    """The one-line error of the required key at the dotted scene ``path`` that a table of the
+    document ``where`` omits, with its type and range: "<where> key '<path>': is missing
+    (<type>: <allowed>)"."""
+    key = key_at(path)
+    within = f": {key.allowed.replace('`', '')}" if key.allowed else ""
+    return ValueError(f"{where} key '{path}': is missing ({key.kind.words}{within})")
 
 
 # ------------------------------------------------------------------ paths and merging
@@ -318,14 +342,27 @@ def merge_documents(
     earlier: dict[str, Any], later: dict[str, Any], keys: dict[str, Key] = SCENE_KEYS
 ) -> dict[str, Any]:
     """``later`` laid over ``earlier`` (two scene documents): the sections (``Key.section``:
-    [chain], [initial], [base], [base.motion]) merge key by key, at every depth; any other
-    value of ``later`` replaces ``earlier``'s whole. Neither argument is changed."""
+    [chain], [initial], [base], [base.motion]) merge key by key, at every depth, except a
+    later section of another variant (``Key.variant``: a [base] of another ``kind``), which
+    replaces the earlier one whole, as a pinned, free or prescribed base is described by
+    keys of its own; any other value of ``later`` replaces ``earlier``'s whole. Neither
+    argument is changed."""
     merged = {**earlier, **later}
     for name, key in keys.items():
         a, b = earlier.get(name), later.get(name)
         if key.section and isinstance(a, dict) and isinstance(b, dict):
-            merged[name] = merge_documents(a, b, key.keys)
+            if not _other_variant(key, a, b):
+                merged[name] = merge_documents(a, b, key.keys)
     return merged
+
+
+def _other_variant(key: Key, earlier: dict[str, Any], later: dict[str, Any]) -> bool:
+    """Whether the ``later`` table names another variant of ``key`` than ``earlier`` (its
+    variant key given, with another value than the earlier table's or its default)."""
+    if key.variant is None:
+        return False
+    name, default = key.variant
+    return name in later and later[name] != earlier.get(name, default)
 
 
 # ------------------------------------------------------------------ the table in the docs

@@ -4,8 +4,9 @@ The file (a path relative to the study file's folder, or absolute) is read with
 ``scene_file_document``, so its tabulated loads' CSV files are found relative to the scene
 file, and a file ``based_on`` another is resolved. The other keys of ``[scene]`` override the
 file's as a later file does (``rodval.core.scene_keys.merge_documents``): the sections
-(``chain``, ``initial``, ``base``, ``base.motion``) are merged key by key, any other value (a
-number, a list: ``latches``, ``stops``, ``loads``, ``times``) replaces the file's whole. The
+(``chain``, ``initial``, ``base``, ``base.motion``) are merged key by key (a ``base`` of
+another ``kind`` replaces the file's base whole), any other value (a number, a list:
+``latches``, ``stops``, ``loads``, ``times``) replaces the file's whole. The
 resolved table, not the path, is what the cases build, run and record; the file's SHA-256
 (with those of the files it is based on) goes into study.json so that a later run in the same
 folder notices that a file changed (``rodval.study.store``). Every error is one line naming
