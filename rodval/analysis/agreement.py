@@ -28,7 +28,9 @@ Definitions (one place; the report and docs/deployment.md quote them):
   of the two runs' last locks (``rodval.analysis.convergence.deployed_mean``, the definition
   ``rodval reference`` converges), and their largest difference, rad (``deployed_gap``;
   ``attitude_gap``), against the reference's band: e_ref x the scale for the angles, the
-  reference's ``attitude`` error bar for the attitude.
+  reference's ``attitude`` error bar for the attitude. A run is **deployed** when every
+  latch of its case locked within it; ``never_locked`` names those that did not (the state
+  after the last lock is then a partly folded structure's, and the report says so).
 * **cause** of a model's parting, measured: (a) ``out of domain``: the model's own verdict
   on its run broke one of its checks (its ``invalid_because``); (b) ``unpredictable``: the
   twin parts as much: at the model's parting lock the twin's |dt| is at least
@@ -317,12 +319,40 @@ def pair_horizon(
 
 
 def lock_list(events: pd.DataFrame, case: Any, model: str) -> list[tuple[str, float]]:
-    """The (label, t) of one run's locks in time order."""
+    """The (label, t) of one run's locks in time order ([] for a run without any)."""
     if events.empty:
         return []
     own = events[(events["case"] == case) & (events["model"] == model)]
-    own = own[own["label"].map(is_lock)].sort_values("t", kind="stable")
+    # a boolean array, not a Series: an empty Series of labels maps to an empty str Series,
+    # which pandas reads as a list of column names (a frame without columns, no "t")
+    own = own[own["label"].map(is_lock).to_numpy(bool)].sort_values("t", kind="stable")
     return [(str(lab), float(t)) for lab, t in zip(own["label"], own["t"])]
+
+
+def locked_hinges(label: str) -> list[int]:
+    """The hinges a lock event's label names ("latch hinge 2", "latch hinge 1, 3")."""
+    if not str(label).startswith("latch hinge"):
+        return []
+    return [int(h) for h in re.findall(r"\d+", str(label))]
+
+
+def never_locked(latched: Sequence[int], locks: Sequence[tuple[str, float]]) -> str:
+    """The latches of ``latched`` (a case's hinges, cases.csv's latch_hinges) that none of a
+    run's ``locks`` ((label, t), ``lock_list``) names, "latch hinge 1, latch hinge 3" ("" when
+    every one locked): latches that never locked within the run, which is not deployed."""
+    done = {h for label, _ in locks for h in locked_hinges(label)}
+    return ", ".join(f"latch hinge {h}" for h in latched if h not in done)
+
+
+def latch_hinges(cases: pd.DataFrame) -> dict[Any, list[int]]:
+    """Case -> the hinges its scene latches (cases.csv's ``latch_hinges``, a JSON list; no
+    entry for a case without the column)."""
+    if "latch_hinges" not in cases:
+        return {}
+    return {
+        case: [int(h) for h in re.findall(r"\d+", str(hs))] if pd.notna(hs) else []
+        for case, hs in zip(cases["case"], cases["latch_hinges"])
+    }
 
 
 #: Columns of ``agreement_table``.
@@ -346,6 +376,7 @@ AGREEMENT_COLUMNS = (
     "worst_impulse_lock",
     "lock_order",
     "locks_within",
+    "never_locked",
     "deployed_gap",
     "deployed_band",
     "attitude_gap",
@@ -473,9 +504,13 @@ def agreement_table(
     runtime: pd.DataFrame,
     reference: str,
     settings: AgreementSettings,
+    latches: Mapping[Any, Sequence[int]] | None = None,
 ) -> pd.DataFrame:
     """One row per case and run (AGREEMENT_COLUMNS): its role (reference, twin, model), how
-    it ended, its verdict (valid; out_of_domain: the checks it broke), its agreement horizon
+    it ended, its verdict (valid; out_of_domain: the checks it broke), ``never_locked``: the
+    case's latches (``latches``: case -> hinges, ``latch_hinges``) the run never locked
+    ("latch hinge 1, latch hinge 3"; "" when every one locked; nan for a case without
+    latches or when ``latches`` is not given), its agreement horizon
     against the reference (s; nan: agrees at every common output time, up to
     ``compared_to``) and the quantity that parts there, the first lock where it parts
     (label, dt s, why), the measured cause, the worst lock-time gap (s) and impulse gap
@@ -499,6 +534,10 @@ def agreement_table(
                 else "model"
             )
             row = _run_row(run, role)
+            if latches and latches.get(case):
+                row["never_locked"] = never_locked(
+                    latches[case], lock_list(events, case, run["model"])
+                )
             if role != "reference" and run["model"] in runs and reference in runs:
                 row.update(_pair_columns(row, runs, events, reference, settings))
             if role == "twin":

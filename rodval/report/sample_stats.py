@@ -13,22 +13,16 @@ Percentiles are numpy's linear interpolation (``numpy.percentile``) at ``PERCENT
 
 from __future__ import annotations
 
-import re
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from rodval.analysis.agreement import latch_hinges
+from rodval.analysis.agreement import locked_hinges as locked_hinges  # rodval.report.acceptance's
 from rodval.report.markdown import to_markdown
 
 PERCENTILES = (5, 50, 95)
-
-
-def locked_hinges(label: str) -> list[int]:
-    """The hinges a lock event's label names ("latch hinge 2", "latch hinge 1, 3")."""
-    if not str(label).startswith("latch hinge"):
-        return []
-    return [int(h) for h in re.findall(r"\d+", str(label))]
 
 
 def lock_statistics(cases: pd.DataFrame, events: pd.DataFrame, models: list[str]) -> pd.DataFrame:
@@ -36,10 +30,7 @@ def lock_statistics(cases: pd.DataFrame, events: pd.DataFrame, models: list[str]
     p_all_locked (fraction of samples in which every latch of the scene locked, the same on
     every row of a model), t_pP (lock time percentiles, s, over the samples where it locked),
     t_min, t_max. ``cases`` needs columns case and latch_hinges (JSON list); O(events)."""
-    hinges_of = {
-        str(c): [int(h) for h in re.findall(r"\d+", str(hs))]
-        for c, hs in zip(cases["case"], cases.get("latch_hinges", pd.Series([""] * len(cases))))
-    }
+    hinges_of = {str(c): hs for c, hs in latch_hinges(cases).items()}
     samples = len(hinges_of)
     rows = []
     for model in models:

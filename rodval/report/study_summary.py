@@ -14,6 +14,7 @@ from rodval.analysis.agreement import (
     AgreementSettings,
     agreement_table,
     check_names,
+    latch_hinges,
     twin_label,
 )
 from rodval.analysis.metrics import left_out_quantities
@@ -287,7 +288,14 @@ def answer_section(
     lock-time and impulse gaps, the run time (markdown lines)."""
     ref = meta["reference"]
     settings = AgreementSettings.from_dict(meta.get("agreement"))
-    table = agreement_table(tables["trajectories"], events, tables["runtime"], ref, settings)
+    table = agreement_table(
+        tables["trajectories"],
+        events,
+        tables["runtime"],
+        ref,
+        settings,
+        latch_hinges(tables["cases"]),
+    )
     if table.empty:
         return []
     lines = ["## Answer\n", _definition(settings, ref)]
@@ -295,7 +303,11 @@ def answer_section(
         lines += _answer_over_cases(table, ref)
     else:
         lines += [" ".join(_sentences(table, ref, settings)) + "\n"]
-        lines.append(to_markdown(drop_constant(_answer_rows(table, settings), ("case",))))
+        lines.append(
+            to_markdown(
+                _deployed_shown(drop_constant(_answer_rows(table, settings, ref), ("case",)))
+            )
+        )
     return lines
 
 
@@ -343,6 +355,8 @@ def _until(row: pd.Series) -> str:
         return "(reference)"
     if pd.isna(row["compared_to"]):
         return "not compared"
+    if pd.isna(row["horizon"]) and row["status"] != "success":
+        return f"its failure at t = {row['compared_to']:.4g} s (the run ends there)"
     if pd.isna(row["horizon"]):
         return f"the end ({row['compared_to']:.4g} s)"
     return f"t = {row['horizon']:.4g} s ({row['horizon_quantity']})"
@@ -371,18 +385,58 @@ def _worst(row: pd.Series) -> tuple[str, str]:
     return dt, imp
 
 
-def _beyond(row: pd.Series) -> str:
+def _deployed_shown(rows: pd.DataFrame) -> pd.DataFrame:
+    """The answer's table without its ``deployed`` column when no run says "no" there (every
+    latch locked in every run, or no latches): a column that would only say "yes"."""
+    if rows["deployed"].str.startswith("no").any():
+        return rows
+    return rows.drop(columns="deployed")
+
+
+def _deployed(row: pd.Series) -> str:
+    """Whether the run deployed: "yes" when every latch of its case locked, "no: ..." naming
+    those that never locked, "" for a case without latches."""
+    missed = row.get("never_locked")
+    if not isinstance(missed, str):
+        return ""
+    return f"no: {missed} never locked" if missed else "yes"
+
+
+def _undeployed(row: pd.Series) -> str:
+    """ ", not deployed: ... never locked within its run" for a run with a latch that never
+    locked, else ""."""
+    missed = row.get("never_locked")
+    if not _filled(missed):
+        return ""
+    return f", not deployed: {missed} never locked within its run"
+
+
+def _reference_row(table: pd.DataFrame, row: pd.Series, ref: str) -> pd.Series | None:
+    """The reference's row of ``row``'s case in the agreement table (None when it has none)."""
+    same = table[(table["case"] == row["case"]) & (table["model"] == ref)]
+    return same.iloc[0] if len(same) else None
+
+
+def _beyond(row: pd.Series, ref_row: pd.Series | None = None) -> str:
     """What stays meaningful beyond the horizon, in words: the lock order, the locks within
-    the lock-time bound, the deployed state's gaps against the reference's bands (rad)."""
+    the lock-time bound, the deployed state's gaps against the reference's bands (rad); a
+    latch that never locked in the run or in the reference (``ref_row``) makes the state
+    after the last lock a partly deployed one, and says so."""
     parts = []
+    missed = {
+        who: r["never_locked"]
+        for who, r in (("this run", row), ("the reference", ref_row))
+        if r is not None and _filled(r.get("never_locked"))
+    }
+    what = "deployed {}" if not missed else "{} after the last lock (not deployed)"
     order = row.get("lock_order")
     if _filled(order):
         parts.append("lock order the same" if order == "same" else f"lock order differs ({order})")
     if _filled(row.get("locks_within")):
         parts.append(f"{row['locks_within']} locks within the lock-time bound")
     for gap, band, name in (
-        ("deployed_gap", "deployed_band", "deployed angles"),
-        ("attitude_gap", "attitude_band", "deployed attitude"),
+        ("deployed_gap", "deployed_band", what.format("angles")),
+        ("attitude_gap", "attitude_band", what.format("attitude")),
     ):
         if pd.notna(row.get(gap)):
             within = (
@@ -391,6 +445,10 @@ def _beyond(row: pd.Series) -> str:
                 else ""
             )
             parts.append(f"{name} {row[gap]:.2g} rad off{within}")
+    if len(set(missed.values())) == 1 and len(missed) == 2:
+        parts.append(f"{missed['this run']} never locked in either run")
+    elif missed:
+        parts.append(", ".join(f"{what} never locked in {who}" for who, what in missed.items()))
     return "; ".join(parts)
 
 
@@ -399,7 +457,7 @@ def _filled(value: Any) -> bool:
     return isinstance(value, str) and bool(value)
 
 
-def _answer_rows(table: pd.DataFrame, settings: AgreementSettings) -> pd.DataFrame:
+def _answer_rows(table: pd.DataFrame, settings: AgreementSettings, ref: str) -> pd.DataFrame:
     """The short table: one row per case and run."""
     rows = []
     for _, row in table.iterrows():
@@ -414,7 +472,10 @@ def _answer_rows(table: pd.DataFrame, settings: AgreementSettings) -> pd.DataFra
                 "cause": row["cause"] if isinstance(row["cause"], str) else "",
                 "worst lock dt": dt,
                 "worst impulse gap": imp,
-                "beyond the horizon": "" if row["role"] == "reference" else _beyond(row),
+                "deployed": _deployed(row),
+                "beyond the horizon": ""
+                if row["role"] == "reference"
+                else _beyond(row, _reference_row(table, row, ref)),
                 "run time": f"{row['wall_s']:.3g} s",
             }
         )
@@ -436,11 +497,11 @@ def _sentences(table: pd.DataFrame, ref: str, settings: AgreementSettings) -> li
         verdict = _verdict(row)
         if row["role"] == "reference":
             out.append(
-                f"The reference {name} is {verdict}{_error_bar(settings)} (run time "
-                f"{row['wall_s']:.3g} s)."
+                f"The reference {name} is {verdict}{_error_bar(settings)}{_undeployed(row)} "
+                f"(run time {row['wall_s']:.3g} s)."
             )
             continue
-        head = f"{name} is {verdict}; it agrees with `{ref}` until {_until(row)}"
+        head = f"{name} is {verdict}{_undeployed(row)}; it agrees with `{ref}` until {_until(row)}"
         if row["role"] == "twin":
             dt, _ = _worst(row)
             moved = f" and moves the locks by at most {dt}" if dt else ""
@@ -458,7 +519,7 @@ def _sentences(table: pd.DataFrame, ref: str, settings: AgreementSettings) -> li
         dt, imp = _worst(row)
         if dt:
             text += f"; worst lock-time gap {dt}, impulse gap {imp or 'n/a'}"
-        beyond = _beyond(row)
+        beyond = _beyond(row, _reference_row(table, row, ref))
         if beyond and (parts != "none" or not pd.isna(row["horizon"])):
             text += f"; beyond: {beyond}"
         out.append(f"{text}; run time {row['wall_s']:.3g} s.")
@@ -497,6 +558,12 @@ def _answer_over_cases(table: pd.DataFrame, ref: str) -> list[str]:
         n = len(part)
         valid = int((part["valid"] == True).sum())  # noqa: E712 - None is not valid
         row: dict[str, Any] = {"model": model, "cases": n, "valid": f"{valid}/{n}"}
+        latched = part["never_locked"].map(lambda v: isinstance(v, str))
+        deployed = ""
+        if latched.any():
+            done = int((part.loc[latched, "never_locked"] == "").sum())
+            row["deployed"] = f"{done}/{int(latched.sum())}"
+            deployed = f", deployed (every latch locked) in {done} of {int(latched.sum())}"
         if (part["role"] != "reference").any():
             h = part["horizon"].fillna(part["compared_to"])
             worst = part.loc[h.idxmin()] if h.notna().any() else None
@@ -521,7 +588,7 @@ def _answer_over_cases(table: pd.DataFrame, ref: str) -> list[str]:
         row["run time p50 (s)"] = f"{part['wall_s'].median():.3g}"
         rows.append(row)
         sentences.append(
-            f"`{model}`: valid in {valid} of {n} cases"
+            f"`{model}`: valid in {valid} of {n} cases{deployed}"
             + (
                 f", agrees with `{ref}` until t = {row['shortest (case)']} at the shortest"
                 f" (median {row['agrees until p5 / p50 (s)'].split(' / ')[-1]} s), parts at a "
