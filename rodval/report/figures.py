@@ -21,6 +21,7 @@ from matplotlib.figure import Figure
 from matplotlib.typing import ColorType
 
 from rodval.analysis.metrics import pareto_front
+from rodval.core.base import rotate
 from rodval.core.modal import Modes
 from rodval.core.out_paths import write_figure
 from rodval.core.scene import UNITS
@@ -62,13 +63,68 @@ def _title_size(which: Literal["figure.titlesize", "axes.titlesize"] = "figure.t
     return FontProperties(size=rcParams[which]).get_size_in_points()
 
 
-def chain_nodes(traj: Trajectory, t: float, l: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Node coordinates (m) at output time t, from x/y if recorded, else from phi and lengths."""
+def moving_base(traj: Trajectory) -> bool:
+    """Whether the run's outputs say its base moves (a free or prescribed body: output
+    "base", base_position)."""
+    return "base_position" in traj.values
+
+
+def drawable(traj: Trajectory, moving: bool = False) -> bool:
+    """Whether the run's outputs place its chain: x, y, or phi hung from the pin at the
+    origin (not for a moving base, ``moving`` or told by its outputs, whose node 0 is not
+    at the origin)."""
+    has_xy = "x" in traj.values and "y" in traj.values
+    return has_xy or ("phi" in traj.values and not (moving or moving_base(traj)))
+
+
+def body_outline(
+    centre: np.ndarray, attitude: np.ndarray, half: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """A body drawn as a square of half side ``half`` (m) about its centre (nt, 2), turned
+    by its attitude (nt,): the closed outline's x, y (m), each (nt, 5)."""
+    corners = half * np.array([[1, 1], [-1, 1], [-1, -1], [1, -1], [1, 1]], float)
+    turned = rotate(np.asarray(attitude)[:, None], corners[None, :, :])
+    return centre[:, None, 0] + turned[..., 0], centre[:, None, 1] + turned[..., 1]
+
+
+def _output_row(traj: Trajectory, t: float) -> int:
+    """The index of output time ``t`` (s) in the run; ValueError when it has none there."""
     i = int(np.argmin(np.abs(traj.times - t)))
     if abs(traj.times[i] - t) > 1e-9:
         raise ValueError(f"t = {t} s is not an output time of trajectory {traj.model!r}")
+    return i
+
+
+def body_at(traj: Trajectory, t: float, l: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The outline (x, y, m) of a moving base's body at output time ``t`` (s): a square
+    about its centre of mass (base_position), turned by base_attitude, node 0 (x, y) on its
+    edge (half side |r_0 - r_c|, at least 5 % of the chain's length ``l`` so that it
+    shows); None when the outputs do not hold the pose and node 0."""
+    need = ("base_position", "base_attitude", "x", "y")
+    if not all(q in traj.values for q in need):
+        return None
+    i = _output_row(traj, t)
+    centre = np.asarray(traj.values["base_position"][i : i + 1], float).reshape(1, 2)
+    node0 = np.array([traj.values["x"][i][0], traj.values["y"][i][0]], float)
+    half = max(float(np.hypot(*(node0 - centre[0]))), 0.05 * float(np.sum(l)))
+    bx, by = body_outline(centre, np.asarray(traj.values["base_attitude"][i], float)[:1], half)
+    return bx[0], by[0]
+
+
+def chain_nodes(
+    traj: Trajectory, t: float, l: np.ndarray, moving: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """Node coordinates (m) at output time t, from x/y if recorded, else from phi and lengths
+    hung from the pin at the origin; ValueError for a moving base (``moving``, or told by
+    the run's outputs) without x, y: its node 0 is not at the origin (``drawable``)."""
+    i = _output_row(traj, t)
     if "x" in traj.values and "y" in traj.values:
         return traj.values["x"][i], traj.values["y"][i]
+    if not drawable(traj, moving):
+        raise ValueError(
+            f"run {traj.model!r} has a moving base but no x, y among its outputs: its chain "
+            "cannot be placed"
+        )
     phi = traj.values["phi"][i]
     return (
         np.concatenate([[0.0], np.cumsum(l * np.cos(phi))]),
@@ -92,10 +148,14 @@ def plot_configurations(
     l: np.ndarray,
     path: Path | str,
     title: str = "",
+    moving: bool = False,
 ) -> Path:
     """Chain configurations at ``times`` (one colour per time), one line style per model.
 
-    Like Fig. 3 of the paper: the chord polygon through the nodes, root at the origin.
+    Like Fig. 3 of the paper: the chord polygon through the nodes, root at the pin at the
+    origin; a moving base's chain where its outputs x, y put it, its body drawn as a square
+    at its pose (``body_at``), no pin (``moving``: the runs' base moves, whatever their
+    outputs say). Every run must be ``drawable``.
     """
     fig, ax = _figure(figsize=(7, 6))
     colours = colormaps["viridis"](np.linspace(0, 0.9, len(times)))
@@ -103,9 +163,13 @@ def plot_configurations(
         for t, c in zip(times, colours):
             if not np.any(np.abs(traj.times - t) < 1e-9):
                 continue  # a failed run may not have reached t
-            x, y = chain_nodes(traj, t, l)
+            x, y = chain_nodes(traj, t, l, moving)
             ax.plot(x, y, ls, color=c, marker="o", ms=3)
-    ax.plot([0], [0], "k^", ms=10)
+            body = body_at(traj, t, l)
+            if body is not None:
+                ax.plot(*body, ls, color=c, lw=1.5)
+    if not moving and any(not moving_base(traj) for traj in trajectories.values()):
+        ax.plot([0], [0], "k^", ms=10)  # the pin of the pinned runs
     _min_height(ax, 0.3)
     ax.set_aspect("equal")
     ax.set_xlabel("x, m")
@@ -135,8 +199,11 @@ def plot_configurations(
     return path
 
 
-def model_styles(labels: Sequence[str]) -> dict[str, dict[str, Any]]:
-    """One colour and line style per model label, the same in every figure of a report."""
+def model_styles(labels: Sequence[str], drawn: Sequence[Any] = ()) -> dict[str, dict[str, Any]]:
+    """One colour and line style per run label, the same in every figure of a report: the
+    study's model ``labels`` in order, then every other label of the runs ``drawn`` (a
+    reference's twin run, "full twin"), in their order."""
+    labels = list(dict.fromkeys([*labels, *map(str, drawn)]))
     return {
         lab: {
             "color": MODEL_COLOURS[i % len(MODEL_COLOURS)],
@@ -244,7 +311,12 @@ def _save(fig: Figure, path: Path | str, title: str = "") -> Path:
 
 def _finish(fig: Figure, axes: Sequence[Axes] | np.ndarray, path: Path, title: str) -> Path:
     handles, _ = axes[0].get_legend_handles_labels()
-    axes[0].legend(fontsize=7, ncol=2 if len(handles) > 6 else 1)
+    if handles:  # no line when no run succeeded or was compared: the figure says so
+        axes[0].legend(fontsize=7, ncol=2 if len(handles) > 6 else 1)
+    else:
+        axes[0].text(
+            0.5, 0.5, "nothing to draw (see Outcome)", transform=axes[0].transAxes, ha="center"
+        )
     return _save(fig, path, title)
 
 
@@ -266,7 +338,7 @@ def plot_discrepancy_vs(
     axes = axes.ravel()
     for ax in axes[len(quantities) :]:
         ax.set_visible(False)
-    styles = model_styles(models)
+    styles = model_styles(models, ok["model"])
     for ax, q in zip(axes, quantities):
         _lines(ax, ok[ok["quantity"] == q], x, metric, others, styles, logx)
         ax.set_title(f"{q}, {UNITS.get(q, '')}")
@@ -287,7 +359,7 @@ def plot_runtime_vs(
     """Integration wall time of successful runs against ``x`` (log-log)."""
     ok = runtime[runtime["status"] == "success"]
     fig, ax = _figure(figsize=(6.5, 4.5))
-    _lines(ax, ok, x, "wall_s", others, model_styles(models), logx)
+    _lines(ax, ok, x, "wall_s", others, model_styles(models, ok["model"]), logx)
     ax.set_xlabel(axis_label(x))
     ax.set_ylabel("integration wall time, s")
     ax.grid(alpha=0.3, which="both")
@@ -318,7 +390,7 @@ def plot_speedup_vs(
     logx: bool = True,
 ) -> Path:
     fig, ax = _figure(figsize=(6.5, 4.5))
-    _lines(ax, speed, x, "speedup", others, model_styles(models), logx)
+    _lines(ax, speed, x, "speedup", others, model_styles(models, speed["model"]), logx)
     ax.axhline(1.0, color="k", lw=0.8)
     ax.set_xlabel(axis_label(x))
     ax.set_ylabel(f"speed-up: wall time of {reference} / of model")
@@ -414,11 +486,12 @@ def plot_deployment(
     l: np.ndarray,
     path: Path | str,
     title: str = "",
+    moving: bool = False,
 ) -> Path:
     """A deployment: one panel per model with the chain at ``times`` (the deployment
     sequence, light to dark), and below them the tip's y (m) against time, every model
     overlaid, with each model's lock times (``events``: columns model, t, label) as dotted
-    vertical lines in its colour."""
+    vertical lines in its colour. A moving base is drawn as in ``plot_configurations``."""
     styles = model_styles(list(trajectories))
     ncol = max(len(trajectories), 1)
     fig = Figure(figsize=(4.0 * ncol, 7.5))
@@ -429,9 +502,13 @@ def plot_deployment(
         for t, col in zip(times, colours):
             if not np.any(np.abs(traj.times - t) < 1e-9):
                 continue
-            x, y = chain_nodes(traj, t, l)
+            x, y = chain_nodes(traj, t, l, moving)
             ax.plot(x, y, "-", color=col, marker="o", ms=2.5, lw=1.2, label=f"t = {t:.3g} s")
-        ax.plot([0], [0], "k^", ms=8)
+            body = body_at(traj, t, l)
+            if body is not None:
+                ax.plot(*body, "-", color=col, lw=1.2)
+        if not (moving or moving_base(traj)):
+            ax.plot([0], [0], "k^", ms=8)
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_title(label)
         ax.set_xlabel("x, m")

@@ -12,8 +12,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from rodval.core.profiles import PROFILE_KEYS
 from rodval.core.trajectory import Trajectory
 from rodval.report.figures import (
+    drawable,
     plot_configurations,
     plot_deployment,
     plot_discrepancy_vs,
@@ -23,7 +25,7 @@ from rodval.report.figures import (
     speedups,
 )
 from rodval.report.markdown import to_markdown
-from rodval.report.tables import trajectory_samples
+from rodval.report.tables import axis_columns, trajectory_samples
 
 
 def varying_params(cases: pd.DataFrame, params: list[str]) -> list[str]:
@@ -38,6 +40,30 @@ def varying_params(cases: pd.DataFrame, params: list[str]) -> list[str]:
     ]
 
 
+def key_name(path: str, label: str) -> str:
+    """The name a figure gives the grid key ``path`` (its table column ``label``): the
+    label, extended to the key a list index, "*" or a profile's key (``PROFILE_KEYS``:
+    first, rest, ...) belongs to (scene.chain.kappa.first -> kappa.first,
+    scene.initial.phi.1 -> phi.1); the label says nothing without it."""
+    parts = path.split(".")
+    depth = max(len(label.split(".")), 1)
+    while depth < len(parts) and (
+        parts[-depth].isdigit() or parts[-depth] == "*" or parts[-depth] in PROFILE_KEYS
+    ):
+        depth += 1
+    return ".".join(parts[-depth:]) if path.endswith(label) else label
+
+
+def axis_names(meta: dict[str, Any]) -> dict[str, str]:
+    """Table column -> the name its figures give it (``key_name``), for the grid's axes."""
+    columns = axis_columns(meta)
+    return {
+        columns[label]: key_name(path, label)
+        for path, label in meta["labels"].items()
+        if label in columns
+    }
+
+
 def figure_slug(cid: str) -> str:
     """A case id as part of a figure's file name: ``n=8,t_end=2`` -> ``n8_t_end2``."""
     return cid.replace(",", "_").replace("=", "")
@@ -50,8 +76,14 @@ def param_figures(
     figures against it, each line one value of the other parameters (markdown lines)."""
     labels = [m["label"] for m in meta["models"]]
     ref, lines = meta["reference"], []
+    names = axis_names(meta)
     speed = speedups(tables["runtime"], ref, params)
     varying = varying_params(tables["cases"], params)
+    # each axis under its name (kappa.first, not first): the name is the figures' x label,
+    # their legends' and their files'
+    tables = {k: tables[k].rename(columns=names) for k in ("cases", "discrepancies", "runtime")}
+    speed = speed.rename(columns=names)
+    varying = [names.get(p, p) for p in varying]
     for x in varying:
         others = [p for p in varying if p != x]
         logx = (
@@ -152,17 +184,41 @@ def _one_case_figures(
         trajs, qs, rods, fig_dir / f"history_{slug}.png", title=f"case {cid}: all models"
     )
     lines.append(f"![time histories, case {cid}](figures/{hist.name})\n")
-    if "phi" in qs or (sub["quantity"] == "phi").any():
+    moving = _moving(row)
+    drawn, lines_not = _drawn(trajs, moving)
+    if drawn and ("phi" in qs or (sub["quantity"] == "phi").any()):
         snapped = _snapped_times(sub, rep["times"], horizon, (0.25, 0.5, 0.75, 1.0))
         conf = plot_configurations(
-            trajs,
+            drawn,
             snapped,
             l,
             fig_dir / f"configurations_{slug}.png",
             title=f"case {cid}: chain at t = " + ", ".join(f"{t:.4g}" for t in snapped) + " s",
+            moving=moving,
         )
         lines.append(f"![configurations, case {cid}](figures/{conf.name})\n")
-    return lines
+    return [*lines, *lines_not]
+
+
+def _moving(row: pd.Series) -> bool:
+    """Whether the case's base moves (cases.csv's base_kind; a study of an older rodval
+    records none: then only a run's base outputs tell)."""
+    kind = row.get("base_kind")
+    return isinstance(kind, str) and kind != "pinned"
+
+
+def _drawn(trajs: dict[str, Trajectory], moving: bool) -> tuple[dict[str, Trajectory], list[str]]:
+    """The runs whose chain the outputs place (``drawable``; ``moving``: the case's base
+    moves) and a markdown line naming the others (a moving base without outputs x, y),
+    none when every run is drawn."""
+    drawn = {k: t for k, t in trajs.items() if drawable(t, moving)}
+    left = [f"`{k}`" for k in trajs if k not in drawn]
+    if not left:
+        return drawn, []
+    return drawn, [
+        f"_Chain not drawn for {', '.join(left)}: a moving base without outputs x, y, whose "
+        "node 0 is not at the origin; add x, y to the [scene] outputs._\n"
+    ]
 
 
 def deployment_figures(
@@ -180,7 +236,11 @@ def deployment_figures(
             continue
         row = cases[cases["case"] == cid].iloc[0]
         l = np.asarray(json.loads(row["l"]))
-        trajs = _case_runs(sub, labels, cid)
+        moving = _moving(row)
+        trajs, note = _drawn(_case_runs(sub, labels, cid), moving)
+        lines += note
+        if not trajs:
+            continue
         snapped = _snapped_times(
             sub, meta["report"]["times"], float(row["horizon"]), (0.0, 0.25, 0.5, 0.75, 1.0)
         )
@@ -191,6 +251,7 @@ def deployment_figures(
             l,
             fig_dir / f"deployment_{figure_slug(cid)}.png",
             title=f"case {cid}: deployment sequence and tip y (dotted: lock times)",
+            moving=moving,
         )
         lines.append(f"![deployment, case {cid}](figures/{fig.name})\n")
     return lines
