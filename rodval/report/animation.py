@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from rodval.core.base import PINNED, Base, rotate
 from rodval.core.out_paths import write_with
 from rodval.core.trajectory import Trajectory
-from rodval.report.figures import MODEL_COLOURS
+from rodval.report.figures import MODEL_COLOURS, body_outline
 
 #: Output formats and their writers.
 FORMATS = (".gif", ".mp4")
@@ -103,20 +103,17 @@ def node_history(
     )
 
 
-def body_outline(
-    centre: np.ndarray, attitude: np.ndarray, half: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """The body drawn as a square of half side ``half`` (m) about its centre (nt, 2), turned
-    by its attitude (nt,): the closed outline's x, y (m), each (nt, 5)."""
-    corners = half * np.array([[1, 1], [-1, 1], [-1, -1], [1, -1], [1, 1]], float)
-    turned = rotate(np.asarray(attitude)[:, None], corners[None, :, :])
-    return centre[:, None, 0] + turned[..., 0], centre[:, None, 1] + turned[..., 1]
-
-
 def body_size(base: Base, l: np.ndarray) -> float:
     """Half side (m) of the square drawn for a body: its hinge offset's length (node 0 on
     the square's edge), at least 5 % of the chain's length so that it shows."""
     return max(float(np.hypot(*base.hinge_offset)), 0.05 * float(np.sum(l)))
+
+
+def run_base(traj: Trajectory) -> Base:
+    """The base of the scene a run carries (``Trajectory.scene``: a run of ``rodval.simulate``),
+    pinned for a run without one (read from files: its scene is in run.json)."""
+    scene = traj.scene
+    return scene.base if scene is not None else PINNED
 
 
 def _count(times: np.ndarray) -> str:
@@ -209,18 +206,20 @@ def animate_runs(
     """Write the runs' motion to ``path`` (.gif or .mp4): every run's chain in its own colour,
     one frame per frame time (``frame_times``), the time in the title, each latch drawn as a
     red square on its hinge node from its lock time on and each stop contact as an orange
-    diamond at its time, the events so far listed in the corner, a moving base's body as a
-    square in the run's colour at its position and attitude (``body_pose``, ``body_size``).
+    diamond at its time, the latest events so far listed beside the drawing, never over it
+    (``listed``, ``_side_panel``), a moving base's body as a square in the run's colour at
+    its position and attitude (``body_pose``, ``body_size``).
     The missing folders above ``path`` are made; the file is written whole or not at all,
     never through a link (``write_with``). ``lengths``: rod lengths (m)
-    per run label; ``bases``: each run's base (default pinned: the pin drawn at the origin; a
-    free base's chain hangs from its node 0, ``node_history``). Each run is drawn only at
+    per run label; ``bases``: each run's base (default ``run_base``: the base of the scene the
+    run carries, else pinned, the pin drawn at the origin; a free base's chain hangs from its
+    node 0, ``node_history``). Each run is drawn only at
     output times it has: the frames are the times all runs share (``shared_times``).
     Cost O(frames x (n + events)) drawing."""
     path = _check_request(Path(path), runs, fps, frames)
     writer = _writer(path, fps)
     times = frame_times(runs, frames)
-    base = {k: (bases or {}).get(k, PINNED) for k in runs}
+    base = {k: (bases or {}).get(k) or run_base(t) for k, t in runs.items()}
     nodes = {k: node_history(t, np.asarray(lengths[k], float), base[k]) for k, t in runs.items()}
     bodies, notes = _bodies(runs, lengths, base)
     # every frame time is an output time of every run (within 1e-12 s): its own row
@@ -236,14 +235,13 @@ def animate_runs(
     locks = {k: ax.plot([], [], "s", color="red", ms=8, mfc="none", mew=2)[0] for k in runs}
     body = {k: ax.plot([], [], "-", color=lines[k].get_color(), lw=2.2)[0] for k in bodies}
     stops = {k: ax.plot([], [], "D", color="orange", ms=7, mfc="none", mew=1.5)[0] for k in runs}
-    ax.legend(loc="upper right", fontsize=7)
-    note = ax.text(0.01, 0.01, "", transform=ax.transAxes, fontsize=7, va="bottom")
+    note = _side_panel(fig, ax, len(runs))
     head = ax.set_title("")
     step = float(np.median(np.diff(times))) if times.size > 1 else 0.0
 
     def draw(i: int) -> None:
         t = times[i]
-        text = []
+        text: list[tuple[float, str]] = []
         for k in runs:
             x, y = nodes[k][0][index[k][i]], nodes[k][1][index[k][i]]
             lines[k].set_data(x, y)
@@ -254,8 +252,8 @@ def animate_runs(
             recent = [node for te, node, lab in done if "latch" not in lab and t - te <= step]
             locks[k].set_data(x[latched], y[latched])
             stops[k].set_data(x[recent], y[recent])
-            text += [f"{k}: {lab} at {te:.3f} s" for te, _, lab in done[-4:]]
-        note.set_text("\n".join(text))
+            text += [(te, f"{k}: {lab} at {te:.3f} s") for te, _, lab in done]
+        note.set_text("\n".join(listed(text)))
         head.set_text(f"{title + ': ' if title else ''}t = {t:.3f} s")
 
     def produce(tmp: Path) -> None:
@@ -269,14 +267,42 @@ def animate_runs(
     return Animated(path, int(times.size), times, events, tuple(notes))
 
 
+#: The most events the animation lists at a time (the latest), beside the drawing.
+LISTED_EVENTS = 12
+
+
+def listed(events: list[tuple[float, str]]) -> list[str]:
+    """The lines of the event list: the LISTED_EVENTS latest of ``events`` ((t s, text)),
+    in time order, the first line saying how many earlier ones are left out."""
+    events = sorted(events, key=lambda e: e[0])
+    shown = [text for _, text in events[-LISTED_EVENTS:]]
+    more = len(events) - len(shown)
+    return [f"... {more} earlier", *shown] if more else shown
+
+
+def _side_panel(fig: Figure, ax: Any, runs: int) -> Any:
+    """The legend of the ``runs`` and the event list below it, beside the axes in the
+    figure's right part, which the drawing never reaches (the axes end at ``FRAME_RIGHT``
+    of the width): the text object the frames fill (at most LISTED_EVENTS + 1 lines,
+    ``listed``)."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=7)
+    # the legend takes about 0.04 of the height per run below the axes' top (0.9)
+    top = min(0.62, 0.86 - 0.04 * runs)
+    return fig.text(FRAME_RIGHT + 0.02, top, "", fontsize=6.5, va="top", ha="left")
+
+
+#: The right edge of the animation's axes, as a fraction of the figure's width.
+FRAME_RIGHT = 0.62
+
+
 def _frame_axes(
     paths: list[tuple[np.ndarray, np.ndarray]], base: Mapping[str, Base]
 ) -> tuple[Figure, Any]:
     """The animation's figure and axes: equal scales holding every node and body outline of
     ``paths`` ((x, y) histories) with a 5 % margin, and the pin at the origin when a run is
     pinned."""
-    fig = Figure(figsize=(6.4, 5.2))
-    ax = fig.add_subplot()
+    fig = Figure(figsize=(9.0, 5.2))
+    ax = fig.add_axes((0.09, 0.1, FRAME_RIGHT - 0.09, 0.8))
     allx = np.concatenate([x.ravel() for x, _ in paths])
     ally = np.concatenate([y.ravel() for _, y in paths])
     pad = 0.05 * max(float(np.ptp(allx)), float(np.ptp(ally)), 1e-9)
