@@ -76,7 +76,13 @@ from reference_models.exudyn_ending import (
     unaudited_drive,
 )
 from reference_models.exudyn_latches import Latches
-from reference_models.exudyn_observe import body_view, momentum_audit, observe, stop_events
+from reference_models.exudyn_observe import (
+    body_view,
+    momentum_audit,
+    observe,
+    recorded_peaks,
+    stop_events,
+)
 from reference_models.exudyn_settings import (
     newton_record,
     simulation_settings,
@@ -447,6 +453,9 @@ class ExudynModel(Model):
                 observe(scene, self.elements, self.EA, times, t_rec, records, lock_steps)
                 if times.size
                 else {}
+            )
+            stats.peaks = recorded_peaks(
+                scene, self.elements, self.EA, reached, t_rec, records, lock_steps
             )
             stats.energy_residual, audit = account(
                 body_view(scene), self.elements, self.EA, times, t_rec, records, events, observed

@@ -1,5 +1,6 @@
 """The exudyn model's outputs: the scene's quantities at the output times from the recorded
-beam-node states (``observe``; definitions in docs/quantities.md)."""
+beam-node states (``observe``; definitions in docs/quantities.md), and the run's peaks on
+every recorded step (``recorded_peaks``)."""
 
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from reference_models.exudyn_beam import (
 )
 from rodval.core.base import Base
 from rodval.core.bounds import MIN_POSITIVE
-from rodval.core.quantities import tip_deflection
+from rodval.core.quantities import PEAK_QUANTITIES, peak_values, tip_deflection
 from rodval.core.scene import QUANTITIES, Scene, hinge_angles
 from rodval.solvers.audit import audit_times
 
@@ -131,6 +132,26 @@ def observe(
     if scene.wants("base"):
         _base_quantities(at, out)
     return out
+
+
+def recorded_peaks(
+    scene: Scene,
+    E: int,
+    EA: float,
+    steps: np.ndarray,
+    t_rec: np.ndarray,
+    records: dict,
+    lock_steps: dict | None = None,
+) -> dict | None:
+    """The run's peaks (``SolverStats.peaks``) of the ``PEAK_QUANTITIES`` the scene outputs:
+    ``peak_values`` of ``observe`` (the outputs' own quantity functions) at every recorded
+    step ``steps`` (s, those the run kept), whatever the output times; None when the scene
+    outputs none of them."""
+    wanted = tuple(q for q in PEAK_QUANTITIES if scene.wants(q))
+    if not wanted:
+        return None
+    observed = observe(scene.with_(outputs=wanted), E, EA, steps, t_rec, records, lock_steps)
+    return {"read_on": "every recorded step", "values": peak_values(steps, observed)}
 
 
 def _base_quantities(at: dict, out: dict) -> None:

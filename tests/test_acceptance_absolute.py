@@ -47,7 +47,8 @@ def _events():
 
 
 def _tables():
-    """cases (latches on hinges 1 and 2, horizon 2.5 s) and full's trajectories."""
+    """cases (latches on hinges 1 and 2, horizon 2.5 s), full's trajectories and both runs'
+    runtime rows (reached t_end; full's recorded peaks)."""
     traj = pd.DataFrame(
         {
             "case": "c",
@@ -61,7 +62,21 @@ def _tables():
     return {
         "cases": pd.DataFrame({"case": ["c"], "horizon": [2.5], "latch_hinges": ["[1, 2]"]}),
         "discrepancies": pd.DataFrame(columns=["case", "model", "quantity", "status"]),
-        "runtime": pd.DataFrame(columns=["case", "model"]),
+        "runtime": pd.DataFrame(
+            {
+                "case": ["c", "c"],
+                "model": ["full", "reduced"],
+                "status": "success",
+                "t_reached": 2.5,
+                # the runs' peaks as runtime.csv records them (SolverStats.peaks), the same
+                # as full's trajectories above
+                "peaks": [
+                    '{"hinge_moment": [{"k": 0, "peak": 310.0, "t": 1.0}, '
+                    '{"k": 1, "peak": 40.0, "t": 1.0}]}',
+                    None,
+                ],
+            }
+        ),
         "trajectories": traj,
     }
 

@@ -202,9 +202,8 @@ def test_report_names_the_models_whose_hinge_moment_was_not_recorded():
          "peak_moment": [12.0]}
     )  # fmt: skip
     models = [{"label": "full", "model": "full"}, {"label": "exu", "model": "exudyn"}]
-    lines = peak_moment_lines(
-        _traj([("c", "full", "phi", 0.0, 1, 0.1)]), events, models, lambda d: d
-    )
+    tables = {"trajectories": _traj([("c", "full", "phi", 0.0, 1, 0.1)])}
+    lines = peak_moment_lines(tables, events, models, lambda d: d)
     assert "lock window" in lines[1]
     assert "`full`, `exu` are not recorded" in lines[2]
 

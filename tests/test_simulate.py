@@ -56,7 +56,9 @@ def test_reduced_model_recovers_bending_only_when_asked(monkeypatch):
     simulate(paper_scene(t_end=0.5, times=[0.5], outputs=("phi",)), "reduced")
     assert calls == []
     simulate(paper_scene(t_end=0.5, times=[0.25, 0.5], outputs=("alpha",)), "reduced")
-    assert calls == [0.25, 0.5]
+    # asked: at the output times, then at the states alpha's peak is read on, between them
+    # (the run's peaks, SolverStats.peaks: rodval.solvers.outputs.PeakGrid)
+    assert calls[:2] == [0.25, 0.5] and len(calls) > 2
 
 
 @pytest.mark.parametrize(

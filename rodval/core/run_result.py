@@ -52,6 +52,12 @@ class SolverStats:
     #: reduced model's quasi-static bending has no bending rates for the rods' bending
     #: damping to act on): ``rodval.core.contract.Model.scene_notes``.
     notes: list[str] = field(default_factory=list)
+    #: The largest |value| of each ``rodval.core.quantities.PEAK_QUANTITIES`` the scene
+    #: outputs, read between the output times, so that it is the run's and not its output
+    #: grid's: ``{"read_on": how, "values": {quantity: [{"k", "peak", "t" (s)}, ...]}}`` (a
+    #: hinge whose moment is impulsive at its lock: ``peak`` None, ``impulse`` N m s, ``t``
+    #: the lock's time; ``rodval.core.quantities.impulsive_locks``); None: none recorded.
+    peaks: dict[str, Any] | None = None
 
     def __setattr__(self, name: str, value: Any) -> None:
         if name == "status":
@@ -83,6 +89,7 @@ class SolverStats:
             "validity": [dict(c) for c in self.validity],
             "switch": None if self.switch is None else dict(self.switch),
             "notes": list(self.notes),
+            "peaks": None if self.peaks is None else dict(self.peaks),
         }
 
     #: The name callers used before ``to_dict``.

@@ -17,6 +17,7 @@ if TYPE_CHECKING:
 #: trajectory's readers have always imported it.
 __all__ = [
     "RESULT_KEYS",
+    "RUN_SETTINGS",
     "SolverStats",
     "Trajectory",
     "UnknownQuantity",
@@ -206,6 +207,22 @@ class Trajectory:
             return pd.DataFrame(columns=["t", "quantity", "k", "value"])
         return pd.concat(parts, ignore_index=True)
 
+
+#: The integrator settings that change what a run computes (``Trajectory.settings``; the
+#: ones that only stop a run, budgets and the divergence guard, are not among them): every
+#: table of runs shows each (a study's runtime.csv, its report's Models table), so that a run
+#: is never read without them (a run with ``error_control = "per-block"`` takes fewer
+#: evaluations and leaves a larger energy residual than a uniform one, issue 54).
+RUN_SETTINGS = (
+    "method",
+    "rtol",
+    "atol",
+    "max_step",
+    "first_step",
+    "error_control",
+    "block_frequency",
+    "bending_scale",
+)
 
 #: The fields of a run's result, the same in memory, in a case record and in run.json.
 RESULT_KEYS = ("model", "options", "settings", "stats", "events")

@@ -4,8 +4,10 @@ valid), per case and event bound (the locks against the reference's,
 ``rodval.analysis.events.lock_comparison``), per model for ``all_latched``, per run for the
 residuals, per case and absolute requirement of a model's own results
 ([[acceptance.require]]: every latch locked by a time, a hinge's lock time and |impulse| in
-a range from events.csv, the peak |hinge_moment| over the output times and a quantity's
-value at t_end from trajectories.csv; ``_require_checks``); the breaches as one line each
+a range from events.csv, the peak |hinge_moment| the run recorded between its output times
+(runtime.csv's ``peaks``, ``SolverStats.peaks``) and a quantity's value at t_end from
+trajectories.csv; ``_require_checks``; a run that did not reach t_end breaks every
+requirement on it, in one line); the breaches as one line each
 (``acceptance breached: CASE: MODEL: hinge 2 lock time: t = 0.6312 s > max 0.61 s``), and
 a JUnit XML report that CI systems display (one test case per check, a ``<failure>`` exactly
 where a bound broke).
@@ -37,8 +39,9 @@ SCALAR_KEYS = ("all_latched", "energy_residual", "momentum_residual")
 #: What an [[acceptance.require]] table may require of a model's own results (absolute, not
 #: against the reference): ``locked_by`` (s, every latch of the scene locked at or before),
 #: ``lock_time`` (s, a hinge's lock time in [min, max]), ``impulse`` (N m s, |a hinge's lock
-#: impulse| in [min, max]), ``peak_hinge_moment`` (N m, max |hinge_moment| over the output
-#: times), ``final`` (a quantity's value at the last output time in [min, max]).
+#: impulse| in [min, max]), ``peak_hinge_moment`` (N m, the run's max |hinge_moment|, read
+#: between the output times: ``SolverStats.peaks``), ``final`` (a quantity's value at the last
+#: output time in [min, max]).
 REQUIRE_ITEMS = ("locked_by", "lock_time", "impulse", "peak_hinge_moment", "final")
 #: Why a run has no energy residual: it was not audited.
 NO_ENERGY_RESIDUAL = (
@@ -190,15 +193,18 @@ def _residual_checks(spec: dict[str, Any], case: str, runtime: pd.DataFrame) -> 
 
 def _own_results(tables: dict[str, pd.DataFrame], events: pd.DataFrame) -> dict[str, Any]:
     """What the requirements read, split by case once (case as text): its cases.csv row,
-    its trajectories and its events."""
+    its trajectories, its events and its runs' runtime.csv rows by model."""
 
     def by_case(frame: pd.DataFrame) -> dict[str, pd.DataFrame]:
         return dict(iter(frame.groupby(frame["case"].astype(str), sort=False)))
 
     empty = pd.DataFrame(columns=["case", "model", "t", "quantity", "k", "value"])
     cases = tables["cases"].assign(case=tables["cases"]["case"].astype(str)).set_index("case")
+    runtime = tables["runtime"]
+    runs = {(str(r["case"]), str(r["model"])): r for _, r in runtime.iterrows()}
     return {
         "cases": cases,
+        "runs": runs,
         "trajectories": by_case(tables.get("trajectories", empty)),
         "events": by_case(events),
         "empty": empty,
@@ -210,9 +216,10 @@ def _require_checks(requires: list[dict[str, Any]], case: str, own: dict[str, An
     """One check per requirement of each [[acceptance.require]] table in ``case`` (classname
     ``acceptance.require``), from the model's own lock events and trajectories (``own``:
     ``_own_results``): locked_by (every latch of the case's latch_hinges), lock_time and
-    impulse (the hinge's first lock), peak_hinge_moment (max |hinge_moment| over the output
-    times), final (the value at the case's horizon). A lock, value or time that is not there
-    breaks the requirement."""
+    impulse (the hinge's first lock), peak_hinge_moment (the run's recorded peak,
+    ``_peak_check``), final (the value at the case's horizon). A lock, value or time that is
+    not there breaks the requirement; a run that did not reach t_end breaks its table in one
+    check that says how it ended (``_unfinished``)."""
     if not requires:
         return []
     row = own["cases"].loc[case]
@@ -222,6 +229,11 @@ def _require_checks(requires: list[dict[str, Any]], case: str, own: dict[str, An
     for req in requires:
         model = req["model"]
         head = f"{case}: {model}"
+        run = own["runs"].get((case, model))
+        stopped = _unfinished(run, float(row["horizon"]))
+        if stopped:
+            checks.append(Check("acceptance.require", f"{head}: requirements", stopped))
+            continue
         locks = _first_locks(ev[ev["model"] == model])
         if "locked_by" in req:
             latched = json.loads(str(row.get("latch_hinges", "[]")))
@@ -239,12 +251,30 @@ def _require_checks(requires: list[dict[str, Any]], case: str, own: dict[str, An
                 "no lock" if lock is None else f"no impulse recorded (lock at t = {lock[0]:.6g} s)"
             )
             checks.append(_range_check(name, "|impulse|", value, r, "N m s", absent))
-        own = traj[traj["model"] == model]
+        mine = traj[traj["model"] == model]
         if "peak_hinge_moment" in req:
-            checks.append(_peak_check(head, req["peak_hinge_moment"], own))
+            checks.append(_peak_check(head, req["peak_hinge_moment"], run))
         for r in req.get("final", []):
-            checks.append(_final_check(head, r, own, float(row["horizon"])))
+            checks.append(_final_check(head, r, mine, float(row["horizon"])))
     return checks
+
+
+def _unfinished(run: pd.Series | None, horizon: float) -> str:
+    """Why a run's requirements cannot hold (its runtime.csv row ``run``; None: the tables
+    have no row for it, nothing to say): it failed or stopped before the case's horizon
+    (s). "" for a run that reached t_end."""
+    if run is None:
+        return ""
+    status = str(run.get("status", "success"))
+    t = pd.to_numeric(pd.Series([run.get("t_reached")]), errors="coerce").iloc[0]
+    short = not pd.isna(t) and float(t) < horizon * (1 - 1e-9)
+    if status == "success" and not short:
+        return ""
+    reached = "unknown" if pd.isna(t) else f"{float(t):.6g} s"
+    return (
+        f"the run did not reach t_end (status {status}, t reached = {reached} of {horizon:g} s): "
+        "no requirement is judged on a partial run"
+    )
 
 
 def _first_locks(events: pd.DataFrame) -> dict[int, tuple[float, float]]:
@@ -289,18 +319,33 @@ def _locked_by_check(
     return Check("acceptance.require", name, f"{', '.join(late)} > {by:g} s" if late else "")
 
 
-def _peak_check(head: str, r: dict[str, Any], traj: pd.DataFrame) -> Check:
-    """max |hinge_moment| over the output times (of r's hinge, or of every hinge) <= max."""
-    rows = traj[traj["quantity"] == "hinge_moment"]
+def _peak_check(head: str, r: dict[str, Any], run: pd.Series | None) -> Check:
+    """The run's peak |hinge_moment| (of r's hinge, or of every hinge) <= max: the peak the
+    run recorded between its output times (runtime.csv's ``peaks``: ``SolverStats.peaks``),
+    never the output times' own. A run without a recorded peak (a study of an older rodval)
+    or whose hinge moment is impulsive at a lock (its entry holds the lock's impulse)
+    breaks it, saying so."""
     which = "every hinge" if "hinge" not in r else f"hinge {r['hinge']}"
-    if "hinge" in r:
-        rows = rows[rows["k"] == r["hinge"]]
     name = f"{head}: peak |hinge_moment| ({which})"
-    values = rows["value"].abs()
-    if values.empty or values.isna().any():
-        return Check("acceptance.require", name, "no hinge_moment values (run failed?)")
-    at = rows.loc[values.idxmax()]
-    peak = float(values.max())
+    raw = None if run is None else run.get("peaks")
+    if raw is None or pd.isna(raw) or "hinge_moment" not in json.loads(str(raw)):
+        why = "no peak recorded between the output times (run the study again to record it)"
+        return Check("acceptance.require", name, why)
+    entries = json.loads(str(raw))["hinge_moment"]
+    if "hinge" in r:
+        entries = [e for e in entries if int(e["k"]) == r["hinge"]]
+    impulsive = [e for e in entries if e.get("impulse") is not None]
+    if impulsive:
+        e = impulsive[0]
+        why = (
+            f"hinge {e['k']}'s moment is impulsive at its lock (t = {e['t']:.6g} s, impulse "
+            f"{e['impulse']:.6g} N m s): no finite peak; bound its impulse instead"
+        )
+        return Check("acceptance.require", name, why)
+    if not entries or any(e["peak"] is None for e in entries):
+        return Check("acceptance.require", name, "no finite hinge_moment recorded")
+    at = max(entries, key=lambda e: float(e["peak"]))
+    peak = float(at["peak"])
     where = "" if "hinge" in r else f" (hinge {int(at['k'])})"
     fail = (
         ""

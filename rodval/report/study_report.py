@@ -26,6 +26,7 @@ from typing import Any
 
 import pandas as pd
 
+from rodval.analysis.agreement import latch_hinges, lock_list, never_locked
 from rodval.analysis.events import (
     COMPARABLE_DT_S,
     COMPARABLE_ENERGY,
@@ -35,15 +36,17 @@ from rodval.analysis.events import (
 from rodval.core.lock_window import MIN_WINDOW_STEPS
 from rodval.core.out_paths import STUDY_SCHEMA, is_stamped, write_file
 from rodval.core.quantities import models_with
+from rodval.core.trajectory import RUN_SETTINGS
 from rodval.models import get_model
 from rodval.models.presets.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
 from rodval.report.error_budget import error_budget
 from rodval.report.markdown import to_markdown
 from rodval.report.sample_stats import sample_events_section, sample_section
+from rodval.report.sensitivity import sensitivity_section
 from rodval.report.study_figures import case_figures, deployment_figures, param_figures
 from rodval.report.study_modes import modes_section
-from rodval.report.study_summary import answer_section, summary_sections
+from rodval.report.study_summary import opening_section, summary_sections
 from rodval.report.tables import (
     ERROR_BUDGET,
     FIGURES,
@@ -81,20 +84,26 @@ def residual_vibration(
     tip's y amplitude (max - min) / 2 and mean (m), the largest |alpha| and |beta| (rad), and
     the chord angles' spread max - min of phi over the rods at the last output time (rad, 0
     for a straight chain). Models without events are measured after the last lock of any
-    model of the case."""
+    model of the case. ``never_locked``: the case's latches (cases.csv's latch_hinges) the
+    run never locked: it is not deployed (a run that locked none has that column only)."""
     rows = []
+    hinges = latch_hinges(cases)
     for (case, model), part in traj.groupby(["case", "model"], sort=False):
         evs = events[events["case"] == case]
         own = evs[evs["model"] == model]
         use = own if not own.empty else evs
+        missed = never_locked(hinges.get(case, []), lock_list(events, case, model))
+        unlocked = {"never_locked": missed} if missed else {}
         if use.empty:
+            if missed:
+                rows.append({"case": case, "model": model, "locks": 0, **unlocked})
             continue
         ends = use["t"].astype(float)
         if "impulse_window" in use:
             ends = ends + use["impulse_window"].astype(float).fillna(0.0)
         t_last = float(ends.max())
         after = part[part["t"] > t_last]
-        row = {"case": case, "model": model, "last_lock_end": t_last, "locks": len(own)}
+        row = {"case": case, "model": model, "last_lock_end": t_last, "locks": len(own), **unlocked}
         n = int(cases.loc[cases["case"] == case, "n"].iloc[0]) if not cases.empty else None
         tip = after[(after["quantity"] == "y") & (after["k"] == n)]["value"]
         if not tip.empty:
@@ -112,44 +121,92 @@ def residual_vibration(
     return pd.DataFrame(rows)
 
 
+def recorded_peaks(runtime: pd.DataFrame, quantity: str = "hinge_moment") -> pd.DataFrame:
+    """The runs' recorded peaks of ``quantity`` (runtime.csv's ``peaks``, each run's
+    ``SolverStats.peaks``, read between its output times): one row per case, model and k
+    with ``peak`` (|value|, the quantity's unit, blank where it is an impulse), ``t_peak``
+    (s), ``impulse`` (N m s, a hinge whose moment is an impulse at its lock) and ``source``
+    (what the peak was read on: ``peaks_read_on``). Empty without recorded peaks."""
+    rows = []
+    if "peaks" in runtime:
+        for _, run in runtime.dropna(subset=["peaks"]).iterrows():
+            for e in json.loads(str(run["peaks"])).get(quantity, []):
+                rows.append(
+                    {
+                        "case": run["case"],
+                        "model": run["model"],
+                        "k": int(e["k"]),
+                        "peak": e["peak"],
+                        "t_peak": e["t"],
+                        "impulse": e.get("impulse"),
+                        "source": str(run.get("peaks_read_on", "")),
+                    }
+                )
+    cols = ["case", "model", "k", "peak", "t_peak", "impulse", "source"]
+    return pd.DataFrame(rows, columns=cols).astype(
+        {"peak": float, "t_peak": float, "impulse": float}
+    )
+
+
 def peak_hinge_moments(
-    traj: pd.DataFrame, events: pd.DataFrame, models: list[dict[str, Any]] | None = None
+    traj: pd.DataFrame,
+    events: pd.DataFrame,
+    models: list[dict[str, Any]] | None = None,
+    runtime: pd.DataFrame | None = None,
 ) -> pd.DataFrame:
     """Largest |hinge moment| (N m) per case, model and hinge, one row each: ``peak_moment``
-    over the output times of the "hinge_moment" trajectories of every model that outputs it
+    the run's, read between its output times (``recorded_peaks`` of ``runtime``, its time
+    ``t_peak``, ``source`` what it was read on; a hinge whose moment is an impulse at its
+    lock: no peak, its ``impulse`` N m s); a run without a recorded peak (a study of an older
+    rodval) gives the peak over the output times of its "hinge_moment" trajectory
+    (``source`` "hinge_moment"), for every model that outputs it
     (``rodval.core.quantities.models_with``; ``models``: the study's ``[{"label", "model"}]``,
-    None: every model in ``traj``), ``source`` "hinge_moment"; beside it ``window_peak``, the
-    lock windows' peak where the model's lock records carry one (``peak_moment`` of
-    events.csv: exudyn's, over every step of the window, so it can exceed the output times'
-    peak). A model with only the lock records gives their peak (``source`` "lock window")."""
+    None: every model in ``traj``). Beside it ``window_peak``, the lock windows' peak where the
+    model's lock records carry one (``peak_moment`` of events.csv: exudyn's, over every step
+    of the window). A model with only the lock records gives their peak (``source`` "lock
+    window")."""
     keys = ["case", "model", "hinge"]
     hm = traj[traj["quantity"] == "hinge_moment"]
     if models is not None:
         labels = {m["label"] for m in models if models_with("hinge_moment", [m["model"]])}
         hm = hm[hm["model"].isin(labels)]
-    peaks = pd.DataFrame(columns=[*keys, "peak_moment"])
+    rec = recorded_peaks(runtime if runtime is not None else pd.DataFrame())
+    rec = rec.rename(columns={"k": "hinge", "peak": "peak_moment"})
+    runs = set(zip(rec["case"].astype(str), rec["model"]))
+    hm = hm[[(str(c), m) not in runs for c, m in zip(hm["case"], hm["model"])]]
+    peaks = rec[[*keys, "peak_moment", "t_peak", "source", "impulse"]]
     if not hm.empty:
         g = hm.assign(abs_value=hm["value"].abs()).groupby(["case", "model", "k"], sort=False)
-        peaks = g["abs_value"].max().reset_index()
-        peaks = peaks.rename(columns={"k": "hinge", "abs_value": "peak_moment"})
-        peaks["hinge"] = peaks["hinge"].astype(int)
+        at = g["abs_value"].idxmax()
+        grid = pd.DataFrame(
+            {
+                "case": [c for c, _, _ in at.index],
+                "model": [m for _, m, _ in at.index],
+                "hinge": [int(k) for _, _, k in at.index],
+                "peak_moment": hm["value"].abs()[at.to_numpy()].to_numpy(),
+                "t_peak": hm["t"][at.to_numpy()].to_numpy(),
+                "source": "hinge_moment",
+            }
+        )
+        peaks = pd.concat([peaks, grid], ignore_index=True) if not peaks.empty else grid
     window = pd.DataFrame(columns=[*keys, "window_peak"])
     if "peak_moment" in events and events["peak_moment"].notna().any():
         part = events.dropna(subset=["peak_moment"])
         window = part.groupby(keys, sort=False)["peak_moment"].max().reset_index()
         window = window.rename(columns={"peak_moment": "window_peak"})
         window["hinge"] = window["hinge"].astype(int)
+    cols = [*keys, "peak_moment", "t_peak", "source", "impulse", "window_peak"]
     if window.empty:
-        return peaks.assign(source="hinge_moment") if not peaks.empty else pd.DataFrame()
+        return peaks.reindex(columns=cols) if not peaks.empty else pd.DataFrame()
     if peaks.empty:
-        return window.assign(peak_moment=window["window_peak"], source="lock window")[
-            [*keys, "peak_moment", "source", "window_peak"]
-        ]
-    out = peaks.assign(source="hinge_moment").merge(window, on=keys, how="outer")
-    only = out["peak_moment"].isna()
+        return window.assign(peak_moment=window["window_peak"], source="lock window").reindex(
+            columns=cols
+        )
+    out = peaks.merge(window, on=keys, how="outer")
+    only = out["source"].isna()
     out["source"] = out["source"].where(~only, "lock window")
     out["peak_moment"] = out["peak_moment"].where(~only, out["window_peak"])
-    return out[[*keys, "peak_moment", "source", "window_peak"]]
+    return out.reindex(columns=cols)
 
 
 def _blanks(df: pd.DataFrame) -> pd.DataFrame:
@@ -217,10 +274,10 @@ def _deployment_section(
             "lock impulses, rigid_rel = the same of the rigid-panel impulses; dE_lost in J, "
             "of different quantities, see above). A lock is compared pointwise only when the "
             "models reach it in the same state: every earlier lock within "
-            f"{COMPARABLE_DT_S * 1e3:g} ms of the reference's and the kinetic energy before it "
-            f"within {COMPARABLE_ENERGY:.0%}, and neither lock grazing (its rigid-panel lock "
-            f"taking less than {GRAZING_LOSS:.0%} of the kinetic energy: the hinge creeps onto "
-            "the latch angle, and its time hangs on small differences of state), neither "
+            f"{COMPARABLE_DT_S * 1e3:g} ms of the reference's and the kinetic plus bending "
+            f"energy before it within {COMPARABLE_ENERGY:.0%}, and neither lock grazing (its "
+            f"rigid-panel lock taking less than {GRAZING_LOSS:.0%} of the kinetic energy: the "
+            "hinge creeps onto the latch angle, and its time hangs on small differences of state), neither "
             "lock's window overlapping another lock of its run (the windowed impulses are not "
             "separable) and neither an exudyn window of fewer than "
             f"{MIN_WINDOW_STEPS} steps of its fixed step; "
@@ -231,29 +288,47 @@ def _deployment_section(
             "\n",
             to_markdown(keep(disc), ".3g"),
         ]
-    lines += peak_moment_lines(tables["trajectories"], events, meta["models"], keep)
+    lines += peak_moment_lines(tables, events, meta["models"], keep)
     resid = residual_vibration(tables["trajectories"], events, tables["cases"])
     if not resid.empty:
         lines += [
             "Residual vibration after the last lock (tip y amplitude and mean in m, largest "
-            "|alpha|, |beta| in rad, spread of the chord angles at the end in rad):\n",
+            "|alpha|, |beta| in rad, spread of the chord angles at the end in rad"
+            + (
+                "; `never_locked`: the latches that did not lock within the run, which is "
+                "then not deployed: its motion after the last lock is a partly folded "
+                "structure's, not a deployed one's residual vibration"
+                if "never_locked" in resid
+                else ""
+            )
+            + "):\n",
             to_markdown(keep(resid), ".4g"),
         ]
     return [*lines, *deployment_figures(fig_dir, meta, tables, events)]
 
 
 def peak_moment_lines(
-    traj: pd.DataFrame, events: pd.DataFrame, models: list[dict[str, Any]], keep: Any
+    tables: dict[str, pd.DataFrame],
+    events: pd.DataFrame,
+    models: list[dict[str, Any]],
+    keep: Any,
 ) -> list[str]:
-    """The peak hinge moments' table (``peak_hinge_moments``) as markdown lines; none when
-    no model recorded a hinge moment."""
-    peaks = peak_hinge_moments(traj, events, models)
+    """The peak hinge moments' table (``peak_hinge_moments`` of the study's trajectories and
+    runtime ``tables``) as markdown lines; none when no model recorded a hinge moment."""
+    traj = tables["trajectories"]
+    peaks = peak_hinge_moments(traj, events, models, tables.get("runtime"))
     if peaks.empty:
         return []
     lines = [
-        "Peak hinge moments (N m): `peak_moment` over the output times from every model that "
-        "outputs `hinge_moment`; `window_peak` over every step of a lock window where the "
-        "model's lock records carry it:\n",
+        "Peak hinge moments (N m): `peak_moment` is each run's largest |hinge_moment|, at "
+        "`t_peak` (s), read between the output times as `source` says (the native models on "
+        "their dense output: a fixed grid of [0, t_end] and the lock windows; exudyn on every "
+        "recorded step), so the same run gives the same peak whatever its output times; "
+        "`source` `hinge_moment`: over the output times only (a run that recorded no peak); "
+        "a hinge whose moment is an impulse at its lock (an ideal latch on rigid chords: the "
+        "reduced and rigid models) has no finite peak: `impulse` gives the lock's (N m s); "
+        "`window_peak` over every step of a lock window where the model's lock records carry "
+        "it:\n",
         to_markdown(_blanks(keep(peaks)), ".4g"),
     ]
     recorded = set(traj.loc[traj["quantity"] == "hinge_moment", "model"])
@@ -264,7 +339,7 @@ def peak_moment_lines(
     ]
     if unrecorded:
         lines.append(
-            "Without `hinge_moment` among the [scene] outputs the output times' peaks of "
+            "Without `hinge_moment` among the [scene] outputs the peaks of "
             + ", ".join(f"`{label}`" for label in unrecorded)
             + " are not recorded: add it there to compare every model's.\n"
         )
@@ -313,8 +388,10 @@ def _error_budget_section(
 
 def model_row(m: dict[str, Any]) -> dict[str, Any]:
     """A study model's row of the report's Models table: its options as the model runs them
-    (defaults included) and the integrator settings that apply to it; "n/a" for a model that
-    integrates itself (exudyn: the study's [integrator] does not apply, its own step does)."""
+    (defaults included: the full model's kinematics and shapes, exudyn's step) and every
+    integrator setting that changes what runs (``rodval.core.trajectory.RUN_SETTINGS``: the
+    method, tolerances, steps, error control); "n/a" for a model that integrates itself
+    (exudyn: the study's [integrator] does not apply, its own step does)."""
     try:
         options = get_model(m["model"], **m["options"]).options()
         uses = uses_integrator(m["model"])
@@ -325,8 +402,14 @@ def model_row(m: dict[str, Any]) -> dict[str, Any]:
         "label": m["label"],
         "model": m["model"],
         "options": json.dumps(options) if options else "",
-        **{k: settings[k] if uses else "n/a" for k in ("method", "rtol", "atol")},
+        **{k: _setting(settings.get(k)) if uses else "n/a" for k in RUN_SETTINGS},
     }
+
+
+def _setting(value: Any) -> Any:
+    """A setting as the Models table shows it: None (the integrator chooses, e.g. the first
+    step) blank."""
+    return "" if value is None else value
 
 
 def study_file(meta: dict[str, Any]) -> str:
@@ -354,6 +437,7 @@ def _header(meta: dict[str, Any], prov: dict[str, Any], constants: dict[str, Any
     mach = prov["machine"]
     pkgs = ", ".join(f"{k} {v}" for k, v in prov["packages"].items() if v)
     units = {"horizon": " s"}
+    compared = len(meta["models"]) > 1  # one model: no reference to name
     same = ", ".join(
         f"{k} = {v:g}{units.get(k, '')}" if isinstance(v, float) else f"{k} = {v}"
         for k, v in constants.items()
@@ -362,10 +446,11 @@ def _header(meta: dict[str, Any], prov: dict[str, Any], constants: dict[str, Any
     return [
         "## Study\n",
         f"{meta['description']}\n" if meta["description"] else "",
-        f"Study file: `{study_file(meta)}` (copied to `study.toml`). {_design(meta)}. "
-        f"Reference model: `{meta['reference']}`."
+        f"Study file: `{study_file(meta)}` (copied to `study.toml`). {_design(meta)}."
+        + (f" Reference model: `{meta['reference']}`." if compared else "")
         + (
-            f" Left out of the tables as the same throughout: {same} and the reference."
+            f" Left out of the tables as the same throughout: {same}"
+            + (" and the reference." if compared else ".")
             if same
             else ""
         )
@@ -410,7 +495,8 @@ def build_report(out: str | Path) -> Path:
     fig_dir.mkdir(exist_ok=True)
     events = read_events(out)
     constants = study_constants(tables["cases"], meta["reference"])
-    lines = [f"# Study `{meta['name']}`\n", *answer_section(meta, tables, events)]
+    peaks = peak_hinge_moments(tables["trajectories"], events, meta["models"], tables["runtime"])
+    lines = [f"# Study `{meta['name']}`\n", *opening_section(meta, tables, events, peaks)]
     lines += _header(meta, prov, constants)
     lines += acceptance_section(meta, tables, events)
     lines += summary_sections(meta, tables, params, constants)
@@ -419,6 +505,13 @@ def build_report(out: str | Path) -> Path:
     if figs:
         lines += ["## Discrepancy, run time and speed-up against the grid parameters\n", *figs]
     lines += sample_section(meta, tables, events)
+    lines += sensitivity_section(
+        fig_dir,
+        meta,
+        tables,
+        events,
+        peaks,
+    )
     lines += _deployment_section(fig_dir, meta, tables, events, constants)
     lines += modes_section(out, fig_dir, meta)
     lines += ["## Time histories and configurations\n", *case_figures(fig_dir, meta, tables)]

@@ -16,7 +16,9 @@ Small parts, each in its own place:
 * divergence guard (``rodval.solvers.guard``) after every accepted step;
 * energy audit (``rodval.solvers.audit``) on the dense output of every accepted step, its
   residual read on the audit grid (``audit.audit_times``), as the momentum audit's;
-* observation at the output times reached.
+* observation at the output times reached; the run's peaks (``SolverStats.peaks``) on the
+  peak grid and the lock windows' probes of the dense output (``outputs.PeakGrid``), not on
+  the output times.
 
 Dense output is formed only on steps that contain output times, events, or when the scene asks
 for "energy". A failure ends the run early with a status, a message and the time reached; the
@@ -32,6 +34,7 @@ from typing import Any
 import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
+from rodval.core.quantities import PEAK_QUANTITIES
 from rodval.core.scene import Scene
 from rodval.core.settings import AUTO, COMPILED_METHODS, IntegratorSettings
 from rodval.core.status import (
@@ -55,7 +58,7 @@ from rodval.solvers.audit import (
 from rodval.solvers.events import EventMonitor, apply_hit
 from rodval.solvers.guard import DivergenceGuard
 from rodval.solvers.limits import MAX_IMPLICIT_SIZE
-from rodval.solvers.outputs import AuditGrid, LockWindows, Outputs
+from rodval.solvers.outputs import AuditGrid, LockWindows, Outputs, PeakGrid
 from rodval.solvers.progress import report
 from rodval.solvers.system import OdeSystem
 
@@ -425,6 +428,18 @@ def _observe(
     return reached, Y, observed
 
 
+def _read_peaks(
+    peaks: PeakGrid, system: OdeSystem, events: list[dict[str, Any]], stats: SolverStats
+) -> None:
+    """``stats.peaks`` from the peak grid's states up to the time reached (``PeakGrid.read``);
+    a failed reading sets the run's status and message (a peak is never silently missing)."""
+    try:
+        stats.peaks = peaks.read(system, stats.t_reached, events)
+    except Exception as exc:  # noqa: BLE001 - reported as the run's failure
+        status, message = _failure(exc, stats.t_reached)
+        update_status(stats, status, f"reading the peaks failed: {message}")
+
+
 def integrate(
     system: OdeSystem,
     scene: Scene,
@@ -451,7 +466,9 @@ def integrate(
     momentum = _audits_momentum(system, scene)
     # the audits' fixed grid, recorded beside the output times
     grid = AuditGrid(scene.t_end) if audit or momentum else None
-    out = Outputs(times, system.y0.size, windows, grid)
+    # the peaks' grid of the dense output, when the scene outputs a peak quantity
+    peaks = PeakGrid(scene.t_end, system.y0.size) if scene.wants(*PEAK_QUANTITIES) else None
+    out = Outputs(times, system.y0.size, windows, grid, peaks)
     stats = SolverStats()
     y = system.y0.astype(float).copy()
     ledger = PowerLedger(system.power) if audit else None
@@ -482,6 +499,8 @@ def integrate(
     _bending_validity(system, reached, Y[: reached.size], observed, stats)
     if momentum:
         _momentum_audit(system, out.Y[out.audit_rows()], stats)
+    if peaks is not None and observed:
+        _read_peaks(peaks, system, events, stats)
     stats.wall_s = time.perf_counter() - start
     return finish(
         stats,

@@ -8,7 +8,9 @@ run's trajectory is the same with or without them. A probe's state goes to its w
 while the system is still in the mode of that time. The audit grid (``AuditGrid``: a fixed
 grid of [0, t_end]) is recorded beside the output times, on the same dense output: the
 momentum and energy audits are read there, so that their residuals are the run's and not the
-output grid's.
+output grid's. The peak grid (``PeakGrid``: a finer fixed grid of [0, t_end]) and the lock
+windows' probes give the states the run's peaks are read on (``SolverStats.peaks``), likewise
+independent of the output times.
 """
 
 from __future__ import annotations
@@ -18,8 +20,18 @@ from typing import Any
 import numpy as np
 
 from rodval.core.lock_window import window_energies, window_nodes
+from rodval.core.quantities import impulsive_locks, peak_values
 from rodval.solvers.audit import audit_times
 from rodval.solvers.system import OdeSystem
+
+#: Intervals of the peak grid (``peak_times``): a run's peaks are read on PEAK_INTERVALS + 1
+#: evenly spaced times of [0, t_end] of its dense output and on its lock windows' probes
+#: (``rodval.core.lock_window.window_nodes``: 256 in each window, the first bending period
+#: after a lock), whatever the output times.
+PEAK_INTERVALS = 4000
+#: The most state values (doubles) the peak grid's states may hold: a system of N states
+#: gets min(PEAK_INTERVALS, PEAK_MAX_VALUES // N) intervals (160 MB at most).
+PEAK_MAX_VALUES = 20_000_000
 
 
 def _add(total: float, terms: np.ndarray) -> float:
@@ -160,6 +172,57 @@ class AuditGrid:
         self.times = audit_times(t_end)
 
 
+def peak_times(t_end: float, size: int) -> np.ndarray:
+    """The peak grid (s): evenly spaced times of [0, t_end], PEAK_INTERVALS intervals, fewer
+    for a system of ``size`` states whose grid would hold more than PEAK_MAX_VALUES values
+    (at least one interval)."""
+    intervals = max(1, min(PEAK_INTERVALS, PEAK_MAX_VALUES // max(size, 1)))
+    return np.linspace(0.0, float(t_end), intervals + 1)
+
+
+class PeakGrid:
+    """The states a run's peaks are read on: the peak grid's (``peak_times``) and the lock
+    windows' probes, taken from the dense output as ``Outputs`` writes them (never a step
+    changed), and observed after the run (``read``) in the mode in effect at each time."""
+
+    def __init__(self, t_end: float, size: int):
+        self.times = peak_times(t_end, size)
+        self.i = 0  # the grid times taken
+        self._t: list[np.ndarray] = []
+        self._Y: list[np.ndarray] = []
+
+    def pending(self) -> np.ndarray:
+        """The grid times not yet taken."""
+        return self.times[self.i :]
+
+    def take(self, times: np.ndarray, Y: np.ndarray, grid: int) -> None:
+        """States Y (m, N) at ``times`` (s), of which ``grid`` are the next grid times."""
+        if len(times):
+            self._t.append(np.array(times, float))
+            self._Y.append(np.array(Y, float))
+        self.i += grid
+
+    def read(
+        self, system: OdeSystem, t_reached: float, events: list[dict[str, Any]]
+    ) -> dict[str, Any]:
+        """The run's peaks (``SolverStats.peaks``): ``peak_values`` of ``system.observe`` (the
+        outputs' own quantity functions) at the states taken up to ``t_reached`` (s), in time
+        order. A system without bending coordinates (``bending_mask`` None: the reduced and
+        rigid chains) locks its chords plastically: a hinge that locked reports the lock's
+        impulse, not a peak (``impulsive_locks``, from the run's ``events``)."""
+        times = np.concatenate(self._t) if self._t else np.zeros(0)
+        Y = np.concatenate(self._Y) if self._Y else np.zeros((0, 0))
+        order = np.argsort(times, kind="stable")
+        keep = order[times[order] <= t_reached]
+        observed = system.observe(times[keep], Y[keep]) if keep.size else {}
+        values = peak_values(times[keep], observed)
+        if system.bending_mask() is None:
+            impulsive_locks(values, events)
+        grid = self.times.size - 1
+        how = f"dense output ({grid} intervals, lock windows)"
+        return {"read_on": how, "values": values}
+
+
 def _recorded(scene: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, ...]:
     """(times, is-scene, is-grid) of the recorded rows: the scene's output times and the
     grid's, sorted, a time in both once."""
@@ -170,10 +233,16 @@ def _recorded(scene: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, ...]:
     return times, is_scene, is_grid
 
 
+#: The kinds of the times ``Outputs`` plans: a recorded row (an output or audit-grid time), a
+#: lock window's probe, a peak-grid time.
+RECORDED, PROBE, PEAK = 0, 1, 2
+
+
 class Outputs:
     """States at the recorded times ``times``, rows of Y filled in time order: the scene's
     output times and the audit grid's (``audit``; ``scene_rows``, ``audit_rows`` split
-    them), and at the lock windows' probe times (handed to ``windows``, not recorded)."""
+    them), and at the lock windows' probe times (handed to ``windows``, not recorded) and
+    the peak grid's (``peaks``: the probes' states and its own go there, not recorded)."""
 
     def __init__(
         self,
@@ -181,6 +250,7 @@ class Outputs:
         size: int,
         windows: LockWindows | None = None,
         audit: AuditGrid | None = None,
+        peaks: PeakGrid | None = None,
     ):
         grid = audit.times if audit is not None else np.zeros(0)
         if grid.size:
@@ -192,6 +262,7 @@ class Outputs:
         self.Y = np.empty((self.times.size, size))
         self.n = 0
         self.windows = windows
+        self.peaks = peaks
 
     def scene_rows(self) -> np.ndarray:
         """Indices of the recorded rows reached that are scene output times."""
@@ -201,27 +272,28 @@ class Outputs:
         """Indices of the recorded rows reached that are audit-grid times."""
         return np.flatnonzero(self.is_grid[: self.n])
 
-    def _merged(self, recorded: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(times, is-recorded mask) of ``recorded`` times and the lock windows' probes."""
+    def _merged(self, recorded: np.ndarray, t: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
+        """(times, kind) of ``recorded`` times (kind RECORDED), the lock windows' probes
+        (PROBE) and the peak grid's times not yet taken (PEAK) up to ``t`` (s), sorted."""
         probes = self.windows.pending() if self.windows is not None else np.zeros(0)
-        if not probes.size:
-            return recorded, np.ones(recorded.size, bool)
-        times = np.concatenate([recorded, probes])
-        mask = np.concatenate([np.ones(recorded.size, bool), np.zeros(probes.size, bool)])
+        grid = self.peaks.pending() if self.peaks is not None else np.zeros(0)
+        grid = grid[: int(np.searchsorted(grid, t, side="right"))]  # one step's, not all
+        times = np.concatenate([recorded, probes, grid])
+        kind = np.repeat([RECORDED, PROBE, PEAK], [recorded.size, probes.size, grid.size])
         order = np.argsort(times, kind="stable")
-        return times[order], mask[order]
+        return times[order], kind[order]
 
     def upto(self, t: float) -> np.ndarray:
-        """The recorded and probe times not yet written that are <= t, sorted."""
+        """The recorded, probe and peak-grid times not yet written that are <= t, sorted."""
         end = int(np.searchsorted(self.times, t, side="right"))
-        times, mask = self._merged(self.times[self.n : end])
+        times, kind = self._merged(self.times[self.n : end], t)
         keep = times <= t
-        self._plan = times[keep], mask[keep]
+        self._plan = times[keep], kind[keep]
         return self._plan[0]
 
     def remaining(self) -> np.ndarray:
-        """All recorded and probe times not yet written, sorted (for a loop that writes them
-        in order, ``write`` after it)."""
+        """All recorded, probe and peak-grid times not yet written, sorted (for a loop that
+        writes them in order, ``write`` after it)."""
         self._plan = self._merged(self.times[self.n :])
         return self._plan[0]
 
@@ -229,10 +301,13 @@ class Outputs:
         """values (k, N) for the first k times of the last ``upto`` / ``remaining``; returns
         the mask of those that are recorded times (output or audit grid: the rows an audit's
         ledger records)."""
-        times, mask = self._plan[0][: len(values)], self._plan[1][: len(values)]
+        times, kind = self._plan[0][: len(values)], self._plan[1][: len(values)]
+        mask = kind == RECORDED
         kept = values[mask]
         self.Y[self.n : self.n + len(kept)] = kept
         self.n += len(kept)
         if self.windows is not None:
             self.windows.take(times[~mask], values[~mask])
+        if self.peaks is not None:
+            self.peaks.take(times[~mask], values[~mask], int(np.count_nonzero(kind == PEAK)))
         return mask

@@ -34,8 +34,8 @@ Absolute requirements bound a model's own results, not its gap to the reference:
     locked_by = 5.0              # s: every latch of the scene locked at or before this time
     lock_time = { hinge = 1, min = 1.9, max = 2.2 }   # s: the hinge's lock time in [min, max]
     impulse = { hinge = 1, max = 12.0 }               # N m s: |lock impulse| in [min, max]
-    peak_hinge_moment = 300.0    # N m: max |hinge_moment| over the output times, every hinge
-                                 # (or { hinge = 0, max = 300.0 }); needs "hinge_moment"
+    peak_hinge_moment = 300.0    # N m: the run's max |hinge_moment|, every hinge (or
+                                 # { hinge = 0, max = 300.0 }); needs "hinge_moment"
     final = { quantity = "phi", k = 4, min = -0.01, max = 0.01 }   # the value at t_end
 
 ``lock_time``, ``impulse`` and ``final`` take one table or an array of them (one per hinge or
@@ -44,7 +44,12 @@ quantity); each has ``min``, ``max`` or both (finite, min <= max; a lock time an
 the cases output (a scene's ``"energy"`` yields ``kinetic``, ``potential`` and ``energy``)
 and its k one that quantity has (``rodval.core.quantities.quantity_k``),
 ``peak_hinge_moment`` needs ``"hinge_moment"`` among the outputs: each refused when the file
-is read, naming the key and what is allowed. Evaluated by ``rodval.report.acceptance``.
+is read, naming the key and what is allowed. ``locked_by`` and a lock time's bounds lie
+within the cases' shortest horizon (a lock after t_end is never seen). A peak is the run's,
+read between its output times (``SolverStats.peaks``; a hinge whose moment is an impulse at
+its lock, in the reduced and rigid models, has none, and a peak requirement on it breaks
+saying so). Evaluated by ``rodval.report.acceptance``; a requirement on a run that did not
+reach t_end breaks.
 """
 
 from __future__ import annotations
@@ -85,8 +90,8 @@ def acceptance_spec(
     "momentum_residual": ...}`` (each bound a dict with model, quantity and its metrics, each
     event bound a dict with model and its metrics, each requirement as
     ``requirement_tables`` gives it; the scalar keys the study gives), or None without the
-    table. ``scenes``: the cases' scenes, against which a requirement's hinge and k are
-    checked (none given: not checked). ValueError naming ``acceptance.<key>`` and what is
+    table. ``scenes``: the cases' scenes, against which a requirement's hinge, k and times
+    are checked (none given: not checked). ValueError naming ``acceptance.<key>`` and what is
     allowed otherwise."""
     if table is None:
         return None
@@ -219,6 +224,23 @@ def requirement_tables(
     return out
 
 
+def _horizon(scenes: Sequence[Scene]) -> float:
+    """The cases' shortest horizon t_end (s); inf when no scene is given."""
+    return min((float(s.t_end) for s in scenes), default=math.inf)
+
+
+def _within_horizon(v: float, key: str, scenes: Sequence[Scene], err: Any) -> float:
+    """A time ``v`` (s) a run must see: at most the cases' shortest horizon."""
+    horizon = _horizon(scenes)
+    if v > horizon:
+        raise err(
+            key,
+            f"must be <= the cases' horizon t_end = {horizon:g} s (a lock after t_end is "
+            f"never seen), got {v:g}",
+        )
+    return v
+
+
 def _requirement(
     item: str, value: Any, key: str, quantities: set[str], scenes: Sequence[Scene], err: Any
 ) -> Any:
@@ -226,7 +248,7 @@ def _requirement(
     if item == "locked_by":
         if not scenes_latch(scenes):
             raise err(key, "needs latches: the cases' scenes have none that is not held")
-        return _number(value, key, err, low=0.0)
+        return _within_horizon(_number(value, key, err, low=0.0), key, scenes, err)
     if item == "peak_hinge_moment":
         if "hinge_moment" not in quantities:
             raise err(key, 'needs "hinge_moment" among the [scene] outputs: add it there')
@@ -273,6 +295,8 @@ def _item_table(
     for bound in ("min", "max"):
         if bound in table:
             out[bound] = _number(table[bound], f"{key}.{bound}", err, low=low)
+            if item == "lock_time":
+                _within_horizon(out[bound], f"{key}.{bound}", scenes, err)
     if "min" not in out and "max" not in out:
         raise err(key, "needs min, max or both" if item != "peak_hinge_moment" else "needs max")
     if out.get("min", -math.inf) > out.get("max", math.inf):

@@ -21,8 +21,9 @@ from typing import Any
 
 from rodval.core.trajectory import Trajectory
 
-#: Version of the case-record layout; a record of another version is recomputed.
-SCHEMA = 2
+#: Version of the case-record layout; a record of another version is recomputed. 3: each
+#: run's stats carry its peaks (``SolverStats.peaks``), which a record of 2 lacks.
+SCHEMA = 3
 
 
 class DamagedRecord(ValueError):

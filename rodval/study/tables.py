@@ -1,13 +1,19 @@
 """The study's tables, built from the saved case records (pandas; written as CSV and markdown).
 
-* ``cases``: case, n, horizon (s), one column per grid axis, l (rod lengths, JSON), fingerprint.
+* ``cases``: case, n, horizon (s), one column per grid axis, l (rod lengths, JSON),
+  latch_hinges (JSON), base_kind (pinned, free, prescribed: where the figures hang the
+  chain), fingerprint.
 * ``trajectories``: tidy case, model, t (s), quantity, k, value (rad, rad/s, m or J).
 * ``discrepancies``: case, n, horizon, axes, model, reference, quantity, max_abs, rms,
   final_abs, max_rel, k_at_max, t_at_max (see ``rodval.analysis.metrics``), status.
 * ``runtime``: case, n, horizon, axes, model, options (JSON: the model options the run ran
-  with, an "auto" resolved, e.g. the full model's kinematics), method, rtol, atol, max_step, wall_s
-  (integration, s), setup_s (model set-up, s), nfev, njev, nlu, nsteps, t_reached (s),
-  status, message.
+  with, an "auto" resolved, e.g. the full model's kinematics and shapes), the settings that
+  change what ran (``rodval.core.trajectory.RUN_SETTINGS``: method, rtol, atol, max_step,
+  first_step, error_control, block_frequency, bending_scale; blank for a model that
+  integrates itself) and exudyn's step, wall_s (integration, s), setup_s (model set-up, s),
+  nfev, njev, nlu, nsteps, t_reached (s), the audits' residuals, the validity verdict,
+  status, message, and the run's peaks (``peaks``: JSON of ``SolverStats.peaks``' values,
+  quantity -> [{k, peak, t}], read between the output times as ``peaks_read_on`` says).
 
 * ``events``: case, n, horizon, axes, model, then one row per state event of a run
   (``Trajectory.events``: t (s), label, hinge, impulse (N m s, the lock impulse over the lock
@@ -41,6 +47,7 @@ from rodval.core.out_paths import write_file
 
 # EVENT_COLUMNS: the events table's leading columns, named here for the table's readers
 from rodval.core.status import STATUS_MESSAGES
+from rodval.core.trajectory import RUN_SETTINGS
 from rodval.core.validity import broken
 from rodval.report.markdown import to_markdown
 from rodval.report.tables import MANIFEST, axis_columns, table_digest, trajectory_samples
@@ -77,6 +84,7 @@ def cases_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFrame
                         int(la["hinge"]) for la in r.scene.get("latches", []) if not la.get("held")
                     )
                 ),
+                "base_kind": r.scene.get("base", {}).get("kind", "pinned"),
                 "fingerprint": r.fingerprint,
             }
             for r in records
@@ -116,10 +124,7 @@ def runtime_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFra
                     **_case_columns(rec, axes),
                     "model": run.label,
                     "options": json.dumps(run.trajectory.options, sort_keys=True),
-                    "method": se.get("method"),
-                    "rtol": se.get("rtol"),
-                    "atol": se.get("atol"),
-                    "max_step": se.get("max_step"),
+                    **{k: se.get(k) for k in RUN_SETTINGS},
                     "step": se.get("step"),
                     "wall_s": st.wall_s,
                     "setup_s": run.setup_s,
@@ -136,6 +141,8 @@ def runtime_table(records: list[CaseRecord], axes: dict[str, str]) -> pd.DataFra
                     "invalid_because": "; ".join(broken(st.validity)),
                     "status": STATUS_MESSAGES[st.status],
                     "message": st.message,
+                    "peaks": None if st.peaks is None else json.dumps(st.peaks["values"]),
+                    "peaks_read_on": None if st.peaks is None else st.peaks["read_on"],
                 }
             )
     return pd.DataFrame(rows)
