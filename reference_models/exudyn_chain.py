@@ -122,7 +122,19 @@ DEFAULTS: dict[str, Any] = {
 #: IntegratorSettings fields that belong to rodval's ODE integrators: exudyn cannot honour
 #: them (its integrator is set by this model's options), so any non-default value is refused.
 #: (``max_wall_s`` and ``blowup_factor`` are honoured: ``exudyn_budget``, ``exudyn_guard``.)
-NATIVE_INTEGRATOR_FIELDS = ("method", "rtol", "atol", "max_step", "first_step", "max_evaluations")
+NATIVE_INTEGRATOR_FIELDS = (
+    "method",
+    "rtol",
+    "atol",
+    "max_step",
+    "first_step",
+    "max_evaluations",
+    "min_step_fraction",
+    "stall_steps",
+    "error_control",
+    "block_frequency",
+    "bending_scale",
+)
 
 
 class ExudynModel(Model):

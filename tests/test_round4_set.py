@@ -176,6 +176,31 @@ def test_quoted_step_auto_reaches_the_exudyn_model_as_auto():
     assert model_options(args) == {"step": "auto"}
 
 
+@pytest.mark.exudyn
+@pytest.mark.parametrize(
+    "setting",
+    [
+        "error_control=per-block",
+        "block_frequency=100.0",
+        "bending_scale=10.0",
+        "stall_steps=5",
+        "min_step_fraction=1e-3",
+    ],
+)
+def test_exudyn_refuses_a_native_integrator_setting_it_cannot_honour(tmp_path, capsys, setting):
+    """`--set error_control=per-block` (and the other settings of rodval's own integrators)
+    on exudyn ran with exit 0 and the setting nowhere in run.json: exudyn's check knew only
+    method, rtol, atol, max_step, first_step and max_evaluations."""
+    pytest.importorskip("exudyn")
+    code = main(["simulate", "paper", "--model", "exudyn", *TINY, "--set", setting,
+                 "--out", str(tmp_path / "run")])  # fmt: skip
+    assert code == 2
+    name = setting.split("=")[0]
+    err = _error(capsys)
+    assert f"integrator setting {name}=" in err and "exudyn" in err
+    assert not (tmp_path / "run" / "run.json").exists()
+
+
 # ------------------------------------------------------------ 4. modes applies scene keys
 
 
