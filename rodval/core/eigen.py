@@ -20,7 +20,8 @@ geometric mean of the spectrum's ends, the direct one above it (both errors are 
 about eps * sqrt(span) relative). The shift sigma is 0 when K is positive definite; otherwise
 (a free hinge: rigid-body modes; a buckled state) the smallest of -s, -100 s, ... for which
 K - sigma M is positive definite, s = 1e-10 max diag(K) / max diag(M); the error this adds to
-a zero eigenvalue is about eps |sigma|. For such a K, eigenvalues below eps lam_max (the
+a zero eigenvalue is about eps |sigma|, and the split is the geometric mean of the shifted
+spectrum's ends, lam - sigma (``_from_inverted``). For such a K, eigenvalues below eps lam_max (the
 round-off that K's own entries put on a zero mode) are returned as exactly 0; a positive
 definite K has no zero modes and none is made (the threshold of 1e-13 lam_max used before
 took exudyn's lowest hinge mode, 6.1e-3, for a zero mode at 16 elements per rod).
@@ -109,9 +110,7 @@ def symmetric_pencil(
     order = np.argsort(-mu)
     lam_i = sigma + 1.0 / mu[order]
     lam_max = max(abs(lam_d[-1]), abs(lam_i[-1]))
-    lam_min = max(abs(lam_i[0]), np.finfo(float).tiny)
-    split = np.sqrt(lam_min * lam_max)
-    low = np.abs(lam_i) <= split
+    low = _from_inverted(lam_i, lam_max, sigma)
     lam = _zero_floor(np.where(low, lam_i, lam_d), sigma)
     if X_d is None or X_i is None:
         return np.sort(lam), None
@@ -121,6 +120,26 @@ def symmetric_pencil(
     X = np.where(low[None, :], Xi, X_d)
     srt = np.argsort(lam, kind="stable")
     return lam[srt], X[:, srt]
+
+
+def _from_inverted(lam_i: np.ndarray, lam_max: float, sigma: float) -> np.ndarray:
+    """Which eigenvalues (ascending ``lam_i``, 1/s^2, from the inverted pencil shifted by
+    ``sigma`` <= 0) are taken, with their vectors, from the inverted pencil rather than the
+    direct one: the ones it carries better. Its eigenvalues mu = 1 / (lam - sigma) carry an
+    absolute error of about eps mu_max, mu_max = 1 / (lam_0 - sigma), so lam an error of
+    about eps (lam - sigma)^2 / (lam_0 - sigma); the direct solve's is eps lam_max: the
+    inverted one wins for lam - sigma <= sqrt((lam_0 - sigma) lam_max), the split (module
+    docstring; with sigma = 0 the geometric mean of the spectrum's ends). A singular K's zero
+    modes (lam_0 - sigma = |sigma|) all fall below it, so their vectors are one basis of the
+    null space; the split set by a zero mode's own round-off (0 or a few ulps of sigma) fell
+    anywhere from 1e-150 to 1e-3, cut a cluster of zero modes in two and mixed vectors of two
+    different bases of the null space, not a basis of it (a free base's rigid modes came out
+    as two equal vectors, issue 54), and took the lowest genuine modes from the direct
+    solve, which carries them to eps lam_max / lam only."""
+    shifted = lam_i - sigma
+    lam_0 = max(float(shifted[0]), np.finfo(float).tiny)
+    low: np.ndarray = shifted <= np.sqrt(lam_0 * lam_max)
+    return low
 
 
 def _zero_floor(lam: np.ndarray, sigma: float) -> np.ndarray:
