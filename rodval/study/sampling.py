@@ -4,13 +4,17 @@ through each key's distribution. Every sample is one case; the same seed gives t
 values, hence identical tables.
 
     [sample]
-    design = "sobol"        # "sobol" (count a power of 2), "lhs" or "random"
+    design = "sobol"        # "sobol" (count a power of 2), "lhs", "random" or "saltelli"
     count = 256
     seed = 1
     [sample.keys]
     "scene.chain.kappa.rest" = { dist = "uniform", low = 30.0, high = 70.0 }
     "scene.latches.*.angle" = { dist = "normal", mean = 0.0, std = 0.01, low = -0.03, high = 0.03 }
     "scene.chain.nu.rest" = { dist = "lognormal", median = 0.05, sigma = 0.3 }
+
+``design = "saltelli"`` is SALib's scheme for Sobol indices (``rodval.report.sensitivity``):
+count = N (D + 2) cases, N a power of 2 >= 8 base samples, D the number of keys, in blocks of D
++ 2 consecutive cases.
 
 Keys are paths into the study document like grid keys; ``*`` sets every element of a list
 (every latch), an integer one element. Distributions (values in the key's own unit):
@@ -32,8 +36,9 @@ from typing import Any
 import numpy as np
 
 from rodval.core.checks import check_keys
+from rodval.report.sensitivity import SALTELLI, saltelli_count_error, saltelli_unit_design
 
-DESIGNS = ("sobol", "lhs", "random")
+DESIGNS = ("sobol", "lhs", "random", SALTELLI)
 SAMPLE_KEYS = {"design", "count", "seed", "keys"}
 #: Most samples a study may draw (each is a case).
 MAX_SAMPLES = 100_000
@@ -109,7 +114,8 @@ def quantiles(spec: dict[str, Any], u: np.ndarray) -> np.ndarray:
 
 
 def unit_design(design: str, count: int, dims: int, seed: int) -> np.ndarray:
-    """(count, dims) points in [0, 1)^dims of the named design, reproducible from ``seed``."""
+    """(count, dims) points in [0, 1)^dims of the named design, reproducible from ``seed``
+    (a Saltelli design's in its blocks of dims + 2 rows)."""
     from scipy.stats import qmc
 
     points: np.ndarray
@@ -117,6 +123,8 @@ def unit_design(design: str, count: int, dims: int, seed: int) -> np.ndarray:
         points = qmc.Sobol(dims, scramble=True, seed=seed).random(count)
     elif design == "lhs":
         points = qmc.LatinHypercube(dims, seed=seed).random(count)
+    elif design == SALTELLI:
+        points = saltelli_unit_design(count, dims, seed)
     else:
         points = np.random.default_rng(seed).random((count, dims))
     return points
@@ -170,5 +178,7 @@ def sample_columns(table: Any, where: str) -> dict[str, list[float]]:
         path: check_distribution(f"{where} key 'sample.keys.{path}'", spec)
         for path, spec in flatten_keys(keys).items()
     }
+    if design == SALTELLI and (why := saltelli_count_error(count, len(specs))):
+        raise ValueError(f"{where} key 'sample.count': {why}")
     u = unit_design(design, count, len(specs), seed)
     return {path: quantiles(spec, u[:, j]).tolist() for j, (path, spec) in enumerate(specs.items())}
