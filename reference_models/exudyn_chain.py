@@ -119,21 +119,11 @@ DEFAULTS: dict[str, Any] = {
     "max_rotation_per_step": 0.1,
 }
 
-#: IntegratorSettings fields that belong to rodval's ODE integrators: exudyn cannot honour
-#: them (its integrator is set by this model's options), so any non-default value is refused.
-#: (``max_wall_s`` and ``blowup_factor`` are honoured: ``exudyn_budget``, ``exudyn_guard``.)
-NATIVE_INTEGRATOR_FIELDS = (
-    "method",
-    "rtol",
-    "atol",
-    "max_step",
-    "first_step",
-    "max_evaluations",
-    "min_step_fraction",
-    "stall_steps",
-    "error_control",
-    "block_frequency",
-    "bending_scale",
+#: IntegratorSettings fields exudyn honours (``exudyn_budget``, ``exudyn_guard``); every other
+#: field belongs to rodval's ODE integrators, and a non-default value of it is refused.
+HONOURED_SETTINGS = ("max_wall_s", "blowup_factor")
+NATIVE_INTEGRATOR_FIELDS = tuple(
+    f.name for f in dataclasses.fields(IntegratorSettings) if f.name not in HONOURED_SETTINGS
 )
 
 
@@ -287,8 +277,7 @@ class ExudynModel(Model):
     @staticmethod
     def check_settings(settings: IntegratorSettings | None) -> None:
         """Refuse native integrator settings exudyn cannot honour: ValueError naming the first
-        field of ``NATIVE_INTEGRATOR_FIELDS`` that differs from ``IntegratorSettings()``.
-        (``blowup_factor`` is honoured: it sets the blow-up check.)"""
+        field of ``NATIVE_INTEGRATOR_FIELDS`` that differs from ``IntegratorSettings()``."""
         if settings is None:
             return
         default = IntegratorSettings()
