@@ -27,6 +27,8 @@ from rodval.bench.precision import (
     baseline_ratios,
     cheapest,
     errors,
+    kernel_options,
+    numpy_models,
     work_precision,
 )
 from rodval.bench.scale import (
@@ -48,6 +50,8 @@ __all__ = [
     "feature_costs",
     "four_panel_wing",
     "growth",
+    "kernel_options",
+    "numpy_models",
     "rigid_latch",
     "stiff_paper",
     "stiffness_rows",

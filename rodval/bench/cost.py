@@ -10,7 +10,9 @@ import numpy as np
 import pandas as pd
 
 from rodval.bench.precision import (
+    KERNELS,
     errors,
+    kernel_options,
     ladder,
     paper_system_of,
     reference_model_reference,
@@ -31,20 +33,22 @@ SPEEDUP_RATIOS = ("full/reduced", "exudyn/full", "exudyn/reduced")
 
 def per_eval_cost(
     n_values=(2, 4, 8, 16, 32, 64, 128, 256, 512),
-    kernels=("numba", "numpy"),
+    kernels=KERNELS,
     models=("full",),
     min_time: float = 0.05,
     repeats: int = 3,
     progress=print,
 ) -> pd.DataFrame:
     """Seconds per right-hand-side evaluation (min over repeats of a timed loop) against n at
-    a random state with the load active."""
+    a random state with the load active, for each of ``kernels`` a model has
+    (``kernel_options``)."""
     rows = []
     rng = np.random.default_rng(0)
     for model in models:
-        for kernel in kernels:
+        taken = kernel_options(model)
+        for kernel in [k for k in kernels if k in taken]:
             for n in n_values:
-                system = paper_system_of(model, paper_scene(n), kernel=kernel)
+                system = paper_system_of(model, paper_scene(n), **taken[kernel])
                 y = rng.normal(scale=0.5, size=system.y0.size)
                 system.rhs(0.3, y)
                 reps = max(1, int(min_time / _once(system, y)))
@@ -78,7 +82,8 @@ def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
     (outputs and dense output: scipy DOP853, where they run in Python):
 
     * damping: nu = 0 chain, damping terms skipped vs forced on (C = 0, same result);
-    * load: RHS evaluation past the load's support (no load term) vs inside it;
+    * load: RHS evaluation past the load's support (no load term) vs inside it, with each
+      right-hand side a model has (``kernel_options``);
     * gamma recovery: reduced model with outputs phi, dphi vs phi, dphi, alpha, beta;
     * dense output: 4 output times vs 2001 (dense output formed only on steps containing one).
     """
@@ -90,6 +95,7 @@ def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
         for forced in (False, True):
             system = paper_system_of(model, undamped)
             system.damped = forced
+            system.use_kernel()  # the compiled kernels read the flag from the arrays it sets
             runs = [integrate(system, undamped, settings, model=model) for _ in range(repeats + 1)]
             walls[forced] = (min(r.stats.wall_s for r in runs[1:]), runs[-1])
         same = np.max(np.abs(walls[True][1]["phi"] - walls[False][1]["phi"]))
@@ -103,8 +109,8 @@ def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
             )
         )
     for model in integrated_models():
-        for kernel in ("numba", "numpy"):
-            system = paper_system_of(model, paper_scene(8), kernel=kernel)
+        for kernel, options in kernel_options(model).items():
+            system = paper_system_of(model, paper_scene(8), **options)
             y = np.random.default_rng(1).normal(scale=0.5, size=system.y0.size)
             cost = {t: min(_timeit(system, y, t) for _ in range(repeats)) for t in (1.5, 0.3)}
             rows.append(

@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from rodval.analysis.metrics import scaled_errors
@@ -17,7 +18,12 @@ from rodval.core.settings import IntegratorSettings
 from rodval.core.trajectory import Trajectory
 from rodval.models import get_model
 from rodval.models.assembly.paper_system import PaperSystem
-from rodval.models.presets.registry import integrated_models, simulate, uses_integrator
+from rodval.models.presets.registry import (
+    integrated_models,
+    option_names,
+    simulate,
+    uses_integrator,
+)
 from rodval.solvers.ode_model import OdeModel
 
 QUANTITIES = ("phi", "dphi", "alpha", "beta")
@@ -39,6 +45,29 @@ REFERENCE_MODEL_STEPS = (1e-3, 5e-4, 2e-4, 1e-4, 5e-5)
 
 
 REFERENCE_MODEL_REF: dict[str, Any] = {"solver": "trapezoidal", "step": 2e-5}
+
+
+#: The right-hand sides a native model may take (its option ``kernel``): compiled, and the
+#: dense numpy reference.
+KERNELS = ("numba", "numpy")
+
+
+def kernel_options(model: str) -> dict[str, dict[str, str]]:
+    """The right-hand sides the benchmarks time native model ``model`` with, each with the
+    model options that select it: both ``KERNELS`` for a model that takes the option
+    ``kernel`` (full, reduced), the compiled one alone, with no option, for a model that
+    does not (rigid: its kernel is fixed). From the registry (``option_names``)."""
+    if "kernel" in option_names(model):
+        return {kernel: {"kernel": kernel} for kernel in KERNELS}
+    return {"numba": {}}
+
+
+def numpy_models(models: tuple[str, ...] | None = None) -> tuple[str, ...]:
+    """Those of ``models`` (default: every model) that rodval integrates and that have a numpy
+    right-hand side (``kernel_options``), in their order."""
+    native = integrated_models()
+    chosen = native if models is None else models
+    return tuple(m for m in chosen if m in native and "numpy" in kernel_options(m))
 
 
 def paper_system_of(model: str, scene: Scene, **options: Any) -> PaperSystem:
@@ -87,7 +116,9 @@ def timed(
 def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str, float]:
     """Relative errors of ``traj`` against ``ref`` (``rodval.analysis.metrics.scaled_errors``
     per quantity as ``final_q``, ``rms_q``, ``max_q``, and ``scd``; see module docstring); NaN
-    for a run that did not reach every output time."""
+    for a run that did not reach every output time. A reference that is zero throughout (the
+    rigid model's alpha, beta) has no scale: the errors are 0 where the run is zero too, else
+    inf."""
     out: dict[str, float] = {}
     worst = 0.0
     for q in quantities:
@@ -97,7 +128,11 @@ def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str
             out.update({f"final_{q}": math.nan, f"rms_{q}": math.nan, f"max_{q}": math.nan})
             worst = math.inf
             continue
-        out.update({f"{k}_{q}": v for k, v in scaled_errors(traj[q], ref[q]).items()})
+        if not np.any(ref[q]):
+            e = 0.0 if not np.any(traj[q]) else math.inf
+            out.update({f"final_{q}": e, f"rms_{q}": e, f"max_{q}": e})
+        else:
+            out.update({f"{k}_{q}": v for k, v in scaled_errors(traj[q], ref[q]).items()})
         worst = max(worst, out[f"max_{q}"])
     out["scd"] = (
         -math.log10(worst) if 0 < worst < math.inf else (math.inf if worst == 0 else math.nan)
@@ -156,7 +191,12 @@ def work_precision(
         if native:
             refs = references(scene, model)
             uncertainty[model] = refs.uncertainty
-            variants = [(m, "numba") for m in methods] + ([("DOP853", "numpy")] if baseline else [])
+            kernels = kernel_options(model)
+            variants = [(m, "numba") for m in methods]
+            if baseline and "numpy" in kernels:
+                variants.append(("DOP853", "numpy"))
+            elif baseline:
+                notes.append(f"model {model}: no numpy right-hand side, so no numpy baseline")
         else:
             ref_model = reference_model_reference(scene, model)
             notes.append(
@@ -167,7 +207,7 @@ def work_precision(
         for method, kernel in variants:
             for knob, settings, opts in ladder(model, method, rtols):
                 if native:
-                    opts = {"kernel": kernel}
+                    opts = kernels[kernel]
                 traj, wall = timed(scene, model, settings, repeats, **opts)
                 ref = refs.for_method(method) if native else ref_model
                 row = {
@@ -220,16 +260,19 @@ def cheapest(frame: pd.DataFrame, quantity: str = "phi", tol: float = 1e-6) -> p
 
 def baseline_ratios(
     scene: Scene,
+    models: tuple[str, ...] | None = None,
     tol: float = 1e-6,
     rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
     repeats: int = 3,
     progress=print,
 ) -> pd.DataFrame:
-    """Per native model: the loosest rtol at which the compiled DOP853 reaches phi error <= tol,
-    then, side by side at that same tolerance, scipy DOP853 with the numba kernel and with
-    the straightforward numpy kernel; speed-up = baseline wall / compiled wall."""
+    """Per model of ``models`` (default: every model) that has a numpy right-hand side
+    (``numpy_models``; the others have no baseline and are left out): the loosest rtol at
+    which the compiled DOP853 reaches phi error <= tol, then, side by side at that same
+    tolerance, scipy DOP853 with the numba kernel and with the straightforward numpy kernel;
+    speed-up = baseline wall / compiled wall."""
     rows = []
-    for model in integrated_models():
+    for model in numpy_models(models):
         refs = references(scene, model)
         for rtol in sorted(rtols, reverse=True):
             settings = IntegratorSettings("DOP853-numba", rtol=rtol, atol=rtol * 1e-2)

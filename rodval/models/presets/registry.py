@@ -60,6 +60,12 @@ def uses_integrator(name: str) -> bool:
     return bool(getattr(model_class(name), "USES_INTEGRATOR_SETTINGS", True))
 
 
+def option_names(name: str) -> tuple[str, ...]:
+    """The option names model ``name`` takes (its class's ``OPTIONS``; ValueError if the
+    model is unknown or not importable)."""
+    return tuple(getattr(model_class(name), "OPTIONS", ()))
+
+
 def modal_options(name: str, options: dict[str, Any]) -> dict[str, Any]:
     """The ones of ``options`` that model ``name``'s modal analysis takes
     (``Model.MODES_OPTIONS``), for callers that hold options for several models."""
@@ -74,12 +80,11 @@ def get_model(name: str | Model, **options: Any) -> Model:
         if options:
             raise ValueError("model options can only be given with a model name")
         return name
-    cls = model_class(name)
-    allowed = tuple(getattr(cls, "OPTIONS", ()))
+    allowed = option_names(name)
     unknown = sorted(set(options) - set(allowed))
     if unknown:
         raise ValueError(_unknown_keyword(name, unknown[0], allowed))
-    return cls(**options)
+    return model_class(name)(**options)
 
 
 def check_scene(model: Model, scene: Scene, settings: IntegratorSettings) -> Scene:
