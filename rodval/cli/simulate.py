@@ -24,6 +24,7 @@ from rodval.cli.options import (
     positive_float,
     scene_overrides,
     time_list,
+    with_scene_values,
 )
 from rodval.core.checks import check_keys
 from rodval.core.scene import EXPANDS, MAX_TIMES, Scene
@@ -31,7 +32,6 @@ from rodval.core.scene_file import (
     read_scene_document,
     scene_from_dict,
     with_horizon,
-    with_overrides,
 )
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.core.validity import describe
@@ -54,11 +54,17 @@ from rodval.solvers.progress import progress_bar
 #: The keys of a run.json's settings a rerun reads: the settings, and the method asked for
 #: when "auto" chose one.
 RERUN_SETTINGS = (*SETTING_NAMES, "requested_method")
-#: Estimated model set-up before the integration's own clock starts (the system's arrays;
-#: the reduced model's banded factors with their equilibration), s per rod, measured on the
-#: loaded 2-core test machine (reduced 3.1e-5 at n = 2e5, 2.2e-5 at 1e6; full 1.7e-6 at
-#: 2e5) with a margin; other models take the largest.
-SETUP_S_PER_ROD = {"reduced": 4e-5, "full": 4e-6}
+#: The model's work in the command outside its integration loop, per rod (s): building the
+#: system (its arrays, the reduced model's banded factors), its first evaluation, the
+#: guard's start, observation and the validity checks. Measured at n = 1e6 on the loaded
+#: 2-core test machine (load average 9; the command's time in ``simulate`` outside the loop
+#: with --set n=1000000 --set 'outputs=["phi"]' --times 0,1,2 --max-evaluations 30: full
+#: 5.1e-6, reduced 4.1e-6, rigid 9.9e-6; the reduced model's was 2.2e-5 before issue 50's
+#: set-up) with a margin; other models take the largest.
+MODEL_S_PER_ROD = {"full": 6e-6, "reduced": 5e-6, "rigid": 1.2e-5}
+#: Loading the compiled loop and kernels from numba's cache (s), once per process: 1.7-1.9 s
+#: measured in a fresh process at load 9 (the native models at n = 8).
+LOAD_S = 2.0
 #: Slack (s) the integration's deadline leaves besides the estimated set-up and writing, for
 #: estimates that fall short (at most a tenth of the budget).
 MARGIN_S = 0.5
@@ -193,6 +199,25 @@ def predicted_values(scene: Scene) -> int:
     return int(scene.times.size * per_time)
 
 
+def model_estimate_s(model: str, n: int) -> float:
+    """Estimated seconds of model ``model``'s work outside its integration loop on a chain of
+    ``n`` rods (``MODEL_S_PER_ROD``), with ``LOAD_S`` for a model rodval integrates when this
+    process has not loaded the compiled loop yet (``rodval.solvers.dop853`` loads it on
+    import)."""
+    per_rod = MODEL_S_PER_ROD.get(model, max(MODEL_S_PER_ROD.values()))
+    loaded = "rodval.solvers.dop853" in sys.modules or not uses_integrator(model)
+    return (0.0 if loaded else LOAD_S) + per_rod * n
+
+
+def write_bound_s(values: int, fmt: str, rods: int, wide: bool) -> float:
+    """Estimated seconds to write the run folder (``write_estimate_s``) whatever time the run
+    reaches: all ``values`` in the format they take (``table_file``), or, for a run cut
+    short, at most ``CSV_MAX_VALUES`` of them as text, the slower writer, which ``--table
+    auto`` chooses for so few (at n = 1e6: 1e6 values as text 6.6 s, 3e6 as npz 1.3 s)."""
+    counts = {values, min(values, CSV_MAX_VALUES)}
+    return max(write_estimate_s(v, table_file(fmt, v), rods, wide=wide) for v in counts)
+
+
 def integration_budget(max_wall_s: float, used_s: float, setup_s: float, write_s: float) -> float:
     """The integration's wall-clock budget (s) within the command's ``max_wall_s``: what is
     left after the time ``used_s`` already spent, the estimated model set-up ``setup_s`` and
@@ -244,9 +269,7 @@ def overridden(doc: dict[str, Any], args) -> tuple[dict[str, Any], str]:
         if path in overrides and option is not None:
             flag = "--" + path.replace("_", "-")
             raise ValueError(f"--set {path} and {flag} both given; give the value once")
-    if not overrides:
-        return doc, str(args.scene)
-    return with_overrides(doc, overrides), f"{args.scene} (with --set {', '.join(overrides)})"
+    return with_scene_values(doc, args)
 
 
 def run(args) -> int:
@@ -259,11 +282,11 @@ def run(args) -> int:
     settings = IntegratorSettings(**settings_kw)
     claim_run_folder(args.out)  # before any work: nothing of the user's is overwritten
     requested = settings.max_wall_s
-    share = write_s = math.inf
+    share = write_s = setup_s = math.inf
     if math.isfinite(requested):
         values = predicted_values(scene)
-        write_s = write_estimate_s(values, table_file(args.table, values), scene.n, wide=args.wide)
-        setup_s = SETUP_S_PER_ROD.get(model, max(SETUP_S_PER_ROD.values())) * scene.n
+        write_s = write_bound_s(values, args.table, scene.n, wide=args.wide)
+        setup_s = model_estimate_s(model, scene.n)
         share = integration_budget(requested, time.perf_counter() - start, setup_s, write_s)
         settings = settings.with_(max_wall_s=share)
     with progress_bar(scene.t_end, enabled=sys.stderr.isatty()):
@@ -277,8 +300,9 @@ def run(args) -> int:
     if math.isfinite(requested):
         notes.append(
             f"--max-wall {requested:g} s is the whole command's budget: {share:.3g} s were "
-            f"left for the integration after reading, the estimated set-up and {write_s:.3g} "
-            f"s estimated for writing; the command took {time.perf_counter() - start:.3g} s"
+            f"left for the integration (which stops within one step of it) after reading, "
+            f"{setup_s:.3g} s estimated for the model's set-up and observation and "
+            f"{write_s:.3g} s for writing; the command took {time.perf_counter() - start:.3g} s"
         )
     print(
         f"{traj.model}: {traj.stats.message}, {describe(traj.stats.valid, traj.stats.validity)}, "

@@ -14,8 +14,10 @@ state gives inf or NaN, never an exception: an attempt with non-finite stages is
 the step cut (``_step_control``); when that continues down to the smallest step, or an
 accepted state is not finite, the run ends as ``NON_FINITE`` at the time it
 reached (a division by zero in the initial-step choice raised ZeroDivisionError). The
-wall-clock budget reads the clock (a call back into Python, ~1 us) once every
-``budget.WALL_CHECK_EVALUATIONS`` evaluations, not on every step.
+wall-clock budget reads the clock (a call back into Python, ~1 us) before a step attempt once
+every ``budget.WALL_CHECK_EVALUATIONS`` evaluations, or as soon as ``budget.READ_INTERVAL_S``
+of work has gone by when evaluations are dear (``budget.read_interval``): a run stops within
+one step of its deadline.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from scipy.integrate._ivp import dop853_coefficients as dc
 
 from rodval.solvers import radau, stiffness
 from rodval.solvers.audit import GAUSS_NODES
-from rodval.solvers.budget import EVENT, NON_FINITE, OK, next_attempt, smallest_step
+from rodval.solvers.budget import EVENT, NON_FINITE, OK, counters, next_attempt, smallest_step
 from rodval.solvers.dop853_events import any_crossing, interpolate, locate, no_events
 from rodval.solvers.guard import GuardSpec, guard_step, new_monitor
 from rodval.solvers.limits import MAX_IMPLICIT_SIZE
@@ -229,7 +231,7 @@ def _step_control(
 ):
     """Step attempts from (t, y) towards t_bound with Hairer's step-size control until one is
     accepted (its stages in K, its solution in y_new). ``controls``, ``atol`` as in ``run``; ``cnt``:
-    [evaluations used, evaluation count at the next clock read], updated. Returns (code, t
+    ``budget.counters``, updated. Returns (code, t
     of the accepted step's end, the next step size): ``OK``, or ``STEP_TOO_SMALL``,
     ``BUDGET``, ``WALL`` or ``NON_FINITE`` with t unchanged.
 
@@ -420,7 +422,7 @@ def run(
     rw = radau.work(N, implicit)
     sc = np.zeros(7)
     n_out = 0
-    cnt = np.zeros(2, np.int64)  # evaluations, and the count at the next clock read
+    cnt = counters()  # evaluations, and the clock reads' counts and time
     nsteps = 0
     t = edges[0]
     while n_out < times.shape[0] and times[n_out] <= t:
