@@ -1,6 +1,7 @@
 """Progress of a single run: the driver reports the time reached after each accepted step to
 the reporter set for the current context (none by default, so library calls print nothing);
-the compiled loop reports every ``WALL_CHECK_EVALUATIONS`` evaluations when a reporter is set.
+the compiled loop at its clock reads (``budget.read_interval``: at most every
+``WALL_CHECK_EVALUATIONS`` evaluations) when a reporter is set.
 
 ``progress_bar`` is the CLI's reporter: a tqdm bar over [0, t_end] s on stderr that appears
 only when the run lasts more than ``delay`` seconds and only on a terminal.
