@@ -20,6 +20,7 @@ Every error is a ValueError naming the file and the key, raised before any work.
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import json
 import math
@@ -40,6 +41,8 @@ from rodval.core.resources import (
 )
 from rodval.core.scene import trajectory_quantities
 from rodval.core.scene_file import anchor_load_files
+from rodval.core.scene_keys import scene_path, set_path
+from rodval.core.settings import SETTING_NAMES
 from rodval.study.acceptance import acceptance_spec
 from rodval.study.case import Case, agreement_spec, build_case
 from rodval.study.document import key_error, plain_document
@@ -329,14 +332,57 @@ def _check_resources(cases: tuple[Case, ...], where: str) -> None:
         raise ValueError(f"{where}: {exc}") from None
 
 
+def study_path(key: str) -> str:
+    """The dotted path of the study file that ``rodval study --set KEY=VALUE`` names: KEY
+    itself when it starts with a table of the study file (``scene.chain.EI``,
+    ``integrator.rtol``, ``models.full.shapes``: a grid key's form), or a scene key without
+    its ``scene.`` (``chain.EI``, as ``rodval simulate --set`` takes it). A bare integrator
+    setting or model option is refused (ValueError naming its paths: a study's [integrator]
+    holds every model's settings, a [models.LABEL] one model's)."""
+    if key.split(".")[0] in TOP_KEYS:
+        return key
+    path = scene_path(key)
+    if path is not None:
+        return f"scene.{path}"
+    if key in SETTING_NAMES:
+        raise ValueError(
+            f"--set {key}: a study's integrator setting goes by its path: --set "
+            f"integrator.{key}=... (every model) or --set models.LABEL.{key}=... (one model)"
+        )
+    raise ValueError(
+        f"--set {key}: not a key of the study file; give its dotted path as a [grid] key does "
+        f"(scene.chain.EI, integrator.rtol; a model option: models.LABEL.{key})"
+    )
+
+
+def with_set_values(doc: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
+    """A copy of the study document ``doc`` with each value of ``overrides`` (``--set KEY`` ->
+    value) set at its ``study_path`` (``set_path``, as a grid sets a case's), checked when
+    the study is; a path given twice (``chain.EI`` and ``scene.chain.EI``) is refused."""
+    out = copy.deepcopy(doc)
+    given: dict[str, str] = {}
+    for key, value in overrides.items():
+        path = study_path(key)
+        if path in given:
+            raise ValueError(f"--set {path} given twice (as {given[path]} and {key}); give it once")
+        given[path] = key
+        try:
+            set_path(out, path, value)
+        except ValueError as exc:
+            raise ValueError(f"--set {key}: {exc}") from None
+    return out
+
+
 def load_study(
     path: str | Path,
     *,
     max_cases: int = MAX_CASES,
     announce: Callable[[int], None] | None = None,
+    overrides: dict[str, Any] | None = None,
 ) -> StudySpec:
     """Read and validate a study file (``path``: str or Path; ``max_cases``, ``announce``: see
-    study_from_dict)."""
+    study_from_dict) with the values of ``overrides`` (``rodval study --set``: key -> value,
+    ``with_set_values``) set; the study's text is then the file's with them set."""
     path = as_path("path", path)
     max_cases = _check_max_cases(max_cases)
     if not path.is_file():
@@ -348,6 +394,9 @@ def load_study(
         raise ValueError(f"{path}: malformed TOML: {exc}") from None
     if isinstance(doc.get("scene"), dict):
         doc["scene"] = anchor_load_files(doc["scene"], path.parent)
+    if overrides:
+        doc = with_set_values(doc, overrides)
+        text = f"# {path} with --set {', '.join(overrides)}\n{toml_text(doc)}"
     return study_from_dict(
         doc,
         where=str(path),
