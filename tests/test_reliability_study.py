@@ -119,6 +119,182 @@ def test_killed_study_leaves_no_stuck_lock_and_another_study_needs_fresh(tmp_pat
     assert json.loads((out / "study.json").read_text())["name"] == "other"
 
 
+#: Child of ``_kill_before_every_change``. argv: study file, start folder (copied into each
+#: killed folder when it exists), base folder, "fresh" or "". For n = 1, 2, ... it forks a
+#: process that runs the study into ``<base>/killed<n>`` and SIGKILLs itself just before its
+#: n-th change of that folder (an open for writing, a folder made or removed, a rename, a
+#: removal), as a kill from outside can land between any two changes; it stops at the n whose
+#: process reaches the start of the cases (its first worker) and prints how many were killed.
+KILL_AT_EVERY_CHANGE = r"""
+import os, shutil, signal, sys, traceback
+from pathlib import Path
+from rodval.study import load_study
+from rodval.study.pipeline import run_study
+
+spec, start, base = load_study(sys.argv[1]), Path(sys.argv[2]), Path(sys.argv[3])
+fresh = sys.argv[4] == "fresh"
+CHANGES = ("open", "os.mkdir", "os.rename", "os.remove", "os.rmdir")
+WRITES = os.O_WRONLY | os.O_RDWR | os.O_CREAT
+
+
+def run_killed_before_change(n, out):
+    seen = 0
+
+    def hook(event, args):
+        nonlocal seen
+        if event == "subprocess.Popen" and "rodval.study.worker" in args[1]:
+            os._exit(3)  # the folder is taken: the first case would start now
+        if event not in CHANGES or not isinstance(args[0], (str, os.PathLike)):
+            return
+        if event == "open" and not args[2] & WRITES:
+            return
+        path = os.path.abspath(args[0])
+        if path == str(out) or path.startswith(str(out) + os.sep):
+            seen += 1
+            if seen == n:
+                os.kill(os.getpid(), signal.SIGKILL)
+
+    sys.addaudithook(hook)
+    run_study(spec, out, workers=1, progress=False, report=False, fresh=fresh)
+
+
+for n in range(1, 500):
+    out = base / f"killed{n:03d}"
+    if start.is_dir():
+        shutil.copytree(start, out)
+    pid = os.fork()
+    if pid == 0:
+        try:
+            run_killed_before_change(n, out)
+        except BaseException:
+            traceback.print_exc()
+        os._exit(4)  # refused, or ended without starting a case
+    status = os.waitpid(pid, 0)[1]
+    if os.WIFEXITED(status) and os.WEXITSTATUS(status) == 3:
+        shutil.rmtree(out, ignore_errors=True)
+        print(n - 1)
+        break
+    assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGKILL, (n, status)
+"""
+
+
+def _kill_before_every_change(
+    study: Path, base: Path, start: Path | None, fresh: bool
+) -> list[Path]:
+    """The folders left by runs of ``study`` killed before each change they make to their
+    folder (``KILL_AT_EVERY_CHANGE``), in the order of the changes; each run starts from a
+    copy of ``start`` (None: a folder that does not exist yet)."""
+    base.mkdir()
+    argv = [str(study), str(start or base / "none"), str(base), "fresh" if fresh else ""]
+    done = subprocess.run(
+        [sys.executable, "-c", KILL_AT_EVERY_CHANGE, *argv],
+        env=ENV, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    killed = int(done.stdout)
+    return [base / f"killed{n:03d}" for n in range(1, killed + 1)]
+
+
+class _CasesStart(Exception):
+    """Raised where a study run that took its folder would start its cases."""
+
+
+def _take(spec, out: Path, monkeypatch, *, fresh: bool = False) -> str:
+    """What ``run_study`` of ``spec`` makes of the folder ``out``: "taken" when it reaches
+    its cases, else the error it gives."""
+    from rodval.study import pipeline
+
+    def start_cases(*args, **kwargs):
+        raise _CasesStart
+
+    monkeypatch.setattr(pipeline, "_run_cases", start_cases)
+    try:
+        pipeline.run_study(spec, out, workers=1, progress=False, report=False, fresh=fresh)
+    except _CasesStart:
+        return "taken"
+    except ValueError as exc:
+        return str(exc)
+    raise AssertionError("run_study ended without starting its cases")
+
+
+def _state(out: Path) -> list[str]:
+    return sorted(str(p.relative_to(out)) for p in out.rglob("*")) if out.exists() else []
+
+
+def _copy(out: Path, name: str) -> Path:
+    import shutil
+
+    copy = out.with_name(f"{out.name}-{name}")
+    if out.exists():
+        shutil.copytree(out, copy)
+    return copy
+
+
+def _holder(out: Path) -> str | None:
+    """The name of the study whose study.json is in ``out`` (None: none there)."""
+    path = out / "study.json"
+    return json.loads(path.read_text())["name"] if path.exists() else None
+
+
+def test_study_killed_at_any_point_of_its_claim_leaves_a_folder_the_next_run_takes(
+    tmp_path, monkeypatch
+):
+    """Issue (a flaky test_killed_study_...): a study killed after it had made OUT/cases but
+    before its study.json was written left a folder every later run refused as "not a study
+    folder of rodval ... it holds 'cases'"; a second study started then, while the first
+    still ran, was told the same instead of "in use". Killed before any change it makes to
+    a new folder, a study leaves one that it takes again, and that another study takes too,
+    or is told holds this study only when its study.json is there; while a run holds the
+    folder (a live run at that point), another is told it is in use."""
+    from rodval.study.store import StudyStore
+
+    tiny = write_study(tmp_path)
+    other = tmp_path / "other.toml"
+    other.write_text(tiny.read_text().replace('name = "tiny"', 'name = "other"'))
+    spec, other_spec = load_study(tiny), load_study(other)
+    killed = _kill_before_every_change(tiny, tmp_path / "runs", None, fresh=False)
+    # the folder, its lock, cases/, study.json, provenance.json, study.toml: at least 6
+    assert len(killed) >= 6, killed
+    for out in killed:
+        state, copy, busy = _state(out), _copy(out, "other"), _copy(out, "busy")
+        with StudyStore(busy).lock():
+            verdict = _take(other_spec, busy, monkeypatch)
+        assert "in use by another rodval study" in verdict, (state, verdict)
+        assert _take(spec, out, monkeypatch) == "taken", state
+        holder = _holder(copy)
+        verdict = _take(other_spec, copy, monkeypatch)
+        if holder is None:
+            assert verdict == "taken", state
+        else:
+            assert "holds another study ('tiny'" in verdict, (state, verdict)
+            assert _take(other_spec, copy, monkeypatch, fresh=True) == "taken", state
+
+
+def test_study_killed_at_any_point_of_fresh_leaves_a_folder_fresh_takes(
+    finished, tmp_path, monkeypatch
+):
+    """Issue: --fresh removed the old study's study.json first; killed before the new one was
+    written, it left the old study's tables and records in a folder no run could take, not
+    even with --fresh. Killed before any change of --fresh, the folder is taken by --fresh,
+    and a run without it is told the folder holds the study its study.json names."""
+    other = write_study(tmp_path, "other.toml", grid="scene.t_end = [0.1]")
+    other.write_text(other.read_text().replace('name = "tiny"', 'name = "other"'))
+    spec = load_study(other)
+    killed = _kill_before_every_change(other, tmp_path / "runs", finished, fresh=True)
+    # one removal at least for each file of the old study
+    assert len(killed) >= len(list(finished.iterdir())), killed
+    for out in killed:
+        state, copy = _state(out), _copy(out, "again")
+        assert _take(spec, out, monkeypatch, fresh=True) == "taken", state
+        holder = _holder(copy)
+        verdict = _take(spec, copy, monkeypatch)
+        assert holder in ("tiny", "other"), state
+        if holder == "other":
+            assert verdict == "taken", state
+        else:
+            assert "holds another study ('tiny'" in verdict, (state, verdict)
+
+
 # ------------------------------------------------------------------- damaged case records
 
 

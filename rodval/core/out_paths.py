@@ -144,8 +144,9 @@ def refuse_foreign(
     """ValueError naming ``flag`` unless ``folder`` is missing, empty, or rodval's
     (``owned(folder)``): rodval writes into no folder that holds files it did not write.
     ``kind`` ("study", "run") and ``marker`` (its file, e.g. "study.json") name the folder
-    rodval looked for in the refusal. A folder that is or holds a symbolic link is refused
-    first (``refuse_links``)."""
+    rodval looked for in the refusal; its housekeeping and the temporary file of an atomic
+    write killed before its rename (of the marker itself) are rodval's. A folder that is or
+    holds a symbolic link is refused first (``refuse_links``)."""
     refuse_links(folder, flag)
     if not folder.exists():
         return
@@ -153,7 +154,11 @@ def refuse_foreign(
         raise ValueError(f"{flag} {folder}: is a file, not a folder")
     if owned(folder):
         return
-    entries = sorted(p.name for p in folder.iterdir() if p.name not in HOUSEKEEPING)
+    entries = sorted(
+        p.name
+        for p in folder.iterdir()
+        if p.name not in HOUSEKEEPING and not TEMPORARY.fullmatch(p.name)
+    )
     if entries:
         raise ValueError(
             f"{flag} {folder}: not a {kind} folder of rodval (no {marker} with rodval's schema "

@@ -8,6 +8,9 @@ and ``figures/``.
 * One writer: ``lock()`` holds ``OUT/.lock`` (an exclusive ``fcntl`` lock, released by the
   kernel when the process dies, so a killed run never leaves it stuck); a second run on the
   same folder is refused with a ``FolderBusy`` naming the holder's pid.
+* Killed at any point, a run leaves a folder the next run takes: ``claim`` writes study.json
+  (atomically) before any other file of the study and ``--fresh`` replaces it last, so the
+  folder never holds a study's files without the study.json that makes it a study folder.
 * One study: a folder that holds another study (``study.json`` with a different name or
   source, or a different grid), or this study when the scene file its [scene] names has
   changed (``scene_file_change``), is refused unless ``fresh=True`` (``--fresh``), which first
@@ -178,7 +181,10 @@ class StudyStore:
     def claim(self, meta: dict[str, Any], *, fresh: bool) -> None:
         """Make the folder this study's: refuse a folder holding another study, or this
         study with a changed scene file (``scene_file_change``), unless ``fresh`` (then
-        remove what that study wrote, ``study_files``); write study.json."""
+        remove what that study wrote, ``study_files``, its study.json last: replaced by this
+        study's); write study.json, then make cases/. A run killed at any point of this
+        leaves a folder the next run takes: it holds a study.json whenever it holds any
+        other file of a study."""
         old = self.meta()
         changed = None if old is None or fresh else scene_file_change(old, meta)
         if changed:
@@ -188,14 +194,16 @@ class StudyStore:
                 f"{self.out} holds another study ({old.get('name')!r} from "
                 f"{old.get('source')!r}); use another --out, or --fresh to start over there"
             )
+        marker = self.out / "study.json"
         if fresh and old is not None:
             for path in self.study_files(old):
-                path.unlink(missing_ok=True)
-            for folder in (self.cases_dir, self.out / FIGURES):
-                if folder.is_dir() and not any(folder.iterdir()):
-                    folder.rmdir()
-        self.cases_dir.mkdir(parents=True, exist_ok=True)
-        write_json_atomic(self.out / "study.json", stamp(meta, STUDY_SCHEMA))
+                if path != marker:
+                    path.unlink(missing_ok=True)
+            figures = self.out / FIGURES
+            if figures.is_dir() and not any(figures.iterdir()):
+                figures.rmdir()
+        write_json_atomic(marker, stamp(meta, STUDY_SCHEMA))
+        self.cases_dir.mkdir(exist_ok=True)
 
 
 def same_study(a: dict[str, Any], b: dict[str, Any]) -> bool:
