@@ -32,7 +32,10 @@ EXAMPLES = int(os.environ.get("RODVAL_FUZZ_EXAMPLES", "0") or 0)
 #: Time limit of one example (s).
 LIMIT_S = 60.0
 #: Budgets given to every run (the fuzzed options may come after them and override them).
-BUDGET = ["--max-wall", "2", "--max-evaluations", "50000"]
+#: The wall budget is the whole command's (reading, loading the compiled loop: about 2 s on a
+#: loaded machine, set-up, writing), which rodval refuses before work when its estimate does
+#: not fit: 10 s leaves a loaded machine room and still ends every example well within LIMIT_S.
+BUDGET = ["--max-wall", "10", "--max-evaluations", "50000"]
 
 
 def budget(default: int, *, expensive: bool = False, share: int = 1) -> settings:
