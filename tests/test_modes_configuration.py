@@ -90,7 +90,7 @@ def test_an_equilibrium_state_is_accepted_about_itself_and_others_are_refused():
     R = static_residual(CHAIN, q, rest=scene.chain.rest_angle)
     assert np.max(np.abs(R)) < AT_REST_RTOL * 100
     np.testing.assert_array_equal(modes(at_eq, "full", count=3).omega, about_eq.omega)
-    with pytest.raises(ValueError, match=r"not at rest \(dphi not zero\)"):
+    with pytest.raises(ValueError, match=r"not at rest \(initial\.dphi not zero\)"):
         modes(paper_scene().with_(initial=InitialState(dphi=0.1)), "full", count=1)
     loaded = _scene(constant(3, Y=30.0))
     q = modes(loaded, "full", about="equilibrium", count=1).equilibrium.q

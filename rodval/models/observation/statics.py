@@ -186,7 +186,7 @@ def check_at_rest(scene: Scene) -> float:
     model's modal analysis. O(n^2) (the dense K of the paper's matrices)."""
     chain, n = scene.chain, scene.n
     ini = scene.initial.resolve(n)
-    moving = [k for k in ("dphi", "dalpha", "dbeta") if np.any(ini[k] != 0)]
+    moving = [f"initial.{k}" for k in ("dphi", "dalpha", "dbeta") if np.any(ini[k] != 0)]
     if moving:
         raise ValueError(
             f"the initial state is not at rest ({', '.join(moving)} not zero), so there is no "
