@@ -6,7 +6,10 @@ each model's results over the samples, as engineers read a deployment's reliabil
   that locked and the percentiles of its lock time (s);
 * ``discrepancy_percentiles``: per model pair and quantity, percentiles of max_abs and rms
   over the samples (the comparisons that were made);
-* ``sample_section``: both as the study report's Sample statistics section.
+* ``sample_section``: both as the study report's Sample statistics section;
+* ``spread``: one quantity's distribution over the cases (min, percentiles, max, the worst
+  case), which ``percentile_rows`` and the report's opening (``rodval.report.study_summary``)
+  give.
 
 Percentiles are numpy's linear interpolation (``numpy.percentile``) at ``PERCENTILES``.
 """
@@ -109,24 +112,42 @@ def sample_section(
 EVENT_QUANTITIES = ("t", "impulse", "energy_lost")
 
 
+def spread(values: pd.Series, cases: pd.Series, absolute: bool = False) -> dict[str, Any]:
+    """The distribution of ``values`` (one per case, in their unit; blank and non-numeric
+    ones left out) over the cases ``cases`` (same index): ``count``, ``min``, ``pP`` for P in
+    PERCENTILES, ``max``, and the worst: ``worst`` the largest value (the largest |value| when
+    ``absolute``), ``worst_case`` its case. Only ``count`` (0) without values."""
+    vals = pd.to_numeric(values, errors="coerce").dropna()
+    if vals.empty:
+        return {"count": 0}
+    at = (vals.abs() if absolute else vals).idxmax()
+    return {
+        "count": len(vals),
+        "min": float(vals.min()),
+        **{f"p{p}": float(np.percentile(vals, p)) for p in PERCENTILES},
+        "max": float(vals.max()),
+        "worst": float(vals[at]),
+        "worst_case": cases[at],
+    }
+
+
 def percentile_rows(
     df: pd.DataFrame, by: list[str], columns: tuple[str, ...], absolute: bool = False
 ) -> pd.DataFrame:
     """Per group of ``by``: the number of rows and, for each of ``columns``, its percentiles
     (PERCENTILES, over the group's non-blank values) and the case of its largest value (of
-    its largest |value| when ``absolute``). O(rows)."""
+    its largest |value| when ``absolute``): ``spread``'s. O(rows)."""
     rows = []
     for key, part in df.groupby(by, sort=False):
         row = dict(zip(by, key if isinstance(key, tuple) else (key,)))
         row["samples"] = len(part)
         for col in columns:
-            vals = pd.to_numeric(part[col], errors="coerce").dropna()
+            s = spread(part[col], part["case"], absolute)
             for p in PERCENTILES:
-                row[f"{col}_p{p}"] = float(np.percentile(vals, p)) if len(vals) else np.nan
-            if len(vals):
-                at = (vals.abs() if absolute else vals).idxmax()
-                row[f"{col}_worst"] = float(vals[at])
-                row[f"{col}_worst_case"] = part.loc[at, "case"]
+                row[f"{col}_p{p}"] = s.get(f"p{p}", np.nan)
+            if s["count"]:
+                row[f"{col}_worst"] = s["worst"]
+                row[f"{col}_worst_case"] = s["worst_case"]
         rows.append(row)
     return pd.DataFrame(rows)
 

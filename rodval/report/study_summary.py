@@ -1,8 +1,12 @@
 """The study report's summary sections, from the saved tables: the Answer it opens with
-(``answer_section``: each model's verdict, agreement horizon, parting lock and its measured
-cause, worst lock gaps and run time; ``rodval.analysis.agreement``), the Outcome (runs,
-failures, invalid runs, comparisons made and not made, by reason), the Discrepancies against
-the reference, the Run time with speed-ups, and the Stability map."""
+(``opening_section``): in a study that compares models, each model's verdict, agreement
+horizon, parting lock and its measured cause, worst lock gaps and run time
+(``answer_section``, ``rodval.analysis.agreement``; the reference's verdict in one sentence
+for the study); in a study of one model, its verdict (``verdict_section``: the acceptance
+gate, which requirement broke in which cases, how the runs ended and deployed, the design
+quantities per hinge over the cases with their worst case), nothing compared; then the
+Outcome (runs, failures, invalid runs, comparisons made and not made, by reason), the
+Discrepancies against the reference, the Run time with speed-ups, and the Stability map."""
 
 from __future__ import annotations
 
@@ -15,12 +19,17 @@ from rodval.analysis.agreement import (
     agreement_table,
     check_names,
     latch_hinges,
+    lock_list,
+    never_locked,
     twin_label,
 )
 from rodval.analysis.metrics import left_out_quantities
 from rodval.core.validity import ENERGY_RESIDUAL_BOUND, SMALL_BENDING_RAD
+from rodval.report.acceptance import acceptance_checks
 from rodval.report.figures import speedups
 from rodval.report.markdown import to_markdown
+from rodval.report.sample_stats import PERCENTILES, spread
+from rodval.report.sensitivity import design_values
 from rodval.report.tables import drop_constant, drop_study_constants
 
 
@@ -61,11 +70,12 @@ def summary_sections(
     failed = runtime[runtime["status"] != "success"]
     left = left_out_table(tables["trajectories"], ref)
     keep = dict(constants or {})
-    lines = _outcome(disc, runtime, failed, left, keep, sampled=bool(meta.get("sample")))
+    one = len(meta["models"]) == 1
+    lines = _outcome(disc, runtime, failed, left, keep, sampled=bool(meta.get("sample")), one=one)
     if meta.get("sample"):
-        return lines + _sampled_sections(disc, runtime, ref)
+        return lines + _sampled_sections(disc, runtime, ref, one)
     lines += _discrepancies(disc, left, ref, len(meta["models"]), params, keep)
-    lines += _run_time(runtime, ref, params, keep)
+    lines += _run_time(runtime, ref, params, keep, one)
     if not failed.empty or (
         "energy_residual" in runtime and runtime["energy_residual"].notna().any()
     ):
@@ -77,12 +87,15 @@ def summary_sections(
 WORST_CASES = 5
 
 
-def _sampled_sections(disc: pd.DataFrame, runtime: pd.DataFrame, ref: str) -> list[str]:
+def _sampled_sections(
+    disc: pd.DataFrame, runtime: pd.DataFrame, ref: str, one: bool = False
+) -> list[str]:
     """A sampled study's Discrepancies and Run time: the worst cases of each model and
     quantity (the percentiles are in Sample statistics) and the run time's percentiles per
-    model; per-case values stay in discrepancies.csv and runtime.csv."""
+    model; per-case values stay in discrepancies.csv and runtime.csv. ``one``: the study has
+    one model (nothing to compare: said in one line)."""
     ok = disc[disc["status"] == "ok"]
-    lines = [f"## Discrepancies against `{ref}`\n"]
+    lines = [_one_model(ref)] if one else [f"## Discrepancies against `{ref}`\n"]
     if not ok.empty:
         idx = ok.groupby(["model", "quantity"], sort=False)["max_abs"].idxmax()
         worst = ok.loc[idx, ["model", "quantity", "case", "max_abs", "max_rel"]]
@@ -119,17 +132,23 @@ def _outcome(
     left: pd.DataFrame,
     constants: dict[str, Any] | None = None,
     sampled: bool = False,
+    one: bool = False,
 ) -> list[str]:
-    """The Outcome section: counts of cases, runs, failed and invalid runs and comparisons,
-    the comparisons not made by reason, the failed runs and the invalid runs (of a sampled
-    study: counted by model and reason, the first WORST_CASES failed runs listed)."""
+    """The Outcome section: counts of cases, runs, failed and invalid runs and comparisons
+    (none counted in a study of ``one`` model), the comparisons not made by reason, the
+    failed runs and the invalid runs (of a sampled study: counted by model and reason, the
+    first WORST_CASES failed runs listed)."""
     invalid = runtime[runtime["valid"].astype(str) == "False"] if "valid" in runtime else failed[:0]
     not_made = disc[disc["status"] != "ok"]
+    compared = (
+        ""
+        if one
+        else f"; {(disc['status'] == 'ok').sum()} comparisons made (case, model, quantity), "
+        f"{len(not_made) + len(left)} could not be made"
+    )
     lines = [
         f"## Outcome\n\n{runtime['case'].nunique()} cases, {len(runtime)} model runs, "
-        f"{len(failed)} failed, {len(invalid)} invalid; "
-        f"{(disc['status'] == 'ok').sum()} comparisons made (case, model, quantity), "
-        f"{len(not_made) + len(left)} could not be made.\n"
+        f"{len(failed)} failed, {len(invalid)} invalid{compared}.\n"
     ]
     reasons = pd.concat(
         [not_made[["status"]], pd.DataFrame({"status": left["why"]}) if len(left) else None]
@@ -187,16 +206,15 @@ def _discrepancies(
     """The Discrepancies section: per model, max_abs and max_rel of each quantity against
     the reference ``ref`` per case, and the quantities left out of the comparison
     (``models``: how many models the study has)."""
-    lines = [f"## Discrepancies against `{ref}`\n"]
     if models == 1:
-        lines.append(f"The study has one model (`{ref}`): nothing to compare.\n")
-    else:
-        lines.append(
-            "Largest absolute difference over all output times and rods (`max_abs`; rad, "
-            "rad/s) and the same relative to each reference rod's largest value "
-            "(`max_rel`); see `discrepancies.csv` for rms, final value and where the "
-            "maximum occurs.\n"
-        )
+        return [_one_model(ref)]
+    lines = [
+        f"## Discrepancies against `{ref}`\n",
+        "Largest absolute difference over all output times and rods (`max_abs`; rad, "
+        "rad/s) and the same relative to each reference rod's largest value "
+        "(`max_rel`); see `discrepancies.csv` for rms, final value and where the "
+        "maximum occurs.\n",
+    ]
     for model, part in disc.groupby("model", sort=False):
         ok = part[part["status"] == "ok"]
         lines.append(f"### `{model}` against `{ref}`\n")
@@ -223,11 +241,21 @@ def _discrepancies(
     return lines
 
 
+def _one_model(label: str) -> str:
+    """The Discrepancies section of a study of one model (``label``)."""
+    return f"## Discrepancies\n\nThe study has one model (`{label}`): nothing to compare.\n"
+
+
 def _run_time(
-    runtime: pd.DataFrame, ref: str, params: list[str], constants: dict[str, Any] | None = None
+    runtime: pd.DataFrame,
+    ref: str,
+    params: list[str],
+    constants: dict[str, Any] | None = None,
+    one: bool = False,
 ) -> list[str]:
     """The Run time section: each successful run's integration wall time (s) per case and
-    model, and each model's speed-up against the reference ``ref``."""
+    model, and each model's speed-up against the reference ``ref`` (none in a study of
+    ``one`` model)."""
     ok = runtime[runtime["status"] == "success"]
     wall = ok.pivot_table(index=["case", *params], columns="model", values="wall_s", sort=False)
     speed = speedups(runtime, ref, params)
@@ -238,8 +266,9 @@ def _run_time(
         wall = wall.join(sp.add_prefix("speed-up "))
     return [
         "## Run time\n",
-        "Integration wall time in s (without model set-up); speed-up = wall time of "
-        f"`{ref}` / wall time of the model.\n",
+        "Integration wall time in s (without model set-up)"
+        + ("" if one else f"; speed-up = wall time of `{ref}` / wall time of the model")
+        + ".\n",
         "Failed runs are left out.\n",
         to_markdown(drop_study_constants(wall.reset_index(), constants or {})),
     ]
@@ -279,13 +308,43 @@ def _stability_map(
 MAX_ANSWER_CASES = 12
 
 
+def opening_section(
+    meta: dict[str, Any],
+    tables: dict[str, pd.DataFrame],
+    events: pd.DataFrame,
+    peaks: pd.DataFrame,
+) -> list[str]:
+    """The report's opening, its answer (markdown lines): with two or more models, each
+    against the reference (``answer_section``); with one, its verdict (``verdict_section``:
+    the acceptance gate, the runs, the quantities of interest over the cases; ``peaks``: the
+    report's peak hinge moments, ``rodval.report.study_report.peak_hinge_moments``) and,
+    when the study runs the model's twin ([agreement.twin]), the one comparison there is:
+    how long the twin agrees with it."""
+    if len(meta["models"]) > 1:
+        return answer_section(meta, tables, events)
+    twin = _agreement_lines(meta, tables, events)
+    label = meta["models"][0]["label"]
+    head = [f"### `{label}` against its twin run\n"] if twin else []
+    return [*verdict_section(meta, tables, events, peaks), *head, *twin]
+
+
 def answer_section(
     meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
 ) -> list[str]:
-    """The report's opening: a paragraph and one short table, model by model, from the runs
-    (``rodval.analysis.agreement.agreement_table``): valid or out of domain and why, the
-    agreement horizon, the first lock where it parts and the measured cause, the worst
-    lock-time and impulse gaps, the run time (markdown lines)."""
+    """The answer of a study that compares models: a paragraph and one short table, model by
+    model, from the runs (``rodval.analysis.agreement.agreement_table``): valid or out of
+    domain and why, the agreement horizon, the first lock where it parts and the measured
+    cause, the worst lock-time and impulse gaps, the run time (markdown lines; none when no
+    run is compared with the reference)."""
+    lines = _agreement_lines(meta, tables, events)
+    return ["## Answer\n", *lines] if lines else []
+
+
+def _agreement_lines(
+    meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
+) -> list[str]:
+    """``answer_section``'s lines below its heading; none when the agreement table holds no
+    run but the reference's (nothing is compared)."""
     ref = meta["reference"]
     settings = AgreementSettings.from_dict(meta.get("agreement"))
     table = agreement_table(
@@ -296,9 +355,9 @@ def answer_section(
         settings,
         latch_hinges(tables["cases"]),
     )
-    if table.empty:
+    if table.empty or (table["role"] == "reference").all():
         return []
-    lines = ["## Answer\n", _definition(settings, ref)]
+    lines = [_definition(settings, ref)]
     if meta.get("sample") or table["case"].nunique() > MAX_ANSWER_CASES:
         lines += _answer_over_cases(table, ref)
     else:
@@ -488,18 +547,20 @@ def _answer_rows(table: pd.DataFrame, settings: AgreementSettings, ref: str) -> 
 
 
 def _sentences(table: pd.DataFrame, ref: str, settings: AgreementSettings) -> list[str]:
-    """The opening paragraph's sentences, one per run, with the figures."""
-    out = []
+    """The opening paragraph's sentences, with the figures: one for the reference (over
+    several cases one for the study, ``_reference_sentence``), then one per compared run."""
+    many = table["case"].nunique() > 1
+    refs = table[table["role"] == "reference"]
+    out = [_reference_sentence(refs, settings)] if many and len(refs) else []
     for _, row in table.iterrows():
-        name = f"`{row['model']}`" + (
-            f" (case `{row['case']}`)" if table["case"].nunique() > 1 else ""
-        )
+        name = f"`{row['model']}`" + (f" (case `{row['case']}`)" if many else "")
         verdict = _verdict(row)
         if row["role"] == "reference":
-            out.append(
-                f"The reference {name} is {verdict}{_error_bar(settings)}{_undeployed(row)} "
-                f"(run time {row['wall_s']:.3g} s)."
-            )
+            if not many:
+                out.append(
+                    f"The reference {name} is {verdict}{_error_bar(settings)}"
+                    f"{_undeployed(row)} (run time {row['wall_s']:.3g} s)."
+                )
             continue
         head = f"{name} is {verdict}{_undeployed(row)}; it agrees with `{ref}` until {_until(row)}"
         if row["role"] == "twin":
@@ -524,6 +585,41 @@ def _sentences(table: pd.DataFrame, ref: str, settings: AgreementSettings) -> li
             text += f"; beyond: {beyond}"
         out.append(f"{text}; run time {row['wall_s']:.3g} s.")
     return out
+
+
+def _reference_sentence(refs: pd.DataFrame, settings: AgreementSettings) -> str:
+    """The reference's one sentence over the cases of its rows ``refs`` (agreement table
+    rows, one per case): in how many it is valid (the others named with their verdict), its
+    error bar, the cases where it is not deployed and which latches never locked there, its
+    median and longest run time."""
+    verdicts = [_verdict(row) for _, row in refs.iterrows()]
+    cases = refs["case"].astype(str).tolist()
+    valid = sum(v == "valid" for v in verdicts)
+    others = [f"{v} in `{c}`" for c, v in zip(cases, verdicts) if v != "valid"]
+    text = f"The reference `{refs['model'].iloc[0]}` is valid in {valid} of {len(refs)} cases"
+    if others:
+        text += f" ({_first(others)})"
+    text += _error_bar(settings)
+    missed = [
+        f"`{c}` ({m} never locked within its run)"
+        for c, m in zip(cases, refs["never_locked"])
+        if _filled(m)
+    ]
+    if missed:
+        text += f", not deployed in {len(missed)} of {len(refs)}: {_first(missed)}"
+    slow = refs.loc[refs["wall_s"].idxmax()] if refs["wall_s"].notna().any() else None
+    if slow is not None:
+        text += (
+            f" (run time median {refs['wall_s'].median():.3g} s, longest "
+            f"{slow['wall_s']:.3g} s in `{slow['case']}`)"
+        )
+    return text + "."
+
+
+def _first(items: list[str], shown: int = WORST_CASES) -> str:
+    """The first ``shown`` of ``items`` joined, and how many more there are."""
+    more = len(items) - shown
+    return ", ".join(items[:shown]) + (f" and {more} more" if more > 0 else "")
 
 
 def _error_bar(settings: AgreementSettings) -> str:
@@ -599,3 +695,208 @@ def _answer_over_cases(table: pd.DataFrame, ref: str) -> list[str]:
         )
     table = pd.DataFrame(rows).astype(object)
     return [" ".join(sentences) + "\n", to_markdown(table.where(table.notna(), ""))]
+
+
+# ---- the verdict a one-model study opens with ---------------------------------------------
+
+
+def verdict_section(
+    meta: dict[str, Any],
+    tables: dict[str, pd.DataFrame],
+    events: pd.DataFrame,
+    peaks: pd.DataFrame,
+) -> list[str]:
+    """A one-model study's answer (markdown lines): the acceptance gate's verdict
+    (``_gate_sentence``), how the runs ended and whether they deployed (``_runs_sentence``),
+    and the design quantities (``rodval.report.sensitivity.design_values``: lock time, lock
+    impulse and peak hinge moment per hinge, a free base's attitude at t_end) over the cases:
+    min, PERCENTILES, max and the worst case (``_quantities_lines``; ``peaks``: the report's
+    peak hinge moments). Nothing in it compares models: there is one."""
+    label = meta["models"][0]["label"]
+    runtime = tables["runtime"][tables["runtime"]["model"] == label]
+    values = design_values({**tables, "events": events, "peaks": peaks})
+    values = values[values["model"] == label]
+    mine = peaks[peaks["model"] == label] if "model" in peaks else peaks
+    return [
+        "## Answer\n",
+        _gate_sentence(meta, tables, events),
+        _runs_sentence(label, runtime, latch_hinges(tables["cases"]), events, values),
+        *_quantities_lines(values, mine, runtime["case"].astype(str).tolist()),
+    ]
+
+
+def _gate_sentence(
+    meta: dict[str, Any], tables: dict[str, pd.DataFrame], events: pd.DataFrame
+) -> str:
+    """The acceptance verdict in one paragraph (``rodval.report.acceptance``): PASSED with
+    the number of checks, or FAILED with each broken requirement, the cases it broke in and
+    the figure against the bound; without an [acceptance] table, that none was set."""
+    if not meta.get("acceptance"):
+        return "Acceptance: no [acceptance] in the study, so no gate was set.\n"
+    checks = acceptance_checks(meta, tables, events)
+    broken = [c for c in checks if not c.held]
+    if not broken:
+        return f"**Acceptance: PASSED** ({len(checks)} checks of the study's [acceptance]).\n"
+    cases = sorted(tables["cases"]["case"].astype(str), key=len, reverse=True)
+    by_requirement: dict[str, list[str]] = {}
+    for c in broken:
+        case = next((k for k in cases if c.name.startswith(f"{k}: ")), "")
+        what = c.name.removeprefix(f"{case}: ") if case else c.name
+        by_requirement.setdefault(what, []).append(f"`{case}`: {c.failure}" if case else c.failure)
+    parts = [
+        f"`{what}` in {len(where)} of {len(cases)} cases ({_first(where, 3)})"
+        if where[0].startswith("`")
+        else f"`{what}` ({where[0]})"
+        for what, where in by_requirement.items()
+    ]
+    return (
+        f"**Acceptance: FAILED**, {len(broken)} of {len(checks)} checks broke: "
+        f"{'; '.join(parts[:WORST_CASES])}"
+        + (f"; {len(parts) - WORST_CASES} more requirements" if len(parts) > WORST_CASES else "")
+        + " (every breach: Acceptance below).\n"
+    )
+
+
+def _runs_sentence(
+    label: str,
+    runtime: pd.DataFrame,
+    latches: dict[Any, list[int]],
+    events: pd.DataFrame,
+    values: pd.DataFrame,
+) -> str:
+    """How the model's runs (``runtime``: its runtime.csv rows) ended (a failed run named
+    with its status, time reached and message), how many are invalid and why, in how many
+    cases every latch locked (``latches``: case -> latched hinges) and which latches never
+    locked where not, and a free base's attitude at t_end over the cases (``values``)."""
+    n = len(runtime)
+    ok = runtime[runtime["status"] == "success"]
+    text = f"`{label}` over {n} case{'s' if n > 1 else ''}: {len(ok)} of {n} runs reached t_end"
+    failed = [
+        f"`{r['case']}` ({r['status']} at t = {r['t_reached']:.4g} s: {r['message']})"
+        for _, r in runtime[runtime["status"] != "success"].iterrows()
+    ]
+    if failed:
+        text += f"; failed: {_first(failed)}"
+    invalid = runtime[runtime["valid"].astype(str) == "False"] if "valid" in runtime else ok[:0]
+    why = [f"`{c}` ({check_names(w)})" for c, w in zip(invalid["case"], invalid["invalid_because"])]
+    text += f"; {len(invalid)} invalid: {_first(why)}" if why else "; none invalid"
+    latched = [c for c in runtime["case"] if latches.get(c)]
+    if latched:
+        missed = {c: never_locked(latches[c], lock_list(events, c, label)) for c in latched}
+        undeployed = [f"`{c}` ({m} never locked within its run)" for c, m in missed.items() if m]
+        text += (
+            f"; deployed (every latch locked) in {len(latched) - len(undeployed)} of {len(latched)}"
+        )
+        if undeployed:
+            text += f", not deployed in {_first(undeployed)}"
+    attitude = values[values["quantity"] == "final_attitude"]
+    if not attitude.empty:
+        s = spread(attitude["value"], attitude["case"], absolute=True)
+        if s["count"]:
+            text += (
+                f"; the free base's attitude at t_end (rad) {_cell(s, n)}, largest |attitude| "
+                f"{_worst_of(s)}"
+            )
+    return text + ".\n"
+
+
+#: The opening table's quantities per hinge: (design quantity, column, worst-case column);
+#: each shown by its absolute value (no "|" in a column name: it would split the table).
+OPENING_QUANTITIES = (
+    ("t_lock", "lock time (s)", "latest (case)"),
+    ("impulse", "lock impulse, absolute (N m s)", "largest (case)"),
+    ("peak_moment", "peak hinge moment (N m)", "highest (case)"),
+)
+
+
+def _quantities_lines(values: pd.DataFrame, peaks: pd.DataFrame, cases: list[str]) -> list[str]:
+    """The opening's table: per hinge, each quantity of OPENING_QUANTITIES over the
+    ``cases`` (``values``: ``design_values`` of the one model) as min / p5 / p50 / p95 / max
+    and its worst case; a hinge whose moment is an impulse at its lock (``peaks``' blank
+    peak beside an ``impulse``) says in how many cases; a peak read on the output times only
+    (``peaks``' source ``hinge_moment``: runtime.csv recorded none) says so."""
+    n = len(cases)
+    per_hinge = values[values["quantity"] != "final_attitude"]
+    if per_hinge.empty:
+        return []
+    rows = []
+    for k in sorted(set(per_hinge["k"].astype(int))):
+        row: dict[str, Any] = {"hinge": k}
+        for q, column, worst in OPENING_QUANTITIES:
+            part = per_hinge[(per_hinge["quantity"] == q) & (per_hinge["k"] == k)]
+            s = spread(part["value"].abs(), part["case"])
+            row[column] = _cell(s, n)
+            row[worst] = _worst_of(s)
+        if "impulse" in peaks:
+            mine = peaks[peaks["hinge"] == k]
+            dirac = int((mine["peak_moment"].isna() & mine["impulse"].notna()).sum())
+            if dirac:
+                note = f"impulsive at its lock in {dirac} of {n}"
+                cell = row[OPENING_QUANTITIES[2][1]]
+                row[OPENING_QUANTITIES[2][1]] = f"{cell}; {note}" if cell else note
+        rows.append(row)
+    table = pd.DataFrame(rows)
+    table = table[[c for c in table.columns if (table[c] != "").any()]]
+    if n == 1:
+        table = table.drop(columns=[w for _, _, w in OPENING_QUANTITIES if w in table])
+    over = (
+        "The model's results"
+        if n == 1
+        else (
+            f"Over the {n} cases, per hinge: {SPREAD_NAMES} of each quantity over "
+            "the cases that have it (k of N when fewer: a latch that did not lock, a run that "
+            "failed) and its worst case (the latest lock, the largest |impulse|, the highest "
+            "peak)"
+        )
+    )
+    notes = [
+        "the lock time and impulse are events.csv's first lock of the hinge (the impulse "
+        "over its lock window, docs/deployment.md)",
+        _peak_note(peaks),
+    ]
+    return [f"{over}; {'; '.join(notes)}:\n", to_markdown(table)]
+
+
+def _peak_note(peaks: pd.DataFrame) -> str:
+    """Where the opening's peak hinge moments come from (``peaks``' ``source``), in words:
+    the peak each run recorded between its output times, or, for a run that recorded none,
+    the output times' largest |hinge_moment|, said so; and why a locked hinge may have none."""
+    source = peaks["source"] if "source" in peaks else pd.Series(dtype=object)
+    if source.empty:
+        return "no peak hinge moment: `hinge_moment` is not among the [scene] outputs"
+    grid = "the largest |hinge_moment| over the output times of trajectories.csv only"
+    recorded = "each run's recorded peak (runtime.csv's `peaks`, read between the output times)"
+    if (source == "hinge_moment").all():
+        text = f"the peak is {grid} (the runs recorded none)"
+    elif (source == "hinge_moment").any():
+        text = f"the peak is {recorded}, else, for the runs that recorded none, {grid}"
+    else:
+        text = f"the peak is {recorded}"
+    if "impulse" in peaks and peaks["impulse"].notna().any():
+        text += (
+            "; an ideal latch on rigid chords (the reduced and rigid models) makes a locked "
+            "hinge's moment an impulse at the lock: no finite peak"
+        )
+    return text
+
+
+#: How ``_cell`` lists a distribution.
+SPREAD_NAMES = " / ".join(["min", *(f"p{p}" for p in PERCENTILES), "max"])
+
+
+def _cell(s: dict[str, Any], cases: int) -> str:
+    """A distribution (``spread``) as SPREAD_NAMES say, min / p5 / p50 / p95 / max (the value
+    alone when there is one), "k of N" when fewer than the ``cases`` have a value; "" without
+    one."""
+    if not s["count"]:
+        return ""
+    if s["count"] == 1:
+        return f"{s['max']:.4g}" + ("" if cases == 1 else f" (1 of {cases})")
+    figures = [s["min"], *(s[f"p{p}"] for p in PERCENTILES), s["max"]]
+    text = " / ".join(f"{v:.4g}" for v in figures)
+    return text + (f" ({s['count']} of {cases})" if s["count"] < cases else "")
+
+
+def _worst_of(s: dict[str, Any]) -> str:
+    """A distribution's (``spread``) worst value and its case."""
+    return f"{s['worst']:.4g} (`{s['worst_case']}`)" if s["count"] else ""
