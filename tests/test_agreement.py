@@ -291,7 +291,7 @@ def test_a_free_bases_deployed_attitude_is_compared_against_its_band():
 def test_the_answer_states_the_references_error_bar_or_that_it_is_not_given():
     """The reference's sentence carries the error bar the study gives (measured by refining
     the reference, `rodval reference`), each figure in its unit; without one, it says so."""
-    from rodval.report.study_summary import _sentences
+    from rodval.report.study_answer import _sentences
 
     traj, events, runtime = _tables(twin_shift=1e-7)
     bar = {"lock_dt": 0.00787, "impulse_rel": 0.00842, "rel": 0.00648, "attitude": 4.5e-4}

@@ -26,7 +26,7 @@ from rodval.core.scene import Chain, InitialState, Latch, Scene
 from rodval.report import animation, figures
 from rodval.report.study_figures import param_figures
 from rodval.report.study_report import build_report, residual_vibration
-from rodval.report.study_summary import answer_section
+from rodval.report.study_answer import answer_section
 from rodval.report.tables import axis_columns, read_events, read_tables
 from rodval.study import load_study, run_study
 
@@ -273,13 +273,25 @@ def test_a_profile_key_axis_is_named_with_its_key(study):
 def test_a_failed_run_is_not_said_to_agree_until_the_end():
     """A run that failed at t = 0 'agreed with the reference until the end (0 s)': it agrees
     until its failure, where the run ends."""
-    from rodval.report.study_summary import _until
+    from rodval.report.study_answer import _until
 
     row = pd.Series({"role": "model", "status": "failed", "horizon": math.nan, "compared_to": 0.0})
     assert _until(row) == "its failure at t = 0 s (the run ends there)"
     done = row.copy()
     done["status"], done["compared_to"] = "success", 0.8
     assert _until(done) == "the end (0.8 s)"
+
+
+def test_a_run_compared_with_a_reference_that_failed_is_not_said_to_agree_until_the_end():
+    """A reference stopped by its evaluation budget at 0.0185 s of 0.3 s made the reduced
+    model 'agree with full until the end (0 s)' (tests/test_fuzz_round4.py's find): the pair
+    is compared up to the reference's failure, and the answer says so."""
+    from rodval.report.study_answer import _until
+
+    row = pd.Series({"role": "model", "status": "success", "horizon": math.nan, "compared_to": 0.0})
+    ref = pd.Series({"role": "reference", "status": "evaluation budget exhausted"})
+    assert _until(row, ref) == "the reference's failure at t = 0 s (compared that far)"
+    assert _until(row, ref.replace("evaluation budget exhausted", "success")) == "the end (0 s)"
 
 
 def test_a_figure_against_a_parameter_without_any_successful_run_says_so(tmp_path):

@@ -21,6 +21,7 @@ does not grow with the number of samples.
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -289,22 +290,32 @@ def _deployment_section(
             to_markdown(keep(disc), ".3g"),
         ]
     lines += peak_moment_lines(tables, events, meta["models"], keep)
-    resid = residual_vibration(tables["trajectories"], events, tables["cases"])
-    if not resid.empty:
-        lines += [
-            "Residual vibration after the last lock (tip y amplitude and mean in m, largest "
-            "|alpha|, |beta| in rad, spread of the chord angles at the end in rad"
-            + (
-                "; `never_locked`: the latches that did not lock within the run, which is "
-                "then not deployed: its motion after the last lock is a partly folded "
-                "structure's, not a deployed one's residual vibration"
-                if "never_locked" in resid
-                else ""
-            )
-            + "):\n",
-            to_markdown(keep(resid), ".4g"),
-        ]
+    lines += _residual_lines(tables, events, keep)
     return [*lines, *deployment_figures(fig_dir, meta, tables, events)]
+
+
+def _residual_lines(
+    tables: dict[str, pd.DataFrame],
+    events: pd.DataFrame,
+    keep: Callable[[pd.DataFrame], pd.DataFrame],
+) -> list[str]:
+    """The residual vibration after the last lock (``residual_vibration``) as markdown lines;
+    none when no run locked."""
+    resid = residual_vibration(tables["trajectories"], events, tables["cases"])
+    if resid.empty:
+        return []
+    never = (
+        "; `never_locked`: the latches that did not lock within the run, which is then not "
+        "deployed: its motion after the last lock is a partly folded structure's, not a "
+        "deployed one's residual vibration"
+    )
+    return [
+        "Residual vibration after the last lock (tip y amplitude and mean in m, largest "
+        "|alpha|, |beta| in rad, spread of the chord angles at the end in rad"
+        + (never if "never_locked" in resid else "")
+        + "):\n",
+        to_markdown(keep(resid), ".4g"),
+    ]
 
 
 def peak_moment_lines(
