@@ -125,8 +125,9 @@ def three_panel_free_scene():
 
 
 def test_latches_lock_against_the_body_as_in_the_native_model():
-    """The study's exudyn options (2 elements, step 1e-3 s, spectral radius 0): hinge 0 locks
-    rod 1 to the body, then hinge 2, as in the native full model; the body's final attitude
+    """exudyn at 2 elements, step 1e-3 s, spectral radius 0 (the companion study's options
+    until 01d9e5f): hinge 0 locks rod 1 to the body, then hinge 2, as in the native full
+    model; the body's final attitude
     and drift (its displacement over the 6 s) agree with the native model's within 1 %
     (measured 0.47 % and 0.38 %; at step 5e-4 s 0.015 % and 0.48 %, at 2.5e-4 s 0.20 % and
     0.54 %: exudyn's lock at a step boundary and the flexible panels); the linear momentum is
