@@ -607,7 +607,9 @@ def _items(value: Any) -> list[dict]:
 
 def _peak(t: dict[str, pd.DataFrame], case: str, model: str, hinge: int | None) -> float:
     """The largest |hinge_moment| of one run (of ``hinge``, or every hinge), over its output
-    times and runtime.csv's peaks between them; nan without the output."""
+    times and runtime.csv's peaks between them; nan without the output; inf where a hinge's
+    moment is impulsive at its lock (a plastic lock: the peak entry holds its impulse and no
+    peak, and a gate on it breaks, docs/studies.md "How a peak is read")."""
     m = values(t["trajectories"], case, model, "hinge_moment")
     if m.empty:
         return math.nan
@@ -618,7 +620,7 @@ def _peak(t: dict[str, pd.DataFrame], case: str, model: str, hinge: int | None) 
     if "peaks" in run and len(run) and isinstance(run["peaks"].iloc[0], str):
         for p in json.loads(run["peaks"].iloc[0]).get("hinge_moment", []):
             if hinge is None or p["k"] == hinge:
-                found = max(found, abs(float(p["peak"])))
+                found = max(found, math.inf if p["peak"] is None else abs(float(p["peak"])))
     return found
 
 
