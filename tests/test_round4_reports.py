@@ -24,9 +24,9 @@ import rodval
 from rodval.core.base import Base
 from rodval.core.scene import Chain, InitialState, Latch, Scene
 from rodval.report import animation, figures
+from rodval.report.study_answer import answer_section
 from rodval.report.study_figures import param_figures
 from rodval.report.study_report import build_report, residual_vibration
-from rodval.report.study_answer import answer_section
 from rodval.report.tables import axis_columns, read_events, read_tables
 from rodval.study import load_study, run_study
 

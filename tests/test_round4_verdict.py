@@ -27,8 +27,8 @@ import pytest
 
 from rodval.analysis.agreement import AGREEMENT_COLUMNS, AgreementSettings, latch_hinges
 from rodval.report.sample_stats import PERCENTILES
-from rodval.report.study_report import build_report, peak_hinge_moments
 from rodval.report.study_answer import _sentences
+from rodval.report.study_report import build_report, peak_hinge_moments
 from rodval.report.study_summary import opening_section, summary_sections
 from rodval.report.tables import axis_columns, read_events, read_tables, study_constants
 from rodval.study import load_study, run_study
