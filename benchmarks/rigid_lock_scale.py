@@ -1,4 +1,4 @@
-"""Cost of the rigid-panel lock (``rodval.core.rigid.rigid_lock``) against n: one call on a
+"""Cost of the rigid-panel lock (``rodval.mechanics.rigid.rigid_lock``) against n: one call on a
 chain of n rods in a random configuration with every second hinge held (so the KKT system has
 its largest number of constraint rows). The time should grow linearly with n (one sparse LU
 of a banded system). Run: ``python benchmarks/rigid_lock_scale.py``."""
@@ -7,8 +7,8 @@ import time
 
 import numpy as np
 
-from rodval.core.rigid import rigid_lock
 from rodval.core.scene import Chain
+from rodval.mechanics.rigid import rigid_lock
 
 
 def main() -> None:

@@ -1,5 +1,5 @@
 """The exudyn model's energy audit and the energy accounts of its lock windows, with rodval's
-definitions (``rodval.solvers.audit``, ``rodval.core.lock_window.window_energies``), from
+definitions (``rodval.solvers.audit``, ``rodval.mechanics.lock_window.window_energies``), from
 the node states exudyn recorded at every step.
 
 * W_ext(t) = int P_ext dt, P_ext = sum of the nodal forces . the node velocities (W);
@@ -55,8 +55,8 @@ from reference_models.exudyn_observe import (
     rod_ends,
 )
 from rodval.core.loads import LoadSet
-from rodval.core.lock_window import window_energies
 from rodval.core.scene import Scene
+from rodval.mechanics.lock_window import window_energies
 from rodval.solvers.audit import balance
 
 

@@ -11,10 +11,10 @@ from numba import njit
 from reference_models.exudyn_beam import GAUSS_W, GAUSS_X, hermite_shapes, stop_moment, wrap_angle
 from reference_models.exudyn_build import BuiltSystem
 from reference_models.exudyn_guard import Guard
-from rodval.core.lock_window import lock_window
-from rodval.core.rigid import rigid_lock
-from rodval.core.root_momentum import root_momentum_fields
 from rodval.core.scene import Chain, Scene
+from rodval.mechanics.lock_window import lock_window
+from rodval.mechanics.rigid import rigid_lock
+from rodval.mechanics.root_momentum import root_momentum_fields
 
 #: Steps after the activation step at which a lock's "after" state is taken (the index-3
 #: constraint brings the relative rate to zero within the activation step; the extra steps let
@@ -52,7 +52,7 @@ class Latches:
     part about the moving hinge node (hinge k's spring, damper and stops, the outboard loads,
     and -v_P x p of the moving reference point), integrated by the trapezoid rule (N m s,
     counter-clockwise positive on rod k+1). The reported ``impulse`` is its mean over the lock
-    window [t_lock, t_lock + w] (``rodval.core.lock_window``, the same window and measure as
+    window [t_lock, t_lock + w] (``rodval.mechanics.lock_window``, the same window and measure as
     the native models'), by the trapezoid rule on the steps."""
 
     def __init__(self, built: BuiltSystem, guard: Guard, scene: Scene, E: int):
@@ -311,7 +311,7 @@ class Latches:
         self.lock_times[item["k"]] = t0
         before = self._measures(t0, item, q, v, a)
         # the chords just before the lock and the hinges held after it: the rigid-panel
-        # lock's data (rodval.core.rigid)
+        # lock's data (rodval.mechanics.rigid)
         before["chords"] = np.array([self._chord(j, q, v) for j in range(self.scene.n)])
         before["held"] = [it["k"] for it in self.items if it["state"] != "armed"]
         self.pending.append(
@@ -368,7 +368,7 @@ class Latches:
         """Record a lock: the impulse is the window mean of S(tau) (``lock_window``); the
         kinetic energy after it is taken ``LOCK_SETTLE_STEPS`` steps after the activation,
         the root's angular momentum jump over the whole window (None, as its before and
-        after, once hinge 0 is held: ``rodval.core.root_momentum``);
+        after, once hinge 0 is held: ``rodval.mechanics.root_momentum``);
         ``window_steps``: the window's length in steps of the run's step, impulse_window / h
         (``rodval.analysis.events.MIN_WINDOW_STEPS``)."""
         item, before, last = ev["item"], ev["before"], ev["last"]

@@ -7,15 +7,15 @@ revolute joints, hinge springs, point masses and load user functions). Then:
   checks before any model runs that it is at rest in equilibrium);
 * ``about="equilibrium"``: exudyn's static solver (``exudyn.solver.SolveStatic``, load
   factor ramped over ``load_steps`` steps, Newton absolute tolerance scaled with EA) under the
-  scene's static loads (``rodval.core.modal.static_loads``, each held as a constant nodal
+  scene's static loads (``rodval.mechanics.modal.static_loads``, each held as a constant nodal
   force) and its hinge springs' rest angles, its result written to the initial state
   (``updateInitialValues=True``).
 
 exudyn's static solver gives the mass matrix, the ODE2 Jacobian (so the axial force's
 geometric stiffness is included), the velocity Jacobian (damping) and the constraint Jacobian
 there, as ``exudyn.solver.ComputeODE2Eigenvalues`` obtains them. The joints' constraints are
-eliminated on the exact 0/1 basis of ``rodval.core.eigen.coordinate_null_space`` and the
-pencils solved by ``rodval.core.eigen`` (``_eigen``: the same digits on every BLAS kernel,
+eliminated on the exact 0/1 basis of ``rodval.mechanics.eigen.coordinate_null_space`` and the
+pencils solved by ``rodval.mechanics.eigen`` (``_eigen``: the same digits on every BLAS kernel,
 docs/modes.md); eigenvectors are mapped back to ODE2 coordinates. With hinge dampers or
 bending damping (``Chain.damped``) each undamped mode is paired with the complex eigenvalue
 s (Im s > 0) of nearest |s|, damping ratio -Re(s) / |s|.
@@ -39,17 +39,16 @@ import numpy as np
 import scipy.linalg
 
 from reference_models.exudyn_chain import ExudynModel
-from rodval.core.eigen import (
+from rodval.core.loads import constant
+from rodval.core.modes import ABOUT, Equilibrium, Modes
+from rodval.core.scene import InitialState, Scene
+from rodval.mechanics.eigen import (
     angular_frequencies,
     coordinate_null_space,
     quadratic_eigenvalues,
     symmetric_pencil,
 )
-from rodval.core.loads import constant
-from rodval.core.modal import (
-    ABOUT,
-    Equilibrium,
-    Modes,
+from rodval.mechanics.modal import (
     check_no_mechanism,
     equilibrium_angles,
     held_hinges,
@@ -57,7 +56,6 @@ from rodval.core.modal import (
     split_rigid,
     static_loads,
 )
-from rodval.core.scene import InitialState, Scene
 
 #: Elongation/displacement ratio above which an exudyn mode counts as axial.
 AXIAL_TOL = 1e-3
@@ -110,9 +108,9 @@ def _eigen(M, K, D, J, *, damped: bool):
     constrained system, the damped eigenvalues s (or None), and the null-space kind used.
 
     The constraints (revolute joints: node positions equal or pinned) are eliminated with the
-    exact 0/1 basis of ``rodval.core.eigen.coordinate_null_space``; only if a constraint has
+    exact 0/1 basis of ``rodval.mechanics.eigen.coordinate_null_space``; only if a constraint has
     another form, the SVD basis exudyn uses. The pencils are solved by
-    ``rodval.core.eigen`` (direct and inverted): exudyn's own ``eigh`` on an SVD basis loses
+    ``rodval.mechanics.eigen`` (direct and inverted): exudyn's own ``eigh`` on an SVD basis loses
     the lowest mode's digits to the pencil's span (axial to hinge modes, 3.7e12 for the paper
     chain) and to the basis' BLAS-dependent orientation."""
     B = coordinate_null_space(J)
@@ -138,7 +136,7 @@ def exudyn_modes(
     **options: Any,
 ) -> Modes:
     """Modes of the exudyn beam model about the scene's initial state or its static
-    equilibrium under the static loads (``rodval.core.modal.static_loads`` at ``load_at``,
+    equilibrium under the static loads (``rodval.mechanics.modal.static_loads`` at ``load_at``,
     each held as a constant nodal force) and the hinge rest angles (see module docstring);
     ``options``: ExudynModel options (elements, EA; the defaults for modes are
     ``MODES_DEFAULTS``)."""

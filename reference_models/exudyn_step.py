@@ -2,7 +2,7 @@
 needs, by attempts.
 
 1. **A-priori step** (``a_priori_step``): the shortest lock window the scene's latches can
-   open (``rodval.core.lock_window.lock_window`` of each armed latch with only the latches
+   open (``rodval.mechanics.lock_window.lock_window`` of each armed latch with only the latches
    held from the start held: the smallest locked segment, so the shortest window; a later
    lock's segment is longer and so is its window) over ``MIN_WINDOW_STEPS`` = 20 steps,
    rounded down to two significant digits, capped by ``STEP_CAP_S`` = 2e-4 s (the fixed
@@ -40,10 +40,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from rodval.core.lock_window import MIN_WINDOW_STEPS, lock_window
 from rodval.core.scene import Scene
 from rodval.core.status import STATUS_FAILED, STATUS_SUCCESS
 from rodval.core.trajectory import Trajectory
+from rodval.mechanics.lock_window import MIN_WINDOW_STEPS, lock_window
 
 #: The option value that chooses the step by attempts.
 AUTO = "auto"

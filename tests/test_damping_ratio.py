@@ -11,8 +11,8 @@ import scipy.linalg
 
 from rodval.cli import main
 from rodval.core.damping import bending_damping_for_ratio, first_free_free_frequency
-from rodval.core.lock_window import _element
 from rodval.core.scene_file import scene_from_dict
+from rodval.mechanics.lock_window import _element
 
 WING = {
     "n": 3,

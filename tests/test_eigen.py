@@ -1,4 +1,4 @@
-"""The shared eigensolver (``rodval.core.eigen``): graded pencils against mpmath, zero modes of
+"""The shared eigensolver (``rodval.mechanics.eigen``): graded pencils against mpmath, zero modes of
 a singular stiffness, damped eigenvalues against the closed form, the exact constraint basis,
 and the paper chain's lowest frequency identical on every BLAS kernel (a subprocess per
 ``OPENBLAS_CORETYPE`` setting)."""
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from rodval.core.eigen import (
+from rodval.mechanics.eigen import (
     angular_frequencies,
     coordinate_null_space,
     quadratic_eigenvalues,

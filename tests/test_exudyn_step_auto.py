@@ -28,11 +28,11 @@ from reference_models.exudyn_step import (
     run_auto,
 )
 from rodval.cli import main
-from rodval.core.lock_window import MIN_WINDOW_STEPS, lock_window
 from rodval.core.resources import ENV_LIMIT
 from rodval.core.scene import Chain, InitialState, Latch, Scene
 from rodval.core.status import STATUS_BLOWUP, STATUS_SUCCESS
 from rodval.core.trajectory import SolverStats, Trajectory
+from rodval.mechanics.lock_window import MIN_WINDOW_STEPS, lock_window
 from rodval.study.spec import load_study
 
 BAD_STEP = r'^step must be "auto" or a number in \(0, 0\.1\] s, got '

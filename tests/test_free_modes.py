@@ -1,6 +1,6 @@
 """Modes of a chain on a free base (issue 40, "modes of a free spacecraft"): the three rigid
 modes (translation x, translation y, rotation about the system's centre of mass; omega ~ 0)
-separated from the flexible ones (``rodval.core.modal.split_rigid``) in the native full model
+separated from the flexible ones (``rodval.mechanics.modal.split_rigid``) in the native full model
 on every rung (``rodval.models.observation.free_modes``) and in exudyn (``reference_models.exudyn_modes``).
 
 Scene: 3 rods l = 1.5 m, m = 3 kg/m, EI = 1e5 N m^2, mu = 0.5 kg, kappa = 50 N m/rad (nu =
@@ -34,7 +34,7 @@ from rodval import Base, paper_scene
 from rodval.analysis.modes import compare_modes, model_modes, pair_modes
 from rodval.core.base import Motion
 from rodval.core.loads import constant
-from rodval.core.modal import RIGID_RATIO
+from rodval.mechanics.modal import RIGID_RATIO
 from rodval.models.presets.full import FullModel
 from rodval.models.presets.reduced import ReducedModel
 

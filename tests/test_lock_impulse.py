@@ -1,6 +1,6 @@
 """The lock impulse (issue 19): one definition in every model, the latch reaction's impulse,
 instantaneous part included, averaged over the lock window after the lock
-(``rodval.core.lock_window``); the native models measure it on their multiplier and cross-check
+(``rodval.mechanics.lock_window``); the native models measure it on their multiplier and cross-check
 it on the outboard angular momentum, exudyn on the angular momentum. In the rigid-panel limit
 it must be the plastic impulse of rigid panels, ``rigid_impulse``."""
 
@@ -12,9 +12,9 @@ import pytest
 from scenes import stiff_damped_latch, two_rod_latch
 
 from rodval import simulate
-from rodval.core.lock_window import first_bending_period, locked_segment, window_nodes
 from rodval.core.scene import Chain, Latch
 from rodval.core.scene_file import scene_from_dict, scene_to_dict
+from rodval.mechanics.lock_window import first_bending_period, locked_segment, window_nodes
 
 
 @pytest.mark.parametrize(

@@ -14,7 +14,7 @@ from checks import assert_refused, run_main
 from rodval import Chain, InitialState, Scene, constant, paper_scene
 from rodval.cli import main
 from rodval.core.loads import harmonic, pulse
-from rodval.core.modal import static_loads
+from rodval.mechanics.modal import static_loads
 from rodval.models.assembly.paper_matrices import hinge_matrix
 from rodval.models.observation.linear_modes import modes
 from rodval.models.observation.statics import AT_REST_RTOL, static_residual

@@ -1,4 +1,4 @@
-"""The rigid-panel lock (``rodval.core.rigid``, issue 19): the one impulse every model's lock
+"""The rigid-panel lock (``rodval.mechanics.rigid``, issue 19): the one impulse every model's lock
 record carries beside its own, computed from the model's chord angles and rates just before
 the lock. Checked against closed forms, an independent dense formulation, the conservation of
 angular momentum, and each model's own impulse in the rigid-panel limit."""
@@ -10,8 +10,8 @@ import pytest
 from scenes import two_rod_latch
 
 from rodval import simulate
-from rodval.core.rigid import node_velocities, rigid_lock
 from rodval.core.scene import Chain
+from rodval.mechanics.rigid import node_velocities, rigid_lock
 
 
 def two_link_closed_form(l, m, mu, w):

@@ -1,5 +1,5 @@
 """The rigid-panel model (issue 49): the chain of rigid rods, the limit EI -> inf of every rung.
-Its lock is the rigid-panel lock of ``rodval.core.rigid`` (computed there from node velocities,
+Its lock is the rigid-panel lock of ``rodval.mechanics.rigid`` (computed there from node velocities,
 another formulation), its energy is kept between locks and lost at them as rigid-panel theory
 says, one rod is the closed-form spring pendulum, a free base keeps its momenta, and the full
 model (exact kinematics, damped panels) tends to it as EI grows."""
@@ -21,8 +21,8 @@ from rodval import Base, simulate  # noqa: E402
 from rodval.cli import main  # noqa: E402
 from rodval.core.base import Motion  # noqa: E402
 from rodval.core.damping import bending_damping_for_ratio  # noqa: E402
-from rodval.core.rigid import rigid_lock  # noqa: E402
 from rodval.core.scene import Chain, InitialState, Scene  # noqa: E402
+from rodval.mechanics.rigid import rigid_lock  # noqa: E402
 from rodval.models.presets.registry import get_model  # noqa: E402
 from rodval.report.tables import read_tables  # noqa: E402
 

@@ -1,7 +1,7 @@
 """Issue 54: unclear refusals and documents that drifted.
 
 1. Modes of the paper chain on a free body: the three rigid modes at zero and rigid, and the
-   lowest flexible modes from the solve that carries them (``rodval.core.eigen``).
+   lowest flexible modes from the solve that carries them (``rodval.mechanics.eigen``).
 2. ``rodval compare``'s lock table: a lock the models reach in the same state is comparable
    (``rodval.analysis.events.comparability``).
 3. Documents that drifted: every module path they name exists; the free base's default
@@ -19,7 +19,7 @@ import pytest
 
 from rodval import Base, paper_scene
 from rodval.cli.compare import lock_table
-from rodval.core.eigen import ZERO_FLOOR, symmetric_pencil
+from rodval.mechanics.eigen import ZERO_FLOOR, symmetric_pencil
 from rodval.models.observation import free_modes as fm
 
 

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rodval.core.lock_window import MIN_WINDOW_STEPS
+from rodval.mechanics.lock_window import MIN_WINDOW_STEPS
 
 #: The leading columns of an events table (after the columns that name the run: case columns
 #: and model); the keys the native and exudyn latch records share.
@@ -52,7 +52,7 @@ EVENT_COLUMNS = (
 COMPARABLE_DT_S = 1e-3
 COMPARABLE_ENERGY = 0.05
 #: A lock is grazing when the rigid-panel lock of the chords just before it would take less
-#: than this fraction of the rigid chain's kinetic energy (``rodval.core.rigid``): its hinge
+#: than this fraction of the rigid chain's kinetic energy (``rodval.mechanics.rigid``): its hinge
 #: approaches the latch angle so slowly that its time and impulse hang on small differences
 #: of state, and a model may not lock at all.
 GRAZING_LOSS = 0.01

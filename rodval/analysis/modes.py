@@ -10,7 +10,7 @@ Comparison
 ``pair_modes`` pairs the modes of two models by shape (``scipy.optimize.linear_sum_assignment``
 on 1 - MAC), not by index; ``compare_modes`` tabulates several models against a reference.
 On a free base both compare the flexible modes only: each model reports its three rigid modes
-(omega ~ 0) first and apart (``Modes.rigid``, ``rodval.core.modal.split_rigid``), and
+(omega ~ 0) first and apart (``Modes.rigid``, ``rodval.mechanics.modal.split_rigid``), and
 ``Modes.flexible`` leaves them out.
 """
 
@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import linear_sum_assignment
 
-from rodval.core.modal import Modes
+from rodval.core.modes import Modes
 from rodval.core.scene import Scene
 from rodval.models.observation.deployed_damping import resolve_damping
 from rodval.models.observation.linear_modes import check_arguments, check_configuration, mac_matrix

@@ -181,8 +181,8 @@ def _record(scene: Scene, m, args) -> dict:
     records it: ``scene_to_dict``; the options the analysis ran with, the held hinges it
     held), the count of flexible modes written, a free base's rigid modes (reported apart
     from them) and the equilibrium found."""
-    from rodval.core.modal import held_hinges
     from rodval.core.scene_file import scene_to_dict
+    from rodval.mechanics.modal import held_hinges
 
     record = {
         "scene": scene_to_dict(scene),

@@ -15,7 +15,7 @@ from typing import Any, ClassVar
 
 from rodval.core.checks import check_keys
 from rodval.core.damping import check_resolved
-from rodval.core.modal import Modes
+from rodval.core.modes import Modes
 from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_BUDGET
@@ -150,7 +150,7 @@ class Model(ABC):
         module, function = cls.MODAL_ANALYSIS.split(":")
         analysis = getattr(importlib.import_module(module), function)
         # a free base (the spacecraft): only analyses that separate its three rigid modes
-        # (``rodval.core.modal.split_rigid``) say so by a true ``FREE_BASE`` attribute
+        # (``rodval.mechanics.modal.split_rigid``) say so by a true ``FREE_BASE`` attribute
         if scene.base.free and not getattr(analysis, "FREE_BASE", False):
             raise ValueError(
                 f"model {cls.name!r}: modes of a chain on a free base (the free spacecraft) are "

@@ -33,7 +33,7 @@ class Latch:
     the angle from the initial state). At the lock the hinge's relative rate drops to zero
     (a plastic impact) and D stays at ``angle`` afterwards. ``window`` (s, > 0): the window
     over which the models measure the lock impulse (None: the first bending period of the
-    locked segment, ``rodval.core.lock_window``). ``held``: the hinge is held from t = 0 (a
+    locked segment, ``rodval.mechanics.lock_window``). ``held``: the hinge is held from t = 0 (a
     clamp, or a joint locked before the run: its initial angle must be ``angle`` and its
     initial rate zero); it never fires an event."""
 

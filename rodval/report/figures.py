@@ -22,7 +22,7 @@ from matplotlib.typing import ColorType
 
 from rodval.analysis.metrics import pareto_front
 from rodval.core.base import rotate
-from rodval.core.modal import Modes
+from rodval.core.modes import Modes
 from rodval.core.out_paths import write_figure
 from rodval.core.scene import UNITS
 from rodval.core.trajectory import Trajectory

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rodval.core.modal import Modes
+from rodval.core.modes import Modes
 from rodval.report.figures import plot_modes
 from rodval.report.markdown import to_markdown
 from rodval.report.study_figures import figure_slug

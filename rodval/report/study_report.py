@@ -34,10 +34,10 @@ from rodval.analysis.events import (
     GRAZING_LOSS,
     event_discrepancies,
 )
-from rodval.core.lock_window import MIN_WINDOW_STEPS
 from rodval.core.out_paths import STUDY_SCHEMA, is_stamped, write_file
 from rodval.core.quantities import models_with
 from rodval.core.trajectory import RUN_SETTINGS
+from rodval.mechanics.lock_window import MIN_WINDOW_STEPS
 from rodval.models import get_model
 from rodval.models.presets.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
@@ -248,7 +248,7 @@ def _deployment_section(
         "segment, the rods joined through held hinges, unless the scene sets it; "
         "`window_closed` false: the run ended inside it); "
         "`rigid_impulse`, the plastic lock of rigid rods with the model's chord angles and "
-        "rates just before the lock (`rodval.core.rigid`), and `impulse_to_rigid`, their "
+        "rates just before the lock (`rodval.mechanics.rigid`), and `impulse_to_rigid`, their "
         "ratio (1 in the rigid-panel limit); the kinetic energy just before and just after "
         "the lock's instantaneous part and their difference (J: the full model's tangent "
         "impact takes out little, the reduced model's chord impact the whole rigid-panel "

@@ -1,6 +1,6 @@
 """Where a run's states go: the scene's output times (the trajectory) and the probe times of the
 lock windows (``LockWindows``: the integrals a latch's lock record needs over the window after
-the lock, ``rodval.core.lock_window``).
+the lock, ``rodval.mechanics.lock_window``).
 
 Probe times are output times the integrators interpolate on their dense output like the
 scene's own (every path: scipy's steps and the compiled loop): they never change a step, so a
@@ -19,14 +19,14 @@ from typing import Any
 
 import numpy as np
 
-from rodval.core.lock_window import window_energies, window_nodes
 from rodval.core.quantities import impulsive_locks, peak_values
+from rodval.mechanics.lock_window import window_energies, window_nodes
 from rodval.solvers.audit import audit_times
 from rodval.solvers.system import OdeSystem
 
 #: Intervals of the peak grid (``peak_times``): a run's peaks are read on PEAK_INTERVALS + 1
 #: evenly spaced times of [0, t_end] of its dense output and on its lock windows' probes
-#: (``rodval.core.lock_window.window_nodes``: 256 in each window, the first bending period
+#: (``rodval.mechanics.lock_window.window_nodes``: 256 in each window, the first bending period
 #: after a lock), whatever the output times.
 PEAK_INTERVALS = 4000
 #: The most state values (doubles) the peak grid's states may hold: a system of N states

@@ -190,7 +190,7 @@ class OdeSystem(ABC):
 
     def energy_parts(self, t: float, y: np.ndarray) -> tuple[float, float, float]:
         """(kinetic, hinge, bending) energy (J) at one state, summing to ``energy``: a lock
-        window's accounts at its end (``rodval.core.lock_window.window_energies``)."""
+        window's accounts at its end (``rodval.mechanics.lock_window.window_energies``)."""
         raise NotImplementedError
 
     def reset(self) -> None:

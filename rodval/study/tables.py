@@ -17,8 +17,8 @@
 
 * ``events``: case, n, horizon, axes, model, then one row per state event of a run
   (``Trajectory.events``: t (s), label, hinge, impulse (N m s, the lock impulse over the lock
-  window, ``rodval.core.lock_window``), impulse_window (s), rigid_impulse (N m s, the
-  rigid-panel lock of the model's chords, ``rodval.core.rigid``), impulse_to_rigid =
+  window, ``rodval.mechanics.lock_window``), impulse_window (s), rigid_impulse (N m s, the
+  rigid-panel lock of the model's chords, ``rodval.mechanics.rigid``), impulse_to_rigid =
   impulse / rigid_impulse, kinetic_before, kinetic_after (J), energy_lost = kinetic_before -
   kinetic_after (J), the lock window's energy accounts (instant_energy_loss, the hinge and
   bending energy before the lock, kinetic, hinge, bending energy, work and dissipated energy
@@ -42,7 +42,7 @@ from rodval.analysis.events import EVENT_COLUMNS as EVENT_COLUMNS
 from rodval.analysis.events import events_frame
 from rodval.analysis.metrics import METRICS
 from rodval.analysis.modes import pair_modes
-from rodval.core.modal import Modes
+from rodval.core.modes import Modes
 from rodval.core.out_paths import write_file
 
 # EVENT_COLUMNS: the events table's leading columns, named here for the table's readers

@@ -1,5 +1,5 @@
 """The native models' lock records: what a latch's lock did (the plastic impact, the rigid-panel
-yardstick) and the terms of the windowed lock impulse (``rodval.core.lock_window``) the driver
+yardstick) and the terms of the windowed lock impulse (``rodval.mechanics.lock_window``) the driver
 integrates over the window after it (``rodval.solvers.outputs.LockWindows``).
 
 The windowed impulse is measured twice on the model's own solution (docs/deployment.md, "The
@@ -25,10 +25,10 @@ from typing import Any
 
 import numpy as np
 
-from rodval.core.lock_window import lock_window
-from rodval.core.rigid import node_velocities, rigid_lock
-from rodval.core.root_momentum import root_momentum_fields
 from rodval.core.scene import hinge_angles
+from rodval.mechanics.lock_window import lock_window
+from rodval.mechanics.rigid import node_velocities, rigid_lock
+from rodval.mechanics.root_momentum import root_momentum_fields
 from rodval.models.assembly.paper_matrices import generalized_forces, node_positions, rod_momenta
 
 #: The systems these functions read: ``rodval.models.assembly.paper_system.PaperSystem`` (which imports
@@ -186,7 +186,7 @@ def lock_record(
     after it) and the event's data: the instantaneous angular impulses (N m s, on the
     outboard rod k+1, counter-clockwise positive: the convention of every model's event
     records), joint linear impulses (N s), kinetic energy before and after (J), the
-    rigid-panel lock of the chords before it (``rodval.core.rigid.rigid_lock``), the angular
+    rigid-panel lock of the chords before it (``rodval.mechanics.rigid.rigid_lock``), the angular
     momentum about the root just before and after (N m s; the impact is internal, so it is
     kept while hinge 0 is free) and what the lock window needs (its length, the
     instantaneous impulse, H_out just before).

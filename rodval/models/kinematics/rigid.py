@@ -5,7 +5,7 @@ O(n) per evaluation (``rigid_kernels``: the ladder's kernels on ``ladder.rigid_c
 Hinge angles are the chords' D_k = phi_k - phi_{k-1} (D_0 = phi_0 - theta on a moving base);
 springs, dampers and stops act on them, a held latch is the exact linear constraint a_k^T phi
 = angle_k, and a lock is the plastic impact of ``lock_records.plastic_jump`` in the metric
-M_pp(phi): the rigid-panel lock of ``rodval.core.rigid`` by construction. Everything else
+M_pp(phi): the rigid-panel lock of ``rodval.mechanics.rigid`` by construction. Everything else
 (events, observation, energies, momenta, lock windows) is the stacked systems'
 (``paper_system.StackedSystem``) with the bending coordinates identically zero.
 """

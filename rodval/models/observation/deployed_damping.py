@@ -18,7 +18,7 @@ dynamics, and hence damping, on every base: the reduced model's bending is quasi
 the rigid model's rods do not bend (Kelvin-Voigt damping does nothing in either), and exudyn
 is the reference it is checked against. The mode is the lowest of positive omega (after the
 three rigid modes of a free base); its ratio is the quadratic eigenproblem's,
-zeta = -Re(s) / |s| (``rodval.core.modal.damping_ratios``), hinge dampers included.
+zeta = -Re(s) / |s| (``rodval.mechanics.modal.damping_ratios``), hinge dampers included.
 
 c_r = beta EI_r on every rod: one retardation time beta (s), the same material loss in every
 panel (each rod's own bending modes then have zeta = beta omega / 2). beta is the root of

@@ -25,14 +25,14 @@ with
   ``about="equilibrium"`` is refused when the scene has static loads; without them the
   equilibrium is the body's attitude theta with straight rods at the hinges' rest angles
   (phi_k = theta + rest_0 + ... + rest_{k-1}; a held latch's angle on its hinge).
-* held latches (``rodval.core.modal.held_hinges``): their hinges' relative rotation fixed,
+* held latches (``rodval.mechanics.modal.held_hinges``): their hinges' relative rotation fixed,
   the pencil taken on the exact basis Z of the motions that keep them
-  (``rodval.core.eigen.constraint_basis``): Z^T M Z, Z^T K Z, Z^T C Z.
+  (``rodval.mechanics.eigen.constraint_basis``): Z^T M Z, Z^T K Z, Z^T C Z.
 
 K has the three rigid motions as its null space (translations x, y; a rotation of the whole
 system, theta and every phi_k together), so the undamped pencil (``symmetric_pencil``,
 shifted for the singular K) has three zero eigenvalues. They are separated from the flexible
-modes by ``rodval.core.modal.split_rigid``: the three smallest, checked to be below 1e-6 of
+modes by ``rodval.mechanics.modal.split_rigid``: the three smallest, checked to be below 1e-6 of
 the first flexible omega, their span checked to hold the two translations and a rigid
 rotation (about the system's centre of mass: the combination M-orthogonal to the
 translations) to 1e-4 of the shapes; they are reported first (``Modes.rigid`` = 3), without
@@ -47,9 +47,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from rodval.core.eigen import angular_frequencies, constraint_basis, symmetric_pencil
-from rodval.core.modal import (
-    Modes,
+from rodval.core.modes import Modes
+from rodval.core.scene import Scene
+from rodval.mechanics.eigen import angular_frequencies, constraint_basis, symmetric_pencil
+from rodval.mechanics.modal import (
     check_no_mechanism,
     damping_ratios,
     equilibrium_angles,
@@ -58,7 +59,6 @@ from rodval.core.modal import (
     split_rigid,
     static_loads,
 )
-from rodval.core.scene import Scene
 from rodval.models.assembly.paper_matrices import damping_matrix, stiffness_matrix
 from rodval.models.kinematics.ladder import ladder_stiffness
 from rodval.models.kinematics.rungs import check_shapes, resolve_kinematics

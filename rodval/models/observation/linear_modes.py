@@ -21,7 +21,7 @@ of the hinge springs about their rest angles and the bending below ``AT_REST_RTO
 pre-stressed fold is refused unless ``allow_unbalanced=True`` (the residual is then
 recorded). A chain held by loads is linearized about its equilibrium (``equilibrium``).
 ``equilibrium``: the static equilibrium under the scene's static loads
-(``rodval.core.modal.static_loads``: the loads that act for ever at their final value,
+(``rodval.mechanics.modal.static_loads``: the loads that act for ever at their final value,
 windowed ones left out and named; or, with ``load_at``, every load at that instant) and the
 hinge rest angles, found by Newton's method on the static residual
 
@@ -33,7 +33,7 @@ same phi (its bending rows are the full model's, condensed).
 
 Held latches
 ------------
-A held latch (``Latch.held``, ``rodval.core.modal.held_hinges``) fixes its hinge's relative
+A held latch (``Latch.held``, ``rodval.mechanics.modal.held_hinges``) fixes its hinge's relative
 rotation: the full model (every rung) solves its pencil on the exact basis Z of the motions
 that keep the held hinges (``statics.held_basis``: each row eliminates its alpha_k), the
 reduced model condenses its bending with the held hinges as equations (``held_reduced``),
@@ -44,7 +44,7 @@ Frequencies and damping
 -----------------------
 Undamped: the generalized eigenproblem (K + K_L) x = omega^2 M x. For the full model with the
 kinematic ("printed") coefficients M is symmetric positive definite:
-``rodval.core.eigen.symmetric_pencil`` (direct and inverted pencil, each eigenvalue from the
+``rodval.mechanics.eigen.symmetric_pencil`` (direct and inverted pencil, each eigenvalue from the
 one that carries it: the same digits on every BLAS kernel).
 The reduced model's M_r = M_pp - K_pg B^-1 M_gp is not symmetric (a quasi-static
 condensation, not a Galerkin projection: asymmetry ~1e-5 of its largest entry at n = 3..8),
@@ -64,7 +64,7 @@ the runs' spectra one-to-one. n = 10 and 32 (all eigenvalues) and 64 (all 192) a
 mpmath at 40 digits (tests/test_modes.py, docs/modes.md).
 
 Damped (nu > 0): the quadratic eigenproblem (s^2 M + s C + K + K_L) x = 0 as a first-order
-state-space problem (``rodval.core.eigen.quadratic_eigenvalues``, inverted); each undamped
+state-space problem (``rodval.mechanics.eigen.quadratic_eigenvalues``, inverted); each undamped
 mode is paired (Hungarian, on the MAC of the displacement parts) with an eigenvalue s of
 positive imaginary part, and the damping ratio is zeta = -Re(s) / |s|. Modes with omega = 0
 (free rigid rotation) have no damping ratio (NaN).
@@ -94,22 +94,15 @@ import scipy.linalg
 from scipy.optimize import linear_sum_assignment
 
 from rodval.core.checks import check_choice, check_type
-from rodval.core.eigen import angular_frequencies, symmetric_pencil
-from rodval.core.modal import (
-    ABOUT,
-    Equilibrium,
-    Modes,
-    damping_ratios,
-    held_hinges,
-    normalize_shapes,
-    static_loads,
-)
+from rodval.core.modes import ABOUT, Equilibrium, Modes
+from rodval.core.scene import Chain, InitialState, Scene
+from rodval.mechanics.eigen import angular_frequencies, symmetric_pencil
+from rodval.mechanics.modal import damping_ratios, held_hinges, normalize_shapes, static_loads
 
-# ``mac_matrix`` lives with ``damping_ratios`` in ``rodval.core.modal`` (shared with the
+# ``mac_matrix`` lives with ``damping_ratios`` in ``rodval.mechanics.modal`` (shared with the
 # free-base modes, ``rodval.models.observation.free_modes``, without an import cycle); re-exported here
 # for its callers (``rodval.analysis.modes``)
-from rodval.core.modal import mac_matrix as mac_matrix
-from rodval.core.scene import Chain, InitialState, Scene
+from rodval.mechanics.modal import mac_matrix as mac_matrix
 from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
     chain_constants,
@@ -401,7 +394,7 @@ def modes(
     """Linearized modes of the native ``model`` ("full" or "reduced"; the full model on any
     rung of the ladder: ``shapes``, ``kinematics``) about the scene's
     initial state at rest (``check_at_rest`` unless ``allow_unbalanced``) or its static
-    equilibrium under its static loads (``rodval.core.modal.static_loads``: the loads acting
+    equilibrium under its static loads (``rodval.mechanics.modal.static_loads``: the loads acting
     for ever, or every load at ``load_at`` s) and hinge rest angles (see module docstring).
     ``count``: the lowest ``count`` modes (default all)."""
     check_arguments(scene, count)

@@ -16,9 +16,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from rodval.core.eigen import angular_frequencies, symmetric_pencil
-from rodval.core.modal import Modes, damping_ratios, held_hinges, static_loads
+from rodval.core.modes import Modes
 from rodval.core.scene import Scene
+from rodval.mechanics.eigen import angular_frequencies, symmetric_pencil
+from rodval.mechanics.modal import damping_ratios, held_hinges, static_loads
 from rodval.models.observation.linear_modes import linear_system, node_shapes
 from rodval.models.observation.statics import no_equilibrium, static_equilibrium
 
@@ -44,7 +45,7 @@ def rigid_modes(
     load_at: float | None = None,
 ) -> Modes:
     """The rigid chain's modes about the scene's initial state (its phi; the rods straight)
-    or its static equilibrium under the static loads (``rodval.core.modal.static_loads``)
+    or its static equilibrium under the static loads (``rodval.mechanics.modal.static_loads``)
     and the hinge rest angles: Modes with the node displacements and hinge angles of each
     mode (``linear_modes.node_shapes``), the lowest ``count`` (default all). The configuration
     check (at rest, balanced) is the caller's (``rodval.analysis.modes``). Pinned base only

@@ -6,12 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from rodval.core.eigen import constraint_basis
-from rodval.core.modal import (
-    Equilibrium,
-    held_hinges,
-)
+from rodval.core.modes import Equilibrium
 from rodval.core.scene import Chain, Scene
+from rodval.mechanics.eigen import constraint_basis
+from rodval.mechanics.modal import held_hinges
 from rodval.models.assembly.paper_matrices import (
     hinge_matrix,
     stiffness_matrix,
@@ -26,7 +24,7 @@ def load_stiffness(l: np.ndarray, phi: np.ndarray, SX: np.ndarray, SY: np.ndarra
 
 def held_basis(scene: Scene, columns: int | None = None) -> np.ndarray | None:
     """Z (N, N - m) with q = Z u exactly the motions that keep the scene's m held hinges
-    (``rodval.core.modal.held_hinges``) at their angles (``constraint_basis`` of their hinge
+    (``rodval.mechanics.modal.held_hinges``) at their angles (``constraint_basis`` of their hinge
     rows, each eliminating its alpha_k), or None without held latches. ``columns``: N, the
     model's coordinates (default 3n; a ladder rung's n (p + 2), whose hinge rows are the
     paper's padded with zeros for the bubbles)."""

@@ -5,7 +5,7 @@ A named composition of the engine, not a model of its own: the ladder's kernels 
 mobility (``rodval.models.kinematics.ladder.rigid_constants``, the limit EI -> inf of every
 rung), restricted to the rigid coordinates (``rodval.models.kinematics.rigid``), with the
 stacked systems' hinge items (springs, dampers, stops; latches as exact linear constraints,
-the plastic lock, which is the rigid-panel lock of ``rodval.core.rigid``) and the ladder's
+the plastic lock, which is the rigid-panel lock of ``rodval.mechanics.rigid``) and the ladder's
 moving bases (``rodval.models.base.moving_base``). It takes no options.
 """
 

@@ -1,7 +1,7 @@
 """The rigid-panel lock: the model-independent yardstick of a latch's impulse.
 
 Every model measures its lock impulse on its own solution (the mean over the lock window of
-the latch's cumulative impulse, ``rodval.core.lock_window``). Beside it each lock record
+the latch's cumulative impulse, ``rodval.mechanics.lock_window``). Beside it each lock record
 carries ``rigid_impulse``: the angular impulse of the same
 lock on a chain of **rigid** rods with the model's chord angles and chord rates just before
 the lock (docs/deployment_native.md, "The rigid-panel impulse"). It depends on the scene's
