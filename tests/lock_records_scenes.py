@@ -14,12 +14,12 @@ import pathlib
 import sys
 
 import numpy as np
+from scenes import spun_damped_latch, three_rods_loaded
 
 from rodval import simulate
 from rodval.bench.fast_path import four_panel_wing
 from rodval.bench.stiffness import rigid_latch
-from rodval.core.loads import harmonic
-from rodval.core.scene import Chain, InitialState, Latch, Scene
+from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 
 REFERENCE = pathlib.Path(__file__).parent / "data" / "lock_records_reference.json"
@@ -28,42 +28,12 @@ REFERENCE = pathlib.Path(__file__).parent / "data" / "lock_records_reference.jso
 SETTINGS = IntegratorSettings(rtol=1e-8, atol=1e-10)
 
 
-def stiff_damped_latch() -> Scene:
-    """tests/test_lock_impulse.py's scene: two rods, EI = 1e7, bending damping 700 N m^2 s."""
-    chain = Chain.uniform(2, l=1.0, m=1.0, EI=1e7, mu=0.5, kappa=[0.0, 5.0], nu=0.0)
-    return Scene(
-        name="stiff_damped_latch",
-        chain=chain.with_(bending_damping=700.0),
-        t_end=0.8,
-        times=np.linspace(0.0, 0.8, 9),
-        initial=InitialState(phi=[0.0, -2.5], dphi=[1.0, 1.5]),
-        latches=(Latch(1, 0.0),),
-        outputs=("phi", "dphi", "angular_momentum"),
-    )
-
-
-def three_rods_loaded() -> Scene:
-    """tests/test_deployment.py's three rods (two latches, hinge dampers) with a harmonic
-    tip force acting through the windows: the loads' terms of the window integrands."""
-    chain = Chain.uniform(3, l=1.0, m=1.0, EI=1e4, mu=0.3, kappa=[0.0, 4.0, 6.0], nu=0.02)
-    return Scene(
-        name="three_rods_loaded",
-        chain=chain,
-        t_end=1.5,
-        times=np.linspace(0.0, 1.5, 16),
-        initial=InitialState(phi=[0.0, -2.0, -3.5], dphi=[0.5, 0.0, 0.0]),
-        latches=(Latch(1, 0.0), Latch(2, 0.0)),
-        loads=(harmonic(3, X=0.3, Y=-0.5, omega=7.0),),
-        outputs=("phi", "hinge_angle"),
-    )
-
-
 def scenes() -> dict[str, Scene]:
     """The latched scenes, by name."""
     return {
         "four_panel_wing": four_panel_wing(),
         "rigid_latch": rigid_latch(),
-        "stiff_damped_latch": stiff_damped_latch(),
+        "spun_damped_latch": spun_damped_latch(),
         "three_rods_loaded": three_rods_loaded(),
     }
 
@@ -72,7 +42,7 @@ def scenes() -> dict[str, Scene]:
 MODELS = {
     "four_panel_wing": ("reduced", "full"),
     "rigid_latch": ("reduced",),
-    "stiff_damped_latch": ("reduced", "full"),
+    "spun_damped_latch": ("reduced", "full"),
     "three_rods_loaded": ("reduced", "full"),
 }
 

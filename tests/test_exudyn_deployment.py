@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from scenes import two_rod_latch
 
 from rodval import Chain, InitialState, Scene, simulate
 from rodval.core import scene as scene_module
@@ -31,21 +32,13 @@ def hinge_quantities(monkeypatch):
     )
 
 
-def two_rod_latch(
+def unfolding_pair(
     t_end=0.5, EI=1e5, num=501, outputs=("phi", "dphi", "hinge_angle", "hinge_moment", "energy")
 ):
     """Two rods stowed folded back (hinge 1 at pi - 0.05 rad), hinge 0 free, the chain turning
     at 1 rad/s; hinge 1's spring (50 N m/rad, rest angle 0) unfolds it; the latch locks
-    hinge 1 straight (angle 0)."""
-    chain = Chain.uniform(2, l=1.5, m=3.0, EI=EI, mu=0.5, kappa=[0.0, 50.0], nu=0.0)
-    return Scene(
-        chain=chain,
-        t_end=t_end,
-        times=np.linspace(0.0, t_end, num),
-        outputs=outputs,
-        initial=InitialState(phi=[0.0, math.pi - 0.05], dphi=[1.0, 1.0]),
-        latches=(Latch(1, 0.0),),
-    )
+    hinge 1 straight (angle 0). (``scenes.two_rod_latch`` with this file's horizon and outputs.)"""
+    return two_rod_latch(EI, t_end=t_end, num=num, outputs=outputs)
 
 
 def run(scene, **options):
@@ -93,7 +86,7 @@ def test_latch_lock_measured_on_the_beam_solution(hinge_quantities):
     switched on; D stays at the latch angle afterwards; the relative rate is killed; kinetic
     energy is lost; the angular momentum about the root (hinge 0 free, no loads) is
     continuous through the lock to 1e-5 of the outboard angular impulse."""
-    tr = run(two_rod_latch())
+    tr = run(unfolding_pair())
     assert len(tr.events) == 1
     ev = tr.events[0]
     assert EVENT_KEYS <= set(ev)
@@ -130,8 +123,8 @@ def test_latch_measures_converge_with_step(hinge_quantities):
     9.1e-4); the angular momentum about the root jumps by less at the finer step (second
     order: 1.1e-4, 2.8e-5, 5.3e-6 N m s at 2e-4, 1e-4, 5e-5 s). The run goes past the lock
     window (22.8 ms at EI = 1e5)."""
-    a = run(two_rod_latch(t_end=0.44, num=45), step=1e-4).events[0]
-    b = run(two_rod_latch(t_end=0.44, num=45), step=5e-5).events[0]
+    a = run(unfolding_pair(t_end=0.44, num=45), step=1e-4).events[0]
+    b = run(unfolding_pair(t_end=0.44, num=45), step=5e-5).events[0]
     assert a["window_closed"] and b["window_closed"]
     assert abs(a["t"] - b["t"]) < 5e-5
     assert a["impulse"] == pytest.approx(b["impulse"], rel=2e-3)
@@ -142,8 +135,8 @@ def test_latch_measures_converge_with_step(hinge_quantities):
 def test_latch_measures_converge_with_elements(hinge_quantities):
     """2 -> 4 elements per rod: lock time within 5e-5 s, impulse within 1 % (measured:
     1.2e-5 s, 0.25 %)."""
-    a = run(two_rod_latch(t_end=0.44, num=45), elements=2).events[0]
-    b = run(two_rod_latch(t_end=0.44, num=45), elements=4).events[0]
+    a = run(unfolding_pair(t_end=0.44, num=45), elements=2).events[0]
+    b = run(unfolding_pair(t_end=0.44, num=45), elements=4).events[0]
     assert abs(a["t"] - b["t"]) < 5e-5
     assert a["impulse"] == pytest.approx(b["impulse"], rel=0.01)
 
@@ -155,7 +148,7 @@ def test_stiff_rods_lock_with_the_rigid_plastic_impulse(hinge_quantities):
     within 1 % (measured 0.29 %; 0.33 % with 4 elements); the lock window is the locked pair's
     first bending period, 7.2 ms."""
     l, m, mu = 1.5, 3.0, 0.5
-    ev = run(two_rod_latch(t_end=0.42, num=43, EI=1e6)).events[0]
+    ev = run(unfolding_pair(t_end=0.42, num=43, EI=1e6)).events[0]
     M11 = m * l**3 / 3 + (m * l + 2 * mu) * l**2
     M22 = m * l**3 / 3 + mu * l**2
     M12 = l * l * (m * l / 2 + mu)
@@ -170,7 +163,7 @@ def test_default_options_run_a_latch_scene_with_spectral_radius_zero():
     """exudyn's defaults work with latches (issue 19): spectral_radius "auto" is 0 for a
     scene with latches and 0.9 without, and the run records the value it used; the lock is
     the one the explicit setting gives (same options, the same numbers to round-off)."""
-    scene = two_rod_latch(t_end=0.45, num=10, outputs=("phi",))
+    scene = unfolding_pair(t_end=0.45, num=10, outputs=("phi",))
     auto = simulate(scene, "exudyn")
     assert auto.success, auto.stats.message
     assert auto.settings["spectral_radius"] == 0.0 and auto.options["spectral_radius"] == "auto"
@@ -187,7 +180,7 @@ def test_default_options_run_a_latch_scene_with_spectral_radius_zero():
     [({"solver": "trapezoidal"}, "generalized-alpha"), ({"spectral_radius": 0.9}, "spectral")],
 )
 def test_latch_scene_refused_before_any_work(options, match):
-    scene = two_rod_latch(t_end=0.1, num=3, outputs=("phi",))
+    scene = unfolding_pair(t_end=0.1, num=3, outputs=("phi",))
     with pytest.raises(ValueError, match=match):
         ExudynModel(**options).simulate(scene)
 
@@ -202,7 +195,7 @@ def test_latch_scene_refused_before_any_work(options, match):
 )
 def test_bad_latches_refused_by_the_scene(latch, match):
     with pytest.raises(ValueError, match=match):
-        two_rod_latch(outputs=("phi",)).with_(latches=(latch,))
+        unfolding_pair(outputs=("phi",)).with_(latches=(latch,))
 
 
 def synthetic_record(case: str, events: dict[str, list[dict]]):

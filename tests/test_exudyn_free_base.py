@@ -21,18 +21,18 @@ mass matrices, internal forces without a resultant).
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from rodval import Base, paper_scene, simulate
-from rodval.core.scene_file import scene_from_dict
 
 exu = pytest.importorskip("exudyn")
 
 pytestmark = pytest.mark.exudyn
+
+from scenes import three_panel_free_scene  # noqa: E402
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
 BODY = Base(
@@ -45,7 +45,7 @@ OUT = ("phi", "alpha", "hinge_angle", "energy", "angular_momentum", "momentum", 
 TIGHT = {"newton_atol_per_EA": 1e-14}
 
 
-def free_scene(t_end: float = 1.0):
+def drifting_body_scene(t_end: float = 1.0):
     """The paper's three rods, straight and at rest, on a 50 kg, 20 kg m^2 body turning at
     0.3 rad/s and moving at (0.1, -0.2) m/s; no load."""
     return paper_scene(3, t_end=t_end).with_(loads=(), outputs=OUT, base=BODY)
@@ -66,7 +66,7 @@ def test_free_chain_keeps_its_momentum_and_angular_momentum():
     """No load: the whole system's P and H about its centre of mass constant to 1e-7 relative
     (P measured 8e-15, H 5.7e-9 at atol 1e-6 N); with Newton's tolerance 100x looser H drifts
     70x more (4.0e-7): the drift is the Newton residual's (module docstring)."""
-    scene = free_scene()
+    scene = drifting_body_scene()
     tight = _run(scene, EA=1e8, **TIGHT)
     loose = _run(scene, EA=1e8, newton_atol_per_EA=1e-12)
     assert _drift(tight["momentum"]) < 1e-12  # round-off: constant mass matrices, measured 8e-15
@@ -85,7 +85,7 @@ def test_free_chain_keeps_its_momentum_and_angular_momentum():
 
 @pytest.fixture(scope="module")
 def native_free():
-    tr = simulate(free_scene(), "full", rtol=1e-10, atol=1e-12)
+    tr = simulate(drifting_body_scene(), "full", rtol=1e-10, atol=1e-12)
     assert tr.stats.success, tr.stats.message
     return tr
 
@@ -97,7 +97,7 @@ def test_body_motion_agrees_with_the_native_full_model(native_free):
     and 1.4e-8 m (step 1e-4 s instead of 2e-4 s: 1.7e-8 rad, 2.7e-9 m). The bounds are ~3x
     the element refinement's change: 1.5e-7 rad, 5e-8 m. (At the default Newton tolerance the
     gaps are 1.1e-5 rad and 2.9e-6 m, the Newton residual's, module docstring.)"""
-    scene = free_scene()
+    scene = drifting_body_scene()
     ex = _run(scene, **TIGHT)
     finer = _run(scene, elements=4, **TIGHT)
     shorter = _run(scene, step=1e-4, **TIGHT)
@@ -112,16 +112,6 @@ def test_body_motion_agrees_with_the_native_full_model(native_free):
     assert np.abs(ex["hinge_angle"][:, 0] - native_free["hinge_angle"][:, 0]).max() < 1e-6
     # ^ measured 4.7e-7 rad: the bending model difference (alpha 4.7e-7 rad) and exudyn's
     # element refinement (3.2e-7 rad); ~2x
-
-
-def three_panel_free_scene():
-    """The companion paper's three panels (studies/companion_three_panel.toml, every hinge
-    latching) deploying from a free 1000 kg, 2000 kg m^2 body, hinge 0 at 1 m from its
-    centre of mass."""
-    doc = tomllib.loads((STUDIES / "companion_three_panel.toml").read_text())["scene"]
-    doc["outputs"] = ["phi", "hinge_angle", "angular_momentum", "momentum", "base"]
-    doc["base"] = {"kind": "free", "mass": 1000.0, "inertia": 2000.0, "hinge_offset": [1.0, 0.0]}
-    return scene_from_dict(doc)
 
 
 def test_latches_lock_against_the_body_as_in_the_native_model():

@@ -38,12 +38,6 @@ from rodval.study.spec import load_study
 BAD_STEP = r'^step must be "auto" or a number in \(0, 0\.1\] s, got '
 
 
-def two_rod_latch(EI: float = 1e7, window: float | None = None) -> Scene:
-    """``scenes.two_rod_latch`` at EI = 1e7 N m^2 by default: its lock window (the locked
-    pair's first bending period) is 2.28 ms, 11.4 steps of the former fixed default 2e-4 s."""
-    return scenes.two_rod_latch(EI, window)
-
-
 SCENE_TOML = """
 n = 2
 t_end = 0.42
@@ -123,19 +117,21 @@ def test_a_study_file_takes_auto_and_refuses_a_bad_step(tmp_path):
 def test_the_a_priori_step_resolves_the_shortest_lock_window():
     """The pair's window over 20 steps, rounded down to two digits, when below the cap; the
     cap (2e-4 s) otherwise; a latch held from the start opens no window."""
-    scene = two_rod_latch(1e7)
+    scene = scenes.two_rod_latch(1e7)
     w = lock_window(scene.chain, scene.latches[0])
     assert w == pytest.approx(2.28e-3, rel=1e-3)
     step, why = a_priori_step(scene)
     assert step == pytest.approx(1.1e-4, rel=1e-12)
     assert w / step >= MIN_WINDOW_STEPS and "lock window" in why
     assert w / STEP_CAP_S < MIN_WINDOW_STEPS  # the former fixed default does not resolve it
-    assert a_priori_step(two_rod_latch(1e3))[0] == STEP_CAP_S
+    assert a_priori_step(scenes.two_rod_latch(1e3))[0] == STEP_CAP_S
     # a window of exactly 20 cap steps: strictly below, so no run holds 19.999... steps
-    assert a_priori_step(two_rod_latch(1e3, window=20 * STEP_CAP_S))[0] == pytest.approx(1.9e-4)
+    assert a_priori_step(scenes.two_rod_latch(1e3, window=20 * STEP_CAP_S))[0] == pytest.approx(
+        1.9e-4
+    )
     free = Scene(chain=Chain.uniform(2), t_end=0.1, times=[0.0, 0.1])
     assert a_priori_step(free) == (STEP_CAP_S, f"the cap {STEP_CAP_S:g} s (no lock windows)")
-    held = two_rod_latch(1e7).with_(
+    held = scenes.two_rod_latch(1e7).with_(
         initial=InitialState(phi=[0.0, 0.0]), latches=(Latch(1, 0.0, held=True),)
     )
     assert a_priori_step(held)[0] == STEP_CAP_S
@@ -172,7 +168,7 @@ def test_a_coarse_step_is_refined_as_far_as_the_window_needs_at_once(monkeypatch
     """A window of 4.5 steps at 1e-3 s needs 20 / 4.5 = 4.4x: three halvings at once."""
     monkeypatch.setattr(exudyn_step, "a_priori_step", lambda scene: (1e-3, "coarse"))
     run_at, calls = _stand_in(4.5e-3, lambda h: None)
-    tr, auto = run_auto(two_rod_latch(), run_at, _never, BOUNDS)
+    tr, auto = run_auto(scenes.two_rod_latch(), run_at, _never, BOUNDS)
     assert calls == [1e-3, 1.25e-4]
     assert auto.met and tr.settings["step"] == 1.25e-4
     assert [a.window_steps_min for a in auto.attempts] == pytest.approx([4.5, 36.0])
@@ -183,7 +179,7 @@ def test_a_coarse_step_is_refined_as_far_as_the_window_needs_at_once(monkeypatch
 def test_an_energy_residual_falling_with_the_step_is_halved_until_within_bound():
     """r = 100 h: 0.02 at 2e-4 s, 0.01 (the bound, which holds) at 1e-4 s."""
     run_at, calls = _stand_in(1.0, lambda h: 100 * h)
-    tr, auto = run_auto(two_rod_latch(1e3), run_at, _never, BOUNDS)
+    tr, auto = run_auto(scenes.two_rod_latch(1e3), run_at, _never, BOUNDS)
     assert calls == [2e-4, 1e-4]
     assert auto.met and auto.record()["chosen"] == 1e-4
     assert auto.record()["attempts"][0]["needs"] == ["the energy residual 0.02 > 0.01"]
@@ -194,7 +190,7 @@ def test_a_residual_that_does_not_fall_with_the_step_stops_and_names_more_elemen
     """exudyn at 2 elements on studies/deployment.toml: 0.231 at 2e-4 s, 0.233 at 1e-4 s."""
     residuals = {2e-4: 0.231, 1e-4: 0.233}
     run_at, calls = _stand_in(1.0, residuals.__getitem__)
-    tr, auto = run_auto(two_rod_latch(1e3), run_at, _never, BOUNDS)
+    tr, auto = run_auto(scenes.two_rod_latch(1e3), run_at, _never, BOUNDS)
     assert calls == [2e-4, 1e-4]
     assert not auto.met and auto.energy_fix == ELEMENTS_FIX
     note = auto.note()
@@ -205,7 +201,7 @@ def test_a_residual_that_does_not_fall_with_the_step_stops_and_names_more_elemen
 def test_no_step_within_the_limits_is_said_never_silently():
     """r = 1e3 h falls with the step but needs 1e-5 s, below the a-priori step / 16."""
     run_at, calls = _stand_in(1.0, lambda h: 1e3 * h)
-    tr, auto = run_auto(two_rod_latch(1e3), run_at, _never, BOUNDS)
+    tr, auto = run_auto(scenes.two_rod_latch(1e3), run_at, _never, BOUNDS)
     assert calls == [2e-4 / 2**i for i in range(MAX_REFINEMENTS + 1)]
     assert not auto.met and auto.record()["met"] is False
     assert tr.settings["step"] == 2e-4 / 2**MAX_REFINEMENTS  # the last attempt is the run
@@ -215,7 +211,7 @@ def test_no_step_within_the_limits_is_said_never_silently():
 
 def test_a_run_that_ends_for_another_reason_is_not_refined():
     run_at, calls = _stand_in(1.0, lambda h: 0.5, status=STATUS_BLOWUP)
-    tr, auto = run_auto(two_rod_latch(1e3), run_at, _never, BOUNDS)
+    tr, auto = run_auto(scenes.two_rod_latch(1e3), run_at, _never, BOUNDS)
     assert calls == [2e-4] and not auto.met
     assert "its run ended before t_end: m (a smaller step is not tried)" in auto.note()
 
@@ -223,7 +219,7 @@ def test_a_run_that_ends_for_another_reason_is_not_refined():
 def test_a_refinement_that_would_not_fit_the_budgets_is_not_run():
     run_at, calls = _stand_in(1.0, lambda h: 100 * h)
     tr, auto = run_auto(
-        two_rod_latch(1e3), run_at, lambda step, predicted: f"no room for {step:g}", BOUNDS
+        scenes.two_rod_latch(1e3), run_at, lambda step, predicted: f"no room for {step:g}", BOUNDS
     )
     assert calls == [2e-4] and not auto.met
     assert "the attempt at 0.0001 s was not run: no room for 0.0001" in auto.note()
@@ -249,11 +245,13 @@ def test_the_verdict_names_more_elements_when_the_step_does_not_close_the_balanc
         "step_used": 1e-4,
     }
     tr = Trajectory("exudyn", "s", np.zeros(1), {}, {}, stats, settings)
-    checks = ExudynModel().validity_checks(two_rod_latch(), tr)
+    checks = ExudynModel().validity_checks(scenes.two_rod_latch(), tr)
     energy = next(c for c in checks if c.assumption == "energy balance")
     assert energy.fix == ELEMENTS_FIX and not energy.holds
     tr.settings.pop("step_auto")
-    energy = next(c for c in ExudynModel().validity_checks(two_rod_latch(), tr) if c.figure == 0.23)
+    energy = next(
+        c for c in ExudynModel().validity_checks(scenes.two_rod_latch(), tr) if c.figure == 0.23
+    )
     assert "smaller step" in energy.fix
 
 
@@ -269,7 +267,7 @@ def exudyn():
 def test_auto_resolves_every_lock_window_where_the_former_default_did_not(exudyn):
     """The former fixed default (2e-4 s) leaves the 2.28 ms window 11.4 steps; "auto" runs the
     a-priori 1.1e-4 s in one attempt, every window >= 20 steps, and says why."""
-    scene = two_rod_latch(1e7)
+    scene = scenes.two_rod_latch(1e7)
     fixed = ExudynModel(step=2e-4).simulate(scene)
     assert fixed.success, fixed.stats.message
     assert [ev["window_steps"] for ev in fixed.events] == pytest.approx([11.4], rel=1e-3)
@@ -287,7 +285,7 @@ def test_auto_refines_a_coarse_step_and_its_run_is_the_fixed_step_run(exudyn, mo
     """From a coarse 4e-4 s (5.7 steps a window) two halvings at once to 1e-4 s (22.8 steps);
     the run kept is exactly the fixed-step run at 1e-4 s, its counters the attempts' sum."""
     monkeypatch.setattr(exudyn_step, "a_priori_step", lambda scene: (4e-4, "coarse (test)"))
-    scene = two_rod_latch(1e7)
+    scene = scenes.two_rod_latch(1e7)
     tr = ExudynModel().simulate(scene)
     assert tr.success, tr.stats.message
     attempts = tr.settings["step_auto"]["attempts"]
@@ -306,7 +304,7 @@ def test_auto_refines_a_coarse_step_and_its_run_is_the_fixed_step_run(exudyn, mo
 def test_a_float_step_records_what_it_did_before(exudyn):
     """A float step is one fixed-step run: its settings hold the keys they held before
     "auto" (no attempts, no requested step) and its notes nothing of "auto"."""
-    tr = ExudynModel(step=2e-4).simulate(two_rod_latch(1e3))
+    tr = ExudynModel(step=2e-4).simulate(scenes.two_rod_latch(1e3))
     assert tr.success, tr.stats.message
     assert "step_auto" not in tr.settings and "requested_step" not in tr.settings
     assert tr.settings["step"] == 2e-4 and tr.options["step"] == 2e-4
@@ -344,7 +342,7 @@ def test_a_refinement_beyond_the_memory_limit_is_refused_and_said(exudyn, monkey
     the coarse run is kept and its note says why no finer one ran."""
     monkeypatch.setattr(exudyn_step, "a_priori_step", lambda scene: (4e-4, "coarse (test)"))
     monkeypatch.setenv(ENV_LIMIT, "0.005")
-    tr = ExudynModel().simulate(two_rod_latch(1e7))
+    tr = ExudynModel().simulate(scenes.two_rod_latch(1e7))
     assert tr.success, tr.stats.message
     auto = tr.settings["step_auto"]
     assert [a["step"] for a in auto["attempts"]] == [4e-4] and not auto["met"]

@@ -4,11 +4,11 @@ heavy-body limit and latches that lock against the body."""
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+from scenes import three_panel_free_scene  # noqa: E402
 
 from rodval import Base, paper_scene, simulate
 from rodval.core.scene_file import scene_from_dict, scene_to_dict
@@ -159,13 +159,6 @@ def test_a_heavy_body_converges_to_the_pinned_chain():
         gaps.append(np.abs(tr["phi"] - ref).max())
     assert gaps[1] < 1e-6
     assert 0.5e-3 < gaps[1] / gaps[0] < 2e-3
-
-
-def three_panel_free_scene(mass=1000.0, inertia=2000.0):
-    doc = tomllib.loads((STUDIES / "companion_three_panel.toml").read_text())["scene"]
-    doc["outputs"] = ["phi", "hinge_angle", "angular_momentum", "momentum", "base"]
-    doc["base"] = {"kind": "free", "mass": mass, "inertia": inertia, "hinge_offset": [1.0, 0.0]}
-    return scene_from_dict(doc)
 
 
 def test_latches_lock_against_the_body_keeping_the_momentum():

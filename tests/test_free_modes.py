@@ -43,7 +43,7 @@ BODY = dict(kind="free", mass=50.0, inertia=20.0, hinge_offset=(0.5, 0.0))
 EXUDYN = dict(elements=16)
 
 
-def free_scene(**body):
+def free_body_pair_scene(**body):
     s = paper_scene(3, t_end=1.0)
     chain = s.chain.with_(l=1.5, m=3.0, EI=1e5, mu=0.5, kappa=50.0)
     return s.with_(chain=chain, loads=(), base=Base(**{**BODY, **body}))
@@ -74,12 +74,12 @@ def check_rigid(m, tol):
 
 @pytest.mark.parametrize("shapes, kinematics", [(1, "first-order"), (1, "exact"), (3, "exact")])
 def test_native_rigid_modes_are_separated(shapes, kinematics):
-    m = model_modes(free_scene(), "full", shapes=shapes, kinematics=kinematics, count=6)
+    m = model_modes(free_body_pair_scene(), "full", shapes=shapes, kinematics=kinematics, count=6)
     check_rigid(m, 1e-10)
     assert m.count == 3 + 6
     assert m.info["static_residual_Nm"] < 1e-12
     # the Model contract gives the same
-    m2 = FullModel.modes(free_scene(), shapes=shapes, kinematics=kinematics, count=6)
+    m2 = FullModel.modes(free_body_pair_scene(), shapes=shapes, kinematics=kinematics, count=6)
     np.testing.assert_array_equal(m2.omega, m.omega)
 
 
@@ -88,8 +88,8 @@ def test_heavy_body_reproduces_the_pinned_chain():
     chain's (node 0 at the hinge offset instead of the origin changes nothing). Measured: mode
     1 8.2e-8 (p = 1) and 1.1e-7 (p = 3) relative, the others <= 3e-9 (the chain's mass and
     moment, ~15 kg and ~110 kg m^2 about the body's centre, over the body's 1e9)."""
-    heavy = free_scene(mass=1e9, inertia=1e9)
-    pinned = free_scene().with_(base=Base())
+    heavy = free_body_pair_scene(mass=1e9, inertia=1e9)
+    pinned = free_body_pair_scene().with_(base=Base())
     for p in (1, 3):
         mh = model_modes(heavy, "full", shapes=p, count=8)
         mp = model_modes(pinned, "full", shapes=p, count=8)
@@ -101,7 +101,7 @@ def test_heavy_body_reproduces_the_pinned_chain():
 
 
 def test_equilibrium_without_loads_is_the_rest_state_and_loads_are_refused():
-    scene = free_scene()
+    scene = free_body_pair_scene()
     a = model_modes(scene, "full", count=4)
     b = model_modes(scene, "full", about="equilibrium", count=4)
     np.testing.assert_allclose(b.omega, a.omega, rtol=1e-12, atol=0)
@@ -111,11 +111,11 @@ def test_equilibrium_without_loads_is_the_rest_state_and_loads_are_refused():
 
 
 def test_free_base_refusals():
-    scene = free_scene()
+    scene = free_body_pair_scene()
     with pytest.raises(ValueError, match="modes of a chain on a free base .* not built"):
         ReducedModel.modes(scene)
     with pytest.raises(ValueError, match="free base's velocity or rate is not zero"):
-        model_modes(free_scene(rate=0.1), "full")
+        model_modes(free_body_pair_scene(rate=0.1), "full")
     spin = Base(kind="prescribed", motion={"attitude": Motion("linear", (0.0, 1.0))})
     with pytest.raises(ValueError, match="prescribed base"):
         FullModel.modes(scene.with_(base=spin))
@@ -128,8 +128,8 @@ def test_attitude_turns_the_rest_state():
     measured from the body): the frequencies are the same as at attitude 0."""
     from rodval.core.scene import InitialState
 
-    a = model_modes(free_scene(), "full", count=5)
-    tilted = free_scene(attitude=0.3).with_(initial=InitialState(phi=np.full(3, 0.3)))
+    a = model_modes(free_body_pair_scene(), "full", count=5)
+    tilted = free_body_pair_scene(attitude=0.3).with_(initial=InitialState(phi=np.full(3, 0.3)))
     b = model_modes(tilted, "full", count=5)
     np.testing.assert_allclose(b.omega[3:], a.omega[3:], rtol=1e-8)  # measured 1.5e-10
     assert max(b.info["rigid_shape_residual"].values()) < 1e-10
@@ -138,7 +138,7 @@ def test_attitude_turns_the_rest_state():
 @pytest.mark.exudyn
 def test_exudyn_rigid_modes_are_separated():
     pytest.importorskip("exudyn")
-    m = model_modes(free_scene(), "exudyn", count=8, **EXUDYN)
+    m = model_modes(free_body_pair_scene(), "exudyn", count=8, **EXUDYN)
     check_rigid(m, 1e-6)
     assert m.count == 3 + 8
 
@@ -154,7 +154,7 @@ def test_flexible_modes_native_against_exudyn(shapes, first):
     the hinge modes from p = 1 (measured <= 2.3e-6), six modes from p = 4 (<= 1.5e-6), eight
     at p = 5 (<= 4.6e-5)."""
     pytest.importorskip("exudyn")
-    scene = free_scene()
+    scene = free_body_pair_scene()
     ex = model_modes(scene, "exudyn", count=first, **EXUDYN)
     nat = model_modes(scene, "full", shapes=shapes, count=first + 2)
     check_rigid(ex, 1e-6)
@@ -176,8 +176,8 @@ def test_exudyn_heavy_body_reproduces_the_pinned_chain():
     1e7 kg 1.5e-6, 1e8 kg 6.6e-6, 1e9 kg -6.1e-6; at 1e9 kg over 8-16 elements and EA 1e6-1e10
     it scatters from 2.7e-7 to 8.8e-6 without a trend in EA); modes 2-6 within 5e-6."""
     pytest.importorskip("exudyn")
-    heavy = model_modes(free_scene(mass=1e9, inertia=1e9), "exudyn", count=6, **EXUDYN)
-    pinned = model_modes(free_scene().with_(base=Base()), "exudyn", count=6, **EXUDYN)
+    heavy = model_modes(free_body_pair_scene(mass=1e9, inertia=1e9), "exudyn", count=6, **EXUDYN)
+    pinned = model_modes(free_body_pair_scene().with_(base=Base()), "exudyn", count=6, **EXUDYN)
     check_rigid(heavy, 1e-6)
     np.testing.assert_allclose(heavy.flexible().omega, pinned.omega, rtol=2e-5)
 
@@ -189,7 +189,7 @@ def test_a_hinge_without_a_spring_is_refused_naming_it(model):
     fix (a user's 5-panel boom with a free root met this as a cryptic split failure)."""
     if model == "exudyn":
         pytest.importorskip("exudyn")
-    scene = free_scene()
+    scene = free_body_pair_scene()
     loose = scene.with_(chain=scene.chain.with_(kappa=[0.0, 50.0, 50.0]))
     with pytest.raises(ValueError, match=r"hinge\(s\) \[0\] have no spring \(chain.kappa = 0\)"):
         model_modes(loose, model)
