@@ -38,7 +38,6 @@ def _vector(name: str, value: Any, unit: str) -> tuple[float, float]:
             f"base {name} must be a pair [x, y] of real numbers ({unit}), got {value!r}"
         )
     x, y = (check_number(f"base {name} ({unit})", v, finite=True) for v in value)
-    check_bounds(f"base {name} ({unit})", np.array([x, y]), None)
     return (x, y)
 
 
@@ -93,8 +92,7 @@ class Base:
             set_(self, name, _vector(name, getattr(self, name), unit))
         for name, unit in (("attitude", "rad"), ("rate", "rad/s")):
             v = check_number(f"base {name} ({unit})", getattr(self, name), finite=True)
-            check_bounds(f"base {name} ({unit})", np.array([v]), None)
-            set_(self, name, v)
+            set_(self, name, v)  # finite: within the chain's bounds (check_bounds)
 
     def _prescribe(self) -> None:
         """Check a prescribed base: its motion laws (``Motion``, by axis) and hinge offset

@@ -9,7 +9,7 @@ import math
 import numbers
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any, cast
+from typing import Any, TypedDict, Unpack, cast
 
 
 def check_keys(
@@ -65,66 +65,60 @@ def check_choice(name: str, value: Any, choices: Iterable[str]) -> str:
     return value
 
 
-def describe_range(
-    *,
-    unit: str = "",
-    low: float = -math.inf,
-    high: float = math.inf,
-    low_open: bool = False,
-    high_open: bool = False,
-    finite: bool = False,
-    integer: bool = False,
-) -> str:
+class Bounds(TypedDict, total=False):
+    """The range ``check_number`` accepts and ``describe_range`` words: ``low``..``high``
+    (defaults -inf..inf; each end open when ``low_open``, ``high_open``), ``finite``,
+    ``integer``; ``unit`` for the words only."""
+
+    unit: str
+    low: float
+    high: float
+    low_open: bool
+    high_open: bool
+    finite: bool
+    integer: bool
+
+
+def describe_range(**bounds: Unpack[Bounds]) -> str:
     """The range of ``check_number`` in words, e.g. "a finite real number > 0 (m)",
     "an integer in [1, 1000]"."""
-    kind = "an integer" if integer else ("a finite real number" if finite else "a real number")
+    low, high = bounds.get("low", -math.inf), bounds.get("high", math.inf)
+    low_open, high_open = bounds.get("low_open", False), bounds.get("high_open", False)
+    finite, unit = bounds.get("finite", False), bounds.get("unit", "")
+    kind = "a finite real number" if finite else "a real number"
+    kind = "an integer" if bounds.get("integer", False) else kind
     if math.isfinite(low) and math.isfinite(high):
-        bounds = f" in {'(' if low_open else '['}{low:g}, {high:g}{')' if high_open else ']'}"
+        ends = f" in {'(' if low_open else '['}{low:g}, {high:g}{')' if high_open else ']'}"
     elif math.isfinite(low):
-        bounds = f" {'>' if low_open else '>='} {low:g}"
+        ends = f" {'>' if low_open else '>='} {low:g}"
     elif math.isfinite(high):
-        bounds = f" {'<' if high_open else '<='} {high:g}"
+        ends = f" {'<' if high_open else '<='} {high:g}"
     else:
-        bounds = ""
-    return f"{kind}{bounds}{f' ({unit})' if unit else ''}"
+        ends = ""
+    return f"{kind}{ends}{f' ({unit})' if unit else ''}"
 
 
 def check_number(
-    name: str,
-    value: Any,
-    *,
-    unit: str = "",
-    low: float = -math.inf,
-    high: float = math.inf,
-    low_open: bool = False,
-    high_open: bool = False,
-    finite: bool = False,
-    integer: bool = False,
-    allowed: str | None = None,
+    name: str, value: Any, *, allowed: str | None = None, **bounds: Unpack[Bounds]
 ) -> float:
     """``value`` as a float (an int when ``integer``) when it is a real number (an integral
     one when ``integer``; never a bool, string, complex or NaN), finite when ``finite``, and
-    within ``low``..``high`` (each end open or closed); else the one-line ValueError
-    "<name> must be <allowed>, got <value>", ``allowed`` defaulting to ``describe_range``.
-    The one number validator of rodval: types before values, the unit in the message."""
+    within ``low``..``high`` (each end open or closed; ``Bounds``); else the one-line
+    ValueError "<name> must be <allowed>, got <value>", ``allowed`` defaulting to
+    ``describe_range``. The one number validator of rodval: types before values, the unit in
+    the message."""
+    integer = bounds.get("integer", False)
+    low, high = bounds.get("low", -math.inf), bounds.get("high", math.inf)
+    low_open, high_open = bounds.get("low_open", False), bounds.get("high_open", False)
     kind = numbers.Integral if integer else numbers.Real
     if isinstance(value, kind) and not isinstance(value, bool):
         v = int(cast(int, value)) if integer else float(value)
         if (
             not math.isnan(v)
-            and (math.isfinite(v) or not finite)
+            and (math.isfinite(v) or not bounds.get("finite", False))
             and (v > low if low_open else v >= low)
             and (v < high if high_open else v <= high)
         ):
             return v
-    if allowed is None:
-        allowed = describe_range(
-            unit=unit,
-            low=low,
-            high=high,
-            low_open=low_open,
-            high_open=high_open,
-            finite=finite,
-            integer=integer,
-        )
-    raise ValueError(f"{name} must be {allowed}, got {value!r}")
+    words = describe_range(**bounds) if allowed is None else allowed
+    raise ValueError(f"{name} must be {words}, got {value!r}")

@@ -1,33 +1,99 @@
-"""The chain's hinge items: latches (a hinge locks at an angle) and one-sided limit stops, and
-the checks a scene makes of them (hinge indices 0..n-1, acting stops, latch angles ahead of
-the initial state). Conventions: ``rodval.core.scene``."""
+"""The chain's hinge items: latches (a hinge locks at an angle) and one-sided limit stops, each
+a class registered by its scene table's name in ``HINGE_ITEMS`` (as the load laws are in
+``LOAD_FACTORIES``) that declares its keys (``KEYS``: the one list, which
+``scene_keys.SCENE_KEYS`` reads), its checks (``__post_init__``; within a scene, ``check_in``)
+and its scene-file table (``from_tables``, ``as_dict``). Conventions: ``rodval.core.scene``."""
 
 from __future__ import annotations
 
+import dataclasses
 import numbers
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar, Self
 
 import numpy as np
 
 from rodval.core.bounds import bounded_number, check_bounds
-from rodval.core.checks import check_number
+from rodval.core.checks import check_keys, check_number
+from rodval.core.keys import BOOLEAN, INTEGER, NUMBER, STRING, Key
 
 
-def _index(name: str, value: Any, n: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ValueError(
-            f"{name} must be an integer hinge index in 0..n-1 = 0..{n - 1}, got {value!r}"
-        )
-    index = int(value)
-    if not 0 <= index < n:
-        raise ValueError(f"{name} must be in 0..n-1 = 0..{n - 1}, got {value}")
-    return index
+def _keys(hinge: str, **more: Key) -> dict[str, Key]:
+    """An item's keys: ``hinge`` (its allowed values in words) and ``angle``, both required,
+    then the kind's own (``more``)."""
+    return {
+        "hinge": Key(INTEGER, "", hinge, required=True),
+        "angle": Key(NUMBER, "rad", "finite", required=True),
+        **more,
+    }
 
 
 @dataclass(frozen=True)
-class Latch:
+class HingeItem:
+    """A part on hinge ``hinge`` (an integer in 0..n-1) acting at the hinge angle ``angle``
+    (rad, finite). A kind is a frozen dataclass subclass that sets ``TABLE``, ``NOUN`` and
+    ``KEYS``, extends ``__post_init__`` and ``check_in`` with its own checks, and is listed
+    in ``HINGE_ITEMS``."""
+
+    TABLE: ClassVar[str]  # its scene-file table ([[latches]]), the name of its Scene field
+    NOUN: ClassVar[str]  # its name in messages ("latch")
+    KEYS: ClassVar[dict[str, Key]]  # its scene-file keys: type, unit, range, required
+
+    hinge: int
+    angle: float
+
+    def __post_init__(self) -> None:
+        hinge = self.hinge
+        if isinstance(hinge, bool) or not isinstance(hinge, numbers.Integral) or hinge < 0:
+            raise ValueError(f"{self.NOUN} hinge must be an integer >= 0, got {hinge!r}")
+        check_number(f"{self.NOUN} angle", self.angle, finite=True, unit="rad")
+
+    def as_dict(self) -> dict[str, Any]:
+        """Its scene-file table (``from_tables`` rebuilds the item from it)."""
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_tables(cls, doc: dict[str, Any], where: str) -> tuple[Self, ...]:
+        """The ``[[TABLE]]`` tables of the scene document ``doc`` (their types already
+        checked, ``scene_keys.check_types``) as items; a ValueError naming
+        ``<where> [[TABLE]] #<i>`` and the key."""
+        out = []
+        for i, spec in enumerate(doc.get(cls.TABLE, [])):
+            place = f"{where} [[{cls.TABLE}]] #{i + 1}"
+            check_keys(spec, cls.KEYS, place)
+            try:
+                out.append(cls(**spec))
+            except ValueError as exc:
+                raise ValueError(f"{place}: {exc}") from None
+        return tuple(out)
+
+    @classmethod
+    def check_in(cls, items: Any, scene: Any) -> tuple[Self, ...]:
+        """The ``scene``'s ``items`` of this kind as a tuple: objects of this class on hinges
+        0..n-1 (ValueError otherwise); a kind adds its checks against the scene."""
+        if isinstance(items, (str, bytes, dict)) or not isinstance(items, Iterable):
+            raise ValueError(f"{cls.TABLE} must be a sequence of rodval.{cls.__name__}")
+        out = tuple(items)
+        for item in out:
+            if not isinstance(item, cls):
+                raise ValueError(
+                    f"{cls.TABLE} must be rodval.{cls.__name__} objects, got {type(item).__name__}"
+                )
+            if item.hinge >= scene.n:
+                raise ValueError(
+                    f"{cls.NOUN} hinge must be in 0..n-1 = 0..{scene.n - 1}, got {item.hinge}"
+                )
+        return out
+
+
+#: A held latch's hinge must start at its angle (rad) and at rest (rad/s) to this distance: the
+#: initial state is on the constraint (round-off of the angles' sums, 1e-12 rad, with room).
+HELD_START = 1e-9
+
+
+@dataclass(frozen=True)
+class Latch(HingeItem):
     """A latch on hinge ``hinge`` (0..n-1): the hinge locks when its angle D reaches
     ``angle`` (rad) moving in ``direction`` (+1: D increasing, -1: decreasing; None: towards
     the angle from the initial state). At the lock the hinge's relative rate drops to zero
@@ -37,20 +103,21 @@ class Latch:
     clamp, or a joint locked before the run: its initial angle must be ``angle`` and its
     initial rate zero); it never fires an event."""
 
-    hinge: int
-    angle: float
+    TABLE = "latches"
+    NOUN = "latch"
+    KEYS = _keys(
+        "0..n-1, one latch per hinge",
+        direction=Key(INTEGER, "", "+1 or -1", none=True),
+        window=Key(NUMBER, "s", "> 0, finite", none=True),
+        held=Key(BOOLEAN),
+    )
+
     direction: int | None = None
     window: float | None = None
     held: bool = False
 
     def __post_init__(self) -> None:
-        if (
-            isinstance(self.hinge, bool)
-            or not isinstance(self.hinge, numbers.Integral)
-            or self.hinge < 0
-        ):
-            raise ValueError(f"latch hinge must be an integer >= 0, got {self.hinge!r}")
-        check_number("latch angle", self.angle, finite=True, unit="rad")
+        super().__post_init__()
         if self.direction is not None and (
             isinstance(self.direction, bool)
             or not isinstance(self.direction, numbers.Integral)
@@ -65,28 +132,66 @@ class Latch:
         if not isinstance(self.held, bool):
             raise ValueError(f"latch held must be true or false, got {self.held!r}")
 
+    def as_dict(self) -> dict[str, Any]:
+        """Its table, ``held`` only when true (other scenes' records unchanged)."""
+        d = super().as_dict()
+        if not self.held:
+            del d["held"]
+        return d
+
+    @classmethod
+    def check_in(cls, items: Any, scene: Any) -> tuple[Self, ...]:
+        """At most one latch per hinge, each ahead of its hinge's initial angle (rad) in its
+        direction; a held latch's hinge at its angle and at rest."""
+        latches = super().check_in(items, scene)
+        hinges = [latch.hinge for latch in latches]
+        if len(set(hinges)) != len(hinges):
+            raise ValueError(f"at most one latch per hinge, got hinges {hinges}")
+        if not latches:
+            return latches
+        D0, rate0 = scene.initial_hinge_angles(), scene.initial_hinge_rates()
+        for latch in latches:
+            d0 = D0[latch.hinge]
+            if latch.held:
+                if abs(d0 - latch.angle) > HELD_START or abs(rate0[latch.hinge]) > HELD_START:
+                    raise ValueError(
+                        f"held latch on hinge {latch.hinge}: the hinge must start at its angle "
+                        f"{latch.angle:.6g} rad and at rest (within {HELD_START:g}), got D = "
+                        f"{d0:.6g} rad, dD/dt = {rate0[latch.hinge]:.6g} rad/s"
+                    )
+                continue
+            side = np.sign(latch.angle - d0)
+            if side == 0 or (latch.direction is not None and side != latch.direction):
+                raise ValueError(
+                    f"latch on hinge {latch.hinge}: the hinge starts at D = {d0:.6g} rad, at or "
+                    f"beyond its latch angle {latch.angle:.6g} rad"
+                    + (f" in direction {latch.direction:+d}" if latch.direction else "")
+                )
+        return latches
+
 
 @dataclass(frozen=True)
-class Stop:
+class Stop(HingeItem):
     """A limit stop on hinge ``hinge``: a one-sided spring-damper acting beyond ``angle``
     (rad) on the ``side`` "upper" (D > angle) or "lower" (D < angle), with moment
     -stiffness (D - angle) - damping dD/dt there (N m; stiffness > 0 in N m/rad, damping >= 0
     in N m s/rad)."""
 
-    hinge: int
-    angle: float
+    TABLE = "stops"
+    NOUN = "stop"
+    KEYS = _keys(
+        "0..n-1",
+        side=Key(STRING, "", '`"upper"`, `"lower"`'),
+        stiffness=Key(NUMBER, "N m/rad", "> 0, <= 1e12"),
+        damping=Key(NUMBER, "N m s/rad", ">= 0, <= 1e12"),
+    )
+
     side: str = "upper"
     stiffness: float = 1e4
     damping: float = 0.0
 
     def __post_init__(self) -> None:
-        if (
-            isinstance(self.hinge, bool)
-            or not isinstance(self.hinge, numbers.Integral)
-            or self.hinge < 0
-        ):
-            raise ValueError(f"stop hinge must be an integer >= 0, got {self.hinge!r}")
-        check_number("stop angle", self.angle, finite=True, unit="rad")
+        super().__post_init__()
         if self.side not in ("upper", "lower"):
             raise ValueError(f"stop side must be 'upper' or 'lower', got {self.side!r}")
         # an acting stop adds its stiffness to kappa and its damping to nu: the same bounds
@@ -98,64 +203,26 @@ class Stop:
         beyond ``angle`` on its ``side``, strictly (the one definition every model uses)."""
         return D > self.angle if self.side == "upper" else D < self.angle
 
-
-def check_acting_stops(chain: Any, stops: tuple[Stop, ...]) -> None:
-    """An acting stop adds its stiffness to its hinge's kappa and its damping to nu: the sums
-    (all of a hinge's stops acting at once) must stay within the chain's bounds."""
-    for field_name, attr, unit in (
-        ("kappa", "stiffness", "N m/rad"),
-        ("nu", "damping", "N m s/rad"),
-    ):
-        total = getattr(chain, field_name).copy()
-        for st in stops:
-            total[st.hinge] += getattr(st, attr)
-        for st in stops:
-            check_bounds(
-                f"stop {attr} + {field_name} of hinge {st.hinge} ({unit})",
-                total[st.hinge : st.hinge + 1],
-                positive=False,
-            )
-
-
-def hinge_items(label: str, cls: type[Latch] | type[Stop], items: Any, n: int) -> tuple[Any, ...]:
-    """The scene's latches or stops (``label``) as a tuple of ``cls`` on hinges 0..n-1."""
-    if isinstance(items, (str, bytes, dict)) or not isinstance(items, Iterable):
-        raise ValueError(f"{label} must be a sequence of rodval.{cls.__name__}")
-    out: tuple[Any, ...] = tuple(items)
-    for item in out:
-        if not isinstance(item, cls):
-            raise ValueError(
-                f"{label} must be rodval.{cls.__name__} objects, got {type(item).__name__}"
-            )
-        _index(f"{label[:-1] if label == 'stops' else 'latch'} hinge", item.hinge, n)
-    return out
-
-
-#: A held latch's hinge must start at its angle (rad) and at rest (rad/s) to this distance: the
-#: initial state is on the constraint (round-off of the angles' sums, 1e-12 rad, with room).
-HELD_START = 1e-9
-
-
-def check_latches(latches: tuple[Latch, ...], D0: np.ndarray, rate0: np.ndarray) -> None:
-    """At most one latch per hinge, each ahead of its hinge's initial angle D0 (rad) in its
-    direction; a held latch's hinge at its angle and at rest (rate0, rad/s)."""
-    hinges = [latch.hinge for latch in latches]
-    if len(set(hinges)) != len(hinges):
-        raise ValueError(f"at most one latch per hinge, got hinges {hinges}")
-    for latch in latches:
-        d0 = D0[latch.hinge]
-        if latch.held:
-            if abs(d0 - latch.angle) > HELD_START or abs(rate0[latch.hinge]) > HELD_START:
-                raise ValueError(
-                    f"held latch on hinge {latch.hinge}: the hinge must start at its angle "
-                    f"{latch.angle:.6g} rad and at rest (within {HELD_START:g}), got D = "
-                    f"{d0:.6g} rad, dD/dt = {rate0[latch.hinge]:.6g} rad/s"
+    @classmethod
+    def check_in(cls, items: Any, scene: Any) -> tuple[Self, ...]:
+        """An acting stop adds its stiffness to its hinge's kappa and its damping to nu: the
+        sums (all of a hinge's stops acting at once) must stay within the chain's bounds."""
+        stops = super().check_in(items, scene)
+        for field_name, attr, unit in (
+            ("kappa", "stiffness", "N m/rad"),
+            ("nu", "damping", "N m s/rad"),
+        ):
+            total = getattr(scene.chain, field_name).copy()
+            for st in stops:
+                total[st.hinge] += getattr(st, attr)
+            for st in stops:
+                check_bounds(
+                    f"stop {attr} + {field_name} of hinge {st.hinge} ({unit})",
+                    total[st.hinge : st.hinge + 1],
+                    positive=False,
                 )
-            continue
-        side = np.sign(latch.angle - d0)
-        if side == 0 or (latch.direction is not None and side != latch.direction):
-            raise ValueError(
-                f"latch on hinge {latch.hinge}: the hinge starts at D = {d0:.6g} rad, at or "
-                f"beyond its latch angle {latch.angle:.6g} rad"
-                + (f" in direction {latch.direction:+d}" if latch.direction else "")
-            )
+        return stops
+
+
+#: The hinge items by scene table (and ``Scene`` field) name, in the scene files' order.
+HINGE_ITEMS: dict[str, type[HingeItem]] = {kind.TABLE: kind for kind in (Latch, Stop)}

@@ -271,22 +271,32 @@ def _switch_times(kind: str, t_on: Any, t_off: Any) -> tuple[float, float]:
     return t_on, t_off
 
 
+def _switched(
+    name: str, node: int, X: Any, Y: Any, law: Callable[[float], Law], **params: float
+) -> NodalForce:
+    """The force ``name`` on ``node`` with the components law(X), law(Y) (X, Y in N, checked
+    here; none where zero) acting on [t_on, t_off] (s, in ``params``), with kinks at its
+    switching times (the parameters t_*); its params X, Y, then ``params``."""
+    X, Y = _real(f"{name} X", X, "N"), _real(f"{name} Y", Y, "N")
+    return NodalForce(
+        node,
+        law(X) if X else None,
+        law(Y) if Y else None,
+        support=(params["t_on"], params["t_off"]),
+        breakpoints=_kinks(*(v for k, v in params.items() if k.startswith("t_"))),
+        name=name,
+        params={"X": X, "Y": Y, **params},
+    )
+
+
 def constant(
     node: int, X: float = 0.0, Y: float = 0.0, t_on: float = 0.0, t_off: float = math.inf
 ) -> NodalForce:
     """A constant force (X, Y) in N switched on at ``t_on`` and off at ``t_off`` (s): a step
     load (t_on > 0) or a constant one."""
-    X, Y = _real("constant X", X, "N"), _real("constant Y", Y, "N")
     t_on, t_off = _switch_times("constant", t_on, t_off)
-    bps = _kinks(t_on, t_off)
-    return NodalForce(
-        node,
-        Constant(X, t_on, t_off) if X else None,
-        Constant(Y, t_on, t_off) if Y else None,
-        support=(t_on, t_off),
-        breakpoints=bps,
-        name="constant",
-        params={"X": X, "Y": Y, "t_on": t_on, "t_off": t_off},
+    return _switched(
+        "constant", node, X, Y, lambda v: Constant(v, t_on, t_off), t_on=t_on, t_off=t_off
     )
 
 
@@ -300,7 +310,6 @@ def ramp(
 ) -> NodalForce:
     """A force rising linearly from 0 at ``t_on`` to (X, Y) N at ``t_full``, then held until
     ``t_off`` (s). Kinks at t_on and t_full, a jump at t_off."""
-    X, Y = _real("ramp X", X, "N"), _real("ramp Y", Y, "N")
     t_on, t_off = _switch_times("ramp", t_on, t_off)
     t_full = _real("ramp t_full", t_full, "s")
     if not (t_on < t_full <= t_off):
@@ -310,19 +319,10 @@ def ramp(
         )
     times = np.array([t_on, t_full])
 
-    def law(v: float) -> PiecewiseLinear | None:
-        return PiecewiseLinear(times, np.array([0.0, v]), hold=True) if v else None
+    def law(v: float) -> PiecewiseLinear:
+        return PiecewiseLinear(times, np.array([0.0, v]), hold=True)
 
-    bps = _kinks(t_on, t_full, t_off)
-    return NodalForce(
-        node,
-        law(X),
-        law(Y),
-        support=(t_on, t_off),
-        breakpoints=bps,
-        name="ramp",
-        params={"X": X, "Y": Y, "t_on": t_on, "t_full": t_full, "t_off": t_off},
-    )
+    return _switched("ramp", node, X, Y, law, t_on=t_on, t_full=t_full, t_off=t_off)
 
 
 def harmonic(
@@ -336,20 +336,14 @@ def harmonic(
 ) -> NodalForce:
     """A harmonic force (X, Y) sin(omega t + phase) in N, omega in rad/s, phase in rad, acting
     on [t_on, t_off] (s)."""
-    X, Y = _real("harmonic X", X, "N"), _real("harmonic Y", Y, "N")
     omega = _real("harmonic omega", omega, "rad/s", positive=True)
     phase = _real("harmonic phase", phase, "rad")
     t_on, t_off = _switch_times("harmonic", t_on, t_off)
-    bps = _kinks(t_on, t_off)
-    return NodalForce(
-        node,
-        Harmonic(X, omega, phase, t_on, t_off) if X else None,
-        Harmonic(Y, omega, phase, t_on, t_off) if Y else None,
-        support=(t_on, t_off),
-        breakpoints=bps,
-        name="harmonic",
-        params={"X": X, "Y": Y, "omega": omega, "phase": phase, "t_on": t_on, "t_off": t_off},
-    )
+
+    def law(v: float) -> Harmonic:
+        return Harmonic(v, omega, phase, t_on, t_off)
+
+    return _switched("harmonic", node, X, Y, law, omega=omega, phase=phase, t_on=t_on, t_off=t_off)
 
 
 #: Largest number of samples of a tabulated force history.

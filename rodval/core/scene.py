@@ -30,9 +30,9 @@ from rodval.core.base import PINNED, Base
 from rodval.core.bounds import as_rod_array
 from rodval.core.checks import check_keys, check_number
 from rodval.core.damping import DampingRequest
+from rodval.core.hinges import HINGE_ITEMS
 from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
 from rodval.core.hinges import Stop as Stop
-from rodval.core.hinges import check_acting_stops, check_latches, hinge_items
 from rodval.core.loads import NodalForce
 from rodval.core.quantities import GROUPS, OUTPUTS, UNIT, check_output_bases, quantities_of
 from rodval.core.resources import check_rods, check_run_memory
@@ -64,6 +64,20 @@ UNIFORM_DEFAULTS: dict[str, float] = dict(
 )
 
 
+#: Each chain field's words in messages and its sign (``as_rod_array``'s ``positive``: True
+#: > 0, False >= 0, None any finite value).
+_FIELD_CHECKS: dict[str, tuple[str, bool | None]] = {
+    "l": ("l (rod length)", True),
+    "m": ("m (mass per length)", True),
+    "EI": ("EI (bending stiffness)", True),
+    "mu": ("mu (node mass)", False),
+    "kappa": ("kappa (hinge stiffness)", False),
+    "nu": ("nu (hinge damping)", False),
+    "rest_angle": ("rest_angle (hinge rest angle, rad)", None),
+    "bending_damping": ("bending_damping (rod bending damping, N m^2 s)", False),
+}
+
+
 @dataclass(frozen=True, eq=False)
 class Chain:
     """Physical data of a plane chain of n rods (see module docstring for conventions).
@@ -83,7 +97,7 @@ class Chain:
     bending_damping: np.ndarray
 
     #: The per-rod / per-hinge arrays, in order.
-    FIELDS = ("l", "m", "EI", "mu", "kappa", "nu", "rest_angle", "bending_damping")
+    FIELDS = tuple(_FIELD_CHECKS)
 
     @classmethod
     def uniform(cls, n: int, **values: Any) -> Chain:
@@ -108,34 +122,17 @@ class Chain:
         **unknown: Any,
     ) -> None:
         check_keys(unknown, self.FIELDS, "Chain", noun="field")  # a ValueError, not TypeError
+        given = dict(zip(self.FIELDS, (l, m, EI, mu, kappa, nu, rest_angle, bending_damping)))
         n = _n
         if n is None:
-            given = (l, m, EI, mu, kappa, nu, rest_angle, bending_damping)
-            sizes = [np.size(v) for v in given if np.ndim(v) > 0]
+            sizes = [np.size(v) for v in given.values() if np.ndim(v) > 0]
             n = sizes[0] if sizes else 1
         n = int(check_number("n (number of rods)", n, integer=True))
         if n < 1:
             raise ValueError(f"n (number of rods) must be >= 1, got {n}")
         check_rods(n)  # before any n-sized array
-        set_ = object.__setattr__
-        set_(self, "l", as_rod_array("l (rod length)", l, n, positive=True))
-        set_(self, "m", as_rod_array("m (mass per length)", m, n, positive=True))
-        set_(self, "EI", as_rod_array("EI (bending stiffness)", EI, n, positive=True))
-        set_(self, "mu", as_rod_array("mu (node mass)", mu, n, positive=False))
-        set_(self, "kappa", as_rod_array("kappa (hinge stiffness)", kappa, n, positive=False))
-        set_(self, "nu", as_rod_array("nu (hinge damping)", nu, n, positive=False))
-        set_(
-            self,
-            "rest_angle",
-            as_rod_array("rest_angle (hinge rest angle, rad)", rest_angle, n, positive=None),
-        )
-        set_(
-            self,
-            "bending_damping",
-            as_rod_array(
-                "bending_damping (rod bending damping, N m^2 s)", bending_damping, n, positive=False
-            ),
-        )
+        for name, (words, positive) in _FIELD_CHECKS.items():
+            object.__setattr__(self, name, as_rod_array(words, given[name], n, positive=positive))
 
     @property
     def n(self) -> int:
@@ -373,13 +370,11 @@ class Scene:
         if not isinstance(self.initial, InitialState):
             raise ValueError("initial must be a rodval.InitialState")
         self.initial.resolve(n)  # validate now, before any work
-        object.__setattr__(self, "latches", hinge_items("latches", Latch, self.latches, n))
-        object.__setattr__(self, "stops", hinge_items("stops", Stop, self.stops, n))
-        check_acting_stops(self.chain, self.stops)
         if not isinstance(self.base, Base):
             raise ValueError(f"base must be a rodval.Base, got {type(self.base).__name__}")
         check_output_bases(self.outputs, self.base.kind)
-        check_latches(self.latches, self.initial_hinge_angles(), self.initial_hinge_rates())
+        for table, kind in HINGE_ITEMS.items():  # the field named by each item's table
+            object.__setattr__(self, table, kind.check_in(getattr(self, table), self))
         if self.damping is not None and not isinstance(self.damping, DampingRequest):
             raise ValueError(
                 "damping must be a rodval.core.damping.DampingRequest or None, got "

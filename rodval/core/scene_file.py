@@ -11,11 +11,10 @@ Every error is a ValueError that names the file and the offending key.
 from __future__ import annotations
 
 import copy
-import dataclasses
 import inspect
 import tomllib
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 
@@ -28,25 +27,21 @@ from rodval.core.damping import (
     bending_damping_for_ratio,
     damping_request,
 )
+from rodval.core.hinges import HINGE_ITEMS
 from rodval.core.loads import LOAD_FACTORIES, NodalForce, pulse
 from rodval.core.profiles import resolve_profiles
 from rodval.core.resources import check_rods
 from rodval.core.scene import (
     DEFAULT_NUM_TIMES,
     MAX_TIMES,
-    QUANTITIES,
     UNIFORM_DEFAULTS,
     Chain,
     InitialState,
-    Latch,
     Scene,
-    Stop,
     output_times,
 )
-from rodval.core.scene_keys import check_types, merge_documents, missing_key, set_path
+from rodval.core.scene_keys import SCENE_KEYS, check_types, merge_documents, missing_key, set_path
 from rodval.core.settings import SETTING_NAMES
-
-_Item = TypeVar("_Item", Latch, Stop)
 
 #: The scenes a file may be ``based_on`` by name: what the file omits takes that scene's
 #: values. In a file, ``based_on`` may also be the path of another scene file
@@ -71,62 +66,36 @@ NEUTRAL_CHAIN: dict[str, float] = dict(
 )
 #: The outputs of a file that names none (``Scene``'s default; outputs are not physics).
 DEFAULT_OUTPUTS: tuple[str, ...] = Scene.outputs
-TOP_KEYS = {
-    "based_on",
-    "base",
-    "name",
-    "n",
-    "t_end",
-    "times",
-    "outputs",
-    "chain",
-    "loads",
-    "initial",
-    "latches",
-    "stops",
-}
-LATCH_KEYS = ("hinge", "angle", "direction", "window", "held")
-STOP_KEYS = ("hinge", "angle", "side", "stiffness", "damping")
+#: The keys of a scene document (``SCENE_KEYS``'s tables).
+TOP_KEYS = set(SCENE_KEYS)
 CHAIN_KEYS = set(Chain.FIELDS)
 INITIAL_KEYS = set(InitialState.KEYS)
 TIMES_KEYS = {"start", "stop", "num"}
 
 
 def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
+    """The output times (s) of ``times`` (its type checked, ``check_types``): a list, a table
+    {start, stop, num} (``output_times``), or None (the scene's default grid)."""
     if value is None:
         return None
-    if isinstance(value, dict):
-        check_keys(value, TIMES_KEYS, f"{where} key 'times'")
-        num = value.get("num", DEFAULT_NUM_TIMES)
-        if isinstance(num, bool) or not isinstance(num, int):
-            raise ValueError(
-                f"{where} key 'times': num must be an integer >= 1 and <= {MAX_TIMES}, got {num!r}"
-            )
-        if not 1 <= num <= MAX_TIMES:
-            raise ValueError(f"{where} key 'times': num must be >= 1 and <= {MAX_TIMES}, got {num}")
-        for key in ("start", "stop"):
-            v = value.get(key)
-            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
-                raise ValueError(f"{where} key 'times.{key}': must be a number (s), got {v!r}")
-        return output_times(float(value.get("start", 0.0)), float(value.get("stop", t_end)), num)
-    if isinstance(value, (list, tuple)):
-        if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value):
-            raise ValueError(f"{where} key 'times': must be a list of numbers (s), got {value!r}")
+    if isinstance(value, list):
         if len(value) > MAX_TIMES:
             raise ValueError(
                 f"{where} key 'times': at most {MAX_TIMES} output times, got {len(value)}"
             )
         return np.array([float(v) for v in value])
-    raise ValueError(
-        f"{where} key 'times': must be a list of seconds or a table {{start, stop, num}}"
-    )
+    check_keys(value, TIMES_KEYS, f"{where} key 'times'")
+    num = value.get("num", DEFAULT_NUM_TIMES)
+    if not 1 <= num <= MAX_TIMES:
+        raise ValueError(f"{where} key 'times': num must be >= 1 and <= {MAX_TIMES}, got {num}")
+    return output_times(float(value.get("start", 0.0)), float(value.get("stop", t_end)), num)
 
 
-def _load(spec: Any, n: int, where: str) -> NodalForce:
-    if not isinstance(spec, dict) or "type" not in spec:
-        raise ValueError(f"{where}: each load needs a 'type' (one of {', '.join(LOAD_FACTORIES)})")
+def _load(spec: dict[str, Any], n: int, where: str) -> NodalForce:
+    """A ``[[loads]]`` table (its types and required keys checked, ``check_types``) as the
+    force its law's factory (``LOAD_FACTORIES``) builds."""
     kind = spec["type"]
-    if not isinstance(kind, str) or kind not in LOAD_FACTORIES:
+    if kind not in LOAD_FACTORIES:
         raise ValueError(
             f"{where}: load type must be one of {', '.join(LOAD_FACTORIES)}, got {kind!r}"
         )
@@ -141,35 +110,7 @@ def _load(spec: Any, n: int, where: str) -> NodalForce:
             f"{where}: unexpected keyword {unknown[0]!r} for load {kind!r} "
             f"(allowed: {', '.join(allowed)})"
         )
-    if "node" not in args:
-        raise ValueError(f"{where}: load {kind!r} needs 'node' (1..n or \"last\")")
     return factory(**args)
-
-
-def latch_dict(latch: Latch) -> dict[str, Any]:
-    """A latch's scene-file table (``held`` only when true: other scenes' records unchanged)."""
-    d = dataclasses.asdict(latch)
-    if not d["held"]:
-        del d["held"]
-    return d
-
-
-def _table_items(
-    d: dict[str, Any], key: str, cls: type[_Item], keys: tuple[str, ...], where: str
-) -> list[_Item]:
-    """``[[latches]]`` / ``[[stops]]`` tables as Latch / Stop objects."""
-    items = d.get(key, [])
-    if not isinstance(items, list):
-        raise ValueError(f"key '{key}' must be an array of tables [[{key}]]")
-    out: list[_Item] = []
-    for i, spec in enumerate(items):
-        place = f"{where} [[{key}]] #{i + 1}"
-        check_keys(spec, set(keys), place)
-        try:
-            out.append(cls(**spec))
-        except ValueError as exc:
-            raise ValueError(f"{place}: {exc}") from None
-    return out
 
 
 def _missing(key: str, what: str) -> ValueError:
@@ -230,8 +171,6 @@ def _horizon(d: dict[str, Any], based_on: str | None) -> float:
     if "t_end" not in d and based_on is None:
         raise _missing("t_end", "horizon, s")
     t_end = d.get("t_end", PAPER_T_END)
-    if isinstance(t_end, bool) or not isinstance(t_end, (int, float)):
-        raise ValueError(f"key 't_end' (horizon) must be a number > 0 s, got {t_end!r}")
     return check_number(
         "t_end (horizon)", t_end, low=0, low_open=True, finite=True, allowed="finite and > 0 s"
     )
@@ -280,8 +219,6 @@ def _loads(d: dict[str, Any], n: int, based_on: str | None, where: str) -> tuple
     ``based_on``)."""
     if "loads" not in d:
         return (pulse(n),) if based_on == "paper" else ()
-    if not isinstance(d["loads"], list):
-        raise ValueError("key 'loads' must be an array of tables [[loads]]")
     return tuple(_load(s, n, f"{where} [[loads]] #{i + 1}") for i, s in enumerate(d["loads"]))
 
 
@@ -323,15 +260,11 @@ def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
         check_keys(init_spec, INITIAL_KEYS, f"{where} [initial]")
         init_spec = resolve_profiles(init_spec, n, f"{where} [initial]")
         outputs = d.get("outputs", DEFAULT_OUTPUTS)
-        if isinstance(outputs, str) or not isinstance(outputs, (list, tuple)):
-            raise ValueError(f"key 'outputs' must be a list from {QUANTITIES}, got {outputs!r}")
-        latches = tuple(_table_items(d, "latches", Latch, LATCH_KEYS, where))
-        stops = tuple(_table_items(d, "stops", Stop, STOP_KEYS, where))
+        items: dict[str, Any] = {t: kind.from_tables(d, where) for t, kind in HINGE_ITEMS.items()}
         return Scene(
             chain=chain,
             loads=loads,
-            latches=latches,
-            stops=stops,
+            **items,
             t_end=t_end,
             times=_times(d.get("times"), t_end, where),
             outputs=tuple(outputs),
@@ -486,8 +419,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "chain": chain,
         "loads": [{"type": f.name, "node": f.node, **f.params} for f in scene.loads],
         "initial": {k: v.tolist() for k, v in init.items()},
-        "latches": [latch_dict(latch) for latch in scene.latches],
-        "stops": [dataclasses.asdict(stop) for stop in scene.stops],
+        **{t: [item.as_dict() for item in getattr(scene, t)] for t in HINGE_ITEMS},
         # a free body only: a pinned scene's dict (and every record made of it) is unchanged
         **({"base": scene.base.as_dict()} if scene.base.moving else {}),
     }

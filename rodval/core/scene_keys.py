@@ -4,7 +4,8 @@ one-line ValueError naming the key by its dotted path before anything is built) 
 table of ``docs/scene_file.md`` (``doc_table``; ``python -m rodval.core.scene_keys
 --doc-table`` prints it, ``--write docs/scene_file.md`` puts it in place). The ranges are
 enforced by the objects the values build (``Chain``, ``Base``, ``Latch``, ...); this table
-states them.
+states them. A hinge item's keys are its own (``rodval.core.hinges.HINGE_ITEMS``: a
+``[[latches]]`` table's are ``Latch.KEYS``).
 
 Dotted paths into a scene document (``set_path``: a study grid's ``scene.chain.EI``, the
 command line's ``--set chain.EI=2e8``; in a list ``*`` is every element, an integer one), and
@@ -18,74 +19,27 @@ profiles, motion laws or ``times``) replaces the earlier one whole.
 from __future__ import annotations
 
 import argparse
-import numbers
 import re
 import sys
-from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-
-@dataclass(frozen=True)
-class Kind:
-    """A type of scene-file value: its words in messages and docs, and its test."""
-
-    words: str
-    accepts: Callable[[Any], bool]
-
-
-def _real(v: Any) -> bool:
-    return isinstance(v, numbers.Real) and not isinstance(v, bool)
-
-
-def _integer(v: Any) -> bool:
-    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
-
-
-def _reals(v: Any) -> bool:
-    return isinstance(v, list) and all(_real(x) for x in v)
-
-
-TABLE = Kind("a table", lambda v: isinstance(v, dict))
-TABLES = Kind("an array of tables", lambda v: isinstance(v, list))
-INTEGER = Kind("an integer", _integer)
-NUMBER = Kind("a number", _real)
-STRING = Kind("a string", lambda v: isinstance(v, str))
-BOOLEAN = Kind("true or false", lambda v: isinstance(v, bool))
-PAIR = Kind("a pair [x, y] of numbers", lambda v: _reals(v) and len(v) == 2)
-NUMBERS = Kind("a list of numbers", _reals)
-STRINGS = Kind(
-    "a list of strings", lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v)
+from rodval.core.hinges import HINGE_ITEMS
+from rodval.core.keys import (
+    INTEGER,
+    NODE,
+    NUMBER,
+    NUMBER_OR_NUMBERS,
+    NUMBERS,
+    PAIR,
+    ROD,
+    STRING,
+    STRINGS,
+    TABLE,
+    TABLES,
+    TIMES,
+    Key,
 )
-NUMBER_OR_NUMBERS = Kind("a number or a list of numbers", lambda v: _real(v) or _reals(v))
-ROD = Kind(
-    "a number, a list of n numbers or a profile table",
-    lambda v: _real(v) or _reals(v) or isinstance(v, dict),
-)
-TIMES = Kind(
-    "a list of numbers or a table {start, stop, num}", lambda v: _reals(v) or isinstance(v, dict)
-)
-NODE = Kind('an integer or "last"', lambda v: _integer(v) or v == "last")
-
-
-@dataclass(frozen=True)
-class Key:
-    """One key of a scene file: its type, unit and allowed values (words), and for a table
-    its keys (``keys``: checked when the value is a table; for an array of tables, each
-    element's). ``section``: a table that ``merge_documents`` merges key by key, unless the
-    later table names another ``variant`` (a key of the table and its default: [base]'s
-    ``kind``), which replaces the earlier table whole; ``required``: a key every table of its
-    array must hold; ``none``: the dict form (a run record) may hold None for "omitted"."""
-
-    kind: Kind
-    unit: str = ""
-    allowed: str = ""
-    keys: dict[str, Key] = field(default_factory=dict)
-    section: bool = False
-    required: bool = False
-    none: bool = False
-    variant: tuple[str, str] | None = None
 
 
 def _rod(unit: str, allowed: str) -> Key:
@@ -190,9 +144,9 @@ SCENE_KEYS: dict[str, Key] = {
         "",
         {
             "type": Key(
-                STRING, "", "`pulse`, `constant`, `ramp`, `harmonic`, `tabulated`; required"
+                STRING, "", "`pulse`, `constant`, `ramp`, `harmonic`, `tabulated`", required=True
             ),
-            "node": Key(NODE, "", '1..n, or `"last"`; required'),
+            "node": Key(NODE, "", '1..n, or `"last"`', required=True),
             "Xbar": Key(NUMBER, "N", "finite (pulse)"),
             "Ybar": Key(NUMBER, "N", "finite (pulse)"),
             "T": Key(NUMBER, "s", "> 0 (pulse)"),
@@ -207,30 +161,8 @@ SCENE_KEYS: dict[str, Key] = {
             "file": Key(STRING, "", "a CSV file with columns t, X and/or Y (tabulated)"),
         },
     ),
-    "latches": Key(
-        TABLES,
-        "",
-        "",
-        {
-            "hinge": Key(INTEGER, "", "0..n-1, one latch per hinge", required=True),
-            "angle": Key(NUMBER, "rad", "finite", required=True),
-            "direction": Key(INTEGER, "", "+1 or -1", none=True),
-            "window": Key(NUMBER, "s", "> 0, finite", none=True),
-            "held": Key(BOOLEAN),
-        },
-    ),
-    "stops": Key(
-        TABLES,
-        "",
-        "",
-        {
-            "hinge": Key(INTEGER, "", "0..n-1", required=True),
-            "angle": Key(NUMBER, "rad", "finite", required=True),
-            "side": Key(STRING, "", '`"upper"`, `"lower"`'),
-            "stiffness": Key(NUMBER, "N m/rad", "> 0, <= 1e12"),
-            "damping": Key(NUMBER, "N m s/rad", ">= 0, <= 1e12"),
-        },
-    ),
+    # each hinge item declares its keys (rodval.core.hinges.HINGE_ITEMS)
+    **{table: Key(TABLES, keys=item.KEYS) for table, item in HINGE_ITEMS.items()},
 }
 
 
