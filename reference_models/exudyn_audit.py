@@ -39,20 +39,25 @@ Cost: O(steps x n x elements) array operations, once after the run.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from reference_models.exudyn_beam import (
+    Array,
+    Nodes,
     beam_elements,
     body_attitude,
     cross2d,
-    hermite_interpolate,
     system_energies,
 )
 from reference_models.exudyn_observe import (
+    Observed,
     chord_angles,
     hinge_rates,
     recorded_hinge_angle,
     rod_ends,
+    states_at,
 )
 from rodval.core.loads import LoadSet
 from rodval.core.scene import Scene
@@ -60,7 +65,7 @@ from rodval.mechanics.lock_window import window_energies
 from rodval.solvers.audit import balance
 
 
-def step_powers(scene: Scene, E: int, t_rec: np.ndarray, records: dict) -> tuple[np.ndarray, ...]:
+def step_powers(scene: Scene, E: int, t_rec: Array, records: Nodes) -> tuple[Array, ...]:
     """(P_ext, P_diss) (W, (steps,)) at the recorded steps (see the module docstring)."""
     chain = scene.chain
     qv = {key: (q, v) for key, (q, v, _) in records.items()}
@@ -93,28 +98,27 @@ def step_powers(scene: Scene, E: int, t_rec: np.ndarray, records: dict) -> tuple
     return p_ext, p_diss
 
 
-def _cumulative(t: np.ndarray, p: np.ndarray) -> np.ndarray:
+def _cumulative(t: Array, p: Array) -> Array:
     """int_0^t p dt (J) at every recorded step by the trapezoidal rule."""
     return np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))])
 
 
-def energy_parts(scene: Scene, E: int, EA: float, times, t_rec, records) -> np.ndarray:
+def energy_parts(
+    scene: Scene, E: int, EA: float, times: Any, t_rec: Array, records: Nodes
+) -> Array:
     """(kinetic, hinge, rod strain) energy (J), (3, len(times)), at any times (s) inside the
     recorded steps (``system_energies`` on the node states interpolated there); the rod strain is
     the bending and the (small) axial strain energy."""
     times = np.asarray(times, float)
-    at = {
-        key: (hermite_interpolate(times, t_rec, q, v), hermite_interpolate(times, t_rec, v, a))
-        for key, (q, v, a) in records.items()
-    }
+    at = states_at(times, t_rec, records)
     phi, _, alpha, beta = chord_angles(scene, E, times, t_rec, records, at)
     kin, strain, hinge = system_energies(scene, E, EA, at, phi, alpha, beta)
     return np.array([kin, hinge, strain])
 
 
 def ledger(
-    scene: Scene, E: int, EA: float, t_rec, records, events: list[dict]
-) -> tuple[np.ndarray, np.ndarray]:
+    scene: Scene, E: int, EA: float, t_rec: Array, records: Nodes, events: list[dict[str, Any]]
+) -> tuple[Array, Array]:
     """W_ext and D (J) at the recorded steps; the lock records in ``events`` get their
     ``instant_energy_loss`` (0), hinge and bending energy before the lock and, for a window
     the recorded steps reach to its end, its energy accounts (module docstring)."""
@@ -141,13 +145,8 @@ def ledger(
 
 
 def audit_quantities(
-    times: np.ndarray,
-    energy: np.ndarray,
-    E0: float,
-    t_rec: np.ndarray,
-    W: np.ndarray,
-    D: np.ndarray,
-) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], float]:
+    times: Array, energy: Array, E0: float, t_rec: Array, W: Array, D: Array
+) -> tuple[Observed, float]:
     """ "work", "dissipated" and "energy_residual" at the output ``times`` (``energy``: E
     there, E0 (J) at t = 0; W, D at the recorded steps, interpolated linearly) and the
     numerical dissipation -R(t_end) (J)."""
@@ -163,7 +162,14 @@ def audit_quantities(
 
 
 def account(
-    scene: Scene, E: int, EA: float, times, t_rec, records, events: list[dict], observed: dict
+    scene: Scene,
+    E: int,
+    EA: float,
+    times: Array,
+    t_rec: Array,
+    records: Nodes,
+    events: list[dict[str, Any]],
+    observed: Observed,
 ) -> tuple[float | None, dict[str, float]]:
     """The audit of a run that reached ``times``: the lock records completed (``ledger``)
     and, where the scene asks for "energy", the audit quantities added to ``observed``;

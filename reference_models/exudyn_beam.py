@@ -6,10 +6,14 @@ as exudyn user functions, and the beam-field quadratures of energy and angular m
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterator, Mapping
+from typing import Any
 
 import numpy as np
 
-from rodval.core.scene import Scene, hinge_angles
+from rodval.core.hinges import Stop
+from rodval.core.loads import NodalForce
+from rodval.core.scene import Chain, Scene, hinge_angles
 
 #: 5-point Gauss-Legendre points on [-1, 1] and their weights, (5,) each (exact to degree 9).
 GAUSS_X, GAUSS_W = np.polynomial.legendre.leggauss(5)
@@ -17,9 +21,14 @@ GAUSS_X, GAUSS_W = np.polynomial.legendre.leggauss(5)
 #: The records' key of a free base's body node (its states [x_c, y_c, theta] (m, m, rad) and
 #: their rates), beside the beam nodes' (rod, local node) keys.
 BODY = (-1, -1)
+#: A numpy array (floats unless said otherwise).
+Array = np.ndarray
+#: Node arrays by node key ((rod, local node) or ``BODY``): recorded (q, v, a) (nt, 4) or, at
+#: given times, (state, rate).
+Nodes = Mapping[tuple[int, int], tuple[Array, ...]]
 
 
-def body_attitude(at: dict) -> tuple[np.ndarray | None, np.ndarray | None]:
+def body_attitude(at: Nodes) -> tuple[Array | None, Array | None]:
     """The free base's attitude theta (rad) and rate (rad/s), (nt,) each, from the node states
     ``at`` (None, None on a pinned base: no body record)."""
     if BODY not in at:
@@ -28,7 +37,7 @@ def body_attitude(at: dict) -> tuple[np.ndarray | None, np.ndarray | None]:
     return q[:, 2], v[:, 2]
 
 
-def positive(name: str, value, *, upper: float = math.inf, integer: bool = False):
+def positive(name: str, value: Any, *, upper: float = math.inf, integer: bool = False) -> Any:
     """``value`` as a float in (0, upper] (an int >= 1 if ``integer``); ValueError naming
     ``name`` otherwise (bools, non-numbers, non-finite values)."""
     ok_type = (
@@ -47,12 +56,12 @@ def positive(name: str, value, *, upper: float = math.inf, integer: bool = False
     return int(value) if integer else float(value)
 
 
-def wrap_angle(a: np.ndarray) -> np.ndarray:
+def wrap_angle(a: Array) -> Array:
     """Angle(s) wrapped to (-pi, pi]."""
-    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+    return np.asarray(np.pi - np.mod(np.pi - a, 2.0 * np.pi))
 
 
-def hermite_shapes(s: np.ndarray, le: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def hermite_shapes(s: Array, le: float) -> tuple[Array, Array, Array]:
     """Cubic Hermite shape functions of an element of length le at local s (m):
     values, first and second s-derivatives, each (len(s), 4) for [r0, r0', r1, r1']."""
     x = s / le
@@ -85,7 +94,7 @@ _ARC_PANELS = 8
 _ARC_X, _ARC_W = np.polynomial.legendre.leggauss(16)
 
 
-def _arc_rule(upper: float) -> tuple[np.ndarray, np.ndarray]:
+def _arc_rule(upper: float) -> tuple[Array, Array]:
     """Nodes and weights integrating over [0, upper] (composite Gauss, exact to round-off for
     the smooth integrands of ``_bent_rod``)."""
     edges = np.linspace(0.0, upper, _ARC_PANELS + 1)
@@ -94,7 +103,7 @@ def _arc_rule(upper: float) -> tuple[np.ndarray, np.ndarray]:
     return x, (half * _ARC_W).ravel()
 
 
-def _bent_rod(alpha: float, beta: float, l: float, elements: int):
+def _bent_rod(alpha: float, beta: float, l: float, elements: int) -> tuple[Array, ...]:
     """One rod bent into the assumed shape with end tangent angles alpha, beta (rad) to its
     chord and arc length exactly l, in its chord frame (x along the chord from the root).
 
@@ -112,13 +121,13 @@ def _bent_rod(alpha: float, beta: float, l: float, elements: int):
         )
     ta, tb = math.tan(alpha), math.tan(beta)
 
-    def g(xi):
-        return ta * (1 - xi) * (1 - 3 * xi) - tb * xi * (2 - 3 * xi)
+    def g(xi: Array) -> Array:
+        return np.asarray(ta * (1 - xi) * (1 - 3 * xi) - tb * xi * (2 - 3 * xi))
 
-    def gp(xi):  # dg/dta, dg/dtb
+    def gp(xi: Array) -> Array:  # dg/dta, dg/dtb
         return np.stack([(1 - xi) * (1 - 3 * xi), -xi * (2 - 3 * xi)])
 
-    def w(xi):
+    def w(xi: Array) -> Array:
         return np.sqrt(1.0 + g(xi) ** 2)
 
     x1, w1 = _arc_rule(1.0)
@@ -159,7 +168,7 @@ def _bent_rod(alpha: float, beta: float, l: float, elements: int):
     return p, t, dp, dt
 
 
-def initial_node_states(scene: Scene, elements: int):
+def initial_node_states(scene: Scene, elements: int) -> tuple[Array, ...]:
     """Reference coordinates (straight rods along the initial chords) and initial coordinate
     offsets and velocities of every beam node, per rod: arrays (n, elements+1, 4) with
     [x, y, slope_x, slope_y] (m, m, -, -) and their rates.
@@ -204,13 +213,14 @@ def revolutions(angle: float) -> float:
     return float(round(angle / (2.0 * math.pi)))
 
 
-def stop_law(side: str):
+def stop_law(side: str) -> Callable[..., float]:
     """springTorqueUserFunction of a one-sided limit stop (exudyn's sign: the returned torque
     is the spring's restoring torque, k (rotation - offset) for a plain spring): stiffness x
     penetration + damping x rate beyond the stop angle (``offset``), zero on the free side."""
     upper = side == "upper"
 
-    def law(mbs, t, item, rotation, omega, stiffness, damping, offset):
+    def law(mbs: Any, t: float, item: int, *spring: float) -> float:
+        rotation, omega, stiffness, damping, offset = spring
         pen = rotation - offset
         if (pen > 0.0) if upper else (pen < 0.0):
             return stiffness * pen + damping * omega
@@ -219,7 +229,7 @@ def stop_law(side: str):
     return law
 
 
-def stop_moment(stop, D, dD):
+def stop_moment(stop: Stop, D: Any, dD: Any) -> Array:
     """The moment (N m, same sign as a hinge spring's kappa (D - rest)) of a limit stop at
     hinge angle(s) D (rad) and rate(s) dD (rad/s): zero on the free side."""
     D = np.asarray(D, float)
@@ -227,16 +237,15 @@ def stop_moment(stop, D, dD):
     return np.where(inside, stop.stiffness * pen + stop.damping * np.asarray(dD, float), 0.0)
 
 
-def load_function(f, errors: list):
+def load_function(f: NodalForce, errors: list[Exception]) -> Callable[..., list[float]]:
     """exudyn load user function of a NodalForce: [X, Y, 0] (N) inside its support, zero
     (and not evaluated) outside; exceptions are recorded and re-raised."""
-    fx, fy = f.fx, f.fy
 
-    def user_function(mbs, t, load):
+    def user_function(mbs: Any, t: float, load: Any) -> list[float]:
         if not f.active(t):
             return [0.0, 0.0, 0.0]
         try:
-            return [fx(t) if fx is not None else 0.0, fy(t) if fy is not None else 0.0, 0.0]
+            return [*force_at(f, t), 0.0]
         except Exception as exc:
             errors.append(exc)
             raise
@@ -244,9 +253,13 @@ def load_function(f, errors: list):
     return user_function
 
 
-def hermite_interpolate(
-    times: np.ndarray, t_rec: np.ndarray, y: np.ndarray, dy: np.ndarray
-) -> np.ndarray:
+def force_at(f: NodalForce, t: float) -> tuple[float, float]:
+    """The components (X, Y) (N) of nodal force ``f`` at t (s), 0.0 for a component it has
+    none of (its support is not checked: ``f.active``)."""
+    return (f.fx(t) if f.fx is not None else 0.0, f.fy(t) if f.fy is not None else 0.0)
+
+
+def hermite_interpolate(times: Array, t_rec: Array, y: Array, dy: Array) -> Array:
     """Cubic Hermite interpolation of records y (nt, m) with derivatives dy at ``times``;
     exact at recorded times."""
     i = np.clip(np.searchsorted(t_rec, times, side="right") - 1, 0, max(t_rec.size - 2, 0))
@@ -256,10 +269,10 @@ def hermite_interpolate(
     th = ((times - t_rec[i])[:, None] / h).clip(0.0, 1.0)
     h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
     h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
-    return h00 * y[i] + h10 * h * dy[i] + h01 * y[i + 1] + h11 * h * dy[i + 1]
+    return np.asarray(h00 * y[i] + h10 * h * dy[i] + h01 * y[i + 1] + h11 * h * dy[i + 1])
 
 
-def beam_elements(chain, E: int, at: dict):
+def beam_elements(chain: Chain, E: int, at: Nodes) -> Iterator[tuple[Any, ...]]:
     """Per element j of every rod k, with the Gauss points of ``GAUSS_X`` on it: (k, weights
     (g,) (m), shape functions S, dS, ddS (g, 4), nodal positions/slopes Q and their rates V
     (nt, 4, 2)) from the node states ``at`` at the output times."""
@@ -276,8 +289,8 @@ def beam_elements(chain, E: int, at: dict):
 
 
 def system_energies(
-    scene: Scene, E: int, EA: float, at: dict, phi, alpha, beta
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    scene: Scene, E: int, EA: float, at: Nodes, phi: Array, alpha: Array, beta: Array
+) -> tuple[Array, Array, Array]:
     """Kinetic, rod strain and hinge energy (J) per output time: beam and point-mass kinetic
     (and a free base's body, m |v_c|^2 / 2 + J theta'^2 / 2, from ``at[BODY]``); the rods'
     bending (EI kappa^2/2) and axial (EA eps^2/2, EA of the run) strain; the hinge springs
@@ -311,15 +324,13 @@ def system_energies(
     return kin, pot, hinge
 
 
-def cross2d(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def cross2d(a: Array, b: Array) -> Array:
     """The planar cross product a_x b_y - a_y b_x of 2-vectors along the last axis: shape
     a.shape[:-1] (broadcast), units the product of a's and b's."""
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return np.asarray(a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0])
 
 
-def _momentum_parts(
-    scene: Scene, E: int, at: dict
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _momentum_parts(scene: Scene, E: int, at: Nodes) -> tuple[Array, Array, Array, Array]:
     """Per part of the system, about node 0 (the root, moving with a free base): the angular
     momenta h (nt, parts) (N m s), linear momenta p (nt, parts, 2) (N s), first mass moments
     (nt, parts, 2) (kg m) and masses (parts,) (kg). The parts are each rod's beam field with
@@ -355,7 +366,7 @@ def _momentum_parts(
     return h, p, first, mass
 
 
-def system_momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
+def system_momenta(scene: Scene, E: int, at: Nodes) -> tuple[Array, Array]:
     """The ``angular_momentum`` rows (nt, 2) (N m s, counter-clockwise positive) and the
     ``momentum`` rows P (nt, 2) (N s) of the whole system (see rodval.core.scene.QUANTITIES),
     summed over ``_momentum_parts``: k = 0 about node 0, H_0 = sum int (r - r_0) x r_t dm;
@@ -366,7 +377,7 @@ def system_momenta(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarr
     return np.stack([H0, H0 - cross2d(S, P) / mass.sum()], -1), P
 
 
-def momentum_audit_rows(scene: Scene, E: int, at: dict) -> tuple[np.ndarray, np.ndarray]:
+def momentum_audit_rows(scene: Scene, E: int, at: Nodes) -> tuple[Array, Array]:
     """(H, G) (N m s, (nt,)) for the angular-momentum audit (``rodval.core.validity``,
     ``momentum_balance``), the same parts as the native models' (each rod with its far node,
     the body): about the system's centre of mass on a free base, about node 0 on a pinned

@@ -1,6 +1,6 @@
 """Building the exudyn beam model of a scene: nodes, ANCF cable elements, a free or prescribed
 base's rigid body, hinges (joints, spring-dampers, stops, latch joints), point masses, loads and sensors
-(``build``)."""
+(``build``), and a run's records read back from the sensors (``read_records``)."""
 
 from __future__ import annotations
 
@@ -8,13 +8,18 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from reference_models.exudyn_beam import (
     BODY,
+    Array,
+    Nodes,
     initial_node_states,
     load_function,
     revolutions,
     stop_law,
 )
+from rodval.core.hinges import Stop
 from rodval.core.scene import Scene
 from rodval.core.validity import momentum_point
 
@@ -26,17 +31,17 @@ class BuiltSystem:
     SC: Any
     mbs: Any
     #: (rod, local node) -> sensors (q, v, a); a free base's body node under ``BODY``
-    node_sensors: dict[tuple[int, int], tuple[int, int, int]]
-    load_errors: list
-    nodes: list  # beam node numbers per rod
-    initial: tuple  # initial_node_states: ref, offsets, velocities
-    latch_joints: dict  # hinge -> exudyn object number of its locking joint
+    node_sensors: dict[tuple[int, int], tuple[int, ...]]
+    load_errors: list[Exception]
+    nodes: list[list[int]]  # beam node numbers per rod
+    initial: tuple[Array, ...]  # initial_node_states: ref, offsets, velocities
+    latch_joints: dict[int, int]  # hinge -> exudyn object number of its locking joint
     body: int | None = None  # a moving base's NodeRigidBody2D (None: pinned to the ground)
     #: a prescribed base's CoordinateConstraints (x, y, theta), () otherwise
-    drives: tuple = ()
+    drives: tuple[int, ...] = ()
 
 
-def _items():
+def _items() -> Any:
     """exudyn's item classes (exudyn is optional: imported on first use)."""
     from exudyn import itemInterface
 
@@ -70,7 +75,7 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     for k in range(chain.n):
         if chain.mu[k] > 0:
             mbs.AddObject(it.ObjectMassPoint2D(nodeNumber=nodes[k][-1], mass=float(chain.mu[k])))
-    load_errors: list = []
+    load_errors: list[Exception] = []
     for f in scene.loads:
         marker = mbs.AddMarker(it.MarkerNodePosition(nodeNumber=nodes[f.node - 1][-1]))
         mbs.AddLoad(
@@ -115,7 +120,7 @@ def body_start(scene: Scene) -> tuple[list[float], list[float], float, float]:
     )
 
 
-def _add_body(mbs, scene: Scene, ground: int) -> tuple[int | None, int]:
+def _add_body(mbs: Any, scene: Scene, ground: int) -> tuple[int | None, int]:
     """A moving base's rigid body: (its NodeRigidBody2D, its ObjectRigidBody2D), the node's
     coordinates [x_c, y_c, theta] (m, m, rad) referenced at the initial position and attitude
     and moving with the initial velocity and rate (``body_start``); (None, ground) on a pinned
@@ -129,7 +134,7 @@ def _add_body(mbs, scene: Scene, ground: int) -> tuple[int | None, int]:
     return node, body
 
 
-def _add_drives(mbs, scene: Scene, node: int | None) -> tuple:
+def _add_drives(mbs: Any, scene: Scene, node: int | None) -> tuple[int, ...]:
     """A prescribed base's three CoordinateConstraints (x_c, y_c, theta), () otherwise: each
     between a ground coordinate marker (marker 0) and the body node's coordinate (marker 1),
     which exudyn holds at q_1 - q_0 = offset, q_1 the node's displacement from its reference
@@ -148,10 +153,12 @@ def _add_drives(mbs, scene: Scene, node: int | None) -> tuple:
     for axis in range(3):
         coord = mbs.AddMarker(it.MarkerNodeCoordinate(nodeNumber=node, coordinate=axis))
 
-        def offset(mbs, t, itemNumber, lOffset, axis=axis):
+        def offset(mbs: Any, t: float, itemNumber: int, lOffset: float, axis: int = axis) -> float:
             return float(motion_at(table, t)[axis, 0] - start[axis])
 
-        def offset_t(mbs, t, itemNumber, lOffset, axis=axis):
+        def offset_t(
+            mbs: Any, t: float, itemNumber: int, lOffset: float, axis: int = axis
+        ) -> float:
             return float(motion_at(table, t)[axis, 1])
 
         drives.append(
@@ -167,7 +174,9 @@ def _add_drives(mbs, scene: Scene, node: int | None) -> tuple:
     return tuple(drives)
 
 
-def _add_rods(mbs, scene: Scene, E: int, EA: float, initial) -> tuple[list, list]:
+def _add_rods(
+    mbs: Any, scene: Scene, E: int, EA: float, initial: tuple[Array, ...]
+) -> tuple[list[list[int]], list[list[int]]]:
     """Each rod's E + 1 slope nodes at their initial states and its E cable elements."""
     it = _items()
     chain = scene.chain
@@ -206,7 +215,9 @@ def _add_rods(mbs, scene: Scene, E: int, EA: float, initial) -> tuple[list, list
     return nodes, elems
 
 
-def _add_hinges(mbs, scene: Scene, E: int, root_body: int, nodes, elems) -> dict[int, int]:
+def _add_hinges(
+    mbs: Any, scene: Scene, E: int, root_body: int, nodes: list[list[int]], elems: list[list[int]]
+) -> dict[int, int]:
     """Hinge k's joint, spring-damper, stops and latch joint; returns hinge -> latch joint.
     Hinge 0 joins ``root_body`` (the ground, or a free base's body at its hinge offset, the
     angle measured from the body frame; a free or prescribed base) to rod 1. A held latch's
@@ -217,7 +228,7 @@ def _add_hinges(mbs, scene: Scene, E: int, root_body: int, nodes, elems) -> dict
     tangent_left = ini["phi"] + ini["alpha"]
     tangent_right = ini["phi"] + ini["beta"]
     latch_of = {latch.hinge: latch for latch in scene.latches}
-    stops_of: dict[int, list] = {}
+    stops_of: dict[int, list[Stop]] = {}
     for stop in scene.stops:
         stops_of.setdefault(stop.hinge, []).append(stop)
     latch_joints: dict[int, int] = {}
@@ -242,7 +253,9 @@ def _add_hinges(mbs, scene: Scene, E: int, root_body: int, nodes, elems) -> dict
         pos1 = mbs.AddMarker(it.MarkerNodePosition(nodeNumber=nodes[k][0]))
         mbs.AddObject(it.ObjectJointRevolute2D(markerNumbers=[pos0, pos1]))
         rot1 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=elems[k][0], localPosition=[0, 0, 0]))
-        springs = [(float(chain.kappa[k]), float(chain.nu[k]), float(chain.rest_angle[k]), 0)]
+        springs: list[tuple[float, float, float, Any]] = [
+            (float(chain.kappa[k]), float(chain.nu[k]), float(chain.rest_angle[k]), 0)
+        ]
         springs += [
             (stop.stiffness, stop.damping, stop.angle, stop_law(stop.side))
             for stop in stops_of.get(k, [])
@@ -254,7 +267,12 @@ def _add_hinges(mbs, scene: Scene, E: int, root_body: int, nodes, elems) -> dict
     return latch_joints
 
 
-def _add_springs(mbs, markers: tuple[int, int], angle0: float, springs: list) -> None:
+def _add_springs(
+    mbs: Any,
+    markers: tuple[int, int],
+    angle0: float,
+    springs: list[tuple[float, float, float, Any]],
+) -> None:
     """Torsional spring-dampers (stiffness N m/rad, damping N m s/rad, offset rad, user law)
     between the two rotation markers, each with its revolution counter from angle0 (rad)."""
     it = _items()
@@ -276,12 +294,12 @@ def _add_springs(mbs, markers: tuple[int, int], angle0: float, springs: list) ->
         )
 
 
-def _add_latch_joint(mbs, markers: tuple[int, int], angle: float, held: bool = False) -> int:
+def _add_latch_joint(mbs: Any, markers: tuple[int, int], angle: float, held: bool = False) -> int:
     """The rotation lock of a latch at ``angle`` (rad), inactive until its event (active from
     the start if ``held``): joint frame 1 = marker 1 turned back by the latch angle, so the
     locked relative rotation is D_k = angle (locally unique)."""
     c, sn = math.cos(-angle), math.sin(-angle)
-    return mbs.AddObject(
+    joint: int = mbs.AddObject(
         _items().ObjectJointGeneric(
             markerNumbers=list(markers),
             constrainedAxes=[0, 0, 0, 0, 0, 1],
@@ -289,6 +307,7 @@ def _add_latch_joint(mbs, markers: tuple[int, int], angle: float, held: bool = F
             activeConnector=bool(held),
         )
     )
+    return joint
 
 
 #: Sensors per recorded node (coordinates, velocities, accelerations) and the doubles each
@@ -319,7 +338,9 @@ def recorded_doubles(scene: Scene, E: int) -> int:
     return SENSORS_PER_NODE * (beam + body)
 
 
-def _add_sensors(mbs, scene: Scene, E: int, nodes, body_node: int | None = None) -> dict:
+def _add_sensors(
+    mbs: Any, scene: Scene, E: int, nodes: list[list[int]], body_node: int | None = None
+) -> dict[tuple[int, int], tuple[int, ...]]:
     """Sensors (coordinates, velocities, accelerations, stored internally) on the beam nodes
     the outputs need (``sensor_nodes``), (rod, node) -> three sensor numbers, and on a moving
     base's body node (``BODY`` -> its three: hinge 0 is measured from it)."""
@@ -343,3 +364,30 @@ def _add_sensors(mbs, scene: Scene, E: int, nodes, body_node: int | None = None)
         )
         for key in sorted(node_of)
     }
+
+
+def read_records(built: BuiltSystem) -> tuple[Array, Nodes, bool]:
+    """A run's records from the sensors of ``built``: the recorded times (s); per (rod, local
+    node) (and ``BODY``) the arrays q, v, a (nt, 4) up to the first non-finite record; whether
+    a non-finite record was cut off."""
+    mbs = built.mbs
+    data = {
+        key: tuple(mbs.GetSensorStoredData(s) for s in ids)
+        for key, ids in built.node_sensors.items()
+    }
+    first = next(iter(data.values()))[0]
+    if first.ndim != 2 or first.shape[0] == 0:
+        return np.empty(0), {}, False
+    t = first[:, 0]
+    # keep one record per time (the solver may write the last step twice)
+    keep = np.concatenate([np.diff(t) > 0, [True]])
+    finite = np.ones(keep.sum(), bool)
+    out: dict[tuple[int, int], tuple[Array, ...]] = {}
+    for key, arrs in data.items():
+        q, v, a = (arr[keep, 1:] for arr in arrs)
+        finite &= np.isfinite(q).all(1) & np.isfinite(v).all(1) & np.isfinite(a).all(1)
+        out[key] = (q, v, a)
+    bad = np.flatnonzero(~finite)
+    end = bad[0] if bad.size else finite.size
+    t = t[keep][:end]
+    return t, {key: tuple(x[:end] for x in arrs) for key, arrs in out.items()}, bool(bad.size)

@@ -59,15 +59,16 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
 
 from reference_models import exudyn_step
 from reference_models.exudyn_audit import account
-from reference_models.exudyn_beam import positive
+from reference_models.exudyn_beam import Array, Nodes, positive
 from reference_models.exudyn_budget import RunBudget, check_plan, refinement_refusal
-from reference_models.exudyn_build import BuiltSystem, build, recorded_doubles
+from reference_models.exudyn_build import BuiltSystem, build, read_records, recorded_doubles
 from reference_models.exudyn_ending import (
     ended,
     lock_records,
@@ -75,8 +76,10 @@ from reference_models.exudyn_ending import (
     solver_message,
     unaudited_drive,
 )
+from reference_models.exudyn_guard import Guard
 from reference_models.exudyn_latches import Latches
 from reference_models.exudyn_observe import (
+    Observed,
     body_view,
     momentum_audit,
     observe,
@@ -182,31 +185,22 @@ class ExudynModel(Model):
     #: exudyn integrates with its own options: rodval's integrator settings do not apply.
     USES_INTEGRATOR_SETTINGS = False
 
-    def __init__(
-        self,
-        *,
-        elements: int = DEFAULTS["elements"],
-        step: float | str = DEFAULTS["step"],
-        EA: float = DEFAULTS["EA"],
-        element: str = DEFAULTS["element"],
-        solver: str = DEFAULTS["solver"],
-        spectral_radius: float | str = DEFAULTS["spectral_radius"],
-        newton_rtol: float = DEFAULTS["newton_rtol"],
-        newton_atol_per_EA: float = DEFAULTS["newton_atol_per_EA"],
-        max_rotation_per_step: float = DEFAULTS["max_rotation_per_step"],
-        **unknown,
-    ):
+    def __init__(self, **options: Any) -> None:
+        """The model with ``options`` (keywords of ``DEFAULTS``, the rest at their defaults)."""
+        unknown = sorted(set(options) - set(DEFAULTS))
         if unknown:
             raise ValueError(_unknown_options_message(unknown))
-        self.elements = positive("elements", elements, integer=True)
-        self.step: float | str = check_step(step)
-        self.EA = positive("EA", EA, upper=1e14)
+        o = {**DEFAULTS, **options}
+        self.elements: int = positive("elements", o["elements"], integer=True)
+        self.step: float | str = check_step(o["step"])
+        self.EA: float = positive("EA", o["EA"], upper=1e14)
+        element, solver, spectral_radius = o["element"], o["solver"], o["spectral_radius"]
         if element not in ELEMENTS:
             raise ValueError(f"element must be one of {ELEMENTS}, got {element!r}")
-        self.element = element
+        self.element: str = element
         if solver not in SOLVERS:
             raise ValueError(f"solver must be one of {SOLVERS}, got {solver!r}")
-        self.solver = solver
+        self.solver: str = solver
         if spectral_radius != "auto" and (
             isinstance(spectral_radius, bool)
             or not isinstance(spectral_radius, (int, float))
@@ -218,10 +212,12 @@ class ExudynModel(Model):
         self.spectral_radius: float | str = (
             "auto" if spectral_radius == "auto" else float(spectral_radius)
         )
-        self.newton_rtol = positive("newton_rtol", newton_rtol, upper=1e-2)
-        self.newton_atol_per_EA = positive("newton_atol_per_EA", newton_atol_per_EA, upper=1e-6)
-        self.max_rotation_per_step = positive(
-            "max_rotation_per_step", max_rotation_per_step, upper=math.pi
+        self.newton_rtol: float = positive("newton_rtol", o["newton_rtol"], upper=1e-2)
+        self.newton_atol_per_EA: float = positive(
+            "newton_atol_per_EA", o["newton_atol_per_EA"], upper=1e-6
+        )
+        self.max_rotation_per_step: float = positive(
+            "max_rotation_per_step", o["max_rotation_per_step"], upper=math.pi
         )
 
     def check_base(self, scene: Scene) -> None:
@@ -263,7 +259,7 @@ class ExudynModel(Model):
         """The beam model of ``scene`` with this model's discretization (``build``)."""
         return build(scene, self.elements, self.EA)
 
-    def _settings(self, scene: Scene):
+    def _settings(self, scene: Scene) -> Any:
         """exudyn's simulation settings of a run of ``scene`` (``simulation_settings``) at the
         fixed step (a float: ``_run_at``)."""
         return simulation_settings(
@@ -440,7 +436,7 @@ class ExudynModel(Model):
             max_rotation_per_step_seen=guard.max_rotation_seen,
         )
         try:
-            t_rec, records, diverged = self._records(built)
+            t_rec, records, diverged = read_records(built)
         except Exception as exc:  # noqa: BLE001
             update_status(stats, STATUS_ERROR, f"reading sensors failed: {exc}")
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
@@ -450,23 +446,9 @@ class ExudynModel(Model):
         stops = stop_events(scene, self.elements, reached, records, lock_steps)
         events = sorted(events + stops, key=lambda ev: ev["t"])
         try:
-            observed = (
-                observe(scene, self.elements, self.EA, times, t_rec, records, lock_steps)
-                if times.size
-                else {}
+            observed, audit = self._observe(
+                scene, (times, reached, t_rec, records), lock_steps, events, stats
             )
-            stats.peaks = recorded_peaks(
-                scene, self.elements, self.EA, reached, t_rec, records, lock_steps
-            )
-            stats.energy_residual, audit = account(
-                body_view(scene), self.elements, self.EA, times, t_rec, records, events, observed
-            )
-            if scene.base.prescribed:
-                stats.energy_residual, audit = unaudited_drive(observed, events)
-            if times.size and momentum_point(scene) is not None:
-                stats.momentum_residual = momentum_residual(
-                    *momentum_audit(scene, self.elements, times[-1], t_rec, records)
-                )
         except Exception as exc:  # noqa: BLE001
             message = f"observation failed: {type(exc).__name__}: {exc}"
             update_status(stats, STATUS_ERROR, message)
@@ -474,7 +456,41 @@ class ExudynModel(Model):
         run_info.update(audit)
         return self._trajectory(scene, times, observed, stats, run_info, events)
 
-    def _solve(self, scene: Scene, built: BuiltSystem, sim, checks: tuple, stats) -> None:
+    def _observe(
+        self,
+        scene: Scene,
+        recorded: tuple[Array, Array, Array, Nodes],
+        lock_steps: dict[int, float],
+        events: list[dict[str, Any]],
+        stats: SolverStats,
+    ) -> tuple[Observed, dict[str, float]]:
+        """The outputs at the kept output times and the audit's settings entry of a run,
+        ``recorded`` = (the kept output times, the recorded times reached, all recorded times,
+        the node records); its peaks and energy and momentum residuals into ``stats``, the
+        lock records in ``events`` completed (``account``)."""
+        times, reached, t_rec, records = recorded
+        E, EA = self.elements, self.EA
+        observed = observe(scene, E, EA, times, t_rec, records, lock_steps) if times.size else {}
+        stats.peaks = recorded_peaks(scene, E, EA, reached, t_rec, records, lock_steps)
+        stats.energy_residual, audit = account(
+            body_view(scene), E, EA, times, t_rec, records, events, observed
+        )
+        if scene.base.prescribed:
+            stats.energy_residual, audit = unaudited_drive(observed, events)
+        if times.size and momentum_point(scene) is not None:
+            stats.momentum_residual = momentum_residual(
+                *momentum_audit(scene, E, times[-1], t_rec, records)
+            )
+        return observed, audit
+
+    def _solve(
+        self,
+        scene: Scene,
+        built: BuiltSystem,
+        sim: Any,
+        checks: tuple[Guard, Latches | None, RunBudget],
+        stats: SolverStats,
+    ) -> None:
         """exudyn's implicit solver over the scene, ``checks`` = (guard, latches or None,
         budget) in its pre-step function; the outcome and counters into ``stats`` (the guard
         keeps its verdict, the budget its stop)."""
@@ -485,7 +501,7 @@ class ExudynModel(Model):
         guard.solver = solver
         jac_on_switch = not sim.timeIntegration.newton.modifiedNewtonJacUpdatePerStep
 
-        def pre_step(mbs, t):
+        def pre_step(mbs: Any, t: float) -> bool:
             go = guard.pre_step(mbs, t)
             if latches is not None and go:
                 try:
@@ -545,32 +561,15 @@ class ExudynModel(Model):
         the step (docs/deployment.md, "Where the lock energy goes")."""
         return "a smaller step (exudyn option step; its numerical dissipation falls with it)"
 
-    def _records(self, built: BuiltSystem):
-        """Recorded times (s); per (rod, local node), arrays q, v, a (nt, 4) up to the first
-        non-finite record; whether a non-finite record was cut off."""
-        mbs = built.mbs
-        data = {
-            key: tuple(mbs.GetSensorStoredData(s) for s in ids)
-            for key, ids in built.node_sensors.items()
-        }
-        first = next(iter(data.values()))[0]
-        if first.ndim != 2 or first.shape[0] == 0:
-            return np.empty(0), {}, False
-        t = first[:, 0]
-        # keep one record per time (the solver may write the last step twice)
-        keep = np.concatenate([np.diff(t) > 0, [True]])
-        finite = np.ones(keep.sum(), bool)
-        out = {}
-        for key, arrs in data.items():
-            q, v, a = (arr[keep, 1:] for arr in arrs)
-            finite &= np.isfinite(q).all(1) & np.isfinite(v).all(1) & np.isfinite(a).all(1)
-            out[key] = (q, v, a)
-        bad = np.flatnonzero(~finite)
-        end = bad[0] if bad.size else finite.size
-        t = t[keep][:end]
-        return t, {key: tuple(x[:end] for x in arrs) for key, arrs in out.items()}, bool(bad.size)
-
-    def _trajectory(self, scene, times, observed, stats, run_info=None, events=()) -> Trajectory:
+    def _trajectory(
+        self,
+        scene: Scene,
+        times: Array,
+        observed: Observed,
+        stats: SolverStats,
+        run_info: dict[str, Any] | None = None,
+        events: Iterable[dict[str, Any]] = (),
+    ) -> Trajectory:
         """``settings``: the integrator, every option, and what the run used (``run_info``:
         steps_planned, step_used (s, the fixed step), steps (taken), min_step_used (s, smaller
         than step_used only if Newton failures halved it), max_rotation_per_step_seen (rad),
@@ -592,8 +591,8 @@ class ExudynModel(Model):
         )
 
 
-def _unknown_options_message(unknown: dict) -> str:
-    names = ", ".join(repr(k) for k in sorted(unknown))
+def _unknown_options_message(unknown: list[str]) -> str:
+    names = ", ".join(repr(k) for k in unknown)
     return (
         f"unknown exudyn model option(s) {names}; allowed options: {', '.join(DEFAULTS)} "
         f"(defaults {DEFAULTS})"

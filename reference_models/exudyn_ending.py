@@ -3,13 +3,16 @@ records, and a prescribed base's unaudited drive (``exudyn_chain.ExudynModel._ru
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
+from reference_models.exudyn_beam import Array
 from reference_models.exudyn_budget import RunBudget
 from reference_models.exudyn_build import BuiltSystem
 from reference_models.exudyn_guard import Guard
 from reference_models.exudyn_latches import Latches
-from reference_models.exudyn_observe import body_view
+from reference_models.exudyn_observe import Observed, body_view
 from rodval.core.scene import Scene
 from rodval.core.status import STATUS_DIVERGED, STATUS_FAILED, update_status
 from rodval.core.trajectory import SolverStats
@@ -20,7 +23,9 @@ DRIVE_UNAUDITED = ("work", "dissipated", "energy_residual")
 DRIVE_WINDOW_KEYS = ("work_window_end", "dissipated_window_end", "energy_residual_window_end")
 
 
-def run_guard(built: BuiltSystem, scene: Scene, E: int, EA: float, factor: float, rotation: float):
+def run_guard(
+    built: BuiltSystem, scene: Scene, E: int, EA: float, factor: float, rotation: float
+) -> Guard:
     """The run's ``Guard``. On a prescribed base it sees the massless body (``body_view``:
     the lock records' kinetic energies are the chain's, as the native models') and checks no
     energy budget: its drive's work, which the budget would need, is not measured (the
@@ -30,7 +35,9 @@ def run_guard(built: BuiltSystem, scene: Scene, E: int, EA: float, factor: float
     )
 
 
-def unaudited_drive(observed: dict, events: list[dict]) -> tuple[None, dict]:
+def unaudited_drive(
+    observed: Observed, events: list[dict[str, Any]]
+) -> tuple[None, dict[str, float]]:
     """A prescribed base's run is not audited for energy: its drive's power (the imposed
     coordinates' constraint forces on the chain) is not measured, so the balance's work would
     miss it. The audit's quantities are dropped from ``observed``, and the lock windows' work,
@@ -45,8 +52,8 @@ def unaudited_drive(observed: dict, events: list[dict]) -> tuple[None, dict]:
 
 
 def ended(
-    scene: Scene, stats: SolverStats, checks: tuple[Guard, RunBudget], t_rec, diverged: bool
-) -> np.ndarray:
+    scene: Scene, stats: SolverStats, checks: tuple[Guard, RunBudget], t_rec: Array, diverged: bool
+) -> Array:
     """How the run ended (status, message, time reached into ``stats``, each ending through
     ``update_status``'s precedence: the guard's verdict, which stopped the solver and says
     why; a state cut off as non-finite; the budget's stop (``checks`` = (guard, budget)) of
@@ -65,7 +72,7 @@ def ended(
     if short:
         stopped = budget.outcome(stats.t_reached)
         update_status(stats, *(stopped or (STATUS_FAILED, "solver stopped before t_end")))
-    times = np.asarray(scene.times)
+    times: Array = np.asarray(scene.times)
     tol = 1e-9 * max(1.0, scene.t_end)
     if not t_rec.size:
         return t_rec
@@ -74,7 +81,7 @@ def ended(
     return times[times < stats.t_reached - tol]  # the state at the detection time is bad
 
 
-def lock_records(latches: Latches | None) -> tuple[list[dict], dict[int, float]]:
+def lock_records(latches: Latches | None) -> tuple[list[dict[str, Any]], dict[int, float]]:
     """The lock events in time order and hinge -> lock time (s), pending locks closed."""
     if latches is None:
         return [], {}
@@ -86,7 +93,7 @@ def lock_records(latches: Latches | None) -> tuple[list[dict], dict[int, float]]
     return events, dict(latches.lock_times.items())
 
 
-def solver_message(solver, default: str) -> str:
+def solver_message(solver: Any, default: str) -> str:
     """exudyn's error string of a failed solve, ``default`` when it gives none."""
     try:
         msg = solver.GetErrorString()

@@ -9,7 +9,15 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from reference_models.exudyn_beam import BODY, GAUSS_W, GAUSS_X, hermite_shapes, system_energies
+from reference_models.exudyn_beam import (
+    BODY,
+    GAUSS_W,
+    GAUSS_X,
+    Array,
+    force_at,
+    hermite_shapes,
+    system_energies,
+)
 from reference_models.exudyn_build import BuiltSystem
 from rodval.core.scene import Scene
 from rodval.core.status import (
@@ -21,8 +29,10 @@ from rodval.core.status import (
 from rodval.solvers.guard import GuardSpec, Monitor, diverged_message
 
 
-@njit(cache=True, error_model="numpy")
-def _state_kernel(q, v, M, end, root, d_ref):  # pragma: no cover - compiled
+@njit(cache=True, error_model="numpy")  # pragma: no cover - compiled
+def _state_kernel(
+    q: Array, v: Array, M: Array, end: Array, root: Array, d_ref: Array
+) -> tuple[bool, float, float, int]:
     """One pass over the state (issue 39: one compiled call a step instead of ~20 numpy
     calls): whether q and v are finite (q.q + v.v), the kinetic energy v^T M v / 2, and the
     largest chord rate |d x d'| / |d|^2 (rad/s, NaN if any is) with its rod (0-based); the
@@ -79,14 +89,15 @@ class Guard:
         factor: float,
         max_rotation: float,
         checks_energy: bool = True,
-    ):
+    ) -> None:
         mbs, chain = built.mbs, scene.chain
         ref, q0, v0 = built.initial
         self.mbs = mbs
         self.solver: Any = None  # exudyn's solver, set by the run
         self.max_rotation = float(max_rotation)
         size = mbs.systemData.ODE2Size()
-        ltg = [
+        #: each rod's beam nodes' ODE2 indices (rod, node 0..E, [x, y, slope x, slope y])
+        self.ltg = ltg = [
             [np.asarray(mbs.systemData.GetNodeLTGODE2(nd), int) for nd in rod]
             for rod in built.nodes
         ]
@@ -108,20 +119,13 @@ class Guard:
             if chain.mu[k] > 0:
                 tip = ltg[k][E][:2]
                 self.M[tip, tip] += chain.mu[k]
-        # chord vectors d = A q + d_ref (rows: x, y of rod 1, 2, ...)
-        self.A = np.zeros((2 * chain.n, size))
-        for k in range(chain.n):
-            for c in range(2):
-                self.A[2 * k + c, ltg[k][E][c]] += 1.0
-                self.A[2 * k + c, ltg[k][0][c]] -= 1.0
-        self.d_ref = self.A @ self.ref
-        # the same chords by gathers (cheaper per step than the product with A): rows x, y
+        # chord vectors d = q[end] - q[root] + d_ref (rows: x, y; a column per rod)
         self._end = np.array([[ltg[k][E][c] for k in range(chain.n)] for c in range(2)], int)
         self._root = np.array([[ltg[k][0][c] for k in range(chain.n)] for c in range(2)], int)
-        self._d_ref = self.d_ref.reshape(chain.n, 2).T.copy()
+        self._d_ref = self.ref[self._end] - self.ref[self._root]
         self.loads = [(f, ltg[f.node - 1][E][:2]) for f in scene.loads]
         ini = scene.initial.resolve(chain.n)
-        at0 = {
+        at0: dict[tuple[int, int], tuple[Array, ...]] = {
             (k, j): ((ref + q0)[k, j][None], v0[k, j][None])
             for k in range(chain.n)
             for j in range(E + 1)
@@ -135,12 +139,12 @@ class Guard:
         self.energy = Monitor(self.spec)
         #: False where the work done on the chain is not measured (a prescribed base's drive)
         self._checks_energy = self.spec.checks_energy and checks_energy
-        self.verdict: tuple | None = None
+        self.verdict: tuple[Any, ...] | None = None
         self.min_step, self.max_rotation_seen = math.inf, 0.0
         self.h = 0.0  # the coming step (s), set by pre_step
-        self.state: tuple | None = None  # (q - reference, v) of the last check
+        self.state: tuple[Array, Array] | None = None  # (q - ref, v) of the last check
 
-    def _add_body(self, scene: Scene, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _add_body(self, scene: Scene, idx: Array) -> tuple[Array, Array]:
         """A free base's body node (coordinates ``idx``): its reference [x_c, y_c, theta] into
         ``ref`` and its mass diag(m, m, J) into ``M``; returns its initial state and rates
         (1, 3) each."""
@@ -151,16 +155,15 @@ class Guard:
         self.M[idx, idx] += np.array([mass, mass, inertia])
         return state, np.array([[b.velocity[0], b.velocity[1], b.rate]])
 
-    def _power(self, t: float, v: np.ndarray) -> float:
+    def _power(self, t: float, v: Array) -> float:
         p = 0.0
         for f, idx in self.loads:
             if f.active(t):
-                fx = f.fx(t) if f.fx is not None else 0.0
-                fy = f.fy(t) if f.fy is not None else 0.0
+                fx, fy = force_at(f, t)
                 p += fx * v[idx[0]] + fy * v[idx[1]]
         return p
 
-    def pre_step(self, mbs, t: float) -> bool:
+    def pre_step(self, mbs: Any, t: float) -> bool:
         h = float(self.solver.it.currentStepSize) if self.solver is not None else 0.0
         self.h = h
         if h > 0:

@@ -4,13 +4,24 @@ function when a hinge angle crosses its latch angle, and the lock records (``Lat
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
 
-from reference_models.exudyn_beam import GAUSS_W, GAUSS_X, hermite_shapes, stop_moment, wrap_angle
+from reference_models.exudyn_beam import (
+    GAUSS_W,
+    GAUSS_X,
+    Array,
+    force_at,
+    hermite_shapes,
+    stop_moment,
+    wrap_angle,
+)
 from reference_models.exudyn_build import BuiltSystem
 from reference_models.exudyn_guard import Guard
+from rodval.core.hinges import Stop
+from rodval.core.loads import NodalForce
 from rodval.core.scene import Chain, Scene
 from rodval.mechanics.lock_window import lock_window
 from rodval.mechanics.rigid import rigid_lock
@@ -55,19 +66,18 @@ class Latches:
     window [t_lock, t_lock + w] (``rodval.mechanics.lock_window``, the same window and measure as
     the native models'), by the trapezoid rule on the steps."""
 
-    def __init__(self, built: BuiltSystem, guard: Guard, scene: Scene, E: int):
+    def __init__(self, built: BuiltSystem, guard: Guard, scene: Scene, E: int) -> None:
         self.mbs, self.guard, self.scene, self.E = built.mbs, guard, scene, E
         chain = scene.chain
         sd = built.mbs.systemData
-        ltg = [[np.asarray(sd.GetNodeLTGODE2(nd), int) for nd in rod] for rod in built.nodes]
-        self.ltg = ltg
+        self.ltg = ltg = guard.ltg
         # a moving base's attitude coordinate: hinge 0's left side (None: the ground's x axis);
         # ``free``: node 0 moves (a free or a prescribed base)
         self.free = built.body is not None
         body = int(sd.GetNodeLTGODE2(built.body)[2]) if built.body is not None else None
         size = guard.ref.size
         D0 = scene.initial_hinge_angles()
-        self.items = []
+        self.items: list[dict[str, Any]] = []
         for latch in scene.latches:
             k = latch.hinge
             direction = latch.direction or int(np.sign(latch.angle - D0[k]))
@@ -86,11 +96,14 @@ class Latches:
                 }
             )
         self.Gx, self.Gy, self.w, self.rod_of = _mass_points(chain, ltg, E, size)
-        self.loads = [(f, ltg[f.node - 1][E][:2], f.node) for f in scene.loads]
-        self.stops: dict[int, list] = {}
+
+        self.loads: list[tuple[NodalForce, Array, int]] = [
+            (f, ltg[f.node - 1][E][:2], f.node) for f in scene.loads
+        ]
+        self.stops: dict[int, list[Stop]] = {}
         for stop in scene.stops:
             self.stops.setdefault(stop.hinge, []).append(stop)
-        self.root = {"left": body, "right": ltg[0][0][2:], "D": float(D0[0])}
+        self.root: dict[str, Any] = {"left": body, "right": ltg[0][0][2:], "D": float(D0[0])}
         # the per-step hinge angles, vectorized: row 0 hinge 0 (root), rows 1.. the latches
         self._sides = _Sides(
             [self.root["left"]] + [it["left"] for it in self.items],
@@ -100,19 +113,19 @@ class Latches:
         self._angle_of = np.array([it["latch"].angle for it in self.items], float)
         self._dir = np.array([it["dir"] for it in self.items], float)
         self._armed = np.array([it["state"] == "armed" for it in self.items], bool)
-        self.prev: dict | None = None
-        self.pending: list[dict] = []
-        self.events: list[dict] = []
+        self.prev: dict[str, Any] | None = None
+        self.pending: list[dict[str, Any]] = []
+        self.events: list[dict[str, Any]] = []
         # hinge -> time its joint was switched on (s): a held latch's from t = 0
         self.lock_times: dict[int, float] = {
             it["k"]: 0.0 for it in self.items if it["state"] == "held"
         }
         self.step_count = 0
         self._cfg = None  # exudyn's configuration of the last accepted state (StartOfStep)
-        self._root_shapes: dict[int, tuple] = {}  # rod -> Hermite slopes at its root
+        self._root_shapes: dict[int, tuple[Array, ...]] = {}  # rod -> its root's slopes
 
     # -- measures --------------------------------------------------------------------------
-    def _state(self, known=None):
+    def _state(self, known: tuple[Array, Array] | None = None) -> tuple[Array, ...]:
         """q (absolute: the reference added), v, a of the last accepted state (exudyn's
         StartOfStep configuration, which at the pre-step equals the current one); ``known``:
         (q - reference, v) the guard read in this pre-step (one read of each a step)."""
@@ -132,7 +145,7 @@ class Latches:
         )
 
     @staticmethod
-    def _angle(q, v, a, idx):
+    def _angle(q: Array, v: Array, a: Array, idx: Any) -> tuple[float, ...]:
         """Tangent angle (wrapped), its rate and acceleration of slope dofs ``idx`` (None: the
         x axis; one index: a free base's attitude coordinate, continuous)."""
         if idx is None:
@@ -148,13 +161,14 @@ class Latches:
         acc = (sx * ay - sy * ax) / r2 - 2.0 * (sx * vx + sy * vy) * cross / r2**2
         return math.atan2(sy, sx), rate, acc
 
-    def _hinge(self, item, q, v, a):
+    def _hinge(self, item: dict[str, Any], *qva: Array) -> tuple[float, float, float]:
+        q, v, a = qva
         tl, rl, al = self._angle(q, v, a, item["left"])
         tr, rr, ar = self._angle(q, v, a, item["right"])
         D = item["D"] + float(wrap_angle(np.array((tr - tl) - item["D"])))
         return D, rr - rl, ar - al
 
-    def _momenta(self, q, v):
+    def _momenta(self, q: Array, v: Array) -> tuple[Array, Array]:
         """Per rod: linear momentum (n, 2) and angular momentum about the origin (n,)."""
         x, y, vx, vy = self.Gx @ q, self.Gy @ q, self.Gx @ v, self.Gy @ v
         n = self.scene.n
@@ -163,17 +177,14 @@ class Latches:
         h = np.bincount(self.rod_of, self.w * (x * vy - y * vx), n)
         return np.stack([px, py], -1), h
 
-    def _chord(self, j: int, q, v) -> tuple[float, float]:
+    def _chord(self, j: int, q: Array, v: Array) -> tuple[float, float]:
         """Angle (rad, in (-pi, pi]) and rate d(phi)/dt = (d x d') / |d|^2 (rad/s) of rod j's
         chord (0-based; d the vector from its root node to its end node)."""
         a, b = self.ltg[j][0][:2], self.ltg[j][self.E][:2]
         d, dd = q[b] - q[a], v[b] - v[a]
         return math.atan2(d[1], d[0]), float((d[0] * dd[1] - d[1] * dd[0]) / (d @ d))
 
-    def _chord_rate(self, j: int, q, v) -> float:
-        return self._chord(j, q, v)[1]
-
-    def _root_moment(self, j: int, q) -> float:
+    def _root_moment(self, j: int, q: Array) -> float:
         """EI kappa_b (N m) at the root of rod j (0-based): the moment the hinge there
         transmits, in the sense of its spring's kappa (D - rest)."""
         E, le = self.E, self.scene.chain.l[j] / self.E
@@ -185,25 +196,18 @@ class Latches:
         r1, r2 = dS[0] @ Q, ddS[0] @ Q
         return float(self.scene.chain.EI[j] * (r1[0] * r2[1] - r1[1] * r2[0]) / (r1 @ r1))
 
-    def _measures(self, t: float, item, q, v, a) -> dict:
-        k, chain = item["k"], self.scene.chain
+    def _measures(self, t: float, item: dict[str, Any], *qva: Array) -> dict[str, Any]:
+        q, v, a = qva
+        k = item["k"]
         p, h = self._momenta(q, v)
         P = q[self.ltg[k][0][:2]]
         vP = v[self.ltg[k][0][:2]]
         p_out = p[k:].sum(0)
         H_out = float(h[k:].sum() - (P[0] * p_out[1] - P[1] * p_out[0]))
-        D, dD, _ = self._hinge(item, q, v, a)
-        moment = chain.kappa[k] * (D - chain.rest_angle[k]) + chain.nu[k] * dD
-        moment += sum(float(stop_moment(st, D, dD)) for st in self.stops.get(k, []))
-        finite = -moment - (vP[0] * p_out[1] - vP[1] * p_out[0])
-        for f, idx, node in self.loads:
-            if node > k and f.active(t):
-                fx = f.fx(t) if f.fx is not None else 0.0
-                fy = f.fy(t) if f.fy is not None else 0.0
-                r = q[idx] - P
-                finite += r[0] * fy - r[1] * fx
-        H_root, root_moment = self._root_momentum(t, q, v, a, p, h)
-        rel = self._chord_rate(k, q, v) - (self._chord_rate(k - 1, q, v) if k > 0 else 0.0)
+        D, dD, moment = self._hinge_moment(item, k, qva)
+        finite = self._loads_moment(t, q, P, -moment - (vP[0] * p_out[1] - vP[1] * p_out[0]), k)
+        H_root, root_moment = self._root_momentum(t, qva, p, h)
+        rel = self._chord(k, q, v)[1] - (self._chord(k - 1, q, v)[1] if k > 0 else 0.0)
         return {
             "t": t,
             "rel": rel,
@@ -217,22 +221,16 @@ class Latches:
             "dD": dD,
         }
 
-    def _root_momentum(self, t: float, q, v, a, p, h) -> tuple[float, float]:
+    def _root_momentum(
+        self, t: float, qva: tuple[Array, ...], p: Array, h: Array
+    ) -> tuple[float, float]:
         """The chain's angular momentum about node 0 (N m s) and its rate's finite moments
         (N m): hinge 0's spring, damper and stops on rod 1 and all loads, about node 0, and on
         a free base (node 0 moving) -v_0 x P; ``p``, ``h``: the rods' momenta (``_momenta``).
-        On a pinned base node 0 is the origin."""
-        chain = self.scene.chain
-        D0, dD0, _ = self._hinge(self.root, q, v, a)
-        root_moment = -(chain.kappa[0] * (D0 - chain.rest_angle[0]) + chain.nu[0] * dD0)
-        root_moment -= sum(float(stop_moment(st, D0, dD0)) for st in self.stops.get(0, []))
+        On a pinned base node 0 is the origin; ``qva`` = (q, v, a)."""
+        q, v, _ = qva
         root = q[self.ltg[0][0][:2]] if self.free else np.zeros(2)
-        for f, idx, _ in self.loads:
-            if f.active(t):
-                fx = f.fx(t) if f.fx is not None else 0.0
-                fy = f.fy(t) if f.fy is not None else 0.0
-                r = q[idx] - root
-                root_moment += r[0] * fy - r[1] * fx
+        root_moment = self._loads_moment(t, q, root, -self._hinge_moment(self.root, 0, qva)[2])
         H_root = float(h.sum())
         if self.free:
             v0, P = v[self.ltg[0][0][:2]], p.sum(0)
@@ -240,8 +238,31 @@ class Latches:
             root_moment -= float(v0[0] * P[1] - v0[1] * P[0])
         return H_root, root_moment
 
+    def _hinge_moment(
+        self, item: dict[str, Any], k: int, qva: tuple[Array, ...]
+    ) -> tuple[float, float, float]:
+        """Hinge k's (D, dD, moment) at the state ``qva`` = (q, v, a): the moment (N m) of its
+        spring, damper and stops, in the sense of kappa (D - rest)."""
+        chain = self.scene.chain
+        D, dD, _ = self._hinge(item, *qva)
+        moment = chain.kappa[k] * (D - chain.rest_angle[k]) + chain.nu[k] * dD
+        moment += sum([float(stop_moment(st, D, dD)) for st in self.stops.get(k, [])])
+        return D, dD, moment
+
+    def _loads_moment(
+        self, t: float, q: Array, about: Array, moment: float, outboard_of: int = 0
+    ) -> float:
+        """``moment`` plus, one by one, the moments (N m) about the point ``about`` of the loads
+        at t on the nodes past node ``outboard_of`` (all of them by default)."""
+        for f, idx, node in self.loads:
+            if node > outboard_of and f.active(t):
+                fx, fy = force_at(f, t)
+                r = q[idx] - about
+                moment += r[0] * fy - r[1] * fx
+        return moment
+
     # -- per step --------------------------------------------------------------------------
-    def pre_step(self, t: float, h: float, solver=None) -> None:
+    def pre_step(self, t: float, h: float, solver: Any = None) -> None:
         """Called before the step to t, on the state at t - h (the last accepted step). The
         hinge angles of hinge 0 and of every armed latch and the bound that a crossing needs
         are one compiled call a step (``_latch_step``); the closed-form roots
@@ -254,19 +275,8 @@ class Latches:
         t0 = t - h
         q, v, a = self._state(self.guard.state)
         armed = self._armed
-        sides = self._sides
         Dl, dDl, ddDl, maybe = _latch_step(
-            q,
-            v,
-            a,
-            sides.kind,
-            sides.i0,
-            sides.i1,
-            self._D,
-            self._angle_of,
-            self._dir,
-            armed,
-            h,
+            q, v, a, self._sides.index, self._D, self._angle_of, self._dir, armed, h
         )
         self.root["D"] = float(self._D[0])
         for ev in list(self.pending):
@@ -298,18 +308,19 @@ class Latches:
                     t_lock = t0
             else:
                 t_lock = t0 + float(tau[i])
-            self._switch(item, int(i), t0, t_lock, h, q, v, a)
+            self._switch(int(i), (t0, t_lock, h), q, v, a)
         if solver is not None:
             solver.conv.jacobianUpdateRequested = True
 
-    def _switch(self, item, i: int, t0: float, t_lock: float, h: float, q, v, a) -> None:
-        """Switch latch ``item`` (row ``i``) on before the step from t0 and open its lock
-        record."""
+    def _switch(self, i: int, times: tuple[float, float, float], *qva: Array) -> None:
+        """Switch latch ``i`` on before the step from t0 and open its lock record; ``times`` =
+        (t0, t_lock, h) (s), ``qva`` = (q, v, a) at t0."""
+        item, (t0, t_lock, h), (q, v, _) = self.items[i], times, qva
         self.mbs.SetObjectParameter(item["joint"], "activeConnector", True)
         item["state"] = "locking"
         self._armed[i] = False
         self.lock_times[item["k"]] = t0
-        before = self._measures(t0, item, q, v, a)
+        before = self._measures(t0, item, *qva)
         # the chords just before the lock and the hinges held after it: the rigid-panel
         # lock's data (rodval.mechanics.rigid)
         before["chords"] = np.array([self._chord(j, q, v) for j in range(self.scene.n)])
@@ -332,7 +343,7 @@ class Latches:
             }
         )
 
-    def _advance(self, ev: dict, now: dict) -> None:
+    def _advance(self, ev: dict[str, Any], now: dict[str, Any]) -> None:
         """One accepted step of a lock's window: the trapezoid integrals of the finite moments
         and of S(tau) = H_out(tau) - H_out(before) - int finite (linear between the steps,
         over the part of the step inside [t_lock, t_lock + w]; in the activation step, whose
@@ -364,7 +375,7 @@ class Latches:
         for ev in list(self.pending):
             self._finish(ev, closed=False)
 
-    def _finish(self, ev: dict, closed: bool) -> None:
+    def _finish(self, ev: dict[str, Any], closed: bool) -> None:
         """Record a lock: the impulse is the window mean of S(tau) (``lock_window``); the
         kinetic energy after it is taken ``LOCK_SETTLE_STEPS`` steps after the activation,
         the root's angular momentum jump over the whole window (None, as its before and
@@ -413,15 +424,15 @@ class Latches:
 
 
 def _mass_points(
-    chain: Chain, ltg: list[list[np.ndarray]], E: int, size: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    chain: Chain, ltg: list[list[Array]], E: int, size: int
+) -> tuple[Array, Array, Array, Array]:
     """The chain's mass points: the quadrature points of every rod (5 Gauss points per
     element, ``GAUSS_X``, ``GAUSS_W``) and the node masses mu_k at the rods' ends. ``ltg``:
     each rod's beam nodes' ODE2 indices (rod, node 0..E, [x, y, slope x, slope y]); ``size``
     the number of ODE2 coordinates. Returns (Gx, Gy (points, size): rows giving each point's
     x, y (m) from the coordinates; w (points,) its mass, kg; rod_of (points,) its rod)."""
-    rows_x: list[np.ndarray] = []
-    rows_y: list[np.ndarray] = []
+    rows_x: list[Array] = []
+    rows_y: list[Array] = []
     wts: list[float] = []
     rod_of: list[int] = []
     for k in range(chain.n):
@@ -454,30 +465,34 @@ class _Sides:
     Each side is None (the ground's x axis), one coordinate index (a free base's attitude,
     continuous) or the two slope coordinates of a beam node (tangent angle atan2(s_y, s_x))."""
 
-    def __init__(self, left: list, right: list):
+    def __init__(self, left: list[Any], right: list[Any]) -> None:
         sides = list(left) + list(right)
         self.rows = len(left)
-        self.kind = np.array(
-            [0 if s is None else (1 if np.ndim(s) == 0 else 2) for s in sides], np.int64
-        )
-        self.i0 = np.array(
-            [0 if s is None else (int(s) if np.ndim(s) == 0 else int(s[0])) for s in sides],
+        #: per side (columns): its kind, first and second coordinate index (``_hinge_rows``)
+        self.index = np.array(
+            [
+                [0 if s is None else (1 if np.ndim(s) == 0 else 2) for s in sides],
+                [0 if s is None else (int(s) if np.ndim(s) == 0 else int(s[0])) for s in sides],
+                [int(s[1]) if np.ndim(s) == 1 else 0 for s in sides],
+            ],
             np.int64,
         )
-        self.i1 = np.array([int(s[1]) if np.ndim(s) == 1 else 0 for s in sides], np.int64)
 
-    def hinges(self, q, v, a, D_prev: np.ndarray):
-        """D (continuous from ``D_prev``), dD, ddD of every row."""
+    def hinges(self, *qva: Array) -> tuple[Array, ...]:
+        """D (continuous from ``D_prev``), dD, ddD of every row; ``qva`` = (q, v, a, D_prev)."""
+        q, v, a, D_prev = qva
         out = np.empty((3, self.rows))
-        _hinge_rows(q, v, a, self.kind, self.i0, self.i1, np.asarray(D_prev, float), out)
+        _hinge_rows(q, v, a, self.index, np.asarray(D_prev, float), out)
         return out[0], out[1], out[2]
 
 
-@njit(cache=True, error_model="numpy")
-def _hinge_rows(q, v, a, kind, i0, i1, D_prev, out):  # pragma: no cover - compiled
+@njit(cache=True, error_model="numpy")  # pragma: no cover - compiled
+def _hinge_rows(q: Array, v: Array, a: Array, index: Array, D_prev: Array, out: Array) -> None:
     """``_Sides.hinges`` compiled: rows 0..R-1 of ``out`` (3, R) <- D, dD, ddD, the sides
-    0..R-1 left and R..2R-1 right (kind 0 ground, 1 body coordinate i0, 2 slope (i0, i1))."""
+    0..R-1 left and R..2R-1 right (``index`` (3, 2R): kind 0 ground, 1 body coordinate i0,
+    2 slope (i0, i1); then i0, i1)."""
     R = out.shape[1]
+    kind, i0, i1 = index[0], index[1], index[2]
     for r in range(R):
         ang = np.zeros(2)
         rate = np.zeros(2)
@@ -501,14 +516,24 @@ def _hinge_rows(q, v, a, kind, i0, i1, D_prev, out):  # pragma: no cover - compi
         out[2, r] = acc[1] - acc[0]
 
 
-@njit(cache=True, error_model="numpy")
-def _latch_step(q, v, a, kind, i0, i1, D, angle, direction, armed, h):  # pragma: no cover
+@njit(cache=True, error_model="numpy")  # pragma: no cover - compiled
+def _latch_step(
+    q: Array,
+    v: Array,
+    a: Array,
+    index: Array,
+    D: Array,
+    angle: Array,
+    direction: Array,
+    armed: Array,
+    h: float,
+) -> tuple[Array, Array, Array, bool]:
     """One pre-step of the latches compiled: row 0 hinge 0, rows 1.. the latches. ``D``
     (continued in place for row 0 and the armed rows); returns D, dD, ddD of the latch rows
     and whether an armed latch is at or past its angle or may cross it within the step h
     (|g| <= |dD| h + |ddD| h^2 / 2, g = D - angle): only then the closed-form roots run."""
     out = np.empty((3, D.size))
-    _hinge_rows(q, v, a, kind, i0, i1, D, out)
+    _hinge_rows(q, v, a, index, D, out)
     D[0] = out[0, 0]
     maybe = False
     for r in range(1, D.size):
@@ -522,7 +547,7 @@ def _latch_step(q, v, a, kind, i0, i1, D, angle, direction, armed, h):  # pragma
     return out[0, 1:].copy(), out[1, 1:].copy(), out[2, 1:].copy(), maybe
 
 
-def _taylor_roots(g: np.ndarray, dg: np.ndarray, ddg: np.ndarray, h: float) -> np.ndarray:
+def _taylor_roots(g: Array, dg: Array, ddg: Array, h: float) -> Array:
     """Per row, the smallest tau in (0, h] where g + dg tau + ddg tau^2 / 2 changes sign from
     that of g, in closed form (NaN where it does not within the step): the stable quadratic
     formula (roots q / c2 and g / q with q = -(dg + sign(dg) sqrt(disc)) / 2, c2 = ddg / 2,
@@ -541,13 +566,6 @@ def _taylor_roots(g: np.ndarray, dg: np.ndarray, ddg: np.ndarray, h: float) -> n
     return np.fmin(r1, r2)
 
 
-def _taylor_root(g: float, dg: float, ddg: float, h: float) -> float | None:
-    """Smallest tau in (0, h] where g + dg tau + ddg tau^2 / 2 changes sign from that of g
-    (None if it does not within the step); the scalar form of ``_taylor_roots``."""
-    tau = float(_taylor_roots(np.array([g]), np.array([dg]), np.array([ddg]), h)[0])
-    return tau if math.isfinite(tau) else None
-
-
 def _hermite_root(t0: float, t1: float, g0: float, dg0: float, g1: float, dg1: float) -> float:
     """Where the cubic Hermite interpolant of g between (t0, g0, dg0) and (t1, g1, dg1) crosses
     zero (g0 and g1 of opposite sign or g1 = 0), by bisection; t1 when not bracketed."""
@@ -555,7 +573,7 @@ def _hermite_root(t0: float, t1: float, g0: float, dg0: float, g1: float, dg1: f
     if h <= 0 or g0 * g1 > 0:
         return t1
 
-    def g(th):
+    def g(th: float) -> float:
         h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
         h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
         return h00 * g0 + h10 * h * dg0 + h01 * g1 + h11 * h * dg1

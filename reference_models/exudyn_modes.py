@@ -38,9 +38,10 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
+from reference_models.exudyn_beam import Array
 from reference_models.exudyn_chain import ExudynModel
-from rodval.core.loads import constant
-from rodval.core.modes import ABOUT, Equilibrium, Modes
+from rodval.core.loads import NodalForce, constant
+from rodval.core.modes import ABOUT, ConstantLoads, Equilibrium, Modes
 from rodval.core.scene import InitialState, Scene
 from rodval.mechanics.eigen import (
     angular_frequencies,
@@ -70,7 +71,7 @@ AXIAL_TOL = 1e-3
 MODES_DEFAULTS = {"EA": 1e8, "elements": 8}
 
 
-def _linear_matrices(exu, mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _linear_matrices(exu: Any, mbs: Any) -> tuple[Array, Array, Array, Array]:
     """(M, K, D, J) of the assembled system at its initial state, by exudyn's static solver as
     ``exudyn.solver.ComputeODE2Eigenvalues`` obtains them: mass matrix, K = -d(ODE2 rhs)/dq,
     D = -d(ODE2 rhs)/dq_t and the position-level constraint Jacobian J (rows: constraints)."""
@@ -103,7 +104,9 @@ def _linear_matrices(exu, mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
     return M, K, D, J
 
 
-def _eigen(M, K, D, J, *, damped: bool):
+def _eigen(
+    M: Array, K: Array, D: Array, J: Array, *, damped: bool
+) -> tuple[Array, Array, Array | None, str]:
     """Undamped eigenvalues omega^2 (ascending) and eigenvectors in ODE2 coordinates of the
     constrained system, the damped eigenvalues s (or None), and the null-space kind used.
 
@@ -147,18 +150,9 @@ def exudyn_modes(
     model = ExudynModel(**{**MODES_DEFAULTS, **options})
     n = scene.n
     loads = static_loads(scene, load_at) if about == "equilibrium" else None
-    held = _held_forces(loads)
-    if scene.base.free:
-        _check_free(scene, held)
-    prestressed = _springs_loaded(scene)
-    if about == "equilibrium" and prestressed:
-        scene = _at_rest_angles(scene)  # the static solve starts where the springs relax
-    _, mbs, nodes = model.assembled(scene.with_(loads=held))
-    _check_nodes(mbs, nodes)
-    # on a free base without loads the start at the rest angles is the equilibrium (a static
-    # solve of the unsupported body would be singular)
-    solved = about == "equilibrium" and (bool(held) or prestressed) and not scene.base.free
-    iters, residual, matrices = _linearized(exu, mbs, model, load_steps if solved else None)
+    scene, mbs, nodes, (iters, residual, matrices) = _linear_system(
+        exu, scene, model, loads, (about, load_steps)
+    )
     lam, V, s_damped, basis = _eigen(*matrices, damped=scene.chain.damped)
     idx, state = _node_states(exu, mbs, nodes, n)
     body = _body_index(mbs) if scene.base.free else None
@@ -169,7 +163,7 @@ def exudyn_modes(
     ends = np.concatenate([state[:1, 0, :2], state[:, -1, :2]])
     d = np.diff(ends, axis=0)
     phi0 = np.arctan2(d[:, 1], d[:, 0])
-    rigid_info: dict = {}
+    rigid_info: dict[str, Any] = {}
     if free:
         lam, dx, dy, hinge, rigid_info = _free_shapes(lam, U, state, theta, ends, count)
     else:
@@ -180,7 +174,7 @@ def exudyn_modes(
         damping[:3] = np.nan
     eq = None
     if about == "equilibrium":
-        phi0, eq = _equilibrium(scene, phi0, iters, load_steps, residual, loads)
+        phi0, eq = _equilibrium(scene, phi0, (iters, load_steps, residual), loads)
     return Modes(
         model="exudyn",
         about=about,
@@ -207,7 +201,29 @@ def exudyn_modes(
 exudyn_modes.FREE_BASE = True  # type: ignore[attr-defined]
 
 
-def _check_free(scene: Scene, held) -> None:
+def _linear_system(
+    exu: Any, scene: Scene, model: ExudynModel, loads: ConstantLoads | None, about: tuple[str, int]
+) -> tuple[Scene, Any, list[list[int]], tuple[int, float, tuple[Array, ...]]]:
+    """The system the modes are about: (the scene as assembled, exudyn's mbs, its beam nodes,
+    ``_linearized``), the static ``loads`` held as constant nodal forces; ``about`` = (about,
+    load_steps): about "equilibrium" a loaded or pre-stressed scene is solved statically in
+    load_steps steps, starting from the hinges' rest angles when pre-stressed."""
+    (about_what, load_steps), held = about, _held_forces(loads)
+    equilibrium = about_what == "equilibrium"
+    if scene.base.free:
+        _check_free(scene, held)
+    prestressed = _springs_loaded(scene)
+    if equilibrium and prestressed:
+        scene = _at_rest_angles(scene)  # the static solve starts where the springs relax
+    _, mbs, nodes = model.assembled(scene.with_(loads=held))
+    _check_nodes(mbs, nodes)
+    # on a free base without loads the start at the rest angles is the equilibrium (a static
+    # solve of the unsupported body would be singular)
+    solved = equilibrium and (bool(held) or prestressed) and not scene.base.free
+    return scene, mbs, nodes, _linearized(exu, mbs, model, load_steps if solved else None)
+
+
+def _check_free(scene: Scene, held: tuple[NodalForce, ...]) -> None:
     """ValueError before any work on a free base: a hinge without a spring
     (``check_no_mechanism``), or static loads (a loaded free body has no equilibrium)."""
     check_no_mechanism(scene)
@@ -218,7 +234,7 @@ def _check_free(scene: Scene, held) -> None:
         )
 
 
-def _check_nodes(mbs, nodes) -> None:
+def _check_nodes(mbs: Any, nodes: list[list[int]]) -> None:
     """RuntimeError unless every beam node of ``nodes`` (rows of exudyn node numbers) is a
     Point2DSlope1 (position x, y in m and slope vector, dimensionless)."""
     for row in nodes:
@@ -228,8 +244,8 @@ def _check_nodes(mbs, nodes) -> None:
 
 
 def _linearized(
-    exu, mbs, model: ExudynModel, load_steps: int | None
-) -> tuple[int, float, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    exu: Any, mbs: Any, model: ExudynModel, load_steps: int | None
+) -> tuple[int, float, tuple[Array, Array, Array, Array]]:
     """(Newton iterations, exudyn's last Newton residual (N), (M, K, D, J)): exudyn's static
     solve in ``load_steps`` load steps first (None: no solve, (0, 0.0)), then the linear
     matrices there (``_linear_matrices``: kg, N/m, N s/m and the constraint Jacobian),
@@ -246,7 +262,9 @@ def _linearized(
     return iters, residual, matrices
 
 
-def _free_shapes(lam, U, state, theta, ends: np.ndarray, count: int | None):
+def _free_shapes(
+    lam: Array, U: Array, state: Array, theta: Array | None, ends: Array, count: int | None
+) -> tuple[Array, Array, Array, Array, dict[str, Any]]:
     """A free base's modes: node shapes with hinge 0 measured from the body (rod 1's root
     tangent less the body's theta, rad), the three rigid modes separated (``split_rigid``;
     ``ends`` (n+1, 2) the nodes' positions, m), then the first ``count`` flexible ones
@@ -264,12 +282,12 @@ def _free_shapes(lam, U, state, theta, ends: np.ndarray, count: int | None):
 
 
 def _equilibrium(
-    scene: Scene, phi0: np.ndarray, iters: int, load_steps: int, residual: float, loads
-) -> tuple[np.ndarray, Equilibrium]:
+    scene: Scene, phi0: Array, solve: tuple[int, int, float], loads: ConstantLoads | None
+) -> tuple[Array, Equilibrium]:
     """The chord angles phi0 (rad) of the equilibrium, unwrapped to within pi of the scene's
-    initial ones, and its record (``Equilibrium``: Newton iterations, load steps, exudyn's last
-    Newton residual in N, the static loads held)."""
-    n = scene.n
+    initial ones, and its record (``Equilibrium``: the static solve's ``solve`` = (Newton
+    iterations, load steps, exudyn's last Newton residual in N), the static loads held)."""
+    (iters, load_steps, residual), n = solve, scene.n
     ini = scene.initial.resolve(n)
     phi0 = ini["phi"] + (phi0 - ini["phi"] + np.pi) % (2 * np.pi) - np.pi
     eq = Equilibrium(
@@ -315,17 +333,18 @@ def _at_rest_angles(scene: Scene) -> Scene:
     )
 
 
-def _held_forces(loads) -> tuple:
+def _held_forces(loads: ConstantLoads | None) -> tuple[NodalForce, ...]:
     """The static loads (``static_loads``; None: none) as constant nodal forces (N)."""
-    if loads is None:
+    if loads is None or loads.X is None or loads.Y is None:
         return ()
+    X, Y = loads.X, loads.Y
     return tuple(
-        constant(int(k) + 1, X=float(loads.X[k]), Y=float(loads.Y[k]))
-        for k in np.flatnonzero((loads.X != 0) | (loads.Y != 0))
+        constant(int(k) + 1, X=float(X[k]), Y=float(Y[k]))
+        for k in np.flatnonzero((X != 0) | (Y != 0))
     )
 
 
-def _static_solve(exu, mbs, model: ExudynModel, load_steps: int) -> tuple[int, float]:
+def _static_solve(exu: Any, mbs: Any, model: ExudynModel, load_steps: int) -> tuple[int, float]:
     """exudyn's static solve in ``load_steps`` load steps (the state becomes the
     configuration the modes are about): (Newton iterations, exudyn's last Newton residual in
     its own norm, N). ValueError if it fails."""
@@ -348,14 +367,14 @@ def _static_solve(exu, mbs, model: ExudynModel, load_steps: int) -> tuple[int, f
     return iters, residual
 
 
-def _node_states(exu, mbs, nodes, n: int) -> tuple[np.ndarray, np.ndarray]:
+def _node_states(exu: Any, mbs: Any, nodes: list[list[int]], n: int) -> tuple[Array, Array]:
     """Each beam node's first ODE2 index (n, E+1) and its position and slope at the
     configuration (n, E+1, 4)."""
     q_all = np.asarray(
         mbs.systemData.GetODE2Coordinates(configuration=exu.ConfigurationType.Initial)
     )
 
-    def node_state(nd):
+    def node_state(nd: int) -> tuple[int, Array]:
         i = mbs.GetNodeODE2Index(nd)
         ref = np.asarray(mbs.GetNodeParameter(nd, "referenceCoordinates"), float)
         return i, ref + q_all[i : i + 4]
@@ -365,7 +384,7 @@ def _node_states(exu, mbs, nodes, n: int) -> tuple[np.ndarray, np.ndarray]:
     return first, np.array(state).reshape(n, first.shape[1], 4)
 
 
-def _body_index(mbs) -> int:
+def _body_index(mbs: Any) -> int:
     """The first ODE2 index of a free base's rigid body node (NodeRigidBody2D: x_c, y_c,
     theta)."""
     for nd in range(mbs.systemData.NumberOfNodes()):
@@ -375,8 +394,14 @@ def _body_index(mbs) -> int:
 
 
 def _bending_modes(
-    lam, V, idx, state, axial_tol: float, count: int | None, body: int | None = None
-):
+    lam: Array,
+    V: Array,
+    idx: Array,
+    state: Array,
+    axial_tol: float,
+    count: int | None,
+    body: int | None = None,
+) -> tuple[Array, Array, Array, Array | None]:
     """The modes without axial content (element elongation along the tangent below
     ``axial_tol`` x the largest node displacement), ascending, the first ``count``:
     (eigenvalues, beam-node shapes (modes, n, E+1, 4), which modes were axial, and the
@@ -402,15 +427,15 @@ def _bending_modes(
 
 
 def _node_shapes(
-    U, state, theta=None, normalize: bool = True
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    U: Array, state: Array, theta: Array | None = None, normalize: bool = True
+) -> tuple[Array, Array, Array]:
     """Node displacements dx, dy (node 0 = rod 1's root, node k = rod k's end) and
     hinge-angle changes of each mode (normalized unless ``normalize`` is False); ``theta``:
     a free body's attitude change per mode, which hinge 0 is measured from."""
     dx = np.concatenate([U[:, :1, 0, 0], U[:, :, -1, 0]], axis=1)
     dy = np.concatenate([U[:, :1, 0, 1], U[:, :, -1, 1]], axis=1)
 
-    def dtheta(s, ds):
+    def dtheta(s: Array, ds: Array) -> Any:
         return (s[..., 0] * ds[..., 1] - s[..., 1] * ds[..., 0]) / np.sum(s * s, -1)
 
     root = dtheta(state[None, :, 0, 2:], U[:, :, 0, 2:])  # (modes, n) rod k root tangent
@@ -422,7 +447,7 @@ def _node_shapes(
     return normalize_shapes(dx, dy, hinge) if normalize else (dx, dy, hinge)
 
 
-def _damping_ratios(omega: np.ndarray, s_damped) -> np.ndarray:
+def _damping_ratios(omega: Array, s_damped: Array | None) -> Array:
     """Each undamped mode's damping ratio from the damped eigenvalue (Im > 0) of nearest |s|
     (Hungarian pairing); 0 without dampers, NaN where undefined."""
     zeta = np.full(omega.size, np.nan)

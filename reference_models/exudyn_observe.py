@@ -4,10 +4,14 @@ every recorded step (``recorded_peaks``)."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from reference_models.exudyn_beam import (
     BODY,
+    Array,
+    Nodes,
     body_attitude,
     hermite_interpolate,
     hermite_shapes,
@@ -20,7 +24,7 @@ from reference_models.exudyn_beam import (
 from rodval.core.base import Base
 from rodval.core.bounds import MIN_POSITIVE
 from rodval.core.quantities import PEAK_QUANTITIES, peak_values, tip_deflection
-from rodval.core.scene import QUANTITIES, Scene, hinge_angles
+from rodval.core.scene import QUANTITIES, Chain, Scene, hinge_angles
 from rodval.solvers.audit import audit_times
 
 #: The mass (kg) and inertia (kg m^2) the beam quadratures (``exudyn_beam``, which read a
@@ -51,7 +55,11 @@ def body_view(scene: Scene) -> Scene:
     return scene.with_(base=free)
 
 
-def _states_at(times: np.ndarray, t_rec: np.ndarray, records: dict) -> dict:
+#: Observed quantities: name -> (values (nt, K), k (K,)).
+Observed = dict[str, tuple[Array, Array]]
+
+
+def states_at(times: Array, t_rec: Array, records: Nodes) -> Nodes:
     """Each recorded node's (state, rate) at ``times`` (cubic Hermite on the records)."""
     return {
         key: (hermite_interpolate(times, t_rec, q, v), hermite_interpolate(times, t_rec, v, a))
@@ -60,24 +68,24 @@ def _states_at(times: np.ndarray, t_rec: np.ndarray, records: dict) -> dict:
 
 
 def momentum_audit(
-    scene: Scene, E: int, reached: float, t_rec: np.ndarray, records: dict
-) -> tuple[np.ndarray, np.ndarray]:
+    scene: Scene, E: int, reached: float, t_rec: Array, records: Nodes
+) -> tuple[Array, Array]:
     """(H, G) (N m s) for the angular-momentum audit (``momentum_audit_rows``) on the audit
     grid's times up to ``reached`` (s): ``rodval.solvers.audit.audit_times``, the grid every
     model reads, whatever the output times."""
     grid = audit_times(scene.t_end)
-    return momentum_audit_rows(scene, E, _states_at(grid[grid <= reached], t_rec, records))
+    return momentum_audit_rows(scene, E, states_at(grid[grid <= reached], t_rec, records))
 
 
 def observe(
     scene: Scene,
     E: int,
     EA: float,
-    times: np.ndarray,
-    t_rec: np.ndarray,
-    records: dict,
-    lock_steps: dict | None = None,
-):
+    times: Array,
+    t_rec: Array,
+    records: Nodes,
+    lock_steps: dict[int, float] | None = None,
+) -> Observed:
     """The scene's quantities at ``times`` from recorded node states (see module docstring).
 
     "hinge_angle": D_k (k = 0..n-1) from the continuous tangent angles; "hinge_moment" (N m):
@@ -93,8 +101,8 @@ def observe(
     scene = body_view(scene)
     n = scene.n
     rods = np.arange(1, n + 1)
-    at = _states_at(times, t_rec, records)
-    out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    at = states_at(times, t_rec, records)
+    out: Observed = {}
     if not scene.wants(*QUANTITIES):
         return out
     phi, dphi, alpha, beta = chord_angles(scene, E, times, t_rec, records, at)
@@ -138,11 +146,11 @@ def recorded_peaks(
     scene: Scene,
     E: int,
     EA: float,
-    steps: np.ndarray,
-    t_rec: np.ndarray,
-    records: dict,
-    lock_steps: dict | None = None,
-) -> dict | None:
+    steps: Array,
+    t_rec: Array,
+    records: Nodes,
+    lock_steps: dict[int, float] | None = None,
+) -> dict[str, Any] | None:
     """The run's peaks (``SolverStats.peaks``) of the ``PEAK_QUANTITIES`` the scene outputs:
     ``peak_values`` of ``observe`` (the outputs' own quantity functions) at every recorded
     step ``steps`` (s, those the run kept), whatever the output times; None when the scene
@@ -154,7 +162,7 @@ def recorded_peaks(
     return {"read_on": "every recorded step", "values": peak_values(steps, observed)}
 
 
-def _base_quantities(at: dict, out: dict) -> None:
+def _base_quantities(at: Nodes, out: Observed) -> None:
     """A moving base's "base" quantities into ``out``: base_position, base_velocity (m, m/s;
     its centre of mass, k = 0, 1), base_attitude, base_rate (rad, rad/s; k = 0), from its body
     node's record."""
@@ -166,7 +174,7 @@ def _base_quantities(at: dict, out: dict) -> None:
     out["base_rate"] = (v[:, 2:3], one)
 
 
-def rod_ends(n: int, E: int, at: dict) -> tuple[np.ndarray, ...]:
+def rod_ends(n: int, E: int, at: Nodes) -> tuple[Array, ...]:
     """The rods' left and right node states and rates (qL, vL, qR, vR), (nt, n, 4)."""
     qL = np.stack([at[(k, 0)][0] for k in range(n)], 1)
     qR = np.stack([at[(k, E)][0] for k in range(n)], 1)
@@ -175,7 +183,9 @@ def rod_ends(n: int, E: int, at: dict) -> tuple[np.ndarray, ...]:
     return qL, vL, qR, vR
 
 
-def chord_angles(scene: Scene, E: int, times, t_rec, records: dict, at: dict):
+def chord_angles(
+    scene: Scene, E: int, times: Array, t_rec: Array, records: Nodes, at: Nodes
+) -> tuple[Array, ...]:
     """(phi, dphi, alpha, beta) (rad, rad/s; (nt, n)) at ``times`` from the node states ``at``
     there: the chord angles continuous in time (unwrapped along every recorded step from the
     initial phi) and the end tangents' angles to the chord."""
@@ -198,7 +208,16 @@ def chord_angles(scene: Scene, E: int, times, t_rec, records: dict, at: dict):
     return phi, dphi, alpha, beta
 
 
-def _hinge_quantities(scene: Scene, E: int, times, at: dict, angles, ends, lock_steps, out):
+def _hinge_quantities(
+    scene: Scene,
+    E: int,
+    times: Array,
+    at: Nodes,
+    angles: tuple[Array, ...],
+    ends: tuple[Array, ...],
+    lock_steps: dict[int, float] | None,
+    out: Observed,
+) -> None:
     """ "hinge_angle" D_k (rad) and "hinge_moment" (N m) into ``out`` (see ``observe``):
     ``angles`` = (phi, alpha, beta) (nt, n); ``ends`` = the rods' left and right node states
     and rates (qL, vL, qR, vR), (nt, n, 4)."""
@@ -222,22 +241,24 @@ def _hinge_quantities(scene: Scene, E: int, times, at: dict, angles, ends, lock_
         out["hinge_moment"] = (M, hinges)
 
 
-def hinge_rates(qL, vL, qR, vR, base_rate=None) -> np.ndarray:
+def hinge_rates(
+    qL: Array, vL: Array, qR: Array, vR: Array, base_rate: Array | None = None
+) -> Array:
     """dD_k/dt (rad/s, (nt, n)): the rate of rod k+1's left end tangent minus rod k's right
     one (for the root: minus a free base's rate ``base_rate`` (nt,), 0 on a pinned base) from
     the rods' end node states and rates (nt, n, 4)."""
 
-    def rate(q, v):
+    def rate(q: Array, v: Array) -> Any:
         return (q[..., 2] * v[..., 3] - q[..., 3] * v[..., 2]) / (q[..., 2] ** 2 + q[..., 3] ** 2)
 
     right = rate(qR, vR)[:, :-1]
-    dD = rate(qL, vL) - np.concatenate([np.zeros((right.shape[0], 1)), right], 1)
+    dD: Array = rate(qL, vL) - np.concatenate([np.zeros((right.shape[0], 1)), right], 1)
     if base_rate is not None:
         dD[:, 0] -= base_rate
     return dD
 
 
-def _root_bending_moment(chain, E: int, at: dict, k: int) -> np.ndarray:
+def _root_bending_moment(chain: Chain, E: int, at: Nodes, k: int) -> Array:
     """The beam's bending moment EI kappa_b (N m) at the root of rod k+1 at every output time,
     kappa_b the curvature of its first cable element's field at s = 0."""
     le = chain.l[k] / E
@@ -248,12 +269,12 @@ def _root_bending_moment(chain, E: int, at: dict, k: int) -> np.ndarray:
     r1 = np.einsum("i,tic->tc", dS, Q)
     r2 = np.einsum("i,tic->tc", ddS, Q)
     curv = (r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]) / np.sum(r1**2, -1)
-    return chain.EI[k] * curv
+    return np.asarray(chain.EI[k] * curv)
 
 
 def stop_events(
-    scene: Scene, E: int, t_rec: np.ndarray, records: dict, lock_times: dict[int, float]
-) -> list[dict]:
+    scene: Scene, E: int, t_rec: Array, records: Nodes, lock_times: dict[int, float]
+) -> list[dict[str, Any]]:
     """The limit stops' contacts as events, as the native models record them: "stop hinge k
     on" when hinge k's angle D_k enters the stop's side, "stop hinge k off" when it leaves
     (``hinge``, ``active``), none for a stop that acts from the start (it is in the initial
@@ -286,17 +307,17 @@ def stop_events(
     return events
 
 
-def recorded_hinge_angle(records: dict, E: int, k: int, D0: float, nt: int) -> np.ndarray:
+def recorded_hinge_angle(records: Nodes, E: int, k: int, D0: float, nt: int) -> Array:
     """D_k (rad) at the first ``nt`` recorded steps: the difference of the end tangents'
     angles (for the root: rod 1's minus a free base's attitude, 0 on a pinned base),
     unwrapped in time from the initial hinge angle D0 (rad)."""
 
-    def tangent(key):  # tangent angle (rad, wrapped) of a rod end at the recorded times
-        return np.arctan2(*records[key][0][:nt, [3, 2]].T)
+    def tangent(key: tuple[int, int]) -> Any:  # tangent angle (rad, wrapped) of a rod end
+        return np.arctan2(*records[key][0][:nt, [3, 2]].T)  # at the recorded times
 
     if k > 0:
         left = tangent((k - 1, E))
     else:
         left = records[BODY][0][:nt, 2] if BODY in records else 0.0
     D = np.unwrap(tangent((k, 0)) - left)
-    return D + 2 * np.pi * np.round((D0 - D[0]) / (2 * np.pi))
+    return np.asarray(D + 2 * np.pi * np.round((D0 - D[0]) / (2 * np.pi)))

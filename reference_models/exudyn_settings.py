@@ -23,7 +23,7 @@ def initial_kick(scene: Scene) -> bool:
 
 def simulation_settings(
     scene: Scene, step: float, newton: tuple[float, float], spectral_radius: float
-):
+) -> Any:
     """exudyn's simulation settings of a run of ``scene``: ``planned_steps`` equal steps of
     ``step`` (s) over t_end, or only the first ``EXUDYN_MAX_STEPS`` of them (exudyn's largest
     count; a budgeted run stops before it); ``newton`` = (relative tolerance, absolute
@@ -58,7 +58,7 @@ def simulation_settings(
     return s
 
 
-def newton_record(sim, latches: bool) -> dict[str, Any]:
+def newton_record(sim: Any, latches: bool) -> dict[str, Any]:
     """The Newton and linear-solver choices of a run, for ``trajectory.settings`` (chosen by
     benchmarks/exudyn_speed.py and the measurements in docs/reference_model.md, "Speed"), and
     whether it started from computed initial accelerations."""

@@ -76,8 +76,10 @@ def test_closed_form_crossing_equals_numpy_roots():
             found += 1
             assert got[i] == pytest.approx(ref, abs=1e-12 * h, rel=1e-9)
     assert found > 1000
-    assert lat._taylor_root(1e-6, -1.0, 0.0, h) == pytest.approx(1e-6)
-    assert lat._taylor_root(1e-6, 1.0, 0.0, h) is None
+    one = [np.array([x]) for x in (1e-6, -1.0, 0.0)]
+    assert lat._taylor_roots(*one, h)[0] == pytest.approx(1e-6)
+    one[1] = np.array([1.0])
+    assert not math.isfinite(lat._taylor_roots(*one, h)[0])
 
 
 def test_vectorized_hinge_angles_equal_the_per_hinge_ones():

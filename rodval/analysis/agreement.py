@@ -117,7 +117,7 @@ def gap_series(values: np.ndarray, reference: np.ndarray) -> np.ndarray:
     scale = float(np.max(np.abs(r))) if r.size else 0.0
     if not scale > 0:
         return np.full(v.shape[0], np.nan)
-    return np.max(np.abs(v - r), axis=1) / scale
+    return np.asarray(np.max(np.abs(v - r), axis=1) / scale)
 
 
 def agreement_horizon(
@@ -187,9 +187,7 @@ def locks_within(
 
 
 def deployed_gap(
-    times: tuple[np.ndarray, np.ndarray],
-    values: tuple[np.ndarray, np.ndarray],
-    since: float,
+    times: tuple[np.ndarray, np.ndarray], values: tuple[np.ndarray, np.ndarray], since: float
 ) -> float:
     """The largest difference (the values' unit) between the model's and the reference's
     deployed states: ``deployed_mean`` of each run's (nt, nk) ``values`` over its output
@@ -219,7 +217,7 @@ def twin_parts_as_much(
     label = model_part["label"]
     if label not in own or label not in ref or math.isnan(model_part["dt"]):
         return False
-    return abs(own[label] - ref[label]) >= AS_MUCH * abs(model_part["dt"])
+    return bool(abs(own[label] - ref[label]) >= AS_MUCH * abs(model_part["dt"]))
 
 
 def check_names(invalid_because: Any) -> str:
@@ -282,7 +280,9 @@ def cause(
 # ---- over the study's tables -------------------------------------------------------------
 
 
-def run_arrays(traj: pd.DataFrame, quantities: Sequence[str]) -> tuple[np.ndarray, dict]:
+def run_arrays(
+    traj: pd.DataFrame, quantities: Sequence[str]
+) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """One run's output times and its (nt, nk) arrays of ``quantities`` (those it has) from
     its rows of a tidy trajectories table (t, quantity, k, value)."""
     times = np.sort(traj["t"].unique())
@@ -357,31 +357,11 @@ def latch_hinges(cases: pd.DataFrame) -> dict[Any, list[int]]:
 
 #: Columns of ``agreement_table``.
 AGREEMENT_COLUMNS = (
-    "case",
-    "model",
-    "role",
-    "status",
-    "valid",
-    "out_of_domain",
-    "horizon",
-    "horizon_quantity",
-    "compared_to",
-    "part_lock",
-    "part_dt",
-    "part_why",
-    "cause",
-    "worst_dt",
-    "worst_dt_lock",
-    "worst_impulse_rel",
-    "worst_impulse_lock",
-    "lock_order",
-    "locks_within",
-    "never_locked",
-    "deployed_gap",
-    "deployed_band",
-    "attitude_gap",
-    "attitude_band",
-    "wall_s",
+    *("case", "model", "role", "status", "valid", "out_of_domain", "horizon"),
+    *("horizon_quantity", "compared_to", "part_lock", "part_dt", "part_why", "cause"),
+    *("worst_dt", "worst_dt_lock", "worst_impulse_rel", "worst_impulse_lock", "lock_order"),
+    *("locks_within", "never_locked", "deployed_gap", "deployed_band", "attitude_gap"),
+    *("attitude_band", "wall_s"),
 )
 
 
@@ -561,22 +541,18 @@ def _row_cause(
     horizon = None if pd.isna(row.get("horizon", math.nan)) else float(row["horizon"])
     twin = None
     if twin_row is not None and "horizon" in twin_row:
-        t_h = twin_row["horizon"]
-        case = row["case"]
-        twin_locks = dict(lock_list(events, case, str(twin_row["model"])))
-        ref_locks = dict(lock_list(events, case, reference))
+        t_h, case = twin_row["horizon"], row["case"]
+        twin_list = lock_list(events, case, str(twin_row["model"]))
+        ref_list = lock_list(events, case, reference)
+        twin_locks, ref_locks = dict(twin_list), dict(ref_list)
         label = part["label"] if part is not None else ""
+        tol_dt = settings.lock_dt + settings.reference_dt
         twin = {
             "horizon": None if pd.isna(t_h) else float(t_h),
             "dt": twin_locks[label] - ref_locks[label]
             if label in twin_locks and label in ref_locks
             else math.nan,
             "parts_as_much": part is not None
-            and twin_parts_as_much(
-                part,
-                lock_list(events, case, str(twin_row["model"])),
-                lock_list(events, case, reference),
-                settings.lock_dt + settings.reference_dt,
-            ),
+            and twin_parts_as_much(part, twin_list, ref_list, tol_dt),
         }
     return cause(row["_checks"], part, horizon, twin)

@@ -161,10 +161,10 @@ def deployed_mean(times: np.ndarray, values: np.ndarray, since: float) -> np.nda
     times, values = np.asarray(times, float), np.asarray(values, float)
     keep = times >= since
     if keep.sum() < 2:
-        return values[-1]
+        return np.asarray(values[-1])
     t, v = times[keep], values[keep]
     dt = np.diff(t).reshape(-1, *([1] * (v.ndim - 1)))
-    return np.sum(0.5 * (v[1:] + v[:-1]) * dt, axis=0) / (t[-1] - t[0])
+    return np.asarray(np.sum(0.5 * (v[1:] + v[:-1]) * dt, axis=0) / (t[-1] - t[0]))
 
 
 def quantities_of_interest(

@@ -8,6 +8,8 @@ that rod's max |value| (dimensionless).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pandas as pd
 
@@ -36,7 +38,7 @@ def table1_gaps(
     return out
 
 
-def crosscheck_paper(**exudyn_options) -> tuple[pd.DataFrame, dict[str, Trajectory]]:
+def crosscheck_paper(**exudyn_options: Any) -> tuple[pd.DataFrame, dict[str, Trajectory]]:
     """Run exudyn and the native full model (printed and published) on the paper example;
     return the gap table (one row per comparison) and the trajectories."""
     scene = paper_scene(times=TABLE1_TIMES)

@@ -24,25 +24,10 @@ from rodval.mechanics.lock_window import MIN_WINDOW_STEPS
 #: The leading columns of an events table (after the columns that name the run: case columns
 #: and model); the keys the native and exudyn latch records share.
 EVENT_COLUMNS = (
-    "t",
-    "label",
-    "hinge",
-    "impulse",
-    "impulse_window",
-    "rigid_impulse",
-    "impulse_to_rigid",
-    "kinetic_before",
-    "kinetic_after",
-    "energy_lost",
-    "instant_energy_loss",
-    "hinge_before",
-    "bending_before",
-    "kinetic_window_end",
-    "hinge_window_end",
-    "bending_window_end",
-    "work_window_end",
-    "dissipated_window_end",
-    "energy_residual_window_end",
+    *("t", "label", "hinge", "impulse", "impulse_window", "rigid_impulse", "impulse_to_rigid"),
+    *("kinetic_before", "kinetic_after", "energy_lost", "instant_energy_loss", "hinge_before"),
+    *("bending_before", "kinetic_window_end", "hinge_window_end", "bending_window_end"),
+    *("work_window_end", "dissipated_window_end", "energy_residual_window_end"),
 )
 
 #: A lock is compared pointwise with the reference's when every earlier lock of the case came
@@ -201,16 +186,8 @@ def state_energies(ev: pd.Series, r: pd.Series) -> tuple[tuple[float, float], st
 
 #: Columns of ``event_discrepancies``.
 DISCREPANCY_COLUMNS = (
-    "case",
-    "label",
-    "model",
-    "reference",
-    "dt",
-    "impulse_abs",
-    "impulse_rel",
-    "rigid_rel",
-    "dE_lost",
-    "not_comparable",
+    *("case", "label", "model", "reference", "dt", "impulse_abs", "impulse_rel", "rigid_rel"),
+    *("dE_lost", "not_comparable"),
 )
 
 
@@ -294,17 +271,8 @@ def earlier_gaps(
 
 #: Columns of ``lock_comparison`` (``_m``: the model's, ``_ref``: the reference's).
 LOCK_COLUMNS = (
-    "case",
-    "label",
-    "t_m",
-    "t_ref",
-    "dt",
-    "impulse_m",
-    "impulse_ref",
-    "impulse_rel",
-    "impulse_to_rigid_m",
-    "impulse_to_rigid_ref",
-    "not_comparable",
+    *("case", "label", "t_m", "t_ref", "dt", "impulse_m", "impulse_ref", "impulse_rel"),
+    *("impulse_to_rigid_m", "impulse_to_rigid_ref", "not_comparable"),
 )
 
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -181,7 +182,7 @@ def left_out_quantities(
 
 def compare_runs(
     trajectories: dict[str, Trajectory], reference: str, outputs: Iterable[str]
-) -> list[dict]:
+) -> list[dict[str, Any]]:
     """Discrepancy rows of every trajectory against the one labelled ``reference``, one row
     per quantity (``discrepancies`` plus model, reference, status). When either run failed,
     the metrics are absent (NaN in tables) and ``status`` says which run failed. A quantity
@@ -190,7 +191,7 @@ def compare_runs(
     compared: a pair is never dropped for lack of a common quantity."""
     ref = trajectories[reference]
     quantities = ref.quantities if ref.success else trajectory_quantities(outputs)
-    rows: list[dict] = []
+    rows: list[dict[str, Any]] = []
     for label, traj in trajectories.items():
         if label == reference:
             continue
@@ -210,8 +211,8 @@ def compare_runs(
 
 
 def _pair_rows(
-    traj: Trajectory, ref: Trajectory, quantities: Iterable[str], base: dict
-) -> list[dict]:
+    traj: Trajectory, ref: Trajectory, quantities: Iterable[str], base: dict[str, Any]
+) -> list[dict[str, Any]]:
     """The rows of one successful pair: the quantities both runs output, compared ("ok");
     those only one of them outputs are left out (``left_out_quantities``). ValueError when
     the runs cannot be compared at all."""

@@ -53,7 +53,9 @@ def model_modes(
     return m
 
 
-def rerun_options(model: str, options: dict[str, Any], where: str) -> tuple[dict, dict]:
+def rerun_options(
+    model: str, options: dict[str, Any], where: str
+) -> tuple[dict[str, Any], dict[str, Any]]:
     """A run's model options (its run.json's ``options``, ``where`` naming the file) split for
     a modal analysis of the same ``model``: (the ones its modes take, ``MODES_OPTIONS``: the
     model's equations, e.g. the full model's coefficients, shapes and kinematics; the ones

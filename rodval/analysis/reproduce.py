@@ -32,7 +32,7 @@ def published_table1() -> pd.DataFrame:
 def run_paper_models(
     coefficients: str = "printed",
     settings: IntegratorSettings = REPRODUCTION_SETTINGS,
-    outputs=("phi", "dphi", "alpha", "beta"),
+    outputs: tuple[str, ...] = ("phi", "dphi", "alpha", "beta"),
 ) -> dict[str, Trajectory]:
     """Full and reduced models on the paper example at the Table 1 times."""
     scene = paper_scene(times=TABLE1_TIMES, outputs=outputs)

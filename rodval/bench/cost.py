@@ -5,15 +5,18 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from rodval.bench.precision import (
     KERNELS,
-    errors,
+    Progress,
     kernel_options,
     ladder,
+    loosest_within,
     paper_system_of,
     reference_model_reference,
     references,
@@ -24,6 +27,7 @@ from rodval.core.scene import paper_scene
 from rodval.core.settings import IntegratorSettings
 from rodval.models import get_model
 from rodval.models.presets.registry import MODEL_NAMES, integrated_models, uses_integrator
+from rodval.models.systems.paper_system import PaperSystem
 from rodval.solvers.driver import integrate
 
 #: The wall-time ratios of ``speedup_vs_n`` ("a/b": model a's time over model b's), where
@@ -32,12 +36,12 @@ SPEEDUP_RATIOS = ("full/reduced", "exudyn/full", "exudyn/reduced")
 
 
 def per_eval_cost(
-    n_values=(2, 4, 8, 16, 32, 64, 128, 256, 512),
-    kernels=KERNELS,
-    models=("full",),
+    n_values: Sequence[int] = (2, 4, 8, 16, 32, 64, 128, 256, 512),
+    kernels: Sequence[str] = KERNELS,
+    models: Sequence[str] = ("full",),
     min_time: float = 0.05,
     repeats: int = 3,
-    progress=print,
+    progress: Progress = print,
 ) -> pd.DataFrame:
     """Seconds per right-hand-side evaluation (min over repeats of a timed loop) against n at
     a random state with the load active, for each of ``kernels`` a model has
@@ -51,24 +55,11 @@ def per_eval_cost(
                 system = paper_system_of(model, paper_scene(n), **taken[kernel])
                 y = rng.normal(scale=0.5, size=system.y0.size)
                 system.rhs(0.3, y)
-                reps = max(1, int(min_time / _once(system, y)))
-                best = min(_loop(system, y, reps) for _ in range(repeats)) / reps
+                reps = max(1, int(min_time / max(_timeit(system, y, 0.3, 1), 1e-7)))
+                best = min(_timeit(system, y, 0.3, reps) for _ in range(repeats))
                 rows.append({"model": model, "kernel": kernel, "n": n, "s_per_eval": best})
                 progress(f"{model} {kernel:5s} n = {n:4d}: {best * 1e6:10.2f} us/eval")
     return with_provenance(pd.DataFrame(rows))
-
-
-def _once(system, y) -> float:
-    t = time.perf_counter()
-    system.rhs(0.3, y)
-    return max(time.perf_counter() - t, 1e-7)
-
-
-def _loop(system, y, reps: int) -> float:
-    t = time.perf_counter()
-    for _ in range(reps):
-        system.rhs(0.3, y)
-    return time.perf_counter() - t
 
 
 def fitted_exponent(n: np.ndarray, cost: np.ndarray, n_min: int = 1) -> float:
@@ -77,7 +68,7 @@ def fitted_exponent(n: np.ndarray, cost: np.ndarray, n_min: int = 1) -> float:
     return float(np.polyfit(np.log(np.asarray(n)[keep]), np.log(np.asarray(cost)[keep]), 1)[0])
 
 
-def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
+def skip_rows(repeats: int = 5, progress: Progress = print) -> pd.DataFrame:
     """Cost with and without each skip, paper example n = 8, compiled DOP853 at rtol 1e-8
     (outputs and dense output: scipy DOP853, where they run in Python):
 
@@ -87,6 +78,17 @@ def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
     * gamma recovery: reduced model with outputs phi, dphi vs phi, dphi, alpha, beta;
     * dense output: 4 output times vs 2001 (dense output formed only on steps containing one).
     """
+    rows = _damping_rows(repeats) + _load_rows(repeats) + _output_rows(repeats)
+    for r in rows:
+        progress(
+            f"{r['skip']:60s} {r['model']:8s} {r['with_skip_s'] * 1e3:9.3f} ms vs "
+            f"{r['without_skip_s'] * 1e3:9.3f} ms"
+        )
+    return with_provenance(pd.DataFrame(rows))
+
+
+def _damping_rows(repeats: int) -> list[dict[str, Any]]:
+    """Per native model: the damping terms skipped on a nu = 0 chain vs forced on."""
     rows = []
     settings = IntegratorSettings("DOP853-numba", rtol=1e-8, atol=1e-10)
     undamped = paper_scene(8, times=(0.5, 1.0, 1.5, 2.0), nu=0.0)
@@ -108,6 +110,12 @@ def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
                 f"max |phi difference| = {same:.1e}",
             )
         )
+    return rows
+
+
+def _load_rows(repeats: int) -> list[dict[str, Any]]:
+    """Per native model and right-hand side: an evaluation past the load's support vs in it."""
+    rows = []
     for model in integrated_models():
         for kernel, options in kernel_options(model).items():
             system = paper_system_of(model, paper_scene(8), **options)
@@ -122,6 +130,13 @@ def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
                     "t = 1.5 s (skipped) vs 0.3 s (evaluated)",
                 )
             )
+    return rows
+
+
+def _output_rows(repeats: int) -> list[dict[str, Any]]:
+    """The reduced model's gamma recovery skipped (outputs phi, dphi only) and its dense output
+    formed only on the steps with output times (4 vs 2001 of them)."""
+    rows = []
     scipy_dop = IntegratorSettings("DOP853", rtol=1e-8, atol=1e-10)
     times = np.linspace(0, 2, 201)
     lean = paper_scene(8, times=times, outputs=("phi", "dphi"))
@@ -148,22 +163,18 @@ def skip_rows(repeats: int = 5, progress=print) -> pd.DataFrame:
             f"4 vs 2001 output times; nfev {few.stats.nfev} vs {many.stats.nfev}",
         )
     )
-    for r in rows:
-        progress(
-            f"{r['skip']:60s} {r['model']:8s} {r['with_skip_s'] * 1e3:9.3f} ms vs "
-            f"{r['without_skip_s'] * 1e3:9.3f} ms"
-        )
-    return with_provenance(pd.DataFrame(rows))
+    return rows
 
 
-def _timeit(system, y, t, reps: int = 2000) -> float:
+def _timeit(system: PaperSystem, y: np.ndarray, t: float, reps: int = 2000) -> float:
+    """Seconds per right-hand-side evaluation of ``system`` at (t, y), over ``reps`` of them."""
     start = time.perf_counter()
     for _ in range(reps):
         system.rhs(t, y)
     return (time.perf_counter() - start) / reps
 
 
-def _skip_row(skip: str, model: str, with_skip: float, without: float, note: str) -> dict:
+def _skip_row(skip: str, model: str, with_skip: float, without: float, note: str) -> dict[str, Any]:
     return {
         "skip": skip,
         "model": model,
@@ -175,20 +186,20 @@ def _skip_row(skip: str, model: str, with_skip: float, without: float, note: str
 
 
 def speedup_vs_n(
-    n_values=(2, 4, 8, 16, 32),
+    n_values: Sequence[int] = (2, 4, 8, 16, 32),
     tol: float = 1e-6,
-    rtols=(1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
+    rtols: Sequence[float] = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
     repeats: int = 3,
     models: tuple[str, ...] = MODEL_NAMES,
-    progress=print,
+    progress: Progress = print,
 ) -> tuple[pd.DataFrame, list[str]]:
     """For each n and model: the cheapest rung of its precision ladder (``ladder``: compiled
     DOP853 tolerances for native models, the step for exudyn) with phi error <= tol against
     that model's own reference; then the full/reduced (and exudyn/native) wall-time ratios at
     that equal accuracy. For exudyn the accuracy is that of its time integration at fixed
     spatial discretization (2 elements per rod by default)."""
-    rows, notes = [], []
-    available = []
+    rows: list[dict[str, Any]] = []
+    notes, available = [], []
     for model in models:
         try:
             get_model(model)
@@ -203,20 +214,15 @@ def speedup_vs_n(
                 references(scene, model).dop if native else reference_model_reference(scene, model)
             )
             method = "DOP853-numba" if native else "default"
-            best = None
-            for knob, settings, opts in ladder(model, method, rtols):
-                traj, wall = timed(scene, model, settings, repeats, **opts)
-                if errors(traj, ref, ("phi",))["max_phi"] <= tol:
-                    best = (knob, wall, traj.stats.nfev)
-                    break
+            best = loosest_within(scene, model, ladder(model, method, rtols), ref, tol, repeats)
             rows.append(
                 {
                     "n": n,
                     "model": model,
                     "method": method,
                     "rtol" if native else "step": best[0] if best else math.nan,
-                    "wall_s": best[1] if best else math.nan,
-                    "nfev": best[2] if best else math.nan,
+                    "wall_s": best[2] if best else math.nan,
+                    "nfev": best[1].stats.nfev if best else math.nan,
                 }
             )
             knob_name = "rtol" if native else "step"

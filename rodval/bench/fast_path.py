@@ -18,10 +18,12 @@ difference (relative) between the two; for the energy scenes both audit residual
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from rodval.bench.precision import Progress
 from rodval.core.loads import constant, pulse
 from rodval.core.scene import Chain, InitialState, Latch, Scene, paper_scene
 from rodval.core.settings import AUTO, IntegratorSettings
@@ -111,8 +113,10 @@ def event_gaps(fast: Trajectory, ref: Trajectory) -> tuple[float, float]:
     return dt, rel
 
 
-def _row(label: str, feature: str, on: bool, model: str, fast: Trajectory, ref: Trajectory):
-    row = {
+def _row(
+    label: str, feature: str, on: bool, model: str, fast: Trajectory, ref: Trajectory
+) -> dict[str, Any]:
+    row: dict[str, Any] = {
         "scene": label,
         "feature": feature,
         "with_feature": on,
@@ -135,7 +139,7 @@ def _row(label: str, feature: str, on: bool, model: str, fast: Trajectory, ref: 
     return row
 
 
-def fast_path_rows(repeats: int = 3, progress=print) -> pd.DataFrame:
+def fast_path_rows(repeats: int = 3, progress: Progress = print) -> pd.DataFrame:
     """One row per case, feature on/off and native model (module docstring)."""
     rows = []
     for label, feature, build in CASES:

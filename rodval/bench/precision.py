@@ -5,6 +5,7 @@ side by side, the cheapest settings per accuracy and the baseline ratios (conven
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -17,16 +18,18 @@ from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.trajectory import Trajectory
 from rodval.models import get_model
-from rodval.models.assembly.paper_system import PaperSystem
 from rodval.models.presets.registry import (
     integrated_models,
     option_names,
     simulate,
     uses_integrator,
 )
+from rodval.models.systems.paper_system import PaperSystem
 from rodval.solvers.ode_model import OdeModel
 
 QUANTITIES = ("phi", "dphi", "alpha", "beta")
+#: Where a benchmark reports each run (``print`` by default).
+Progress = Callable[[str], object]
 
 
 DOP853_FAMILY = ("DOP853", "DOP853-numba")
@@ -80,7 +83,9 @@ def paper_system_of(model: str, scene: Scene, **options: Any) -> PaperSystem:
     return system
 
 
-def ladder(model: str, method: str, rtols) -> list[tuple[float, IntegratorSettings, dict]]:
+def ladder(
+    model: str, method: str, rtols: Sequence[float]
+) -> list[tuple[float, IntegratorSettings, dict[str, Any]]]:
     """(precision knob, settings, model options), loosest first: the tolerance ladder
     (atol = rtol / 100) for native models, the step ladder for fixed-step reference models."""
     if uses_integrator(model):
@@ -104,7 +109,7 @@ SLOW_RUN_S = 2.0
 
 
 def timed(
-    scene: Scene, model: str, settings: IntegratorSettings, repeats: int = 3, **options
+    scene: Scene, model: str, settings: IntegratorSettings, repeats: int = 3, **options: Any
 ) -> tuple[Trajectory, float]:
     """(trajectory, min wall time over ``repeats`` runs after a warm-up run) in s."""
     warm = simulate(scene, model, settings=settings, **options)
@@ -113,7 +118,28 @@ def timed(
     return runs[-1], min(r.stats.wall_s for r in runs)
 
 
-def errors(traj: Trajectory, ref: Trajectory, quantities=QUANTITIES) -> dict[str, float]:
+def loosest_within(
+    scene: Scene,
+    model: str,
+    rungs: list[tuple[float, IntegratorSettings, dict[str, Any]]],
+    ref: Trajectory,
+    tol: float,
+    repeats: int,
+) -> tuple[float, Trajectory, float, float] | None:
+    """The first (loosest) of ``rungs`` (``ladder``) whose run's phi error (``max_phi`` of
+    ``errors``) against ``ref`` is <= tol: (its knob, trajectory, wall time (s, ``timed``),
+    error); None when none is."""
+    for knob, settings, opts in rungs:
+        traj, wall = timed(scene, model, settings, repeats, **opts)
+        err = errors(traj, ref, ("phi",))["max_phi"]
+        if err <= tol:
+            return knob, traj, wall, err
+    return None
+
+
+def errors(
+    traj: Trajectory, ref: Trajectory, quantities: Sequence[str] = QUANTITIES
+) -> dict[str, float]:
     """Relative errors of ``traj`` against ``ref`` (``rodval.analysis.metrics.scaled_errors``
     per quantity as ``final_q``, ``rms_q``, ``max_q``, and ``scd``; see module docstring); NaN
     for a run that did not reach every output time. A reference that is zero throughout (the
@@ -152,7 +178,7 @@ class References:
         return self.dop if method in DOP853_FAMILY else self.other
 
 
-def references(scene: Scene, model: str, **options) -> References:
+def references(scene: Scene, model: str, **options: Any) -> References:
     runs = [
         simulate(scene, model, method=m, rtol=r, atol=a, **options)
         for m, r, a in (REFERENCE_DOP, REFERENCE_OTHER)
@@ -173,43 +199,32 @@ def work_precision(
     repeats: int = 3,
     budget_s: float = 20.0,
     baseline: bool = True,
-    progress=print,
+    progress: Progress = print,
 ) -> tuple[pd.DataFrame, dict[str, float], list[str]]:
     """One row per (model, method, kernel, rtol): cost and errors. For each model and method
     the ladder (loosest first) stops after a run slower than ``budget_s``. ``baseline`` adds
     scipy DOP853 with the numpy right-hand side (``kernel="numpy"``) for native models.
 
     Returns (rows, reference uncertainty per model, notes)."""
-    rows, uncertainty, notes = [], {}, []
+    rows: list[dict[str, Any]] = []
+    uncertainty: dict[str, float] = {}
+    notes: list[str] = []
     for model in models:
         try:
             get_model(model)
         except ValueError as exc:
             notes.append(f"model {model} skipped: {exc}")
             continue
-        native = uses_integrator(model)
-        if native:
-            refs = references(scene, model)
+        native, kernels = uses_integrator(model), kernel_options(model)
+        refs, variants = _model_plan(scene, model, methods, baseline, notes)
+        if isinstance(refs, References):
             uncertainty[model] = refs.uncertainty
-            kernels = kernel_options(model)
-            variants = [(m, "numba") for m in methods]
-            if baseline and "numpy" in kernels:
-                variants.append(("DOP853", "numpy"))
-            elif baseline:
-                notes.append(f"model {model}: no numpy right-hand side, so no numpy baseline")
-        else:
-            ref_model = reference_model_reference(scene, model)
-            notes.append(
-                f"model {model}: step ladder {REFERENCE_MODEL_STEPS} s (its default "
-                f"solver); reference = {REFERENCE_MODEL_REF}"
-            )
-            variants = [("default", "")]
         for method, kernel in variants:
             for knob, settings, opts in ladder(model, method, rtols):
                 if native:
                     opts = kernels[kernel]
                 traj, wall = timed(scene, model, settings, repeats, **opts)
-                ref = refs.for_method(method) if native else ref_model
+                ref = refs.for_method(method) if isinstance(refs, References) else refs
                 row = {
                     "model": model,
                     "method": method if native else traj.options["solver"],
@@ -242,6 +257,30 @@ def work_precision(
     return with_provenance(frame), uncertainty, notes
 
 
+def _model_plan(
+    scene: Scene, model: str, methods: list[str], baseline: bool, notes: list[str]
+) -> tuple[References | Trajectory, list[tuple[str, str]]]:
+    """The references of ``model`` (``References`` of a native model, the fixed-step reference
+    of a reference model) and its (method, kernel) variants: every one of ``methods`` on the
+    compiled right-hand side, and with ``baseline`` scipy DOP853 on the numpy one where the
+    model has it, for a native model; its default solver for a reference model (``notes``
+    say so)."""
+    if uses_integrator(model):
+        refs = references(scene, model)
+        variants = [(m, "numba") for m in methods]
+        if baseline and "numpy" in kernel_options(model):
+            variants.append(("DOP853", "numpy"))
+        elif baseline:
+            notes.append(f"model {model}: no numpy right-hand side, so no numpy baseline")
+        return refs, variants
+    ref_model = reference_model_reference(scene, model)
+    notes.append(
+        f"model {model}: step ladder {REFERENCE_MODEL_STEPS} s (its default "
+        f"solver); reference = {REFERENCE_MODEL_REF}"
+    )
+    return ref_model, [("default", "")]
+
+
 def with_provenance(frame: pd.DataFrame) -> pd.DataFrame:
     """Machine and package versions as constant columns (so a CSV carries its own context)."""
     info = {
@@ -262,9 +301,9 @@ def baseline_ratios(
     scene: Scene,
     models: tuple[str, ...] | None = None,
     tol: float = 1e-6,
-    rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
+    rtols: Sequence[float] = (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
     repeats: int = 3,
-    progress=print,
+    progress: Progress = print,
 ) -> pd.DataFrame:
     """Per model of ``models`` (default: every model) that has a numpy right-hand side
     (``numpy_models``; the others have no baseline and are left out): the loosest rtol at

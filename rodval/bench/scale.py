@@ -6,18 +6,28 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
 from numba import njit
 
 from rodval.bench.cost import fitted_exponent
-from rodval.bench.precision import SLOW_RUN_S, errors, paper_system_of, timed, with_provenance
+from rodval.bench.precision import (
+    SLOW_RUN_S,
+    Progress,
+    ladder,
+    loosest_within,
+    paper_system_of,
+    with_provenance,
+)
 from rodval.core.scene import Scene, paper_scene
 from rodval.core.settings import IntegratorSettings
 from rodval.models.presets.registry import integrated_models, simulate
 from rodval.solvers.driver import integrate
 from rodval.solvers.guard import GuardSpec
+from rodval.solvers.system import CompiledForm, OdeSystem
 
 #: Chain sizes of ``rodval bench scale`` (each model stops at its own budget, see scale_rows).
 SCALE_N = (2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384, 32768, 65536, 100000)
@@ -39,12 +49,16 @@ def scale_scene(n: int) -> Scene:
 
 
 @njit(cache=True)
-def _rhs_loop(rhs, t, y, P, S, M, L, out, reps):
+def _rhs_loop(  # the compiled form's rhs and its arguments, called reps times
+    rhs: Any, t: float, y: Any, P: Any, S: Any, M: Any, L: Any, out: Any, reps: int
+) -> None:
     for _ in range(reps):
         rhs(t, y, P, S, M, L, out)
 
 
-def compiled_rhs_cost(form, t: float, y: np.ndarray, min_time: float = 0.05, repeats: int = 3):
+def compiled_rhs_cost(
+    form: CompiledForm, t: float, y: np.ndarray, min_time: float = 0.05, repeats: int = 3
+) -> float:
     """Seconds per call of a CompiledForm's right-hand side at (t, y), called from a compiled
     loop (no Python call in between): min over ``repeats`` loops of >= ``min_time`` s."""
     y = np.ascontiguousarray(y, dtype=np.float64)
@@ -63,7 +77,15 @@ def compiled_rhs_cost(form, t: float, y: np.ndarray, min_time: float = 0.05, rep
     return best
 
 
-def compiled_states(system, scene: Scene, settings: IntegratorSettings) -> np.ndarray:
+def _form(system: OdeSystem) -> CompiledForm:
+    """The compiled form of ``system`` (ValueError for a system without one)."""
+    form = system.compiled()
+    if form is None:
+        raise ValueError(f"{type(system).__name__} has no compiled form")
+    return form
+
+
+def compiled_states(system: OdeSystem, scene: Scene, settings: IntegratorSettings) -> np.ndarray:
     """The full state vectors at the scene's output times, from the compiled DOP853 run with
     ``settings`` (no guard; the driver's own run is timed separately)."""
     from rodval.solvers import dop853
@@ -71,18 +93,21 @@ def compiled_states(system, scene: Scene, settings: IntegratorSettings) -> np.nd
 
     times = np.asarray(scene.times, float)
     Y = np.empty((times.size, system.y0.size))
-    n_out = dop853.integrate_compiled(
-        system.compiled(),
-        system.y0,
-        segment_edges(scene),
-        times,
+    controls = dop853.Controls(
         settings.rtol,
         settings.atol,
         settings.max_step,
         settings.first_step,
         settings.max_evaluations,
-        GuardSpec(),  # no guard: the driver's own run is timed separately
+    )
+    n_out = dop853.integrate_compiled(
+        _form(system),
+        system.y0,
+        segment_edges(scene),
+        times,
         Y,
+        controls,
+        GuardSpec(),  # no guard: the driver's own run is timed separately
     ).n_out
     return Y[:n_out]
 
@@ -95,7 +120,7 @@ def subnormal_count(y: np.ndarray) -> int:
 
 def scale_row(
     model: str, n: int, rtol: float = 1e-6, repeats: int = 3, min_time: float = 0.05
-) -> dict:
+) -> dict[str, Any]:
     """One (model, n) of the scale benchmark: set-up, integration wall time (min over
     ``repeats`` runs, one run when slower than SLOW_RUN_S), evaluations, the compiled RHS cost
     at a random state and at the run's state at RUN_STATE_T, the loop's cost per evaluation
@@ -110,7 +135,7 @@ def scale_row(
         runs += [integrate(system, scene, settings, model=model) for _ in range(repeats)]
     traj = runs[-1]
     wall = min(r.stats.wall_s for r in runs)
-    form = system.compiled()
+    form = _form(system)
     y_rand = np.random.default_rng(0).normal(scale=0.5, size=system.y0.size)
     states = compiled_states(system, scene, settings)
     i_mid = int(np.argmin(np.abs(np.asarray(scene.times) - RUN_STATE_T)))
@@ -142,12 +167,12 @@ def scale_row(
 
 
 def scale_rows(
-    n_values=SCALE_N,
+    n_values: Sequence[int] = SCALE_N,
     models: tuple[str, ...] | None = None,
     rtol: float = 1e-6,
     repeats: int = 3,
     budget_s: float = 60.0,
-    progress=print,
+    progress: Progress = print,
 ) -> tuple[pd.DataFrame, list[str]]:
     """``scale_row`` for every n (ascending) and model (default: the native ones), the models
     side by side at each n; a model stops after its first run slower than ``budget_s``
@@ -194,11 +219,11 @@ SCALE_REFERENCE_RTOL = 1e-11
 
 
 def speedup_scale(
-    n_values=(2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 10000),
+    n_values: Sequence[int] = (2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 10000),
     tol: float = 1e-6,
-    rtols=(1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9),
+    rtols: Sequence[float] = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9),
     repeats: int = 3,
-    progress=print,
+    progress: Progress = print,
 ) -> pd.DataFrame:
     """Reduced vs full at equal phi accuracy against n, both models at each n in one run: per
     model the loosest rung of the compiled DOP853 ladder (atol = rtol/100) whose max phi error
@@ -218,15 +243,10 @@ def speedup_scale(
             )
             if not ref.success:
                 raise RuntimeError(f"reference run of {model} n = {n} failed: {ref.stats.message}")
-            best = None
-            for rtol in sorted(rtols, reverse=True):
-                settings = IntegratorSettings("DOP853-numba", rtol=rtol, atol=rtol * 1e-2)
-                traj, wall = timed(scene, model, settings, repeats)
-                err = errors(traj, ref, ("phi",))["max_phi"]
-                if err <= tol:
-                    best = (rtol, wall, traj.stats.nfev, err)
-                    break
-            rtol, wall, nfev, err = best if best else (math.nan,) * 4
+            rungs = ladder(model, "DOP853-numba", rtols)
+            best = loosest_within(scene, model, rungs, ref, tol, repeats)
+            rtol, traj, wall, err = best if best else (math.nan, None, math.nan, math.nan)
+            nfev = traj.stats.nfev if traj is not None else math.nan
             rows.append(
                 {
                     "n": n,

@@ -18,11 +18,13 @@ EI <= 1e6, the compiled Radau IIA at rtol 1e-11 above), in rad.
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from rodval.bench.fast_path import best_run
+from rodval.bench.precision import Progress
 from rodval.core.scene import Chain, InitialState, Latch, Scene, paper_scene
 from rodval.core.settings import AUTO, IntegratorSettings
 from rodval.core.status import Status
@@ -65,7 +67,9 @@ def reference(scene: Scene, model: str, EI: float) -> Trajectory:
     return simulate(scene, model, settings=settings)
 
 
-def _row(scene: Scene, model: str, method: str, tr: Trajectory, ref: Trajectory | None):
+def _row(
+    scene: Scene, model: str, method: str, tr: Trajectory, ref: Trajectory | None
+) -> dict[str, Any]:
     switch = tr.stats.switch or {}
     err = np.nan
     if ref is not None and ref.success and tr.times.size == ref.times.size:
@@ -84,7 +88,9 @@ def _row(scene: Scene, model: str, method: str, tr: Trajectory, ref: Trajectory 
     }
 
 
-def stiffness_rows(repeats: int = 3, progress=print, budget_s: float = 20.0) -> pd.DataFrame:
+def stiffness_rows(
+    repeats: int = 3, progress: Progress = print, budget_s: float = 20.0
+) -> pd.DataFrame:
     """One row per scene, native model and method (module docstring); each run may use
     ``budget_s`` wall seconds (a method that cannot finish is reported so, not waited for)."""
     rows = []

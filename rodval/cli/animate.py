@@ -3,30 +3,29 @@
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
+from rodval.cli import SUMMARIES
 from rodval.cli.options import positive_int
 
+#: ``rodval animate --help``'s description (argparse rewraps it).
+DESCRIPTION = """Write the chain's motion of one or more `rodval simulate` run folders to FILE (.gif
+with Pillow, .mp4 with the ffmpeg program), the runs overlaid in one frame each, the time in the
+title, each latch marked on its hinge node from its lock on, stop contacts marked at their times.
+Nodes from the runs' x, y outputs, else from phi and the rod lengths, hung from the pin at the
+origin or, for a free base, from node 0 where the body moved (output 'base'; a free-base run with
+neither x, y nor 'base' is refused). Each run is drawn only at output times it has: the frames are
+the output times all runs share (a note says so when the runs' times differ; runs sharing fewer than
+2 are refused). A free or prescribed base's body is drawn as a square at its position and attitude
+(from output 'base', or a prescribed base's laws). The folders above FILE are made when missing;
+FILE inside another command's output folder, or a link, is refused before any work."""
 
-def register(sub) -> None:
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     from rodval.report.animation import MAX_FPS, MAX_FRAMES
 
-    p = sub.add_parser(
-        "animate",
-        help="animate runs (GIF or MP4)",
-        description="Write the chain's motion of one or more `rodval simulate` run folders to "
-        "FILE (.gif with Pillow, .mp4 with the ffmpeg program), the runs overlaid in one frame "
-        "each, the time in the title, each latch marked on its hinge node from its lock on, "
-        "stop contacts marked at their times. Nodes from the runs' x, y outputs, else from "
-        "phi and the rod lengths, hung from the pin at the origin or, for a free base, from "
-        "node 0 where the body moved (output 'base'; a free-base run with neither x, y nor "
-        "'base' is refused). Each run is drawn only at output times it has: the frames are "
-        "the output times all runs share (a note says so when the runs' times differ; runs "
-        "sharing fewer than 2 are refused). A free or prescribed base's body is drawn as a square "
-        "at its position and attitude (from output 'base', or a prescribed base's laws). "
-        "The folders above FILE are made when missing; FILE inside another command's output "
-        "folder, or a link, is refused before any work.",
-    )
+    p = sub.add_parser("animate", help=SUMMARIES["animate"], description=DESCRIPTION)
     p.add_argument("runs", metavar="RUN", type=Path, nargs="+", help="run folder(s)")
     p.add_argument("--out", required=True, type=Path, help="FILE.gif or FILE.mp4")
     p.add_argument(
@@ -44,7 +43,7 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     from rodval.core.out_paths import check_output_file, in_command_folder
     from rodval.core.scene_file import scene_from_dict
     from rodval.report.animation import FORMATS, animate_runs, shared_times

@@ -8,12 +8,14 @@ import argparse
 import json
 import shlex
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from rodval import bench
+from rodval.cli import SUMMARIES
 from rodval.cli.options import positive_float
 from rodval.core.out_paths import write_file
 from rodval.core.provenance import provenance
@@ -27,7 +29,7 @@ DEFAULT_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "DOP853-numba")
 DEFAULT_RTOLS = "1e-4,1e-6,1e-8,1e-10"
 
 
-def _float_list(name: str):
+def _float_list(name: str) -> Callable[[str], list[float]]:
     def parse(text: str) -> list[float]:
         values = []
         for part in text.split(","):
@@ -45,7 +47,7 @@ def _float_list(name: str):
     return parse
 
 
-def _choice_list(name: str, allowed: tuple[str, ...]):
+def _choice_list(name: str, allowed: tuple[str, ...]) -> Callable[[str], list[str]]:
     def parse(text: str) -> list[str]:
         values = [v.strip() for v in text.split(",") if v.strip()]
         bad = [v for v in values if v not in allowed]
@@ -80,8 +82,26 @@ def _repeats(text: str) -> int:
     return v
 
 
-def _simple():
-    return (
+#: ``rodval bench --help``'s description (argparse rewraps it).
+DESCRIPTION = """Performance measurements on the paper example; see docs/performance.md."""
+
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    p = sub.add_parser("bench", help=SUMMARIES["bench"], description=DESCRIPTION)
+    bsub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
+    _add_work_precision(bsub)
+    cn = bsub.add_parser("cost-n", help="seconds per RHS evaluation against n, fitted exponent")
+    cn.add_argument("--n-values", type=_int_list, default=[2, 4, 8, 16, 32, 64, 128, 256, 512])
+    cn.set_defaults(func=run_cost_n)
+    sk = bsub.add_parser("skips", help="cost with and without each skipped piece of work")
+    sk.set_defaults(func=run_skips)
+    sp = bsub.add_parser(
+        "speedup", help="reduced vs full (and exudyn) at equal phi accuracy against n"
+    )
+    sp.add_argument("--n-values", type=_int_list, default=[2, 4, 8, 16, 32])
+    sp.set_defaults(func=run_speedup)
+    _add_scale(bsub)
+    for name, text, func in (
         (
             "fast-path",
             "the default method against scipy's DOP853 with and without events and energy",
@@ -92,16 +112,17 @@ def _simple():
             "near-rigid panels: auto against the compiled DOP853 and Radau IIA across EI",
             run_stiffness,
         ),
-    )
+    ):
+        bsub.add_parser(name, help=text).set_defaults(func=func)
+    for q in bsub.choices.values():
+        q.add_argument(
+            "--repeats", type=_repeats, default=3, help="timed runs after a warm-up (min is kept)"
+        )
+        q.add_argument("--out", required=True, type=Path, help="output folder")
+        q.set_defaults(out_folder="bench")
 
 
-def register(sub) -> None:
-    p = sub.add_parser(
-        "bench",
-        help="performance benchmarks (work-precision, cost vs n, ...)",
-        description="Performance measurements on the paper example; see docs/performance.md.",
-    )
-    bsub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
+def _add_work_precision(bsub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     wp = bsub.add_parser("work-precision", help="error against cost for every model and integrator")
     wp.add_argument("--n", type=int, default=8, help="number of rods (default 8)")
     wp.add_argument(
@@ -125,16 +146,9 @@ def register(sub) -> None:
         help="stop a method's ladder after a run slower than this, s (default 20)",
     )
     wp.set_defaults(func=run_work_precision)
-    cn = bsub.add_parser("cost-n", help="seconds per RHS evaluation against n, fitted exponent")
-    cn.add_argument("--n-values", type=_int_list, default=[2, 4, 8, 16, 32, 64, 128, 256, 512])
-    cn.set_defaults(func=run_cost_n)
-    sk = bsub.add_parser("skips", help="cost with and without each skipped piece of work")
-    sk.set_defaults(func=run_skips)
-    sp = bsub.add_parser(
-        "speedup", help="reduced vs full (and exudyn) at equal phi accuracy against n"
-    )
-    sp.add_argument("--n-values", type=_int_list, default=[2, 4, 8, 16, 32])
-    sp.set_defaults(func=run_speedup)
+
+
+def _add_scale(bsub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     sc = bsub.add_parser(
         "scale",
         help="wall time and cost per evaluation against n up to 1e5 (reduced vs full), "
@@ -164,18 +178,9 @@ def register(sub) -> None:
         "--no-speedup", dest="speedup", action="store_false", help="skip the speed-up part"
     )
     sc.set_defaults(func=run_scale)
-    simple = [bsub.add_parser(name, help=text) for name, text, _ in _simple()]
-    for q, (_, _, func) in zip(simple, _simple()):
-        q.set_defaults(func=func)
-    for q in (wp, cn, sk, sp, sc, *simple):
-        q.add_argument(
-            "--repeats", type=_repeats, default=3, help="timed runs after a warm-up (min is kept)"
-        )
-        q.add_argument("--out", required=True, type=Path, help="output folder")
-        q.set_defaults(out_folder="bench")
 
 
-def _write(out: Path, stem: str, frame, title: str, body: list[str]) -> None:
+def _write(out: Path, stem: str, frame: pd.DataFrame, title: str, body: list[str]) -> None:
     out.mkdir(parents=True, exist_ok=True)
     write_file(out / f"{stem}.csv", frame.to_csv(index=False))
     write_file(out / "provenance.json", json.dumps(provenance(), indent=2, default=str))
@@ -185,11 +190,11 @@ def _write(out: Path, stem: str, frame, title: str, body: list[str]) -> None:
     print(f"-> {out / (stem + '.md')}")
 
 
-def _table(frame, columns, floatfmt=".3g") -> str:
+def _table(frame: pd.DataFrame, columns: list[str], floatfmt: str = ".3g") -> str:
     return to_markdown(frame[columns], floatfmt)
 
 
-def run_work_precision(args) -> int:
+def run_work_precision(args: argparse.Namespace) -> int:
     if args.n < 1:
         raise ValueError(f"--n must be an integer >= 1, got {args.n}")
     scene = paper_scene(args.n, times=np.linspace(0, 2, 41))
@@ -200,35 +205,10 @@ def run_work_precision(args) -> int:
     plots = plot_work_precision(frame, args.out)
     ratios = bench.baseline_ratios(scene, tuple(args.models), repeats=args.repeats)
     write_file(args.out / "baseline_ratios.csv", ratios.to_csv(index=False))
-    ratio_cols = [
-        "model",
-        "method",
-        "kernel",
-        "rtol",
-        "wall_s",
-        "nfev",
-        "max_phi",
-        "speedup_vs_numpy_DOP853",
-    ]
+    ratio_cols = "model method kernel rtol wall_s nfev max_phi speedup_vs_numpy_DOP853".split()
     best = bench.cheapest(frame)
-    cols = [
-        "model",
-        "method",
-        "kernel",
-        "rtol",
-        "wall_s",
-        "nfev",
-        "njev",
-        "nlu",
-        "nsteps",
-        "max_phi",
-        "rms_phi",
-        "final_phi",
-        "max_dphi",
-        "max_alpha",
-        "max_beta",
-        "scd",
-    ]
+    cols = [*ratio_cols[:6], *"njev nlu nsteps max_phi rms_phi final_phi max_dphi".split()]
+    cols += "max_alpha max_beta scd".split()
     body = [
         f"Paper example, n = {args.n}, 0..2 s, 41 output times. Errors: max relative over "
         "output times (see rodval.bench).",
@@ -266,7 +246,7 @@ def run_work_precision(args) -> int:
 FIT_N_MIN = 32
 
 
-def run_cost_n(args) -> int:
+def run_cost_n(args: argparse.Namespace) -> int:
     distinct = sorted(set(args.n_values))
     if len(distinct) < 2:
         raise ValueError(
@@ -310,14 +290,14 @@ def run_cost_n(args) -> int:
     return 0
 
 
-def run_skips(args) -> int:
+def run_skips(args: argparse.Namespace) -> int:
     frame = bench.skip_rows(repeats=args.repeats)
     body = [_table(frame, ["skip", "model", "with_skip_s", "without_skip_s", "saving", "note"])]
     _write(args.out, "skips", frame, "What a scene does not need: cost with and without", body)
     return 0
 
 
-def run_fast_path(args) -> int:
+def run_fast_path(args: argparse.Namespace) -> int:
     frame = bench.fast_path_rows(repeats=args.repeats)
     costs = bench.feature_costs(frame)
     body = [
@@ -328,22 +308,8 @@ def run_fast_path(args) -> int:
         "",
         _table(
             frame,
-            [
-                "scene",
-                "feature",
-                "with_feature",
-                "model",
-                "auto_method",
-                "auto_wall_s",
-                "auto_nfev",
-                "scipy_wall_s",
-                "speedup",
-                "events",
-                "max_event_dt_s",
-                "max_impulse_rel",
-                "auto_residual",
-                "scipy_residual",
-            ],
+            "scene feature with_feature model auto_method auto_wall_s auto_nfev scipy_wall_s "
+            "speedup events max_event_dt_s max_impulse_rel auto_residual scipy_residual".split(),
         ),
         "",
         "The default method with the feature over without it (wall time and cost per evaluation):",
@@ -356,7 +322,7 @@ def run_fast_path(args) -> int:
     return 0
 
 
-def run_stiffness(args) -> int:
+def run_stiffness(args: argparse.Namespace) -> int:
     frame = bench.stiffness_rows(repeats=args.repeats)
     body = [
         "Wall s (`stats.wall_s`, best of the repeats after a warm-up) of the default method "
@@ -379,18 +345,12 @@ def run_stiffness(args) -> int:
     return 0
 
 
-def run_speedup(args) -> int:
+def run_speedup(args: argparse.Namespace) -> int:
     frame, notes = bench.speedup_vs_n(args.n_values, repeats=args.repeats)
     body = [
         "Fastest run with phi error <= 1e-6 against each model's own reference; wall times in s.",
         "",
-        frame[
-            [
-                c
-                for c in frame
-                if not c.startswith(("version_", "python", "platform", "processor", "cpu_count"))
-            ]
-        ].to_markdown(index=False, floatfmt=".3g"),
+        _no_provenance(frame).to_markdown(index=False, floatfmt=".3g"),
         "",
         *[f"- {n}" for n in notes],
     ]
@@ -398,14 +358,10 @@ def run_speedup(args) -> int:
     return 0
 
 
-def _no_provenance(frame):
-    return frame[
-        [
-            c
-            for c in frame
-            if not c.startswith(("version_", "python", "platform", "processor", "cpu_count"))
-        ]
-    ]
+def _no_provenance(frame: pd.DataFrame) -> pd.DataFrame:
+    """``frame`` without the provenance columns (versions, machine)."""
+    prov = ("version_", "python", "platform", "processor", "cpu_count")
+    return frame[[c for c in frame if not c.startswith(prov)]]
 
 
 def _load() -> str:
@@ -416,7 +372,7 @@ def _load() -> str:
     return f"load average {one:.2f} / {five:.2f} / {fifteen:.2f} on {os.cpu_count()} cores"
 
 
-def run_scale(args) -> int:
+def run_scale(args: argparse.Namespace) -> int:
     foreign = [m for m in args.models or () if not uses_integrator(m)]
     if foreign:
         raise ValueError(
@@ -437,19 +393,8 @@ def run_scale(args) -> int:
     plot = plot_scale(frame, speedup, args.out / "scale.png")
     wall = frame.pivot(index="n", columns="model", values="wall_s")
     wall.columns = [f"{m} wall (s)" for m in wall.columns]
-    cols = [
-        "model",
-        "n",
-        "setup_s",
-        "wall_s",
-        "nfev",
-        "nsteps",
-        "wall_per_eval_s",
-        "rhs_random_s",
-        "rhs_run_s",
-        "observe_s_per_time",
-        "subnormals_run_state",
-    ]
+    cols = "model n setup_s wall_s nfev nsteps wall_per_eval_s rhs_random_s rhs_run_s".split()
+    cols += ["observe_s_per_time", "subnormals_run_state"]
     body = [
         "Paper chain of n rods, the paper's pulse at the last node, 0..2 s, 21 output times "
         "(phi, phi'), compiled DOP853 at rtol 1e-6 (atol 1e-8); wall = integration and "

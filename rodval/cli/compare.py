@@ -4,30 +4,28 @@ are refused, naming the scene keys that differ, unless ``--allow-different-scene
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from rodval.cli import CliError
+from rodval.cli import SUMMARIES, CliError
+
+#: ``rodval compare --help``'s description (argparse rewraps it).
+DESCRIPTION = """Compare run A against the reference run B (output folders of `rodval simulate`):
+DIR/discrepancies.csv and .md (per quantity: max_abs, rms, final_abs, max_rel, where the maximum is;
+see rodval.analysis.metrics) and DIR/histories.png. When either run recorded lock events (latches),
+also the lock table: per lock label both lock times, dt = t_A - t_B (s), both lock impulses and
+impulse_rel, both impulse_to_rigid and why a lock is not comparable pointwise (locks only one run
+has included), printed and written to DIR/events.csv and DIR/events.md (see rodval.analysis.events).
+A run whose trajectory is not the one its run.json records (cut, edited) or whose run.json records
+no digest of it is refused. DIR must be new, empty or an output folder of rodval compare (refused
+before any work otherwise: another command's folder, a folder holding a file or link rodval did not
+write); the files of an earlier compare there are replaced (an events.csv the new runs have no locks
+for is removed)."""
 
 
-def register(sub) -> None:
-    p = sub.add_parser(
-        "compare",
-        help="compare two runs of the same scene",
-        description="Compare run A against the reference run B (output folders of `rodval "
-        "simulate`): DIR/discrepancies.csv and .md (per quantity: max_abs, rms, final_abs, "
-        "max_rel, where the maximum is; see rodval.analysis.metrics) and DIR/histories.png. "
-        "When either run recorded lock events (latches), also the lock table: per lock "
-        "label both lock times, dt = t_A - t_B (s), both lock impulses and impulse_rel, both "
-        "impulse_to_rigid and why a lock is not comparable pointwise (locks only one run "
-        "has included), printed and written to DIR/events.csv and DIR/events.md (see "
-        "rodval.analysis.events). "
-        "A run whose trajectory is not the one its run.json records (cut, edited) or whose "
-        "run.json records no digest of it is refused. DIR must be new, empty or an output "
-        "folder of rodval compare (refused before any work otherwise: another command's "
-        "folder, a folder holding a file or link rodval did not write); the files of an "
-        "earlier compare there are replaced (an events.csv the new runs have no locks for is "
-        "removed).",
-    )
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    p = sub.add_parser("compare", help=SUMMARIES["compare"], description=DESCRIPTION)
     p.add_argument("a", metavar="A", type=Path, help="run folder to compare")
     p.add_argument("b", metavar="B", type=Path, help="reference run folder")
     p.add_argument("--out", required=True, type=Path, help="output folder")
@@ -41,7 +39,7 @@ def register(sub) -> None:
     p.set_defaults(func=run, out_folder="compare")
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     from rodval.analysis.metrics import discrepancies
     from rodval.core.out_paths import clear_previous, write_file, write_with
     from rodval.core.quantities import ROD_QUANTITIES
@@ -93,6 +91,9 @@ def run(args) -> int:
     return 0
 
 
+if TYPE_CHECKING:
+    import pandas as pd
+
 #: Columns of compare's lock table (A: the run compared, B: the reference run).
 LOCK_TABLE_COLUMNS = {
     "label": "label",
@@ -108,7 +109,7 @@ LOCK_TABLE_COLUMNS = {
 }
 
 
-def lock_table(events_a: list, events_b: list):
+def lock_table(events_a: list[dict[str, Any]], events_b: list[dict[str, Any]]) -> pd.DataFrame:
     """The locks of run A against the reference run B side by side (one row per lock label,
     ``rodval.analysis.events.lock_comparison``, columns LOCK_TABLE_COLUMNS); empty when
     neither run recorded a lock."""

@@ -2,32 +2,33 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+from rodval.cli import SUMMARIES
 from rodval.cli.options import add_model_options, model_options, positive_int, with_scene_values
 from rodval.core.out_paths import clear_previous, write_file
 
 if TYPE_CHECKING:
+    from rodval.core.modes import Modes
     from rodval.core.scene import Scene
 
 
-def register(sub) -> None:
+#: ``rodval modes --help``'s description (argparse rewraps it).
+DESCRIPTION = """Linearize SCENE ('paper', a TOML scene file or the run.json of a run) about its
+initial state at rest or its static equilibrium under its static loads (the loads acting for ever,
+or every load at --load-at T) and write DIR/frequencies.csv (mode, omega_rad_s, f_hz,
+damping_ratio), DIR/modes.csv (mode, kind node_dx/node_dy/hinge, k, value; shapes normalized to a
+largest node displacement of 1), DIR/modes.png and DIR/modes.json. With --compare, also
+DIR/compare.csv: the modes of the other models paired with this model's by MAC (see docs/modes.md)."""
+
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     from rodval.models.presets.registry import MODEL_NAMES
 
-    p = sub.add_parser(
-        "modes",
-        help="natural frequencies and mode shapes about a configuration",
-        description="Linearize SCENE ('paper', a TOML scene file or the run.json of a run) "
-        "about its initial state at rest or its static equilibrium under its static loads "
-        "(the loads acting for ever, or every load at --load-at T) and write "
-        "DIR/frequencies.csv (mode, omega_rad_s, f_hz, damping_ratio), DIR/modes.csv "
-        "(mode, kind node_dx/node_dy/hinge, k, value; shapes normalized to a largest "
-        "node displacement of 1), DIR/modes.png and DIR/modes.json. With --compare, "
-        "also DIR/compare.csv: the modes of the other models paired with this "
-        "model's by MAC (see docs/modes.md).",
-    )
+    p = sub.add_parser("modes", help=SUMMARIES["modes"], description=DESCRIPTION)
     p.add_argument(
         "scene",
         metavar="SCENE",
@@ -77,7 +78,7 @@ def register(sub) -> None:
     p.set_defaults(func=run, out_folder="modes")
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     from rodval.analysis.modes import model_modes
     from rodval.report.figures import plot_modes
 
@@ -118,7 +119,9 @@ def run(args) -> int:
     return 0
 
 
-def _given_options(args, model: str, compare: tuple[str, ...]) -> dict:
+def _given_options(
+    args: argparse.Namespace, model: str, compare: tuple[str, ...]
+) -> dict[str, Any]:
     """The model options of the command line (--set KEY=VALUE, --coefficients; the two for
     one key refused, ``model_options``), each one that the modes of ``model`` or of a
     --compare model take (``MODES_OPTIONS``); any other option is refused, naming it, and so
@@ -158,7 +161,7 @@ def _compare_list(text: str | None) -> tuple[str, ...]:
     return compare
 
 
-def _options_for(model: str, pool: dict) -> dict:
+def _options_for(model: str, pool: dict[str, Any]) -> dict[str, Any]:
     """The options of ``pool`` (the command line's) that ``model``'s modes take."""
     from rodval.models.presets.registry import model_class
 
@@ -166,7 +169,7 @@ def _options_for(model: str, pool: dict) -> dict:
     return {k: v for k, v in pool.items() if k in accepted}
 
 
-def _ran_options(m) -> dict:
+def _ran_options(m: Modes) -> dict[str, Any]:
     """The options the modal analysis of ``m`` ran with (its model's ``MODES_OPTIONS``, and
     exudyn's resolved model options)."""
     from rodval.models.presets.registry import model_class
@@ -176,7 +179,7 @@ def _ran_options(m) -> dict:
     return options
 
 
-def _record(scene: Scene, m, args) -> dict:
+def _record(scene: Scene, m: Modes, args: argparse.Namespace) -> dict[str, Any]:
     """modes.json: what the modes are of and about (the complete resolved scene, as run.json
     records it: ``scene_to_dict``; the options the analysis ran with, the held hinges it
     held), the count of flexible modes written, a free base's rigid modes (reported apart
@@ -184,7 +187,7 @@ def _record(scene: Scene, m, args) -> dict:
     from rodval.core.scene_file import scene_to_dict
     from rodval.mechanics.modal import held_hinges
 
-    record = {
+    record: dict[str, Any] = {
         "scene": scene_to_dict(scene),
         "model": m.model,
         "about": m.about,
@@ -213,7 +216,7 @@ def _record(scene: Scene, m, args) -> dict:
     return record
 
 
-def _summary(scene: Scene, m, args) -> list[str]:
+def _summary(scene: Scene, m: Modes, args: argparse.Namespace) -> list[str]:
     """The printed lines: what was linearized about what, the equilibrium, the modes."""
     import numpy as np
 
@@ -249,8 +252,8 @@ def _summary(scene: Scene, m, args) -> list[str]:
 
 
 def _comparison(
-    scene: Scene, m, models: tuple[str, ...], pool: dict, args
-) -> tuple[list[str], dict]:
+    scene: Scene, m: Modes, models: tuple[str, ...], pool: dict[str, Any], args: argparse.Namespace
+) -> tuple[list[str], dict[str, Modes]]:
     """The other models' modes paired by MAC with ``m`` (written to DIR/compare.csv): the
     lines printed and every model's modes (name -> Modes; modes.json records their options)."""
     from rodval.analysis.modes import compare_modes, model_modes
@@ -277,7 +280,7 @@ def _comparison(
     ], computed
 
 
-def _scene_and_model(args) -> tuple[Scene, str, dict, dict]:
+def _scene_and_model(args: argparse.Namespace) -> tuple[Scene, str, dict[str, Any], dict[str, Any]]:
     """The scene of SCENE ('paper', a TOML file, or a run.json: its recorded scene) with the
     scene values of --set (``with_scene_values``, as ``rodval simulate`` sets them), the
     model (--model, else a run.json's own model, else "full") and, for a run.json of the same
@@ -289,8 +292,8 @@ def _scene_and_model(args) -> tuple[Scene, str, dict, dict]:
     from rodval.core.scene_file import scene_from_dict
 
     doc, model, _, options = rerun_request(args)
-    carried: dict = {}
-    computed: dict = {}
+    carried: dict[str, Any] = {}
+    computed: dict[str, Any] = {}
     if Path(args.scene).suffix == ".json":
         carried, computed = rerun_options(model, options, str(args.scene))
     doc, where = with_scene_values(doc, args)

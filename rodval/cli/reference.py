@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from rodval.cli import SUMMARIES
 from rodval.cli.options import positive_float, positive_int
 
 #: Levels a refinement may ask for: at least three (two changes, one ratio); at most eight
@@ -45,30 +46,27 @@ def level_count(text: str) -> int:
     return v
 
 
-def register(sub) -> None:
-    p = sub.add_parser(
-        "reference",
-        help="refine the exudyn reference until it converges, with its error bar",
-        description="Run SCENE ('paper', a TOML scene file or the run.json of an earlier run: "
-        "its scene) with the exudyn model at levels "
-        "i = 0, 1, ...: elements E0 * 2**i per rod and step H0 / 2**i, until every quantity "
-        "of interest (each lock's time, s, and impulse, relative; the chord angles at the "
-        "scene's output times and their mean after the last lock, the deployed state, rad; on "
-        "a free base the body's attitude the same way) has an estimated error below TOL over "
-        "at least three compared levels, or --levels levels ran. The levels compared are the "
-        "finest and those just before it that finished, are valid by the model's own checks "
-        "and lock alike; a level that fails ends the refinement, and then no error bar is "
-        "given. The error of the finest level is "
-        "Richardson's |d| / (2**p - 1) where the observed order p shows, else the last change "
-        "|d| (rodval.analysis.convergence). Writes DIR/level_I.json as each level finishes (a "
-        "rerun of the same request reuses them), then DIR/levels.csv (one row per level) and "
-        "DIR/reference.json (the finest level's settings, the levels compared and their error "
-        "bar, whose reference_error a study's [agreement] takes as it is; none when a level "
-        "failed or fewer than two levels compare). Exit 0 converged, 1 not converged or no "
-        "error bar (naming the quantity or the level), 2 bad input. DIR must be new, empty or "
-        "an output folder of rodval reference (refused before any work otherwise). The levels "
-        "record the outputs phi, energy (its audit is part of the verdict) and base only.",
-    )
+#: ``rodval reference --help``'s description (argparse rewraps it).
+DESCRIPTION = """Run SCENE ('paper', a TOML scene file or the run.json of an earlier run: its scene)
+with the exudyn model at levels i = 0, 1, ...: elements E0 * 2**i per rod and step H0 / 2**i, until
+every quantity of interest (each lock's time, s, and impulse, relative; the chord angles at the
+scene's output times and their mean after the last lock, the deployed state, rad; on a free base the
+body's attitude the same way) has an estimated error below TOL over at least three compared levels,
+or --levels levels ran. The levels compared are the finest and those just before it that finished,
+are valid by the model's own checks and lock alike; a level that fails ends the refinement, and then
+no error bar is given. The error of the finest level is Richardson's |d| / (2**p - 1) where the
+observed order p shows, else the last change |d| (rodval.analysis.convergence). Writes
+DIR/level_I.json as each level finishes (a rerun of the same request reuses them), then
+DIR/levels.csv (one row per level) and DIR/reference.json (the finest level's settings, the levels
+compared and their error bar, whose reference_error a study's [agreement] takes as it is; none when
+a level failed or fewer than two levels compare). Exit 0 converged, 1 not converged or no error bar
+(naming the quantity or the level), 2 bad input. DIR must be new, empty or an output folder of
+rodval reference (refused before any work otherwise). The levels record the outputs phi, energy (its
+audit is part of the verdict) and base only."""
+
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    p = sub.add_parser("reference", help=SUMMARIES["reference"], description=DESCRIPTION)
     p.add_argument("scene", metavar="SCENE", help="'paper', a TOML scene file or a run.json")
     p.add_argument(
         "--converge",
@@ -471,7 +469,7 @@ def levels_table(levels: Levels) -> str:
     frame = pd.DataFrame.from_records(records)
     tail = ["status", "t_reached", "message", "compared", "reused"]
     frame = frame[[c for c in frame.columns if c not in tail] + tail]
-    return frame.to_csv(index=False, float_format="%.10g")
+    return str(frame.to_csv(index=False, float_format="%.10g"))
 
 
 def reference_record(scene_name: str, tol: float, levels: Levels, t_end: float) -> dict[str, Any]:
@@ -552,7 +550,7 @@ def summary(record: dict[str, Any], levels: Levels) -> list[str]:
     return lines
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     from rodval.core.out_paths import clear_previous, mark_output_folder, write_file
 
     scene, notes = read_scene(args.scene)

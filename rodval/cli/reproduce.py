@@ -2,22 +2,21 @@
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 from pathlib import Path
 
-from rodval.cli import CliError
+from rodval.cli import SUMMARIES, CliError
 from rodval.core.out_paths import write_file
 
+#: ``rodval reproduce --help``'s description (argparse rewraps it).
+DESCRIPTION = """Run the paper's example with the full and reduced models and write DIR/table1.csv,
+DIR/table1.md, DIR/configurations.png; with exudyn installed, also cross-check against the
+independent beam model (DIR/crosscheck.csv, DIR/crosscheck.md)."""
 
-def register(sub) -> None:
-    p = sub.add_parser(
-        "reproduce",
-        help="reproduce the paper's example (Table 1, Fig. 3, cross-check)",
-        description="Run the paper's example with the full and reduced models and "
-        "write DIR/table1.csv, DIR/table1.md, DIR/configurations.png; "
-        "with exudyn installed, also cross-check against the independent "
-        "beam model (DIR/crosscheck.csv, DIR/crosscheck.md).",
-    )
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    p = sub.add_parser("reproduce", help=SUMMARIES["reproduce"], description=DESCRIPTION)
     p.add_argument("target", choices=("paper",), help="what to reproduce")
     p.add_argument("--out", required=True, type=Path, help="output folder")
     p.add_argument(
@@ -43,7 +42,7 @@ def register(sub) -> None:
     p.set_defaults(func=run, out_folder="reproduce")
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     from rodval.report.paper import crosscheck_markdown, reproduce_paper
 
     have_exudyn = importlib.util.find_spec("exudyn") is not None

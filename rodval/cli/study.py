@@ -7,6 +7,7 @@ import signal
 import sys
 from pathlib import Path
 
+from rodval.cli import SUMMARIES
 from rodval.cli.options import (
     acceptance_exit,
     add_junit_option,
@@ -17,18 +18,14 @@ from rodval.cli.options import (
     set_options,
 )
 
+#: ``rodval study --help``'s description (argparse rewraps it).
+DESCRIPTION = """Run every case of the study FILE (TOML, see studies/README.md) and write
+DIR/cases/*.json (one per finished case), DIR/{trajectories,discrepancies,runtime,cases}.csv with
+markdown versions, DIR/report.md and DIR/figures/. An interrupted study resumes where it stopped."""
 
-def register(sub) -> None:
-    from rodval.study.spec import MAX_CASES
 
-    p = sub.add_parser(
-        "study",
-        help="run a study (grid of scenes x models) and write tables and a report",
-        description="Run every case of the study FILE (TOML, see studies/README.md) and write "
-        "DIR/cases/*.json (one per finished case), DIR/{trajectories,discrepancies,"
-        "runtime,cases}.csv with markdown versions, DIR/report.md and DIR/figures/. "
-        "An interrupted study resumes where it stopped.",
-    )
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    p = sub.add_parser("study", help=SUMMARIES["study"], description=DESCRIPTION)
     p.add_argument("file", metavar="FILE", type=Path, help="study file (TOML)")
     p.add_argument("--out", required=True, type=Path, metavar="DIR", help="output folder")
     p.add_argument(
@@ -58,6 +55,14 @@ def register(sub) -> None:
     p.add_argument(
         "--scheduler", metavar="ADDR", help="dask scheduler address, e.g. tcp://host:8786"
     )
+    _add_output_options(p)
+    p.set_defaults(func=run)
+
+
+def _add_output_options(p: argparse.ArgumentParser) -> None:
+    """The options of what the study writes, its size and the messages it prints."""
+    from rodval.study.spec import MAX_CASES
+
     p.add_argument(
         "--fresh",
         action="store_true",
@@ -91,10 +96,9 @@ def register(sub) -> None:
         "(scene. may be left out); the keys: studies/README.md",
     )
     add_junit_option(p)
-    p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     from rodval.study import load_study, run_study
     from rodval.study.spec import MAX_CASES
     from rodval.study.store import StudyStore
