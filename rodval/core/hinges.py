@@ -12,9 +12,6 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any, ClassVar, Self
 
-import numpy as np
-
-from rodval.core.bounds import bounded_number, check_bounds
 from rodval.core.checks import check_keys, check_number
 from rodval.core.keys import BOOLEAN, INTEGER, NUMBER, STRING, Key
 
@@ -160,7 +157,7 @@ class Latch(HingeItem):
                         f"{d0:.6g} rad, dD/dt = {rate0[latch.hinge]:.6g} rad/s"
                     )
                 continue
-            side = np.sign(latch.angle - d0)
+            side = int(latch.angle > d0) - int(latch.angle < d0)
             if side == 0 or (latch.direction is not None and side != latch.direction):
                 raise ValueError(
                     f"latch on hinge {latch.hinge}: the hinge starts at D = {d0:.6g} rad, at or "
@@ -194,6 +191,8 @@ class Stop(HingeItem):
         super().__post_init__()
         if self.side not in ("upper", "lower"):
             raise ValueError(f"stop side must be 'upper' or 'lower', got {self.side!r}")
+        from rodval.core.bounds import bounded_number  # numpy: not at import (`rodval --help`)
+
         # an acting stop adds its stiffness to kappa and its damping to nu: the same bounds
         bounded_number("stop stiffness (N m/rad)", self.stiffness, positive=True)
         bounded_number("stop damping (N m s/rad)", self.damping, positive=False)
@@ -207,6 +206,8 @@ class Stop(HingeItem):
     def check_in(cls, items: Any, scene: Any) -> tuple[Self, ...]:
         """An acting stop adds its stiffness to its hinge's kappa and its damping to nu: the
         sums (all of a hinge's stops acting at once) must stay within the chain's bounds."""
+        from rodval.core.bounds import check_bounds
+
         stops = super().check_in(items, scene)
         for field_name, attr, unit in (
             ("kappa", "stiffness", "N m/rad"),
