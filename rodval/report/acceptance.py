@@ -24,6 +24,7 @@ from typing import Any
 
 import pandas as pd
 
+from rodval.analysis.agreement import locked_hinges
 from rodval.core.out_paths import write_with
 
 #: The metrics an acceptance bound may limit (columns of discrepancies.csv); the study file's
@@ -279,8 +280,6 @@ def _unfinished(run: pd.Series | None, horizon: float) -> str:
 
 def _first_locks(events: pd.DataFrame) -> dict[int, tuple[float, float]]:
     """Hinge -> (t s, impulse N m s) of its first lock among one run's ``events``."""
-    from rodval.report.sample_stats import locked_hinges
-
     locks: dict[int, tuple[float, float]] = {}
     for _, e in events.sort_values("t", kind="stable").iterrows():
         for h in locked_hinges(e["label"]):
@@ -378,8 +377,6 @@ def _latched_checks(
     """One check per model: in at least ``fraction`` of the cases whose scene has latches
     (cases.csv's latch_hinges) every latch locked in that model (its "latch hinge ..."
     events); the failure names the cases where some did not."""
-    from rodval.report.sample_stats import locked_hinges
-
     if "latch_hinges" not in cases:
         return [
             Check("acceptance.events", f"{m}: all latched", "cases.csv has no latch_hinges column")

@@ -226,15 +226,7 @@ def animate_runs(
     index = {k: np.searchsorted(t.times, times - 1e-12) for k, t in runs.items()}
     marks = {k: _event_marks(t) for k, t in runs.items()}
     fig, ax = _frame_axes([*nodes.values(), *bodies.values()], base)
-    lines = {
-        k: ax.plot(
-            [], [], "-o", color=MODEL_COLOURS[i % len(MODEL_COLOURS)], ms=3, lw=1.6, label=k
-        )[0]
-        for i, k in enumerate(runs)
-    }
-    locks = {k: ax.plot([], [], "s", color="red", ms=8, mfc="none", mew=2)[0] for k in runs}
-    body = {k: ax.plot([], [], "-", color=lines[k].get_color(), lw=2.2)[0] for k in bodies}
-    stops = {k: ax.plot([], [], "D", color="orange", ms=7, mfc="none", mew=1.5)[0] for k in runs}
+    lines, locks, body, stops = _artists(ax, list(runs), list(bodies))
     note = _side_panel(fig, ax, len(runs))
     head = ax.set_title("")
     step = float(np.median(np.diff(times))) if times.size > 1 else 0.0
@@ -265,6 +257,22 @@ def animate_runs(
     write_with(path, produce)
     events = tuple((k, te, lab) for k in runs for te, _, lab in marks[k] if te <= times[-1])
     return Animated(path, int(times.size), times, events, tuple(notes))
+
+
+def _artists(ax: Any, runs: list[str], bodies: list[str]) -> tuple[dict[str, Any], ...]:
+    """The lines the frames fill, by run label: each run's chain (in its colour), latch marks
+    (red squares), body outline (``bodies``: the runs with a moving base's body) and stop
+    contacts (orange diamonds)."""
+    lines = {
+        k: ax.plot(
+            [], [], "-o", color=MODEL_COLOURS[i % len(MODEL_COLOURS)], ms=3, lw=1.6, label=k
+        )[0]
+        for i, k in enumerate(runs)
+    }
+    locks = {k: ax.plot([], [], "s", color="red", ms=8, mfc="none", mew=2)[0] for k in runs}
+    body = {k: ax.plot([], [], "-", color=lines[k].get_color(), lw=2.2)[0] for k in bodies}
+    stops = {k: ax.plot([], [], "D", color="orange", ms=7, mfc="none", mew=1.5)[0] for k in runs}
+    return lines, locks, body, stops
 
 
 #: The most events the animation lists at a time (the latest), beside the drawing.

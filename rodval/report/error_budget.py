@@ -68,11 +68,14 @@ def _base_part(
     key: tuple[Any, ...],
     keys: list[str],
     match: list[int],
-    pinned: dict[tuple[Any, ...], float],
+    pinned: dict[tuple[Any, ...], float] | None,
     last: float,
 ) -> tuple[float, str]:
     """(base part, the reason it is blank or ""): 0 on a pinned row, the gap ``last`` less its
-    pinned counterpart's on another base (``split_gaps``)."""
+    pinned counterpart's on another base (``split_gaps``); blank when the gaps' base kind does
+    not vary (``pinned`` None)."""
+    if pinned is None:
+        return math.nan, NO_BASE_AXIS
     kind = key[keys.index("base_kind")]
     counterpart = tuple(key[i] for i in match)
     if kind == "pinned":
@@ -122,11 +125,7 @@ def split_gaps(
     rung carries (or the reference's own error), not that more shapes make the model worse.
     The parts are differences of distances to the reference (each gap is a largest absolute
     difference), with no sign of their own. O(rows of ``gaps``)."""
-    by = list(by)
-    rung_list = sorted(
-        {(str(k), int(p)) for k, p in zip(gaps["kinematics"], gaps["shapes"])},
-        key=lambda r: (KINEMATICS.index(r[0]) if r[0] in KINEMATICS else len(KINEMATICS), r),
-    )
+    rung_list = _rungs(gaps)
     p_max = ladder_p_max(rung_list)
     if p_max is None:
         return None
@@ -134,36 +133,59 @@ def split_gaps(
     kinds = set(gaps["base_kind"].dropna()) if with_kind else set()
     base_varies = "pinned" in kinds and len(kinds) > 1
     keys = [*by, *(["base_kind"] if with_kind else []), "quantity"]
-    table: dict[tuple[Any, ...], dict[tuple[str, int], float]] = {}
-    for rec in gaps.to_dict("records"):
-        row = table.setdefault(tuple(_key(rec[c]) for c in keys), {})
-        row.setdefault((str(rec["kinematics"]), int(rec["shapes"])), float(rec["gap"]))
+    table = _gap_table(gaps, keys)
     top = (EXACT, p_max)
     match = [i for i, c in enumerate(keys) if c not in base_columns and c != "base_kind"]
-    pinned = _pinned_gaps(table, keys, match, top) if base_varies else {}
+    pinned = _pinned_gaps(table, keys, match, top) if base_varies else None
     out = []
     for key, row in table.items():
         gap = {r: row.get(r, math.nan) for r in rung_list}
-        first, exact1, last = gap[(FIRST_ORDER, 1)], gap[(EXACT, 1)], gap[top]
-        base, note = (
-            _base_part(key, keys, match, pinned, last) if base_varies else (math.nan, NO_BASE_AXIS)
-        )
-        quantity = key[-1]
+        base, note = _base_part(key, keys, match, pinned, gap[top])
         out.append(
             {
                 **dict(zip(keys, key)),
-                "unit": UNITS.get(str(quantity), ""),
+                "unit": UNITS.get(str(key[-1]), ""),
                 **{rung_name(*r): gap[r] for r in rung_list},
                 "p_max": p_max,
-                "kinematics": first - exact1,
-                "shapes": exact1 - last,
-                "base": base,
-                "remainder": last if math.isnan(base) else last - base,
+                **_parts(gap, top, base),
                 "base_note": note,
             }
         )
     frame, lead = pd.DataFrame(out), [*keys[:-1], "quantity", "unit"]
     return frame[[*lead, *(c for c in frame.columns if c not in lead)]]
+
+
+def _rungs(gaps: pd.DataFrame) -> list[tuple[str, int]]:
+    """The rungs (kinematics, shapes) of ``gaps``: first-order before exact, then by p."""
+    return sorted(
+        {(str(k), int(p)) for k, p in zip(gaps["kinematics"], gaps["shapes"])},
+        key=lambda r: (KINEMATICS.index(r[0]) if r[0] in KINEMATICS else len(KINEMATICS), r),
+    )
+
+
+def _gap_table(
+    gaps: pd.DataFrame, keys: list[str]
+) -> dict[tuple[Any, ...], dict[tuple[str, int], float]]:
+    """The rungs' gaps by group key (the values of ``keys``), each rung's first row only."""
+    table: dict[tuple[Any, ...], dict[tuple[str, int], float]] = {}
+    for rec in gaps.to_dict("records"):
+        row = table.setdefault(tuple(_key(rec[c]) for c in keys), {})
+        row.setdefault((str(rec["kinematics"]), int(rec["shapes"])), float(rec["gap"]))
+    return table
+
+
+def _parts(
+    gap: dict[tuple[str, int], float], top: tuple[str, int], base: float
+) -> dict[str, float]:
+    """One row's parts (``split_gaps``) from its rungs' ``gap``, ``top`` the exact rung of
+    p_max and ``base`` its base part (NaN when blank)."""
+    first, exact1, last = gap[(FIRST_ORDER, 1)], gap[(EXACT, 1)], gap[top]
+    return {
+        "kinematics": first - exact1,
+        "shapes": exact1 - last,
+        "base": base,
+        "remainder": last if math.isnan(base) else last - base,
+    }
 
 
 def _key(value: Any) -> Any:

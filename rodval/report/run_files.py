@@ -239,9 +239,7 @@ def trajectory_npz(traj: Trajectory) -> bytes:
     for q, arr in traj.values.items():
         arrays[f"values:{q}"] = np.asarray(arr, np.float64)
         arrays[f"k:{q}"] = np.asarray(traj.k_index[q], np.int64)
-    buffer = io.BytesIO()
-    np.savez(buffer, allow_pickle=False, **arrays)
-    return buffer.getvalue()
+    return _npz_bytes(arrays)
 
 
 def value_count(traj: Trajectory) -> int:
@@ -414,16 +412,24 @@ def _scene_arrays(path: Path, rec: dict[str, Any]) -> dict[str, np.ndarray]:
 
 
 def write_run(
-    traj: Trajectory, scene: Scene, out: Path, *, wide: bool = False, table: str = "auto"
+    traj: Trajectory,
+    scene: Scene,
+    out: Path,
+    *,
+    wide: bool = False,
+    table: str = "auto",
+    claimed: bool = False,
 ) -> list[str]:
     """Write the run folder ``out``: the trajectory (``table``: "csv" trajectory.csv, "npz"
     trajectory.npz, "auto" the csv up to ``CSV_MAX_VALUES`` values), trajectory_wide.csv when
     ``wide``, scene_arrays.npz when the scene has large arrays, and the stamped run.json
     (written last) that records their digests and names. The files of the previous run in
     ``out`` that this run does not write are removed first. ValueError (before writing) when
-    ``out`` holds files rodval did not write. Returns the files written besides run.json."""
+    ``out`` holds files rodval did not write, unless ``claimed`` (the caller's
+    ``claim_run_folder`` before the run). Returns the files written besides run.json."""
     out = Path(out)
-    claim_run_folder(out)
+    if not claimed:
+        claim_run_folder(out)
     scene = resolve_damping(scene)  # the c the models ran (converted once per process)
     doc, arrays = scene_record(scene)
     name = table_file(table, value_count(traj))

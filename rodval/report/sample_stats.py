@@ -21,8 +21,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rodval.analysis.agreement import latch_hinges
-from rodval.analysis.agreement import locked_hinges as locked_hinges  # rodval.report.acceptance's
+from rodval.analysis.agreement import latch_hinges, locked_hinges
 from rodval.report.markdown import to_markdown
 
 PERCENTILES = (5, 50, 95)

@@ -151,6 +151,19 @@ def _frame(rows: list[dict[str, Any]]) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=VALUE_COLUMNS)
 
 
+def _values(rows: pd.DataFrame, k: str, value: str) -> pd.DataFrame:
+    """A reader's frame (``VALUE_COLUMNS``) of ``rows``: its case (as text) and model, its
+    column ``k`` as k and ``value`` as the value."""
+    return pd.DataFrame(
+        {
+            "case": rows["case"].astype(str),
+            "model": rows["model"],
+            "k": rows[k].astype(int),
+            "value": rows[value].astype(float),
+        }
+    )
+
+
 def lock_times(t: dict[str, pd.DataFrame]) -> pd.DataFrame:
     """Each run's first lock time of each hinge (s), from events.csv's lock labels."""
     ev = t["events"]
@@ -168,15 +181,7 @@ def lock_impulses(t: dict[str, pd.DataFrame]) -> pd.DataFrame:
     if "impulse" not in ev or "hinge" not in ev or ev.empty:
         return _frame([])
     locks = ev[ev["label"].map(is_lock).to_numpy(bool)].sort_values("t", kind="stable")
-    first = locks.drop_duplicates(["case", "model", "hinge"])
-    return pd.DataFrame(
-        {
-            "case": first["case"].astype(str),
-            "model": first["model"],
-            "k": first["hinge"].astype(int),
-            "value": first["impulse"].astype(float),
-        }
-    )
+    return _values(locks.drop_duplicates(["case", "model", "hinge"]), "hinge", "impulse")
 
 
 def peak_moments(t: dict[str, pd.DataFrame]) -> pd.DataFrame:
@@ -184,16 +189,7 @@ def peak_moments(t: dict[str, pd.DataFrame]) -> pd.DataFrame:
     runtime.csv's recorded peak, else the output times' maximum, as its ``source`` says;
     blank for a hinge whose moment is an impulse at its lock)."""
     p = t["peaks"]
-    if p.empty:
-        return _frame([])
-    return pd.DataFrame(
-        {
-            "case": p["case"].astype(str),
-            "model": p["model"],
-            "k": p["hinge"].astype(int),
-            "value": p["peak_moment"].astype(float),
-        }
-    )
+    return _frame([]) if p.empty else _values(p, "hinge", "peak_moment")
 
 
 def final_attitude(t: dict[str, pd.DataFrame]) -> pd.DataFrame:
@@ -206,14 +202,8 @@ def final_attitude(t: dict[str, pd.DataFrame]) -> pd.DataFrame:
     att = traj[(traj["quantity"] == "base_attitude") & traj["case"].astype(str).isin(free)]
     if att.empty:
         return _frame([])
-    last = att[att["t"] == att.groupby(["case", "model"])["t"].transform("max")]
-    return pd.DataFrame(
-        {
-            "case": last["case"].astype(str),
-            "model": last["model"],
-            "k": last["k"].astype(int),
-            "value": last["value"].astype(float),
-        }
+    return _values(
+        att[att["t"] == att.groupby(["case", "model"])["t"].transform("max")], "k", "value"
     )
 
 

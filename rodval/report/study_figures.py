@@ -5,7 +5,6 @@ from the saved tables (``rodval.report.figures`` draws them; this module chooses
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +24,13 @@ from rodval.report.figures import (
     speedups,
 )
 from rodval.report.markdown import to_markdown
-from rodval.report.tables import axis_columns, trajectory_samples
+from rodval.report.tables import (
+    QUARTERS,
+    axis_columns,
+    report_rods,
+    snapped_times,
+    trajectory_samples,
+)
 
 
 def varying_params(cases: pd.DataFrame, params: list[str]) -> list[str]:
@@ -124,16 +129,6 @@ def _case_runs(sub: pd.DataFrame, labels: list[str], cid: str) -> dict[str, Traj
     }
 
 
-def _snapped_times(
-    sub: pd.DataFrame, times: list[float] | None, horizon: float, fractions: Sequence[float]
-) -> list[float]:
-    """The output times of ``sub`` nearest to the report's ``times`` (s; default: the
-    ``fractions`` of the ``horizon``), those within the horizon, sorted and distinct."""
-    out_t = np.unique(sub["t"].to_numpy())
-    want = times or [horizon * f for f in fractions]
-    return sorted({float(out_t[np.abs(out_t - t).argmin()]) for t in want if t <= horizon})
-
-
 def case_figures(fig_dir: Path, meta: dict[str, Any], tables: dict[str, pd.DataFrame]) -> list[str]:
     """Per report case: every model's time histories of the report's rods and quantities and
     the chain's configurations at the report times; then the values at the report times
@@ -177,7 +172,7 @@ def _one_case_figures(
     lines = [f"### Case `{cid}` (n = {n}, horizon = {horizon:g} s)\n"]
     if not trajs:
         return [*lines, "_No model produced output for this case._\n"]
-    rods = sorted({n if r == "last" else int(r) for r in rep["rods"] if r == "last" or int(r) <= n})
+    rods = report_rods(rep, n)
     qs = [q for q in rep["quantities"] if (sub["quantity"] == q).any()]
     slug = figure_slug(cid)
     hist = plot_time_histories(
@@ -187,7 +182,7 @@ def _one_case_figures(
     moving = _moving(row)
     drawn, lines_not = _drawn(trajs, moving)
     if drawn and ("phi" in qs or (sub["quantity"] == "phi").any()):
-        snapped = _snapped_times(sub, rep["times"], horizon, (0.25, 0.5, 0.75, 1.0))
+        snapped = snapped_times(sub, rep["times"], horizon, QUARTERS)
         conf = plot_configurations(
             drawn,
             snapped,
@@ -241,8 +236,8 @@ def deployment_figures(
         lines += note
         if not trajs:
             continue
-        snapped = _snapped_times(
-            sub, meta["report"]["times"], float(row["horizon"]), (0.0, 0.25, 0.5, 0.75, 1.0)
+        snapped = snapped_times(
+            sub, meta["report"]["times"], float(row["horizon"]), (0.0, *QUARTERS)
         )
         fig = plot_deployment(
             trajs,

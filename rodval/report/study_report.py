@@ -31,6 +31,7 @@ from rodval.analysis.agreement import latch_hinges, lock_list, never_locked
 from rodval.analysis.events import (
     COMPARABLE_DT_S,
     COMPARABLE_ENERGY,
+    EVENT_COLUMNS,
     GRAZING_LOSS,
     event_discrepancies,
 )
@@ -58,23 +59,12 @@ from rodval.report.tables import (
     study_constants,
 )
 
-#: Columns of the events table shown in the report, when present.
+#: Columns of the events table shown in the report, when present: the run, the lock and its
+#: impulse and energies (``EVENT_COLUMNS``' impulse ... energy_lost, the window's end), its
+#: window's state and the root's angular momentum jump.
 EVENT_REPORT_COLUMNS = (
-    "case",
-    "model",
-    "label",
-    "t",
-    "impulse",
-    "impulse_window",
-    "rigid_impulse",
-    "impulse_to_rigid",
-    "kinetic_before",
-    "kinetic_after",
-    "energy_lost",
-    "dissipated_window_end",
-    "energy_residual_window_end",
-    "window_closed",
-    "angular_momentum_root_jump",
+    *("case", "model", "label", "t", *EVENT_COLUMNS[3:10], *EVENT_COLUMNS[-2:]),
+    *("window_closed", "angular_momentum_root_jump"),
 )
 
 
@@ -221,6 +211,28 @@ def _blanks(df: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
+#: What the Deployment section's events table holds, in words.
+EVENTS_TEXT = (
+    "Every recorded event (`events.csv`): lock time t (s); the lock impulse (N m s, on the "
+    "outboard rod, counter-clockwise positive), one definition in every model: the latch "
+    "reaction's impulse, instantaneous part included, averaged over the lock window of "
+    "`impulse_window` s after the lock (the first bending period of the locked segment, the "
+    "rods joined through held hinges, unless the scene sets it; `window_closed` false: the "
+    "run ended inside it); `rigid_impulse`, the plastic lock of rigid rods with the model's "
+    "chord angles and rates just before the lock (`rodval.mechanics.rigid`), and "
+    "`impulse_to_rigid`, their ratio (1 in the rigid-panel limit); the kinetic energy just "
+    "before and just after the lock's instantaneous part and their difference (J: the full "
+    "model's tangent impact takes out little, the reduced model's chord impact the whole "
+    "rigid-panel loss, exudyn's is taken two steps after the lock); the energy dissipated "
+    "from just before the lock to the window's end (instantaneous losses and dampers) and the "
+    "residual of that window's energy balance (J: exudyn's is its integrator's numerical "
+    "dissipation; the kinetic, hinge and bending parts are in `events.csv`); the jump of the "
+    "angular momentum about the root through the lock (N m s; an internal impulse leaves it "
+    "unchanged while hinge 0 is free; blank once hinge 0 is held, where the ground's or the "
+    "base's holding moment makes it meaningless). docs/deployment.md defines each.\n"
+)
+
+
 def _deployment_section(
     fig_dir: Path,
     meta: dict[str, Any],
@@ -237,61 +249,50 @@ def _deployment_section(
         return []
     if meta.get("sample"):
         return sample_events_section(meta, tables, events)
-    ref, labels = meta["reference"], [m["label"] for m in meta["models"]]
     keep = _keep(constants)
+    shown = events[[c for c in EVENT_REPORT_COLUMNS if c in events]]
     lines = [
         "## Deployment: locks, impulses and residual vibration\n",
-        "Every recorded event (`events.csv`): lock time t (s); the lock impulse (N m s, on "
-        "the outboard rod, counter-clockwise positive), one definition in every model: the "
-        "latch reaction's impulse, instantaneous part included, averaged over the lock "
-        "window of `impulse_window` s after the lock (the first bending period of the locked "
-        "segment, the rods joined through held hinges, unless the scene sets it; "
-        "`window_closed` false: the run ended inside it); "
-        "`rigid_impulse`, the plastic lock of rigid rods with the model's chord angles and "
-        "rates just before the lock (`rodval.mechanics.rigid`), and `impulse_to_rigid`, their "
-        "ratio (1 in the rigid-panel limit); the kinetic energy just before and just after "
-        "the lock's instantaneous part and their difference (J: the full model's tangent "
-        "impact takes out little, the reduced model's chord impact the whole rigid-panel "
-        "loss, exudyn's is taken two steps after the lock); the energy dissipated from "
-        "just before the lock to the window's end (instantaneous losses and dampers) and the "
-        "residual of that window's energy balance (J: exudyn's is its integrator's numerical "
-        "dissipation; the kinetic, hinge and bending parts are in `events.csv`); the jump of "
-        "the angular momentum about the root through the lock (N m s; an internal impulse "
-        "leaves it unchanged while hinge 0 is free; blank once hinge 0 is held, where the "
-        "ground's or the base's holding moment makes it meaningless). docs/deployment.md "
-        "defines each.\n",
-        to_markdown(_blanks(keep(events[[c for c in EVENT_REPORT_COLUMNS if c in events]])), ".5g"),
+        EVENTS_TEXT,
+        to_markdown(_blanks(keep(shown)), ".5g"),
     ]
-    silent = [lab for lab in labels if not (events["model"] == lab).any()]
+    silent = [m["label"] for m in meta["models"] if not (events["model"] == m["label"]).any()]
     if silent:
         lines.append(
             "No events from " + ", ".join(f"`{s}`" for s in silent) + ": those runs did not "
             "latch (a model without latch support ignores the scene's latches).\n"
         )
-    disc = event_discrepancies(events, ref)
-    if not disc.empty:
-        lines += [
-            f"Lock discrepancies against `{ref}` (dt in s, impulse_rel = |dS| / |S_ref| of the "
-            "lock impulses, rigid_rel = the same of the rigid-panel impulses; dE_lost in J, "
-            "of different quantities, see above). A lock is compared pointwise only when the "
-            "models reach it in the same state: every earlier lock within "
-            f"{COMPARABLE_DT_S * 1e3:g} ms of the reference's and the kinetic plus bending "
-            f"energy before it within {COMPARABLE_ENERGY:.0%}, and neither lock grazing (its "
-            f"rigid-panel lock taking less than {GRAZING_LOSS:.0%} of the kinetic energy: the "
-            "hinge creeps onto the latch angle, and its time hangs on small differences of state), neither "
-            "lock's window overlapping another lock of its run (the windowed impulses are not "
-            "separable) and neither an exudyn window of fewer than "
-            f"{MIN_WINDOW_STEPS} steps of its fixed step; "
-            "`not_comparable` says why otherwise: the two runs reach that lock in different "
-            "states, so its pointwise gap adds up the earlier differences. Whether such a gap "
-            "is a model's error or the motion's own sensitivity is measured, not assumed: the "
-            "Answer above compares it with the reference's twin run when the study has one:"
-            "\n",
-            to_markdown(keep(disc), ".3g"),
-        ]
+    lines += _discrepancy_lines(event_discrepancies(events, meta["reference"]), meta, keep)
     lines += peak_moment_lines(tables, events, meta["models"], keep)
     lines += _residual_lines(tables, events, keep)
     return [*lines, *deployment_figures(fig_dir, meta, tables, events)]
+
+
+def _discrepancy_lines(
+    disc: pd.DataFrame, meta: dict[str, Any], keep: Callable[[pd.DataFrame], pd.DataFrame]
+) -> list[str]:
+    """The lock discrepancies against the reference (``event_discrepancies``) as markdown
+    lines, with when a lock is compared pointwise; none without any."""
+    if disc.empty:
+        return []
+    return [
+        f"Lock discrepancies against `{meta['reference']}` (dt in s, impulse_rel = |dS| / "
+        "|S_ref| of the lock impulses, rigid_rel = the same of the rigid-panel impulses; "
+        "dE_lost in J, of different quantities, see above). A lock is compared pointwise "
+        "only when the models reach it in the same state: every earlier lock within "
+        f"{COMPARABLE_DT_S * 1e3:g} ms of the reference's and the kinetic plus bending "
+        f"energy before it within {COMPARABLE_ENERGY:.0%}, and neither lock grazing (its "
+        f"rigid-panel lock taking less than {GRAZING_LOSS:.0%} of the kinetic energy: the "
+        "hinge creeps onto the latch angle, and its time hangs on small differences of "
+        "state), neither lock's window overlapping another lock of its run (the windowed "
+        "impulses are not separable) and neither an exudyn window of fewer than "
+        f"{MIN_WINDOW_STEPS} steps of its fixed step; `not_comparable` says why otherwise: "
+        "the two runs reach that lock in different states, so its pointwise gap adds up the "
+        "earlier differences. Whether such a gap is a model's error or the motion's own "
+        "sensitivity is measured, not assumed: the Answer above compares it with the "
+        "reference's twin run when the study has one:\n",
+        to_markdown(keep(disc), ".3g"),
+    ]
 
 
 def _residual_lines(
@@ -357,7 +358,7 @@ def peak_moment_lines(
     return lines
 
 
-def _keep(constants: dict[str, Any]) -> Any:
+def _keep(constants: dict[str, Any]) -> Callable[[pd.DataFrame], pd.DataFrame]:
     """A function that drops the study's constant columns from a table."""
     return lambda df: drop_study_constants(df, constants)
 
@@ -516,13 +517,7 @@ def build_report(out: str | Path) -> Path:
     if figs:
         lines += ["## Discrepancy, run time and speed-up against the grid parameters\n", *figs]
     lines += sample_section(meta, tables, events)
-    lines += sensitivity_section(
-        fig_dir,
-        meta,
-        tables,
-        events,
-        peaks,
-    )
+    lines += sensitivity_section(fig_dir, meta, tables, events, peaks)
     lines += _deployment_section(fig_dir, meta, tables, events, constants)
     lines += modes_section(out, fig_dir, meta)
     lines += ["## Time histories and configurations\n", *case_figures(fig_dir, meta, tables)]

@@ -295,7 +295,7 @@ def _stability_map(
     ]
 
 
-# ---- the answer the report opens with ----------------------------------------------------
+# ---- the answer the report opens with (a one-model study's verdict) ----------------------
 
 
 def opening_section(
@@ -305,44 +305,29 @@ def opening_section(
     peaks: pd.DataFrame,
 ) -> list[str]:
     """The report's opening, its answer (markdown lines): with two or more models, each
-    against the reference (``answer_section``); with one, its verdict (``verdict_section``:
-    the acceptance gate, the runs, the quantities of interest over the cases; ``peaks``: the
-    report's peak hinge moments, ``rodval.report.study_report.peak_hinge_moments``) and,
-    when the study runs the model's twin ([agreement.twin]), the one comparison there is:
-    how long the twin agrees with it."""
-    if len(meta["models"]) > 1:
-        return answer_section(meta, tables, events)
-    twin = agreement_lines(meta, tables, events)
-    label = meta["models"][0]["label"]
-    head = [f"### `{label}` against its twin run\n"] if twin else []
-    return [*verdict_section(meta, tables, events, peaks), *head, *twin]
-
-
-# ---- the verdict a one-model study opens with ---------------------------------------------
-
-
-def verdict_section(
-    meta: dict[str, Any],
-    tables: dict[str, pd.DataFrame],
-    events: pd.DataFrame,
-    peaks: pd.DataFrame,
-) -> list[str]:
-    """A one-model study's answer (markdown lines): the acceptance gate's verdict
+    against the reference (``answer_section``); with one, its verdict: the acceptance gate's
     (``_gate_sentence``), how the runs ended and whether they deployed (``_runs_sentence``),
     and the design quantities (``rodval.report.sensitivity.design_values``: lock time, lock
     impulse and peak hinge moment per hinge, a free base's attitude at t_end) over the cases:
     min, PERCENTILES, max and the worst case (``_quantities_lines``; ``peaks``: the report's
-    peak hinge moments). Nothing in it compares models: there is one."""
+    peak hinge moments, ``rodval.report.study_report.peak_hinge_moments``); nothing in it
+    compares models. When the study runs the one model's twin ([agreement.twin]), the one
+    comparison there is follows: how long the twin agrees with it."""
+    if len(meta["models"]) > 1:
+        return answer_section(meta, tables, events)
     label = meta["models"][0]["label"]
     runtime = tables["runtime"][tables["runtime"]["model"] == label]
     values = design_values({**tables, "events": events, "peaks": peaks})
     values = values[values["model"] == label]
     mine = peaks[peaks["model"] == label] if "model" in peaks else peaks
+    twin = agreement_lines(meta, tables, events)
     return [
         "## Answer\n",
         _gate_sentence(meta, tables, events),
         _runs_sentence(label, runtime, latch_hinges(tables["cases"]), events, values),
         *_quantities_lines(values, mine, runtime["case"].astype(str).tolist()),
+        *([f"### `{label}` against its twin run\n"] if twin else []),
+        *twin,
     ]
 
 

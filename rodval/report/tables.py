@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from rodval.analysis.metrics import METRICS
@@ -26,69 +28,24 @@ ERROR_BUDGET = "error_budget"
 ALL_TABLES = (*TABLES, "events", "modes", "mac", "mode_shapes", ERROR_BUDGET)
 #: The report's figure folder in a study folder (the PNG files report.md links).
 FIGURES = "figures"
-FIXED = (
-    "case",
-    "n",
-    "horizon",
-    "model",
-    "reference",
-    "quantity",
-    "method",
-    "rtol",
-    "atol",
-    "max_step",
-    "step",
-    "wall_s",
-    "setup_s",
-    "nfev",
-    "njev",
-    "nlu",
-    "nsteps",
-    "t_reached",
-    "status",
-    "message",
-    "t",
-    "k",
-    "value",
-    "l",
-    "fingerprint",
-    *METRICS,
-)
 #: Columns each table must have (every column ``rodval.study.tables`` writes but the grid
 #: axes, which depend on the study).
 REQUIRED = {
     "cases": ("case", "n", "horizon", "l"),
     "trajectories": ("case", "model", "t", "quantity", "k", "value"),
-    "discrepancies": (
-        "case",
-        "n",
-        "horizon",
-        "model",
-        "reference",
-        "quantity",
-        "max_abs",
-        "rms",
-        "final_abs",
-        "max_rel",
-        "status",
+    "discrepancies": tuple(
+        "case n horizon model reference quantity max_abs rms final_abs max_rel status".split()
     ),
-    "runtime": (
-        "case",
-        "n",
-        "horizon",
-        "model",
-        "method",
-        "rtol",
-        "atol",
-        "wall_s",
-        "setup_s",
-        "nfev",
-        "nsteps",
-        "t_reached",
-        "status",
-        "message",
+    "runtime": tuple(
+        "case n horizon model method rtol atol wall_s setup_s nfev nsteps t_reached status "
+        "message".split()
     ),
 }
+#: The tables' fixed columns: a grid axis labelled like one keeps its full path as its column.
+FIXED = frozenset(
+    [*(c for cols in REQUIRED.values() for c in cols), "max_step", "step", "njev", "nlu"]
+    + ["fingerprint", *METRICS]
+)
 
 
 def axis_columns(meta: dict[str, Any]) -> dict[str, str]:
@@ -281,15 +238,8 @@ def trajectory_samples(
         if sub.empty:
             continue
         horizon = float(cases.loc[cases["case"] == cid, "horizon"].iloc[0])
-        n = int(cases.loc[cases["case"] == cid, "n"].iloc[0])
-        rods = sorted(
-            {n if r == "last" else int(r) for r in rep["rods"] if r == "last" or int(r) <= n}
-        )
-        want = rep["times"] or [horizon * f for f in (0.25, 0.5, 0.75, 1.0)]
-        out_times = sub["t"].unique()
-        snapped = sorted(
-            {float(out_times[abs(out_times - t).argmin()]) for t in want if t <= horizon}
-        )
+        rods = report_rods(rep, int(cases.loc[cases["case"] == cid, "n"].iloc[0]))
+        snapped = snapped_times(sub, rep["times"], horizon, QUARTERS)
         pick = sub[
             sub["t"].isin(snapped) & sub["k"].isin(rods) & sub["quantity"].isin(rep["quantities"])
         ]
@@ -300,6 +250,27 @@ def trajectory_samples(
             wide.insert(0, "case", cid)
         parts.append(wide)
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
+
+
+#: The report times of a case whose [report] gives none: these fractions of its horizon.
+QUARTERS = (0.25, 0.5, 0.75, 1.0)
+
+
+def report_rods(rep: dict[str, Any], n: int) -> list[int]:
+    """The rods the report (``rep``: study.json's ``report``) draws of a chain of ``n`` rods,
+    "last" as n, in order, each once."""
+    return sorted({n if r == "last" else int(r) for r in rep["rods"] if r == "last" or int(r) <= n})
+
+
+def snapped_times(
+    sub: pd.DataFrame, times: list[float] | None, horizon: float, fractions: Sequence[float]
+) -> list[float]:
+    """The output times of ``sub`` (rows of the trajectories table) nearest to the report's
+    ``times`` (s; default: the ``fractions`` of the ``horizon``), those within the horizon,
+    sorted and distinct."""
+    out_t = np.unique(sub["t"].to_numpy())
+    want = times or [horizon * f for f in fractions]
+    return sorted({float(out_t[np.abs(out_t - t).argmin()]) for t in want if t <= horizon})
 
 
 def read_events(out: Path) -> pd.DataFrame:

@@ -105,16 +105,9 @@ def acceptance_spec(
     valid = table.get("valid", False)
     if not isinstance(valid, bool):
         raise err(".valid", f"must be true or false, got {valid!r}")
-    raw = table.get("bound", [])
-    if not isinstance(raw, list) or not all(isinstance(b, dict) for b in raw):
-        raise err(".bound", "must be an array of tables [[acceptance.bound]]")
-    raw_events = table.get("event", [])
-    if not isinstance(raw_events, list) or not all(isinstance(b, dict) for b in raw_events):
-        raise err(".event", "must be an array of tables [[acceptance.event]]")
+    raw, raw_events = _tables(table, "bound", err), _tables(table, "event", err)
     scalars = _scalars(table, err)
-    raw_requires = table.get("require", [])
-    if not isinstance(raw_requires, list) or not all(isinstance(b, dict) for b in raw_requires):
-        raise err(".require", "must be an array of tables [[acceptance.require]]")
+    raw_requires = _tables(table, "require", err)
     if not raw and not valid and not raw_events and not raw_requires and not scalars:
         raise err(
             "",
@@ -139,6 +132,14 @@ def acceptance_spec(
     events = _event_bounds(raw_events, others, reference, where, err)
     requires = requirement_tables(raw_requires, labels, quantities, scenes, where, err)
     return {"valid": valid, "bounds": bounds, "events": events, "requires": requires, **scalars}
+
+
+def _tables(table: dict[str, Any], key: str, err: Any) -> list[dict[str, Any]]:
+    """The [[acceptance.KEY]] tables (none: []), an array of tables or the error."""
+    raw = table.get(key, [])
+    if not isinstance(raw, list) or not all(isinstance(b, dict) for b in raw):
+        raise err(f".{key}", f"must be an array of tables [[acceptance.{key}]]")
+    return raw
 
 
 def _scalars(table: dict[str, Any], err: Any) -> dict[str, float]:

@@ -32,13 +32,14 @@ def plain_document(doc: Any, where: str) -> dict[str, Any]:
     return plain
 
 
-def flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    """The leaves of nested tables by their dotted paths: {"scene": {"n": v}} -> {"scene.n": v}."""
+def flatten(d: dict[str, Any], prefix: str = "", leaf: str = "") -> dict[str, Any]:
+    """The leaves of nested tables by their dotted paths: {"scene": {"n": v}} -> {"scene.n": v};
+    a table holding the key ``leaf`` (e.g. a sample's "dist") is a leaf too."""
     out: dict[str, Any] = {}
     for k, v in d.items():
         path = f"{prefix}.{k}" if prefix else str(k)
-        if isinstance(v, dict):
-            out.update(flatten(v, path))
+        if isinstance(v, dict) and not (leaf and leaf in v):
+            out.update(flatten(v, path, leaf))
         else:
             out[path] = v
     return out

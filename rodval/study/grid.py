@@ -19,7 +19,7 @@ from typing import Any
 
 from rodval.study.document import flatten, key_error
 from rodval.study.model_specs import INTEGRATOR_KEYS
-from rodval.study.sampling import flatten_keys, sample_columns
+from rodval.study.sampling import sample_columns
 
 GRID_ROOTS = ("scene", "integrator", "models")
 
@@ -171,5 +171,5 @@ def sample_meta(table: Any) -> dict[str, Any] | None:
         "design": table.get("design", "sobol"),
         "count": table["count"],
         "seed": table["seed"],
-        "keys": {p: dict(v) for p, v in flatten_keys(table["keys"]).items()},
+        "keys": {p: dict(v) for p, v in flatten(table["keys"], leaf="dist").items()},
     }

@@ -21,15 +21,16 @@ from tqdm import tqdm
 
 from rodval.analysis.metrics import compare_runs
 from rodval.core.checks import as_path, check_choice, check_type
+from rodval.core.out_paths import write_file
 from rodval.core.provenance import provenance
 from rodval.core.scene_file import scene_to_dict
 from rodval.core.status import STATUS_CRASHED, STATUS_DIVERGED, STATUS_TIMEOUT, update_status
 from rodval.core.trajectory import Trajectory
 from rodval.study.case import Case
 from rodval.study.records import CaseRecord, DamagedRecord, RunRecord, read_case
-from rodval.study.schedule import BACKENDS, default_workers, run_dask, run_processes
+from rodval.study.schedule import BACKENDS, Done, default_workers, run_dask, run_processes
 from rodval.study.spec import StudySpec, load_study
-from rodval.study.store import StudyStore, write_json_atomic, write_text_atomic
+from rodval.study.store import StudyStore, write_json_atomic
 
 RETRIED = (STATUS_TIMEOUT, STATUS_CRASHED)
 
@@ -163,16 +164,7 @@ def run_study(
     """
     spec = _as_study(spec)
     out = as_path("out", out)
-    check_choice("backend", backend, BACKENDS)
-    if backend == "dask" and not scheduler:
-        raise ValueError("backend 'dask' needs --scheduler ADDRESS of a running dask scheduler")
-    if backend == "processes" and scheduler is not None:
-        raise ValueError(
-            f"scheduler {scheduler!r:.60}: the processes backend runs on this machine and takes "
-            "no scheduler; use backend 'dask'"
-        )
-    workers = _check_workers(default_workers() if workers is None else workers)
-    _check_case_timeout(case_timeout)
+    runner = _runner(backend, workers, scheduler, case_timeout)
     if out.exists() and not out.is_dir():
         raise ValueError(f"out must be a folder, got the file {str(out)!r}")
     start = time.perf_counter()
@@ -182,22 +174,13 @@ def run_study(
     with store.lock():
         store.claim(study_meta(spec, store.out), fresh=fresh)
         write_json_atomic(store.out / "provenance.json", provenance())
-        write_text_atomic(store.out / "study.toml", spec.text)
+        write_file(store.out / "study.toml", spec.text)
         reused = [c.id for c in spec.cases if resume and _reusable(store, c, warnings)]
         # Longest first (rods x horizon as the cost guess) so that no big case starts last.
         todo = sorted(
             (c for c in spec.cases if c.id not in reused), key=lambda c: -c.scene.n * c.scene.t_end
         )
-        failed = _run_cases(
-            store,
-            spec.name,
-            todo,
-            backend=backend,
-            workers=workers,
-            scheduler=scheduler,
-            case_timeout=case_timeout,
-            progress=progress,
-        )
+        failed = _run_cases(store, spec.name, todo, runner, progress)
         _write_results(store.out, spec, report)
     return StudyRun(
         out=store.out,
@@ -220,15 +203,41 @@ def _as_study(spec: Any) -> StudySpec:
     return spec
 
 
-def _check_workers(workers: Any) -> int:
-    """``workers`` when it is an integer >= 1, else ValueError."""
+@dataclass(frozen=True)
+class Runner:
+    """Where a study's cases run: ``backend`` "processes" (``workers`` warm processes on this
+    machine) or "dask" (the cluster at ``scheduler``), each case within ``case_timeout`` s
+    (None: no limit)."""
+
+    backend: str
+    workers: int
+    scheduler: str | None
+    case_timeout: float | None
+
+    def run(self, payloads: list[dict[str, Any]], done: Done) -> None:
+        """Run the ``payloads``, calling ``done`` as each ends."""
+        if self.backend == "processes":
+            run_processes(payloads, done, self.workers, self.case_timeout)
+        else:
+            assert self.scheduler is not None
+            run_dask(payloads, done, self.scheduler, self.case_timeout)
+
+
+def _runner(backend: Any, workers: Any, scheduler: Any, case_timeout: Any) -> Runner:
+    """``run_study``'s runner arguments checked (ValueError naming the first that is wrong):
+    a backend of BACKENDS, a scheduler for dask and none for processes, ``workers`` an
+    integer >= 1 (None: every core), ``case_timeout`` None or a finite number > 0 (s)."""
+    check_choice("backend", backend, BACKENDS)
+    if backend == "dask" and not scheduler:
+        raise ValueError("backend 'dask' needs --scheduler ADDRESS of a running dask scheduler")
+    if backend == "processes" and scheduler is not None:
+        raise ValueError(
+            f"scheduler {scheduler!r:.60}: the processes backend runs on this machine and takes "
+            "no scheduler; use backend 'dask'"
+        )
+    workers = default_workers() if workers is None else workers
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
-    return workers
-
-
-def _check_case_timeout(case_timeout: Any) -> None:
-    """ValueError unless ``case_timeout`` is None (no limit) or a finite number > 0 (s)."""
     if case_timeout is not None and (
         isinstance(case_timeout, bool)
         or not isinstance(case_timeout, int | float)
@@ -237,20 +246,13 @@ def _check_case_timeout(case_timeout: Any) -> None:
         raise ValueError(
             f"case_timeout must be a finite number > 0 s or None (no limit), got {case_timeout!r:.60}"
         )
+    return Runner(backend, workers, scheduler, case_timeout)
 
 
 def _run_cases(
-    store: StudyStore,
-    name: str,
-    todo: list[Case],
-    *,
-    backend: str,
-    workers: int,
-    scheduler: str | None,
-    case_timeout: float | None,
-    progress: bool,
+    store: StudyStore, name: str, todo: list[Case], runner: Runner, progress: bool
 ) -> int:
-    """Run the cases ``todo`` on the backend, writing each one's record to ``store`` as it
+    """Run the cases ``todo`` on the ``runner``, writing each one's record to ``store`` as it
     finishes (with a progress bar named ``name``); returns the number of failed model runs.
     A case with a twin run ([agreement.twin]) is two payloads, the case's and the twin's
     (``Case.payloads``); its record is written when both have finished."""
@@ -270,18 +272,14 @@ def _run_cases(
         if len(got) < expected:
             return
         record = case_record(case, [run for part in got for run in part])
-        write_text_atomic(store.case_path(case.id), record.to_json())
+        write_file(store.case_path(case.id), record.to_json())
         failed += sum(r.status != 0 for r in record.runs)
         bar.update(1)
         bar.set_postfix(failed_runs=failed)
 
     payloads = [p for c in todo for p in c.payloads()]
     try:
-        if backend == "processes":
-            run_processes(payloads, done, workers, case_timeout)
-        else:
-            assert scheduler is not None
-            run_dask(payloads, done, scheduler, case_timeout)
+        runner.run(payloads, done)
     finally:
         bar.close()
     return failed

@@ -37,6 +37,7 @@ import numpy as np
 
 from rodval.core.checks import check_keys
 from rodval.report.sensitivity import SALTELLI, saltelli_count_error, saltelli_unit_design
+from rodval.study.document import flatten
 
 DESIGNS = ("sobol", "lhs", "random", SALTELLI)
 SAMPLE_KEYS = {"design", "count", "seed", "keys"}
@@ -130,18 +131,6 @@ def unit_design(design: str, count: int, dims: int, seed: int) -> np.ndarray:
     return points
 
 
-def flatten_keys(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    """Dotted paths -> distribution tables (a table with ``dist`` ends a path)."""
-    out: dict[str, Any] = {}
-    for k, v in d.items():
-        path = f"{prefix}.{k}" if prefix else str(k)
-        if isinstance(v, dict) and "dist" not in v:
-            out.update(flatten_keys(v, path))
-        else:
-            out[path] = v
-    return out
-
-
 def sample_columns(table: Any, where: str) -> dict[str, list[float]]:
     """The ``[sample]`` table checked and drawn: key path -> its ``count`` values, in sample
     order. ValueError naming ``sample.<key>`` for anything wrong, before any case exists."""
@@ -176,7 +165,7 @@ def sample_columns(table: Any, where: str) -> dict[str, list[float]]:
         )
     specs = {
         path: check_distribution(f"{where} key 'sample.keys.{path}'", spec)
-        for path, spec in flatten_keys(keys).items()
+        for path, spec in flatten(keys, leaf="dist").items()
     }
     if design == SALTELLI and (why := saltelli_count_error(count, len(specs))):
         raise ValueError(f"{where} key 'sample.count': {why}")

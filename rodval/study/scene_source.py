@@ -45,7 +45,8 @@ def resolve_scene(
     table: Any, folder: Path, where: str, study_keys: Iterable[str] = ()
 ) -> tuple[Any, SceneFile | None]:
     """The [scene] ``table`` of the study ``where`` with its ``file`` (relative to
-    ``folder``) read and the table's other keys laid over it (``merge_scene``), and the file
+    ``folder``) read and the table's other keys laid over it as a later scene file's are
+    (``merge_documents``: neither is changed), and the file
     read; ``table`` itself and None when it names no file. ``study_keys``: the top-level keys
     of a study file; a file holding one that no scene file has is refused as a study file."""
     if not isinstance(table, dict) or "file" not in table:
@@ -61,13 +62,7 @@ def resolve_scene(
             "scene file (docs/scene_file.md)",
         )
     overrides = {k: v for k, v in table.items() if k != "file"}
-    return merge_scene(document, overrides), SceneFile(str(path), digest)
-
-
-def merge_scene(document: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
-    """``document`` (a scene file's table) with ``overrides`` laid over it as a later scene
-    file is (``merge_documents``). Neither argument is changed."""
-    return merge_documents(document, overrides)
+    return merge_documents(document, overrides), SceneFile(str(path), digest)
 
 
 def _scene_path(table: dict[str, Any], folder: Path, where: str) -> Path:

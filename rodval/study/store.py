@@ -55,6 +55,8 @@ MAX_NAME = 120
 
 #: The files a study writes at the top of its folder besides its tables.
 TOP_FILES = ("study.json", "study.toml", "provenance.json", "report.md", MANIFEST)
+#: Those and its tables (``<name>.csv`` and ``.md``).
+STUDY_TOP_FILES = (*TOP_FILES, *(f"{t}.{e}" for t in ALL_TABLES for e in ("csv", "md")))
 
 
 class FolderBusy(ValueError):
@@ -71,14 +73,9 @@ def case_file_name(case_id: str) -> str:
     return f"{safe[: MAX_NAME - 5 - 17]}~{digest}.json"
 
 
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write to a temporary file beside ``path`` and rename it over ``path``, never through
-    a link (``rodval.core.out_paths.write_file``)."""
-    write_file(path, text)
-
-
 def write_json_atomic(path: Path, obj: Any) -> None:
-    write_text_atomic(path, json.dumps(obj, indent=1, default=repr))
+    """``obj`` as JSON, written atomically, never through a link (``write_file``)."""
+    write_file(path, json.dumps(obj, indent=1, default=repr))
 
 
 class StudyStore:
@@ -152,8 +149,7 @@ class StudyStore:
         rel = inside(path, self.out)
         if rel is None:
             return None
-        top = {*TOP_FILES, *HOUSEKEEPING, *(f"{t}.{e}" for t in ALL_TABLES for e in ("csv", "md"))}
-        if str(rel) in top or rel.parts[0] in ("cases", FIGURES):
+        if str(rel) in {*STUDY_TOP_FILES, *HOUSEKEEPING} or rel.parts[0] in ("cases", FIGURES):
             return f"a file of the study in {self.out}"
         return None
 
@@ -162,9 +158,7 @@ class StudyStore:
         study.json, study.toml, provenance.json, the tables (``<name>.csv`` and ``.md``) and
         their manifest, report.md, the figures report.md links, the records of its cases and the temporary
         files of interrupted atomic writes. ``--fresh`` removes these and nothing else."""
-        top = list(TOP_FILES)
-        top += [f"{name}.{ext}" for name in ALL_TABLES for ext in ("csv", "md")]
-        files = [self.out / name for name in top]
+        files = [self.out / name for name in STUDY_TOP_FILES]
         report = self.out / "report.md"
         if report.is_file():
             linked = re.findall(rf"\]\({FIGURES}/([^)/]+\.png)\)", report.read_text())
