@@ -12,23 +12,13 @@ import time
 import traceback
 import warnings
 from collections.abc import Collection, Sequence
+from typing import Any, NoReturn
 
-#: Subcommand modules, in the order ``rodval --help`` lists them.
-COMMANDS = (
-    "reproduce",
-    "simulate",
-    "reference",
-    "compare",
-    "study",
-    "report",
-    "bench",
-    "modes",
-    "animate",
-)
-#: Each subcommand's line in ``rodval --help``, the ``help`` its module's ``register`` gives
-#: (tests/test_startup.py checks they agree): ``rodval --help`` and ``--version`` list the
-#: subcommands without importing their modules, whose options name constants of the heavy
-#: modules (the registry's model names, the study's limits, the animation's).
+#: Each subcommand (its module) in the order ``rodval --help`` lists them, and its line there,
+#: the ``help`` its module's ``register`` gives (tests/test_startup.py checks they agree):
+#: ``rodval --help`` and ``--version`` list the subcommands without importing their modules,
+#: whose options name constants of the heavy modules (the registry's model names, the
+#: study's limits, the animation's).
 SUMMARIES = {
     "reproduce": "reproduce the paper's example (Table 1, Fig. 3, cross-check)",
     "simulate": "run one scene with one model",
@@ -40,6 +30,8 @@ SUMMARIES = {
     "modes": "natural frequencies and mode shapes about a configuration",
     "animate": "animate runs (GIF or MP4)",
 }
+#: Subcommand modules, in the order ``rodval --help`` lists them.
+COMMANDS = tuple(SUMMARIES)
 
 
 #: An argument argparse reads as a value, not an option (``OneLineParser``).
@@ -55,11 +47,11 @@ class OneLineParser(argparse.ArgumentParser):
     reads any argument that starts with '-' and a digit or '.' as a value (``--times -1,2``,
     ``--rtol -1e-3``) so that its parser can say what is allowed. Subparsers inherit it."""
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
 
-    def error(self, message: str):
+    def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 

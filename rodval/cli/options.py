@@ -5,11 +5,13 @@ from __future__ import annotations
 import argparse
 import math
 import tomllib
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from rodval.core.scene_keys import scene_path
 from rodval.core.settings import (
+    COUNT_RANGE,
     DEFAULTS,
     MAX_COUNT,
     METHODS,
@@ -27,7 +29,7 @@ def positive_float(
     below: float = math.inf,
     least: float = 0.0,
     allowed: str | None = None,
-):
+) -> Callable[[str], float]:
     """Parser of a number > 0, >= ``least`` and < ``below`` for option ``name``; finite unless
     ``finite=False``. ``allowed`` words the range in messages (default: from the bounds)."""
     if allowed is None:
@@ -48,8 +50,8 @@ def positive_float(
     return parse
 
 
-def positive_int(name: str):
-    """A parser of an integer count in [1, MAX_COUNT] for option ``name``."""
+def positive_int(name: str) -> Callable[[str], int]:
+    """A parser of an integer count (``COUNT_RANGE``) for option ``name``."""
 
     def parse(text: str) -> int:
         try:
@@ -57,9 +59,7 @@ def positive_int(name: str):
         except ValueError:
             v = 0
         if not 1 <= v <= MAX_COUNT:
-            raise argparse.ArgumentTypeError(
-                f"{name} must be an integer in [1, {MAX_COUNT}], got {text!r}"
-            )
+            raise argparse.ArgumentTypeError(f"{name} must be {COUNT_RANGE}, got {text!r}")
         return v
 
     return parse
@@ -154,31 +154,30 @@ def add_integrator_options(p: argparse.ArgumentParser) -> None:
         "steps; scipy's DOP853 otherwise), a scipy solve_ivp method, or DOP853-numba / "
         "Radau-numba (native models)",
     )
-    p.add_argument(
-        "--rtol",
-        type=positive_float("--rtol", below=1.0, least=MIN_RTOL, allowed=RTOL_RANGE),
-        help=f"relative tolerance: {RTOL_RANGE} (default {d['rtol']:g})",
-    )
-    p.add_argument(
-        "--atol",
-        type=positive_float("--atol"),
-        help=f"absolute tolerance > 0 (default {d['atol']:g})",
-    )
-    p.add_argument(
-        "--max-step",
-        type=positive_float("--max-step", finite=False),
-        help="largest step, s (default unbounded)",
-    )
-    p.add_argument(
-        "--max-evaluations",
-        type=positive_int("--max-evaluations"),
-        help=f"right-hand-side evaluations a run may use (default {d['max_evaluations']})",
-    )
-    p.add_argument(
-        "--max-wall",
-        type=positive_float("--max-wall", finite=False),
-        help="wall-clock seconds a run may use (default: no limit)",
-    )
+    for flag, parse, what in (
+        (
+            "--rtol",
+            positive_float("--rtol", below=1.0, least=MIN_RTOL, allowed=RTOL_RANGE),
+            f"relative tolerance: {RTOL_RANGE} (default {d['rtol']:g})",
+        ),
+        ("--atol", positive_float("--atol"), f"absolute tolerance > 0 (default {d['atol']:g})"),
+        (
+            "--max-step",
+            positive_float("--max-step", finite=False),
+            "largest step, s (default unbounded)",
+        ),
+        (
+            "--max-evaluations",
+            positive_int("--max-evaluations"),
+            f"right-hand-side evaluations a run may use (default {d['max_evaluations']})",
+        ),
+        (
+            "--max-wall",
+            positive_float("--max-wall", finite=False),
+            "wall-clock seconds a run may use (default: no limit)",
+        ),
+    ):
+        p.add_argument(flag, type=parse, help=what)
 
 
 def integrator_settings(args: argparse.Namespace) -> dict[str, object]:
@@ -292,16 +291,21 @@ def scene_overrides(args: argparse.Namespace) -> dict[str, object]:
 def with_scene_values(doc: dict[str, Any], args: argparse.Namespace) -> tuple[dict[str, Any], str]:
     """The scene document ``doc`` (of SCENE, ``args.scene``) with the scene values of ``--set
     PATH=VALUE`` set (``scene_overrides``, ``with_overrides``: a study grid's paths), and the
-    name its errors go by: SCENE, with the --set keys. ``doc`` is not changed."""
+    name its errors go by: SCENE, with the --set keys. ``doc`` is not changed. --set t_end
+    beside --t-end, or times beside --times, is refused: one value each."""
     from rodval.core.scene_file import with_overrides
 
     overrides = scene_overrides(args)
+    for path in ("t_end", "times"):
+        if path in overrides and getattr(args, path, None) is not None:
+            flag = "--" + path.replace("_", "-")
+            raise ValueError(f"--set {path} and {flag} both given; give the value once")
     if not overrides:
         return doc, str(args.scene)
     return with_overrides(doc, overrides), f"{args.scene} (with --set {', '.join(overrides)})"
 
 
-def add_junit_option(p) -> None:
+def add_junit_option(p: argparse.ArgumentParser) -> None:
     """--junit FILE (rodval study, rodval report)."""
     p.add_argument(
         "--junit",

@@ -8,6 +8,7 @@ whole command's budget, from the process start to the last file written.
 
 from __future__ import annotations
 
+import argparse
 import math
 import sys
 import time
@@ -22,7 +23,6 @@ from rodval.cli.options import (
     integrator_settings,
     model_options,
     positive_float,
-    scene_overrides,
     time_list,
     with_scene_values,
 )
@@ -70,7 +70,7 @@ LOAD_S = 2.0
 MARGIN_S = 0.5
 
 
-def register(sub) -> None:
+def register(sub: Any) -> None:
     p = sub.add_parser(
         "simulate",
         help="run one scene with one model",
@@ -134,7 +134,7 @@ def _listing(times: np.ndarray) -> str:
 def _grid_step(doc: dict[str, Any], scene: Scene) -> float | None:
     """The spacing (s) of the scene's output times when they are the file's evenly spaced
     ``{start, stop, num}`` grid ending at the horizon (num >= 2), else None."""
-    times = scene.times
+    times: np.ndarray = scene.times
     if not isinstance(doc.get("times"), dict) or times.size < 2 or times[-1] != scene.t_end:
         return None
     return float(times[-1] - times[0]) / (times.size - 1)
@@ -242,7 +242,9 @@ def integration_budget(max_wall_s: float, used_s: float, setup_s: float, write_s
 # ------------------------------------------------------------------------- the command
 
 
-def rerun_request(args) -> tuple[dict[str, Any], str, dict[str, Any], dict[str, Any]]:
+def rerun_request(
+    args: argparse.Namespace,
+) -> tuple[dict[str, Any], str, dict[str, Any], dict[str, Any]]:
     """(scene document, model, integrator settings, options) of SCENE: a run.json's own, or
     a scene file's with the defaults."""
     path = Path(args.scene)
@@ -260,22 +262,10 @@ def rerun_request(args) -> tuple[dict[str, Any], str, dict[str, Any], dict[str, 
     return dict(previous["scene"]), model, settings_kw, options
 
 
-def overridden(doc: dict[str, Any], args) -> tuple[dict[str, Any], str]:
-    """The scene document with the scene values of ``--set PATH=VALUE`` set (a study grid's
-    paths, ``with_overrides``), and the name its errors go by (SCENE, with the --set keys).
-    --set t_end beside --t-end, or times beside --times, is refused: one value each."""
-    overrides = scene_overrides(args)
-    for path, option in (("t_end", args.t_end), ("times", args.times)):
-        if path in overrides and option is not None:
-            flag = "--" + path.replace("_", "-")
-            raise ValueError(f"--set {path} and {flag} both given; give the value once")
-    return with_scene_values(doc, args)
-
-
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     start = args.started  # the command's start (rodval.cli.main): its budget counts from it
     doc, model, settings_kw, options = rerun_request(args)
-    doc, where = overridden(doc, args)
+    doc, where = with_scene_values(doc, args)
     scene, notes = build_scene(doc, where, args.t_end, args.times)
     options.update(model_options(args))
     settings_kw.update(integrator_settings(args))
@@ -293,7 +283,7 @@ def run(args) -> int:
         traj = simulate(scene, model, settings=settings, **options)
     if "max_wall_s" in traj.settings:  # the command's budget, which a rerun shares out again
         traj.settings["max_wall_s"] = requested
-    write_run(traj, scene, args.out, wide=args.wide, table=args.table)
+    write_run(traj, scene, args.out, wide=args.wide, table=args.table, claimed=True)
     if table_file(args.table, value_count(traj)) == TABLE_NPZ:
         why = f" (more than {CSV_MAX_VALUES}; --table csv writes text)" * (args.table == "auto")
         notes.append(f"the trajectory ({value_count(traj)} values) is in {TABLE_NPZ}{why}")

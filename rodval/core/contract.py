@@ -16,7 +16,8 @@ from typing import Any, ClassVar
 from rodval.core.checks import check_keys
 from rodval.core.damping import check_resolved
 from rodval.core.modes import Modes
-from rodval.core.scene import Scene
+from rodval.core.resources import check_run_memory, dense_path
+from rodval.core.scene import Scene, trajectory_quantities
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_BUDGET
 from rodval.core.trajectory import Trajectory
@@ -41,19 +42,29 @@ class Model(ABC):
     MODES_OPTIONS: ClassVar[tuple[str, ...]] = ()
     #: Largest energy-audit residual of a valid run of this model (``rodval.core.validity``).
     energy_residual_bound: ClassVar[float] = ENERGY_RESIDUAL_BOUND
+    #: What its options resolved to for its scene, and why (``scene_options``; first in notes).
+    chosen: tuple[str, ...] = ()
 
     def simulate(self, scene: Scene, settings: IntegratorSettings | None = None) -> Trajectory:
         """Run the scene (default integrator settings when None) and judge the run's validity;
-        never raise for a failed integration (report it in the stats)."""
+        never raise for a failed integration (report it in the stats). Refused before any
+        work (ValueError): settings against the horizon, a base the model does not have, a
+        deployed damping request not converted, a run that would not fit in memory."""
         settings = IntegratorSettings() if settings is None else settings
-        model, chosen = self.for_scene(scene)
-        if model is not self:  # an option resolved for the scene: run it, say what it chose
-            trajectory = model.simulate(scene, settings)
-            trajectory.stats.notes = [*chosen, *trajectory.stats.notes]
-            return trajectory
+        model = self.for_scene(scene)[0]
+        if model is not self:  # an option resolved for the scene: run the model it resolves to
+            return model.simulate(scene, settings)
         settings.check_horizon(scene.t_end)
         self.check_base(scene)
         check_resolved(scene, f"model {self.name!r}")  # a deployed damping request, converted
+        check_run_memory(
+            scene.n,
+            scene.times.size,
+            trajectory_quantities(scene.outputs),
+            model=self.name,
+            dense=dense_path(self.name, self.options(), settings.method),
+            what=f"scene {scene.name!r} with model {self.name!r}",
+        )
         trajectory = self.run(scene, settings)
         trajectory.scene = scene
         stats = trajectory.stats
@@ -61,19 +72,33 @@ class Model(ABC):
             stats.message += f"; fix: {self.stiffness_fix(scene)}"
         checks = self.validity_checks(scene, trajectory)
         stats.valid, stats.validity = verdict(checks, finished=trajectory.success)
-        stats.notes = self.scene_notes(scene)
+        stats.notes = [*self.chosen, *self.scene_notes(scene)]
         return trajectory
 
     @abstractmethod
     def run(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
         """Run the scene; never raise for a failed integration (report it in the stats)."""
 
+    @classmethod
+    def scene_options(
+        cls, scene: Scene, options: dict[str, Any]
+    ) -> tuple[dict[str, Any], list[str]]:
+        """``options`` with those that depend on the scene ("auto") resolved for ``scene`` before
+        the model is built (one model object), and the notes that say to what and why
+        (``chosen``); by default as given, no notes."""
+        return options, []
+
     def for_scene(self, scene: Scene) -> tuple[Model, list[str]]:
-        """This model with its options that depend on the scene ("auto") resolved for
-        ``scene``, and the notes that say what they resolved to and why (recorded in
-        ``SolverStats.notes``); ``simulate`` runs the resolved model. By default itself, no
-        notes."""
-        return self, []
+        """This model with its options that depend on the scene resolved for ``scene``
+        (``scene_options``), and the notes that say so (its ``chosen``, recorded first in
+        ``SolverStats.notes``); ``simulate`` runs the resolved model. Itself, no notes, when
+        nothing was left to resolve (or it was built for the scene: ``chosen`` set)."""
+        options, notes = ({}, []) if self.chosen else self.scene_options(scene, self.options())
+        if not notes:
+            return self, []
+        model = type(self)(**options)
+        model.chosen = tuple(notes)
+        return model, notes
 
     def check_base(self, scene: Scene) -> None:
         """ValueError (before any work) unless this model, with its options, has the scene's

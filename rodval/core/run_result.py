@@ -5,7 +5,7 @@ of its own validity. Its status changes only through ``rodval.core.status.update
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from rodval.core.status import STATUS_SUCCESS, Status
@@ -71,26 +71,9 @@ class SolverStats:
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-ready form, the same in a study's case record and in run.json (with
         ``success``, derived from ``status``); inverse of ``from_dict``."""
-        return {
-            "status": int(self.status),
-            "success": self.success,
-            "message": self.message,
-            "t_reached": self.t_reached,
-            "nfev": self.nfev,
-            "njev": self.njev,
-            "nlu": self.nlu,
-            "nsteps": self.nsteps,
-            "wall_s": self.wall_s,
-            "energy_residual": self.energy_residual,
-            "momentum_residual": self.momentum_residual,
-            "max_bending": self.max_bending,
-            "small_bending": self.small_bending,
-            "valid": self.valid,
-            "validity": [dict(c) for c in self.validity],
-            "switch": None if self.switch is None else dict(self.switch),
-            "notes": list(self.notes),
-            "peaks": None if self.peaks is None else dict(self.peaks),
-        }
+        record = asdict(self)  # the lists and dicts copied: the record's own
+        del record["status"]
+        return {"status": int(self.status), "success": self.success, **record}
 
     #: The name callers used before ``to_dict``.
     as_dict = to_dict

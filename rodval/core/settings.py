@@ -7,6 +7,7 @@ This module is the one source of defaults for the Python API, the CLI and study 
 from __future__ import annotations
 
 import math
+import numbers
 import sys
 from dataclasses import asdict, dataclass, fields
 from typing import Any
@@ -43,6 +44,36 @@ ERROR_CONTROLS = ("uniform", "per-block")
 #: inside the compiled loop's int64 counters (a larger one failed at run time with numba's
 #: "No matching definition" or OverflowError).
 MAX_COUNT = 2**53
+#: The allowed counts, for messages.
+COUNT_RANGE = f"an integer in [1, {MAX_COUNT}]"
+
+
+#: Each number setting's range, checked once (``check_number``'s keywords; ``allowed`` words
+#: it for a number out of range, a value that is no real number is told "a real number ...",
+#: ``rodval.core.checks.describe_range``).
+NUMBER_BOUNDS: dict[str, dict[str, Any]] = {
+    "rtol": {"low": MIN_RTOL, "high": 1, "high_open": True, "allowed": RTOL_RANGE},
+    "atol": {"low": 0, "low_open": True, "finite": True, "allowed": "a finite number > 0"},
+    "max_step": {"low": 0, "low_open": True, "allowed": "> 0 (inf: no limit)"},
+    "first_step": {
+        "low": 0,
+        "low_open": True,
+        "finite": True,
+        "allowed": "a finite number > 0 or None",
+    },
+    "max_evaluations": {"integer": True, "low": 1, "high": MAX_COUNT, "allowed": COUNT_RANGE},
+    "max_wall_s": {"low": 0, "low_open": True, "allowed": "> 0 (inf: no limit)"},
+    "blowup_factor": {"low": 1, "low_open": True, "allowed": "> 1 (inf disables)"},
+    "min_step_fraction": {"low": 0, "high": 1, "high_open": True, "allowed": "in [0, 1)"},
+    "stall_steps": {"integer": True, "low": 1, "high": MAX_COUNT, "allowed": COUNT_RANGE},
+    "block_frequency": {
+        "low": 0,
+        "low_open": True,
+        "finite": True,
+        "allowed": "a finite frequency > 0 (rad/s)",
+    },
+    "bending_scale": {"low": 1, "finite": True, "allowed": "a finite number >= 1"},
+}
 
 
 @dataclass(frozen=True)
@@ -109,64 +140,15 @@ class IntegratorSettings:
             raise ValueError(
                 f"error_control must be one of {ERROR_CONTROLS}, got {self.error_control!r}"
             )
-        check_number(
-            "block_frequency",
-            self.block_frequency,
-            low=0,
-            low_open=True,
-            finite=True,
-            allowed="a finite frequency > 0 (rad/s)",
-        )
-        check_number(
-            "bending_scale", self.bending_scale, low=1, finite=True, allowed="a finite number >= 1"
-        )
-        for name in (
-            "rtol",
-            "atol",
-            "max_step",
-            "max_wall_s",
-            "blowup_factor",
-            "min_step_fraction",
-        ):
-            check_number(name, getattr(self, name))
-        check_number("rtol", self.rtol, low=MIN_RTOL, high=1, high_open=True, allowed=RTOL_RANGE)
-        check_number(
-            "atol", self.atol, low=0, low_open=True, finite=True, allowed="a finite number > 0"
-        )
-        for name in ("max_step", "max_wall_s"):
-            check_number(
-                name, getattr(self, name), low=0, low_open=True, allowed="> 0 (inf: no limit)"
-            )
-        if self.first_step is not None:
-            check_number("first_step", self.first_step)
-            check_number(
-                "first_step",
-                self.first_step,
-                low=0,
-                low_open=True,
-                finite=True,
-                allowed="a finite number > 0 or None",
-            )
-        check_number(
-            "blowup_factor", self.blowup_factor, low=1, low_open=True, allowed="> 1 (inf disables)"
-        )
-        check_number(
-            "min_step_fraction",
-            self.min_step_fraction,
-            low=0,
-            high=1,
-            high_open=True,
-            allowed="in [0, 1)",
-        )
-        for name in ("stall_steps", "max_evaluations"):
-            check_number(
-                name,
-                getattr(self, name),
-                integer=True,
-                low=1,
-                high=MAX_COUNT,
-                allowed=f"an integer in [1, {MAX_COUNT}]",
-            )
+        for name, bounds in NUMBER_BOUNDS.items():
+            value = getattr(self, name)
+            if value is None and name == "first_step":
+                continue
+            if not bounds.get("integer") and (
+                isinstance(value, bool) or not isinstance(value, numbers.Real)
+            ):
+                bounds = dict(bounds, allowed=None)  # "... must be a real number ..., got"
+            check_number(name, value, **bounds)
 
     def check_horizon(self, t_end: float) -> None:
         """The settings against a scene's horizon t_end (s), before any work: a first step

@@ -45,7 +45,8 @@ def step_integral(power: Power, dense: Dense, t0: float, t1: float) -> np.ndarra
     ts = t0 + 0.5 * h * (_NODES + 1.0)
     states = dense(ts)
     P = np.array([power(t, states[:, i]) for i, t in enumerate(ts)])
-    return 0.5 * h * (_WEIGHTS @ P)
+    integral: np.ndarray = 0.5 * h * (_WEIGHTS @ P)
+    return integral
 
 
 class PowerLedger:

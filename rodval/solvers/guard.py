@@ -104,7 +104,7 @@ OK, BLOWUP, STALLED = 0, 4, 5
 
 
 @njit(cache=True, error_model="numpy")
-def guard_step(g, mon, h, mech, guarded):
+def guard_step(g: np.ndarray, mon: np.ndarray, h: float, mech: np.ndarray, guarded: bool) -> int:
     """The guard after one accepted step of h (s): the one arithmetic of every path.
     ``g``: ``GuardSpec.as_array()``; ``mon``: the run's monitor [short steps in a row, last
     step (s), W+ (J), last positive load power (W), T (J), budget (J)], updated here (the
@@ -199,10 +199,11 @@ class DivergenceGuard:
     ):
         checked = system.has_energy and math.isfinite(settings.blowup_factor)
         energy0 = system.energy_budget(0.0, y0) if checked else 0.0
+        power0 = system.power(0.0, y0)[0] if checked else 0.0
         self.spec = GuardSpec.from_settings(settings, t_end, energy0)
         self.g = self.spec.as_array()
         self.system = system if checked else None
-        self.mon = new_monitor(system.power(0.0, y0)[0] if checked else 0.0)
+        self.mon = new_monitor(power0)
 
     def check(self, t0: float, t1: float, y: np.ndarray) -> Verdict | None:
         """Verdict after the accepted step [t0, t1] that ended in state y."""

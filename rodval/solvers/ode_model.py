@@ -7,7 +7,7 @@ from abc import abstractmethod
 
 from rodval.core.contract import Model
 from rodval.core.scene import Scene
-from rodval.core.settings import AUTO, IntegratorSettings
+from rodval.core.settings import AUTO, COMPILED_METHODS, IntegratorSettings
 from rodval.core.status import STATUS_ERROR, exception_line, numerical_failure
 from rodval.core.trajectory import SolverStats, Trajectory
 from rodval.solvers.driver import integrate
@@ -27,7 +27,7 @@ class OdeModel(Model):
         ``model error`` (or a numerical failure's, ``rodval.core.status.numerical_failure``),
         the message, t_reached = 0."""
         start = time.perf_counter()
-        if settings.compiled or settings.method == AUTO:
+        if settings.method in (AUTO, *COMPILED_METHODS):
             from rodval.solvers import dop853
 
             dop853.warm_up()  # the compiled loop, in the background while the system is built

@@ -302,7 +302,7 @@ class Outputs:
         the mask of those that are recorded times (output or audit grid: the rows an audit's
         ledger records)."""
         times, kind = self._plan[0][: len(values)], self._plan[1][: len(values)]
-        mask = kind == RECORDED
+        mask: np.ndarray = kind == RECORDED
         kept = values[mask]
         self.Y[self.n : self.n + len(kept)] = kept
         self.n += len(kept)

@@ -5,8 +5,10 @@ y' = f(t, y) with its initial state, its observation map, and optional capabilit
 method with the same (t, y) signature:
 
 * ``jacobian(t, y)``: analytic df/dy, used by implicit scipy methods (``has_jacobian``);
-* ``kinetic_energy``, ``energy``, ``energy_budget``, ``power`` (``has_energy``): used by the
-  divergence guard (``rodval.solvers.guard``) and the energy audit (``rodval.solvers.audit``);
+* ``kinetic_energy``, ``energy``, ``energy_budget``, ``power``, ``energy_history``
+  (``has_energy``): used by the divergence guard (``rodval.solvers.guard``) and the energy
+  audit (``rodval.solvers.audit``); ``momentum_audit_rows`` (``has_momentum``): the
+  angular-momentum audit;
 * ``event_functions`` / ``apply_event``: state events (a hybrid system whose state jumps and
   whose equations switch at a crossing, e.g. a hinge latching), handled by the driver's event
   loop (``rodval.solvers.events``);
@@ -126,6 +128,8 @@ class OdeSystem(ABC):
     has_jacobian: bool = False
     #: True when ``kinetic_energy``, ``energy``, ``energy_budget`` and ``power`` are.
     has_energy: bool = False
+    #: True when ``momentum_audit_rows`` is (the driver's angular-momentum audit).
+    has_momentum: bool = False
 
     @abstractmethod
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -153,6 +157,17 @@ class OdeSystem(ABC):
 
     def power(self, t: float, y: np.ndarray) -> tuple[float, float]:
         """(P_ext, P_diss) (W): power of the applied loads and power taken out by dampers."""
+        raise NotImplementedError
+
+    def energy_history(self, times: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        """E (J) per state of a history Y (nt, N) at ``times`` (s), each in the mode in effect
+        at its time, as ``observe`` reports it: the energy audit's E on its grid; state by
+        state (``energy``) unless the system evaluates whole histories."""
+        return np.array([self.energy(float(t), y) for t, y in zip(times, Y)])
+
+    def momentum_audit_rows(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(H, G) (N m s, (nt,) each) per state of Y: the angular momentum about the point the
+        scene conserves it about, and the gross one (``rodval.core.validity.momentum_balance``)."""
         raise NotImplementedError
 
     def max_bending(self, times: np.ndarray, Y: np.ndarray) -> float | None:

@@ -7,11 +7,11 @@ State y = [q; q'] (6n). M(phi) q'' = [Q; 0; 0] - h - C q' - K q, see ``paper_mat
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from rodval.core.scene import Scene
-from rodval.core.settings import IntegratorSettings
-from rodval.core.trajectory import Trajectory
 from rodval.core.validity import DAMPING_FIX, setting
 from rodval.models.assembly import kernels
 from rodval.models.assembly.paper_matrices import (
@@ -22,7 +22,6 @@ from rodval.models.assembly.paper_matrices import (
     convective_terms,
     hinge_matrix,
 )
-from rodval.models.assembly.paper_system import PaperModel, PaperSystem
 from rodval.models.hinge_items import deployment
 from rodval.models.hinge_items.lock_records import plastic_jump
 from rodval.models.kinematics.rungs import (
@@ -33,6 +32,8 @@ from rodval.models.kinematics.rungs import (
     check_rung_options,
     check_shapes,
 )
+from rodval.models.systems.paper_model import PaperModel
+from rodval.models.systems.paper_system import PaperSystem
 
 
 class FullSystem(PaperSystem):
@@ -51,14 +52,14 @@ class FullSystem(PaperSystem):
         )
         self.use_kernel()
 
-    def kernel_constants(self):
+    def kernel_constants(self) -> np.ndarray:
         return kernels.full_constants(self.cc, self.chain)
 
     def forces(self, t: float, q: np.ndarray, v: np.ndarray, skj: np.ndarray) -> np.ndarray:
         """Right-hand side f = [Q; 0; 0] - h - C q' - K q of M q'' = f (3n)."""
         n = self.n
         h_phi, h_gamma = convective_terms(self.cc, skj, v[:n], v[n : 2 * n], v[2 * n :])
-        f = self.rest - self.K @ q
+        f: np.ndarray = self.rest - self.K @ q
         if self.damped:
             f -= self.C @ v
         f[:n] -= h_phi
@@ -68,7 +69,7 @@ class FullSystem(PaperSystem):
             f[:n] += Q
         return f
 
-    def numpy_rhs(self, t, y):
+    def numpy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         n = self.n
         q, v = y[: 3 * n], y[3 * n :]
         ckj, skj = angle_differences(q[:n])
@@ -124,10 +125,10 @@ class FullSystem(PaperSystem):
         J[3 * n :] = np.linalg.solve(M, np.hstack([dfdq, dfdv]))
         return J
 
-    def generalized_rates(self, y):
+    def generalized_rates(self, y: np.ndarray) -> np.ndarray:
         return y[3 * self.n :]
 
-    def accel_locked(self, t, y):
+    def accel_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """q'' and the multipliers of M q'' = f + A_L^T lambda, A_L q'' = 0 (A_L: the rows of
         the locked hinges): the dense KKT system with the numpy kernel, superposition of
         O(n) solves with the compiled one (deployment.full_accel_locked)."""
@@ -153,7 +154,7 @@ class FullSystem(PaperSystem):
         z = np.linalg.solve(K, rhs)
         return z[: 3 * n], z[3 * n :]
 
-    def unit_responses(self, q, hinges) -> np.ndarray:
+    def unit_responses(self, q: np.ndarray, hinges: Any) -> np.ndarray:
         """M(q)^-1 a_k for each hinge k, (m, 3n) (the paper's M depends on phi = q[:n])."""
         n = self.n
         phi = q[:n]
@@ -164,20 +165,22 @@ class FullSystem(PaperSystem):
         M = assemble_mass(self.cc, angle_differences(phi)[0])
         return np.linalg.solve(M, hinge_matrix(n)[hinges].T).T
 
-    def plastic_jump(self, y, hinges, angles):
+    def plastic_jump(
+        self, y: np.ndarray, hinges: Any, angles: Any
+    ) -> tuple[np.ndarray, np.ndarray]:
         return plastic_jump(self, y, hinges, angles)
 
-    def energy_budget(self, t, y):
+    def energy_budget(self, t: float, y: np.ndarray) -> float:
         n = self.n
         return self.kinetic_energy(t, y) + float(
             self.potential(y[:n], y[n : 2 * n], y[2 * n : 3 * n])
         )
 
-    def rigid(self, Y):
+    def rigid(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         n = self.n
         return Y[:, :n], Y[:, 3 * n : 4 * n]
 
-    def bending(self, times, Y):
+    def bending(self, times: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, ...]:
         n = self.n
         return Y[:, n : 2 * n], Y[:, 2 * n : 3 * n], Y[:, 4 * n : 5 * n], Y[:, 5 * n :]
 
@@ -208,23 +211,22 @@ class FullModel(PaperModel):
         if (self.shapes, self.kinematics) not in (PAPER_RUNG, (PAPER_RUNG[0], AUTO)):
             check_rung_options(self.coefficients, self.kernel)
 
-    def options(self):
+    def options(self) -> dict[str, Any]:
         return {**super().options(), "shapes": self.shapes, "kinematics": self.kinematics}
 
-    def for_scene(self, scene: Scene) -> tuple[FullModel, list[str]]:
-        """This model with ``kinematics = "auto"`` resolved for ``scene`` (``auto_kinematics``,
-        the one rule) and the note that says what it chose and why; itself, no note, when the
-        kinematics was given."""
-        if self.kinematics != AUTO:
-            return self, []
-        kinematics, note = auto_kinematics(scene, self.coefficients, self.kernel)
-        return FullModel(self.coefficients, self.kernel, self.shapes, kinematics), [note]
-
-    def run(self, scene: Scene, settings: IntegratorSettings) -> Trajectory:
-        """The run of ``scene`` on the kinematics it resolves to (``for_scene``), so that the
-        trajectory's options hold the kinematics that ran."""
-        model = self.for_scene(scene)[0]
-        return super().run(scene, settings) if model is self else model.run(scene, settings)
+    @classmethod
+    def scene_options(
+        cls, scene: Scene, options: dict[str, Any]
+    ) -> tuple[dict[str, Any], list[str]]:
+        """``options`` with ``kinematics = "auto"`` (the default) resolved for ``scene``
+        (``auto_kinematics``, the one rule), and the note that says what it chose and why; as
+        given, no note, when the kinematics was given (a bad value is refused by the model)."""
+        kinematics = options.get("kinematics", AUTO)
+        if not (isinstance(kinematics, str) and kinematics == AUTO):
+            return options, []
+        coefficients = options.get("coefficients", DEFAULT_VARIANT)
+        kinematics, note = auto_kinematics(scene, coefficients, options.get("kernel", "numba"))
+        return {**options, "kinematics": kinematics}, [note]
 
     def energy_fix(self) -> str:
         """The first-order kinematics does not keep energy (docs/stability.md): its exact
@@ -272,25 +274,11 @@ class FullModel(PaperModel):
         """The system of ``scene`` on this model's rung and base; the free base's, the moving
         bases' and the ladder's modules (and their compiled kernels) are imported only by a
         scene that uses them."""
-        if self.kinematics == AUTO:
-            return self.for_scene(scene)[0].system(scene)
-        paper = (self.shapes, self.kinematics) == PAPER_RUNG
-        if scene.base.moving:
-            self.check_base(scene)
-            if scene.base.free and paper:
-                from rodval.models.base.free_base_system import FreeBaseSystem
-
-                return FreeBaseSystem(scene)
-            from rodval.models.base import moving_base
-
-            kind = (
-                moving_base.LadderFreeSystem
-                if scene.base.free
-                else (moving_base.LadderPrescribedSystem)
-            )
-            return kind(scene, self.coefficients, self.kernel, self.shapes, self.kinematics)
-        if paper:
+        if self.kinematics == AUTO:  # a model built without its scene: resolved for it here
+            return FullModel(**self.scene_options(scene, self.options())[0]).system(scene)
+        self.check_base(scene)
+        if not scene.base.moving and (self.shapes, self.kinematics) == PAPER_RUNG:
             return FullSystem(scene, self.coefficients, self.kernel)
-        from rodval.models.kinematics.ladder import LadderSystem
+        from rodval.models.systems.chain_system import chain_system
 
-        return LadderSystem(scene, self.coefficients, self.kernel, self.shapes, self.kinematics)
+        return chain_system(scene, self.shapes, self.kinematics, self.coefficients, self.kernel)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from functools import cached_property
 from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 
@@ -31,9 +32,10 @@ from rodval.models.assembly.paper_matrices import (
     hinge_matrix,
     quasi_static_bending,
 )
-from rodval.models.assembly.paper_system import PaperModel, PaperSystem
 from rodval.models.bending import reduced_banded
 from rodval.models.hinge_items import deployment
+from rodval.models.systems.paper_model import PaperModel
+from rodval.models.systems.paper_system import PaperSystem
 
 
 class ReducedSystem(PaperSystem):
@@ -54,7 +56,7 @@ class ReducedSystem(PaperSystem):
         self._work = np.zeros(reduced_banded.sweep_work_size(self.n))
         self.use_kernel()
 
-    def kernel_constants(self):
+    def kernel_constants(self) -> np.ndarray:
         return reduced_banded.banded_constants(self.cc, self.chain)
 
     def compiled_scratch(self) -> np.ndarray:
@@ -64,7 +66,7 @@ class ReducedSystem(PaperSystem):
             self._scratch = np.zeros((1, 1, reduced_banded.rhs_work_size(self.n)))
         return self._scratch
 
-    def rhs(self, t, y):
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """The compiled O(n) solve gives gamma with phi'': it is kept for the small-bending
         check (``max_bending``) at no extra cost."""
         if self.kernel != "numba" or self.locked:
@@ -76,14 +78,12 @@ class ReducedSystem(PaperSystem):
         out[:n] = y[n:]
         reduced_banded.reduced_solve_work(
             self.V,
-            y[:n],
-            y[n:],
+            y,
             sums is not None,
             np.ascontiguousarray(SX),
             np.ascontiguousarray(SY),
             self.damped,
-            out[n:],
-            self._gamma,
+            (out[n:], self._gamma),
             self._work,
             reduced_banded.METHOD_AUTO,
         )
@@ -96,7 +96,7 @@ class ReducedSystem(PaperSystem):
         if self._scratch is not None:
             self._scratch[0, 0, -1] = 0.0
 
-    def max_bending(self, times, Y):
+    def max_bending(self, times: np.ndarray, Y: np.ndarray) -> float | None:
         """The largest |alpha|, |beta| (rad) the O(n) solves met during the run (every
         evaluation: no recovery at output times); with the numpy kernel, or once a hinge has
         locked, over the output times (recovered in the mode in effect at each)."""
@@ -130,14 +130,18 @@ class ReducedSystem(PaperSystem):
     @property
     def K_r(self) -> np.ndarray:
         """Reduced stiffness K_pp - K_pg B^-1 K_gp (N m/rad, n x n, dense)."""
-        return self._dense.K_r
+        K_r: np.ndarray = self._dense.K_r
+        return K_r
 
     @property
     def C_r(self) -> np.ndarray:
         """Reduced damping C_pp - K_pg B^-1 C_gp (N m s/rad, n x n, dense)."""
-        return self._dense.C_r
+        C_r: np.ndarray = self._dense.C_r
+        return C_r
 
-    def reduced_matrices(self, phi: np.ndarray):
+    def reduced_matrices(
+        self, phi: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """M_r(phi), G_r(phi) and the bending-row blocks M_gp, G_gp (for recovery)."""
         cc, d = self.cc, self._dense
         ckj, skj = angle_differences(phi)
@@ -152,7 +156,7 @@ class ReducedSystem(PaperSystem):
     def forces(self, t: float, phi: np.ndarray, dphi: np.ndarray, G_r: np.ndarray) -> np.ndarray:
         """f_r = Q - G_r phi'^2 - C_r phi' - K_r phi + rest_r of M_r phi'' = f_r (n)."""
         d = self._dense
-        f = d.rest_r - d.K_r @ phi - G_r @ (dphi * dphi)
+        f: np.ndarray = d.rest_r - d.K_r @ phi - G_r @ (dphi * dphi)
         if self.damped:
             f -= d.C_r @ dphi
         Q = self.generalized_force(t, phi)
@@ -160,7 +164,7 @@ class ReducedSystem(PaperSystem):
             f += Q
         return f
 
-    def numpy_rhs(self, t, y):
+    def numpy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         n = self.n
         phi, dphi = y[:n], y[n:]
         M_r, G_r, _, _ = self.reduced_matrices(phi)
@@ -214,9 +218,10 @@ class ReducedSystem(PaperSystem):
         r += d.K_gp @ phi - d.rest_g
         if self.damped:
             r += d.C_gp @ dphi
-        return -d.B_inv @ r
+        gamma: np.ndarray = -d.B_inv @ r
+        return gamma
 
-    def solve_locked(self, t, y):
+    def solve_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """phi'' (n), gamma (2n) and the multipliers (m) with the locked hinges held at their
         angles, D_k = a_p^T phi + a_g^T gamma = angle_k an equation of the solve (the
         kappa_k -> infinity limit of the reduced model). numpy: the dense unreduced system
@@ -231,16 +236,13 @@ class ReducedSystem(PaperSystem):
             x, gamma, lam = np.empty(n), np.empty(2 * n), np.empty(m)
             ok = deployment.reduced_solve_locked(
                 self.V,
-                phi,
-                dphi,
+                y,
                 sums is not None,
                 SX,
                 SY,
                 self.damped,
-                h,
-                self._lock_a,
-                x,
-                gamma,
+                (h, self._lock_a),
+                (x, gamma),
                 lam,
             )
             if not ok:
@@ -264,11 +266,13 @@ class ReducedSystem(PaperSystem):
         z = np.linalg.solve(Kz, rhs)
         return z[:n], z[n : 3 * n], z[3 * n :]
 
-    def accel_locked(self, t, y):
+    def accel_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         x, _, lam = self.solve_locked(t, y)
         return x, lam
 
-    def plastic_jump(self, y, hinges, angles):
+    def plastic_jump(
+        self, y: np.ndarray, hinges: Any, angles: Any
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Delta phi' = M_pp^-1 C^T mu, (C M_pp^-1 C^T) mu = -C phi', with C the rows
         c_k = dD_k/dphi of the static hinge angles (deployment.reduced_hinge_gradient) and
         M_pp the reduced model's kinetic metric (T = 1/2 phi'^T M_pp phi'): the velocity
@@ -289,24 +293,24 @@ class ReducedSystem(PaperSystem):
         dphi += W.T @ mu
         return y, mu
 
-    def generalized_rates(self, y):
+    def generalized_rates(self, y: np.ndarray) -> np.ndarray:
         """[phi'; 0; 0]: the reduced model drops the bending rates from its kinetic energy and
         from its phi rows, so its dampers dissipate phi'^T C_pp phi' (see docs/stability.md)."""
         n = self.n
         return np.concatenate([y[n:], np.zeros(2 * n)])
 
-    def energy_budget(self, t, y):
+    def energy_budget(self, t: float, y: np.ndarray) -> float:
         """T + Pi at the quasi-static bending gamma = B^-1 (A_g^T kappa rest - K_gp phi)
         (exact when phi'' = phi' = 0); O(n)."""
         n = self.n
         gamma = quasi_static_bending(self.chain, y[:n])
         return self.kinetic_energy(t, y) + float(self.potential(y[:n], gamma[:n], gamma[n:]))
 
-    def rigid(self, Y):
+    def rigid(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         n = self.n
         return Y[:, :n], Y[:, n:]
 
-    def bending(self, times, Y):
+    def bending(self, times: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, ...]:
         n = self.n
         gamma = np.array([self.recover_bending(t, y) for t, y in zip(times, Y)]).reshape(-1, 2 * n)
         zeros = np.zeros_like(gamma[:, :n])

@@ -10,8 +10,7 @@ import importlib
 from typing import Any
 
 from rodval.core.contract import Model
-from rodval.core.resources import check_run_memory, dense_path
-from rodval.core.scene import Scene, trajectory_quantities
+from rodval.core.scene import Scene
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.core.trajectory import Trajectory
 from rodval.models.observation.deployed_damping import resolve_damping
@@ -51,7 +50,8 @@ def model_class(name: str) -> type[Model]:
         mod = importlib.import_module(module)
     except ImportError as exc:
         raise ValueError(f"model {name!r} is not available: {exc}") from exc
-    return getattr(mod, cls)
+    found: type[Model] = getattr(mod, cls)
+    return found
 
 
 def uses_integrator(name: str) -> bool:
@@ -87,6 +87,18 @@ def get_model(name: str | Model, **options: Any) -> Model:
     return model_class(name)(**options)
 
 
+def scene_model(model: str | Model, scene: Scene, options: dict[str, Any]) -> Model:
+    """The model ``simulate`` runs ``scene`` with, built once: by name, its options that depend
+    on the scene resolved first (``Model.scene_options``, its notes the model's ``chosen``); a
+    Model instance resolved for the scene (``Model.for_scene``)."""
+    if isinstance(model, Model):
+        return get_model(model, **options).for_scene(scene)[0]
+    resolved, notes = model_class(model).scene_options(scene, options)
+    built = get_model(model, **resolved)
+    built.chosen = tuple(notes)
+    return built
+
+
 def check_scene(model: Model, scene: Scene, settings: IntegratorSettings) -> Scene:
     """What ``model`` (with its options) refuses for ``scene`` with ``settings``, before any
     work: a ValueError naming the reason. The settings against the scene's horizon
@@ -94,8 +106,8 @@ def check_scene(model: Model, scene: Scene, settings: IntegratorSettings) -> Sce
     (``Model.check_base``: a moving base on the reduced model, the output "drive" on exudyn)
     and a bending damping stated for the deployed structure, converted to the rods' c
     (``deployed_damping.resolve_damping``: the same c for every model). Returns the scene
-    the model runs (``scene`` itself unless converted). The one definition ``simulate`` and
-    a study's plan (``rodval.study.case``) both ask."""
+    the model runs (``scene`` itself unless converted): what ``simulate`` refuses
+    (``Model.simulate``), for a study's plan (``rodval.study.case``) before its runs."""
     settings.check_horizon(scene.t_end)
     model.check_base(scene)
     return resolve_damping(scene)
@@ -151,14 +163,5 @@ def simulate(
             f"give integrator settings either as settings= or as keywords, not "
             f"both (got settings= and {', '.join(sorted(integ))})"
         )
-    m = get_model(model, **options)
-    scene = check_scene(m, scene, settings)
-    check_run_memory(
-        scene.n,
-        scene.times.size,
-        trajectory_quantities(scene.outputs),
-        model=m.name,
-        dense=dense_path(m.name, m.options(), settings.method),
-        what=f"scene {scene.name!r} with model {m.name!r}",
-    )
-    return m.simulate(scene, settings)
+    # a deployed damping converted to the rods' c; the model refuses the rest (Model.simulate)
+    return scene_model(model, scene, options).simulate(resolve_damping(scene), settings)
