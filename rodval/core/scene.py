@@ -298,6 +298,14 @@ def _scene_outputs(outputs: Any) -> tuple[str, ...]:
     return tuple(dict.fromkeys(names))
 
 
+def check_horizon(t_end: Any) -> float:
+    """The horizon t_end (s) as a float: a finite real number > 0 (the one check of it)."""
+    return check_number(
+        "t_end (horizon)", t_end, low=0, low_open=True, finite=True,
+        allowed="a real number, finite and > 0 s",
+    )  # fmt: skip
+
+
 @dataclass(frozen=True, eq=False)
 class Scene:
     """A complete simulation request: the *what*, independent of any model or integrator.
@@ -347,15 +355,7 @@ class Scene:
         if not isinstance(self.chain, Chain):
             raise ValueError(f"chain must be a rodval.Chain, got {type(self.chain).__name__}")
         n = self.chain.n
-        check_number("t_end (horizon)", self.t_end, allowed="a real number > 0 s")
-        t_end = check_number(
-            "t_end (horizon)",
-            self.t_end,
-            low=0,
-            low_open=True,
-            finite=True,
-            allowed="finite and > 0 s",
-        )
+        t_end = check_horizon(self.t_end)
         object.__setattr__(self, "t_end", t_end)
         object.__setattr__(self, "loads", _scene_loads(self.loads, n))
         times = _scene_times(self.times, t_end)

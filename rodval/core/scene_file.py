@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from rodval.core.base import BASE_KINDS, PINNED, Base
-from rodval.core.checks import check_keys, check_number
+from rodval.core.checks import check_keys
 from rodval.core.damping import (
     PANEL,
     RATIO_KEYS,
@@ -38,6 +38,7 @@ from rodval.core.scene import (
     Chain,
     InitialState,
     Scene,
+    check_horizon,
     output_times,
 )
 from rodval.core.scene_keys import SCENE_KEYS, check_types, merge_documents, missing_key, set_path
@@ -170,10 +171,7 @@ def _horizon(d: dict[str, Any], based_on: str | None) -> float:
     """``t_end``, the horizon (s): a finite number > 0 (the paper's 2 s with ``based_on``)."""
     if "t_end" not in d and based_on is None:
         raise _missing("t_end", "horizon, s")
-    t_end = d.get("t_end", PAPER_T_END)
-    return check_number(
-        "t_end (horizon)", t_end, low=0, low_open=True, finite=True, allowed="finite and > 0 s"
-    )
+    return check_horizon(d.get("t_end", PAPER_T_END))
 
 
 def _chain(
