@@ -67,13 +67,12 @@ def test_every_combination_runs_locks_and_keeps_its_energy_balance(base, kinemat
 def test_the_first_rung_on_a_free_body_is_the_paper_free_base_to_round_off():
     """The ladder's p = 1 first-order rung on a free body (``chain_base``) against the paper's
     free-base kernels (``free_base``): the same equations, other arithmetic: 1e-14."""
-    from rodval.models.base.free_base_system import FreeBaseSystem
-    from rodval.models.base.moving_base import LadderFreeSystem
+    from rodval.models.systems.chain_system import ChainSystem, LadderSystem
 
     body = Base(kind="free", mass=1e3, inertia=2e3, hinge_offset=(1.0, 0.0), rate=0.3)
     sc = latch3_scene().with_(base=body)
-    paper = FreeBaseSystem(sc)
-    rung = LadderFreeSystem(sc, "printed", "numba", 1, "first-order")
+    paper = ChainSystem(sc)
+    rung = LadderSystem(sc, "printed", "numba", 1, "first-order")
     rng = np.random.default_rng(1)
     for _ in range(3):
         y = paper.y0 + 0.1 * rng.standard_normal(paper.y0.size)

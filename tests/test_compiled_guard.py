@@ -37,20 +37,21 @@ def test_compiled_mechanics_equal_the_python_energy_and_power(model, coefficient
 def test_compiled_loop_stops_when_kinetic_energy_exceeds_its_budget():
     # Physically T <= E(0) + W+; a budget of half the load work (factor 0.5, allowed only in
     # this direct call) is exceeded as soon as the pulse has set the chain moving.
-    from rodval.solvers import budget, dop853
+    from rodval.solvers import budget, compiled
 
     scene = paper_scene(2, t_end=0.5)
     system = get_model("full").system(scene)
     form = system.compiled()
     Y = np.empty((scene.times.size, system.y0.size))
     edges = np.array([0.0, 0.5])
-    args = (form, system.y0, edges, scene.times, 1e-8, 1e-10, np.inf, None, 10**7)
-    n_out, _, _, code, t, *_ = dop853.integrate_compiled(
-        *args, GuardSpec(stall_steps=1000, blowup_factor=0.5), Y
+    controls = compiled.Controls(1e-8, 1e-10, np.inf, None, 10**7)
+    args = (form, system.y0, edges, scene.times, Y, controls)
+    n_out, _, _, code, t, *_ = compiled.integrate_compiled(
+        *args, GuardSpec(stall_steps=1000, blowup_factor=0.5)
     )
     assert code == budget.BLOWUP and 0 < t < 0.5 and n_out < scene.times.size
-    n_out, _, _, code, t, *_ = dop853.integrate_compiled(
-        *args, GuardSpec(stall_steps=1000, blowup_factor=1.0001), Y
+    n_out, _, _, code, t, *_ = compiled.integrate_compiled(
+        *args, GuardSpec(stall_steps=1000, blowup_factor=1.0001)
     )
     assert code == budget.OK and t == 0.5 and n_out == scene.times.size
 

@@ -12,7 +12,7 @@ from scenes import three_panel_free_scene  # noqa: E402
 
 from rodval import Base, paper_scene, simulate
 from rodval.core.scene_file import scene_from_dict, scene_to_dict
-from rodval.models.base.free_base_system import FreeBaseSystem
+from rodval.models.systems.chain_system import ChainSystem
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
 BODY = dict(kind="free", mass=50.0, inertia=20.0, hinge_offset=[0.5, 0.2])
@@ -95,7 +95,7 @@ def test_bordered_solve_inverts_the_mass_matrix_of_the_kinetic_energy():
     """The kernel's O(n) solve (chain eliminated, 3 x 3 Schur complement) against the dense
     M(Q) of the compiled T at a random state: M U^T = A^T for the unit hinge moments, hinge 0
     acting on the body too (entries ~1e2..1e3 kg m^2: 1e-10 is ~1e3 ulps of them)."""
-    system = FreeBaseSystem(free_scene(4))
+    system = ChainSystem(free_scene(4))
     rng = np.random.default_rng(7)
     y = system.y0 + 0.2 * rng.standard_normal(system.y0.size)
     M = _mass_matrix(system, y)
@@ -110,7 +110,7 @@ def test_bordered_solve_inverts_the_mass_matrix_of_the_kinetic_energy():
 def test_momenta_are_the_models_own_conjugate_momenta():
     """P is dT/dx_c'; H about the origin is T's momentum of a rigid rotation when the rods
     are straight (the first-order velocity field of rod_momenta is exact there)."""
-    system = FreeBaseSystem(free_scene(3))
+    system = ChainSystem(free_scene(3))
     rng = np.random.default_rng(3)
     y = system.y0 + 0.2 * rng.standard_normal(system.y0.size)
     n, N = system.n, system.N
@@ -176,7 +176,7 @@ def test_latches_lock_against_the_body_keeping_the_momentum():
     after = tr.times > tr.events[-1]["t"]
     assert np.abs(D[after][:, [0, 2]]).max() < 1e-9  # held at 0 (the latch angle)
     assert np.abs(tr["base_attitude"][-1, 0]) > 0.05  # the body turned: it took the impulse
-    system = FreeBaseSystem(scene)
+    system = ChainSystem(scene)
     y = system.y0.copy()
     held = np.array([0, 2])
     y_new, _ = system.plastic_jump(y, held, system.hinge_rows(held) @ y[: system.N])

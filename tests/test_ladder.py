@@ -16,11 +16,12 @@ from ladder_lagrangian import equations, kinetic_energy
 import rodval
 from rodval import simulate
 from rodval.core.scene import Chain, Latch, Scene
-from rodval.models.kinematics.ladder import LadderSystem, ladder_constants
+from rodval.models.kinematics.ladder import ladder_constants
 from rodval.models.kinematics.ladder_kernels import ladder_accel, ladder_kinetic
 from rodval.models.kinematics.shapes import rod_shapes, shape_polynomials
 from rodval.models.observation.linear_modes import modes
 from rodval.models.presets.full import FullModel, FullSystem
+from rodval.models.systems.chain_system import LadderSystem
 
 EPS = np.finfo(float).eps
 

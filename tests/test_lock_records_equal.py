@@ -59,7 +59,7 @@ def test_the_arrays_give_the_probe_by_probe_records_in_one_run(monkeypatch, name
     """The same comparison within one tree, independent of the stored run: the records with
     the integrands on whole arrays against those of ``OdeSystem.window_rows``, which calls
     ``window_terms`` one probe at a time (the per-state definition); same bound."""
-    from rodval.models.assembly.paper_system import PaperSystem
+    from rodval.models.systems.paper_system import PaperSystem
     from rodval.solvers.system import OdeSystem
 
     scene = scenes()[name]

@@ -11,7 +11,8 @@ from rodval.bench.stiffness import rigid_latch, stiff_paper
 from rodval.core.settings import IntegratorSettings
 from rodval.models import get_model
 from rodval.solvers import radau, stiffness
-from rodval.solvers.dop853 import RADAU_STEPPER, integrate_compiled
+from rodval.solvers.compiled import Controls, integrate_compiled, packed
+from rodval.solvers.dop853 import RADAU_STEPPER
 from rodval.solvers.dop853_events import interpolate
 from rodval.solvers.guard import GuardSpec
 
@@ -55,10 +56,10 @@ def test_compiled_radau_is_scipys_radau():
     system = get_model("full").system(scene)
     edges = np.concatenate([[0.0], scene.breakpoints, [scene.t_end]])
     Y = np.empty((scene.times.size, system.y0.size))
+    controls = Controls(1e-6, 1e-8, np.inf, None, 10**7, stepper=RADAU_STEPPER)
     ours = integrate_compiled(
-        system.compiled(), system.y0, edges, scene.times, 1e-6, 1e-8, np.inf, None, 10**7,
-        GuardSpec(), Y, stepper=RADAU_STEPPER,
-    )  # fmt: skip
+        system.compiled(), system.y0, edges, scene.times, Y, controls, GuardSpec()
+    )
     y, steps = system.y0, 0
     for a, b in zip(edges[:-1], edges[1:]):
         sol = solve_ivp(system.rhs, (a, b), y, method="Radau", rtol=1e-6, atol=1e-8)
@@ -156,9 +157,7 @@ def test_spectral_radius_finds_the_bending_frequency():
         form.rhs(0.0, yy, form.P, form.S, form.M, form.L, fj)
         J[:, j] = (fj - f) / 1e-7
     exact = np.max(np.abs(np.linalg.eigvals(J)))
-    rho = stiffness.spectral_radius(
-        form.rhs, form.P, form.S, form.M, form.L, 0.0, y, f, np.empty(N), np.empty(N), np.empty(N)
-    )
+    rho = stiffness.spectral_radius(packed(form), 0.0, y, f, np.empty(N), np.empty(N), np.empty(N))
     assert abs(rho / exact - 1) < 0.1, (rho, exact)
 
 

@@ -180,7 +180,7 @@ def test_constants_without_chain_constants(coefficients):
 
 
 def test_accel_wrapper_and_band_structure():
-    """reduced_accel_banded writes reduced_solve's phi'' (the sweep: METHOD_AUTO with a
+    """reduced_accel writes reduced_solve's phi'' (the sweep: METHOD_AUTO with a
     regular system); every coefficient of the assembled
     matrix lies inside the declared band (KL, KU); scales are powers of two."""
     n = 12
@@ -191,7 +191,7 @@ def test_accel_wrapper_and_band_structure():
     phi, dphi = rng.normal(size=n), rng.normal(size=n)
     SX, SY = ref.loads.suffix_sums(0.3)
     out = np.empty(n)
-    rb.reduced_accel_banded(Cst, phi, dphi, True, SX, SY, True, out)
+    rb.reduced_accel(Cst, np.concatenate([phi, dphi]), True, SX, SY, True, out)
     ddphi, _ = rb.bending_at(Cst, phi, dphi, (SX, SY), True, rb.METHOD_SWEEP)
     np.testing.assert_array_equal(out, ddphi)
     assert_close(out, ref.numpy_rhs(0.3, np.concatenate([phi, dphi]))[n:])
@@ -217,17 +217,17 @@ def test_work_array_variant(n, method):
         (rb.work_size(n) if method == rb.METHOD_BAND else rb.sweep_work_size(n)) + 3, np.nan
     )
     for _ in range(2):
-        phi, dphi = rng.normal(size=n), rng.normal(size=n)
+        y = np.concatenate([rng.normal(size=n), rng.normal(size=n)])
         a = np.empty(n), np.empty(2 * n)
         b = np.empty(n), np.empty(2 * n)
         assert rb.reduced_solve_work(
-            Cst, phi, dphi, True, SX, SY, True, *a, np.empty(rb.work_size(n)), method
+            Cst, y, True, SX, SY, True, a, np.empty(rb.work_size(n)), method
         )
-        assert rb.reduced_solve_work(Cst, phi, dphi, True, SX, SY, True, *b, work, method)
+        assert rb.reduced_solve_work(Cst, y, True, SX, SY, True, b, work, method)
         np.testing.assert_array_equal(a[0], b[0])
         np.testing.assert_array_equal(a[1], b[1])
         if method == rb.METHOD_AUTO:
-            assert rb.reduced_solve(Cst, phi, dphi, True, SX, SY, True, *b)
+            assert rb.reduced_solve(Cst, y, True, SX, SY, True, b)
             np.testing.assert_array_equal(a[0], b[0])
             np.testing.assert_array_equal(a[1], b[1])
 
@@ -262,8 +262,8 @@ def band_residual(Cst, phi, dphi, SX, SY, ddphi, gamma):
     n = phi.size
     N = lu.NB * n
     c, s = np.cos(phi), np.sin(phi)
-    vec = np.empty(5 * n)
-    rb.reduced_forces(Cst, phi, dphi, c, s, True, SX, SY, True, vec)
+    f = np.empty((3, n))
+    rb.reduced_forces(Cst, np.concatenate([phi, dphi]), c, s, True, SX, SY, True, f)
     unscaled = Cst.copy()
     unscaled[lu.C_RSCALE :] = 1.0
     A = np.empty((N, lu.W))
@@ -271,7 +271,7 @@ def band_residual(Cst, phi, dphi, SX, SY, ddphi, gamma):
         lu._fill_rod(unscaled, k, c, s, A, -1)
     i = lu.NB * np.arange(n)
     b = np.zeros(N)
-    b[i + lu.E_PHI], b[i + lu.E_AL], b[i + lu.E_BE] = vec[:n], vec[n : 2 * n], vec[2 * n : 3 * n]
+    b[i + lu.E_PHI], b[i + lu.E_AL], b[i + lu.E_BE] = f
     l, M = Cst[rb.V_L], Cst[rb.V_OUTER]
     u = np.zeros(N)
     u[i + lu.U_X], u[i + lu.U_A], u[i + lu.U_B] = ddphi, gamma[:n], gamma[n:]

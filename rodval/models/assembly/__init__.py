@@ -1,2 +1,1 @@
-"""The assembled chain system: the paper's matrices, the compiled O(n) kernels, the system and its
-energies."""
+"""The assembled chain: the paper's matrices and the compiled O(n) kernels."""

@@ -21,15 +21,23 @@ Argument conventions: ``full_accel(V, y, has_load, SX, SY, damped, out)`` for th
 right-hand side (whose loads may be any callable); ``full_rhs`` and ``*_mechanics`` have the
 compiled integrators' type ``rodval.solvers.signature.RHS_TYPE`` (loads from the compiled load
 table, ``rodval.core.loads.load_sums``, O(log rows) per evaluation). ``V`` holds rows of
-length-n vectors (layout ``V_*`` below), ``S = [damped]``.
+length-n vectors (layout ``V_*`` below), ``S = [damped]``. Generalized forces are one array
+``f`` of rows (n each): f[0] on phi, then one row per bending coordinate (alpha, beta).
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 
 from rodval.core.loads import load_sums
+
+#: A float64 array (numba reads no annotation: they are mypy's); two of them, a kernel's outputs.
+Arr = NDArray[np.float64]
+Pair = tuple[Arr, Arr]
 
 # Rows of V (per-rod vectors). Shared by both models.
 V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB = range(9)
@@ -37,7 +45,7 @@ V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB = range(9)
 V_PA, V_PB, V_AP, V_BP, V_AA, V_AB, V_EPS, V_PI, V_RHO, V_TAU = range(9, 19)
 
 
-def constant_rows(cc, chain) -> list[np.ndarray]:
+def constant_rows(cc: Any, chain: Any) -> list[Arr]:
     """The rows V_L .. V_CB shared by every kernel (and by reduced_banded's constants); V_KB
     = 4 EI/l (N m) and V_CB = 4 bending_damping/l (N m s), see paper_matrices.bending_blocks."""
     return [
@@ -53,7 +61,7 @@ def constant_rows(cc, chain) -> list[np.ndarray]:
     ]
 
 
-def full_constants(cc, chain) -> np.ndarray:
+def full_constants(cc: Any, chain: Any) -> Arr:
     """V for the full model: chain vectors plus the per-rod constants of the bending
     elimination. With M_gg,j = [[aa, ab], [ab, aa]], e = (1, -1), p = (pa, pb), a = (ap, bp):
     eps = e^T M_gg^-1 e, pi = p^T M_gg^-1 e, rho = e^T M_gg^-1 a, tau = p^T M_gg^-1 a."""
@@ -82,7 +90,9 @@ def full_constants(cc, chain) -> np.ndarray:
 
 
 @njit(cache=True)
-def hinge_forces(V, phi, alpha, beta, row, out_p, out_a, out_b):
+def hinge_forces(
+    V: Arr, phi: Arr, alpha: Arr, beta: Arr, row: int, out_p: Arr, out_a: Arr, out_b: Arr
+) -> None:
     """out += A^T diag(V[row]) (A [phi; alpha; beta] - rest), O(n): hinge springs about
     their rest angles (row V_KAPPA) or dampers (row V_NU: no rest rate)."""
     n = phi.shape[0]
@@ -101,7 +111,7 @@ def hinge_forces(V, phi, alpha, beta, row, out_p, out_a, out_b):
 
 
 @njit(cache=True)
-def gpp_times(V, c, s, x, out):
+def gpp_times(V: Arr, c: Arr, s: Arr, x: Arr, out: Arr) -> None:
     """out -= G_pp x, G_pp[k,j] = l_k l_j M_max(k,j) s_kj, O(n)."""
     n = c.shape[0]
     l, outer = V[V_L], V[V_OUTER]
@@ -120,7 +130,7 @@ def gpp_times(V, c, s, x, out):
 
 
 @njit(cache=True)
-def upper_times(V, c, s, x, cos_part, out, sign):
+def upper_times(V: Arr, c: Arr, s: Arr, x: Arr, cos_part: bool, out: Arr, sign: float) -> None:
     """out += sign * X x with X[k,j] = l_k w_j (c_kj if cos_part else s_kj) for k < j, O(n)."""
     n = c.shape[0]
     l, w = V[V_L], V[V_W]
@@ -136,7 +146,7 @@ def upper_times(V, c, s, x, cos_part, out, sign):
 
 
 @njit(cache=True)
-def upper_t_times(V, c, s, x, cos_part, out, sign):
+def upper_t_times(V: Arr, c: Arr, s: Arr, x: Arr, cos_part: bool, out: Arr, sign: float) -> None:
     """out += sign * X^T x for the X of ``upper_times``, O(n)."""
     n = c.shape[0]
     l, w = V[V_L], V[V_W]
@@ -152,7 +162,7 @@ def upper_t_times(V, c, s, x, cos_part, out, sign):
 
 
 @njit(cache=True)
-def generator_solve(d, a, b, e, r, x):
+def generator_solve(d: Arr, a: Arr, b: Arr, e: Arr, r: Arr, x: Arr) -> None:
     """Solve S x = r for S = diag(d) + tril(a b^T, -1) + triu(b e^T, 1) (2-vectors a_k, b_k,
     e_k per row, (n, 2) arrays): S[k,j] = a_k . b_j (k > j), b_k . e_j (k < j); O(n)."""
     n = d.shape[0]
@@ -191,15 +201,7 @@ def generator_solve(d, a, b, e, r, x):
 
 
 @njit(cache=True)
-def _schur_solve(V, c, s, r, x):
-    """Solve S x = r for the full model's Schur complement S = M_pp - M_pg M_gg^-1 M_gp in
-    O(n): S = diag(d) + tril(a b^T) + triu(b e^T) with 2-vectors a_k, b_k, e_k per rod."""
-    d, a, b, e = schur_generators(V, c, s)
-    generator_solve(d, a, b, e, r, x)
-
-
-@njit(cache=True)
-def schur_generators(V, c, s):
+def schur_generators(V: Arr, c: Arr, s: Arr) -> tuple[Arr, Arr, Arr, Arr]:
     """(d, a, b, e) of the Schur complement S = diag(d) + tril(a b^T) + triu(b e^T) (see
     ``generator_solve``) from the rows V_L, V_OUTER, V_W, V_PPDIAG, V_EPS .. V_TAU; O(n)."""
     n = c.shape[0]
@@ -232,17 +234,18 @@ def schur_generators(V, c, s):
 
 
 @njit(cache=True)
-def full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
-    """f = [Q; 0; 0] - h - C q' - K q + A^T kappa rest of the full model (N m) into fp, fa, fb
-    (zeroed here), O(n). C q' (hinge dampers and the rods' bending damping) only when
+def full_forces(
+    V: Arr, y: Arr, c: Arr, s: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, f: Arr
+) -> None:
+    """f = [Q; 0; 0] - h - C q' - K q + A^T kappa rest of the full model (N m) into the rows
+    f (3, n) (zeroed here), O(n). C q' (hinge dampers and the rods' bending damping) only when
     ``damped``."""
     n = V.shape[1]
     q, v = y[: 3 * n], y[3 * n :]
     phi, alpha, beta = q[:n], q[n : 2 * n], q[2 * n :]
     dphi, dalpha, dbeta = v[:n], v[n : 2 * n], v[2 * n :]
-    fp[:] = 0.0
-    fa[:] = 0.0
-    fb[:] = 0.0
+    f[:] = 0.0
+    fp, fa, fb = f[0], f[1], f[2]
     hinge_forces(V, phi, alpha, beta, V_KAPPA, fp, fa, fb)
     if damped:
         hinge_forces(V, dphi, dalpha, dbeta, V_NU, fp, fa, fb)
@@ -266,7 +269,7 @@ def full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb):
 
 
 @njit(cache=True)
-def load_moments(V, c, s, SX, SY, fp):
+def load_moments(V: Arr, c: Arr, s: Arr, SX: Arr, SY: Arr, fp: Arr) -> None:
     """fp += Q, the loads' generalized forces on phi: Q_k = l_k (c_k SY_k - s_k SX_k) (N m)
     from the load suffix sums SX, SY (N); O(n)."""
     l = V[V_L]
@@ -275,10 +278,12 @@ def load_moments(V, c, s, SX, SY, fp):
 
 
 @njit(cache=True)
-def full_solve(V, c, s, fp, fa, fb, out):
-    """q'' = M(phi)^-1 [fp; fa; fb] (3n) into ``out``, O(n): the bending coordinates are
-    eliminated per rod, the Schur complement is solved by ``_schur_solve``."""
+def full_solve(V: Arr, c: Arr, s: Arr, f: Arr, out: Arr) -> None:
+    """q'' = M(phi)^-1 f (3n; f the rows (3, n) of ``full_forces``) into ``out``, O(n): the
+    bending coordinates are eliminated per rod, the Schur complement S = M_pp - M_pg M_gg^-1
+    M_gp (``schur_generators``) is solved in generator form."""
     n = V.shape[1]
+    fp, fa, fb = f[0], f[1], f[2]
     # g = M_gg^-1 f_g per rod; r = f_p - M_pg g; S x_p = r; x_g = M_gg^-1 (f_g - M_gp x_p)
     aa, ab = V[V_AA], V[V_AB]
     ga = np.empty(n)
@@ -290,7 +295,8 @@ def full_solve(V, c, s, fp, fa, fb, out):
     r = fp - V[V_PA] * ga - V[V_PB] * gb
     upper_times(V, c, s, ga - gb, True, r, -1.0)
     xp = out[:n]
-    _schur_solve(V, c, s, r, xp)
+    d, a, b, e = schur_generators(V, c, s)
+    generator_solve(d, a, b, e, r, xp)
     ut = np.zeros(n)
     upper_t_times(V, c, s, xp, True, ut, 1.0)
     for k in range(n):
@@ -302,43 +308,47 @@ def full_solve(V, c, s, fp, fa, fb, out):
 
 
 @njit(cache=True)
-def full_accel(V, y, has_load, SX, SY, damped, out):
+def full_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
     """Accelerations q'' (3n) of the full model at y = [q; q'] into ``out``: M(phi) q'' =
     [Q; 0; 0] - h - C q' - K q. SX, SY are the load suffix sums (N), used when ``has_load``.
     O(n) time and memory."""
     n = V.shape[1]
     c = np.cos(y[:n])
     s = np.sin(y[:n])
-    fp = np.empty(n)
-    fa = np.empty(n)
-    fb = np.empty(n)
-    full_forces(V, y, c, s, has_load, SX, SY, damped, fp, fa, fb)
-    full_solve(V, c, s, fp, fa, fb, out)
+    f = np.empty((3, n))
+    full_forces(V, y, c, s, has_load, SX, SY, damped, f)
+    full_solve(V, c, s, f, out)
 
 
 @njit(cache=True, inline="always")
-def rhs_head(t, y, L, SX, SY, out):
+def rhs_head(t: float, y: Arr, L: Arr, SX: Arr, SY: Arr, out: Arr) -> bool:
     """The start of a compiled right-hand side y' = [v; a] of a state y = [q; v]: out's first
     half = v, the load suffix sums at t (N) into SX, SY (``load_sums``); returns whether a
     load acts. O(N)."""
     half = y.shape[0] // 2
     for i in range(half):  # a loop: a slice assignment compiles numba's shape check
         out[i] = y[half + i]
-    return load_sums(L, t, SX, SY)
+    return bool(load_sums(L, t, SX, SY))
+
+
+@njit(cache=True, inline="always")
+def rhs_start(t: float, y: Arr, P: Arr, L: Arr, out: Arr) -> tuple[bool, Arr, Arr]:
+    """``rhs_head`` with the load sums allocated (n each, n = P's columns): (has_load, SX,
+    SY). O(N)."""
+    SX = np.empty(P.shape[1])
+    SY = np.empty(P.shape[1])
+    return rhs_head(t, y, L, SX, SY, out), SX, SY
 
 
 @njit(cache=True)
-def full_rhs(t, y, P, S, M, L, out):
+def full_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the full model (compiled integrators' right-hand side, loads from table L)."""
-    n = P.shape[1]
-    SX = np.empty(n)
-    SY = np.empty(n)
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    full_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[3 * n :])
+    has_load, SX, SY = rhs_start(t, y, P, L, out)
+    full_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[3 * P.shape[1] :])
 
 
 @njit(cache=True)
-def _mpp_quadratic(V, c, s, x):
+def _mpp_quadratic(V: Arr, c: Arr, s: Arr, x: Arr) -> float:
     """x^T M_pp x (kg m^2/s^2 for rates x), O(n): M_pp[k,j] = l_k l_j M_max(k,j) c_kj off the
     diagonal, c_kj = c_k c_j + s_k s_j by prefix sums."""
     n = c.shape[0]
@@ -350,11 +360,11 @@ def _mpp_quadratic(V, c, s, x):
         total += d[k] * x[k] * x[k] + 2.0 * l[k] * outer[k] * x[k] * (c[k] * pc + s[k] * ps)
         pc += l[k] * c[k] * x[k]
         ps += l[k] * s[k] * x[k]
-    return total
+    return float(total)
 
 
 @njit(cache=True)
-def load_power(V, c, s, dphi, L, t):
+def load_power(V: Arr, c: Arr, s: Arr, dphi: Arr, L: Arr, t: float) -> float:
     """P_ext = Q . phi' (W) with Q_k = l_k (c_k SY_k - s_k SX_k); 0 when no load acts."""
     n = c.shape[0]
     SX = np.empty(n)
@@ -369,7 +379,7 @@ def load_power(V, c, s, dphi, L, t):
 
 
 @njit(cache=True)
-def compiled_damper_power(V, S, dphi, dalpha, dbeta):
+def compiled_damper_power(V: Arr, S: Arr, dphi: Arr, dalpha: Arr, dbeta: Arr) -> float:
     """q'^T C q' = sum_k nu_k (dD_k/dt)^2 + sum_k cb_k (a'^2 + a' b' + b'^2) (W), dD_k/dt =
     phi'_k + alpha'_k - phi'_{k-1} - beta'_{k-1} (the hinge rates,
     ``rodval.core.scene.hinge_angles`` of the rates), cb = 4 bending_damping/l on the bending
@@ -389,7 +399,7 @@ def compiled_damper_power(V, S, dphi, dalpha, dbeta):
 
 
 @njit(cache=True)
-def full_mechanics(t, y, P, S, M, L, out):
+def full_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) of the full model into out[:3]: T = 1/2 q'^T M q' (J) with the
     kinematic (printed, symmetric) mass matrix, the load power (W) and the damper power
     sum_k nu_k (dD_k/dt)^2 (W; 0 unless S[0], the damped flag). O(n)."""
@@ -411,7 +421,7 @@ def full_mechanics(t, y, P, S, M, L, out):
 
 
 @njit(cache=True)
-def reduced_mechanics(t, y, P, S, M, L, out):
+def reduced_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) of the reduced model into out[:3]: T = 1/2 phi'^T M_pp phi' (J; its
     bending rates are dropped, in its dampers too: P_diss = sum_k nu_k (phi'_k -
     phi'_{k-1})^2, W), the load power (W). O(n)."""

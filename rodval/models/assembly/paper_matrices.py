@@ -35,6 +35,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any, cast
 
 import numpy as np
 from scipy.linalg import solveh_banded
@@ -69,7 +70,7 @@ class ChainConstants:
     def pp_scale(self) -> np.ndarray:
         """l_k l_j M_max(k,j), (n, n): O(n^2) memory, for the dense reference only."""
         idx = np.arange(self.n)
-        return np.outer(self.l, self.l) * self.outer_mass[np.maximum.outer(idx, idx)]
+        return np.asarray(np.outer(self.l, self.l) * self.outer_mass[np.maximum.outer(idx, idx)])
 
     @cached_property
     def w_upper(self) -> np.ndarray:
@@ -163,7 +164,7 @@ def angle_jacobian(scale: np.ndarray, dtrig: np.ndarray, u: np.ndarray) -> np.nd
     dtrig[k,j] = trig'(phi_k - phi_j) (cos -> -s_kj, sin -> c_kj):
     d(X u)_k/dphi_i = delta_ki (X' u)_k - X'_ki u_i with X' = scale * dtrig, (n, n)."""
     Xp = scale * dtrig
-    return np.diag(Xp @ u) - Xp * u
+    return np.asarray(np.diag(Xp @ u) - Xp * u)
 
 
 def hinge_matrix(n: int) -> np.ndarray:
@@ -199,7 +200,7 @@ def stiffness_matrix(chain: Chain) -> np.ndarray:
     """K = Hessian of Pi (3n, 3n): hinge springs A^T diag(kappa) A plus bending blocks
     (4 EI/l) [[1, 1/2], [1/2, 1]] on (alpha_k, beta_k)."""
     A = hinge_matrix(chain.n)
-    return A.T @ (chain.kappa[:, None] * A) + bending_blocks(chain.EI, chain.l, chain.n)
+    return np.asarray(A.T @ (chain.kappa[:, None] * A) + bending_blocks(chain.EI, chain.l, chain.n))
 
 
 def rest_forces(chain: Chain) -> np.ndarray:
@@ -215,25 +216,28 @@ def rest_forces(chain: Chain) -> np.ndarray:
 
 
 def potential_energy(
-    chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, attitude=None
+    chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, attitude: Any = None
 ) -> np.ndarray:
     """Pi = hinge_energy + bending_energy (J), per row of (..., n) arrays, O(n)."""
-    return hinge_energy(chain, phi, alpha, beta, attitude) + bending_energy(chain, alpha, beta)
+    hinge = hinge_energy(chain, phi, alpha, beta, attitude)
+    return cast(np.ndarray, hinge + bending_energy(chain, alpha, beta))
 
 
 def hinge_energy(
-    chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, attitude=None
+    chain: Chain, phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, attitude: Any = None
 ) -> np.ndarray:
     """1/2 sum_k kappa_k (D_k - rest_k)^2 (J): the hinge springs, per row, O(n); ``attitude``
     a free base's theta (rad), hinge 0's reference (``hinge_angles``)."""
     D = hinge_angles(phi, alpha, beta, attitude) - chain.rest_angle
-    return 0.5 * np.sum(chain.kappa * D * D, axis=-1)
+    return cast(np.ndarray, 0.5 * np.sum(chain.kappa * D * D, axis=-1))  # a float for one row
 
 
 def bending_energy(chain: Chain, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     """1/2 sum_k (4 EI_k/l_k)(a^2 + a b + b^2) (J): the rods' bending, per row, O(n)."""
     kb = 4.0 * chain.EI / chain.l
-    return 0.5 * np.sum(kb * (alpha * alpha + alpha * beta + beta * beta), axis=-1)
+    return cast(
+        np.ndarray, 0.5 * np.sum(kb * (alpha * alpha + alpha * beta + beta * beta), axis=-1)
+    )
 
 
 def quasi_static_bending(chain: Chain, phi: np.ndarray) -> np.ndarray:
@@ -259,7 +263,7 @@ def quasi_static_bending(chain: Chain, phi: np.ndarray) -> np.ndarray:
 
 
 def damper_power(
-    chain: Chain, dphi: np.ndarray, dalpha: np.ndarray, dbeta: np.ndarray, attitude_rate=None
+    chain: Chain, dphi: np.ndarray, dalpha: np.ndarray, dbeta: np.ndarray, attitude_rate: Any = None
 ) -> float:
     """P_diss = q'^T C q' = sum_k nu_k (dD_k/dt)^2 + sum_k (4 c_k/l_k)(a'^2 + a' b' + b'^2)
     >= 0 (W; c = bending_damping, a', b' the bending rates alpha'_k, beta'_k; hinge 0's rate
@@ -274,14 +278,16 @@ def damping_matrix(chain: Chain) -> np.ndarray:
     """C = Hessian of the dissipation function (3n, 3n): the hinge dampers A^T diag(nu) A plus
     the rods' Kelvin-Voigt blocks (4 c/l) [[1, 1/2], [1/2, 1]] on (alpha'_k, beta'_k)."""
     A = hinge_matrix(chain.n)
-    return A.T @ (chain.nu[:, None] * A) + bending_blocks(chain.bending_damping, chain.l, chain.n)
+    return np.asarray(
+        A.T @ (chain.nu[:, None] * A) + bending_blocks(chain.bending_damping, chain.l, chain.n)
+    )
 
 
 def generalized_forces(
     l: np.ndarray, phi: np.ndarray, SX: np.ndarray, SY: np.ndarray
 ) -> np.ndarray:
     """Q_k = l_k (cos phi_k SY_k - sin phi_k SX_k), SX_k = sum_{j>=k} X_j (N m)."""
-    return l * (np.cos(phi) * SY - np.sin(phi) * SX)
+    return np.asarray(l * (np.cos(phi) * SY - np.sin(phi) * SX))
 
 
 def node_positions(l: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -317,8 +323,8 @@ def rod_momenta(
     )
     r0, v0, r1, v1 = r[..., :-1, :], v[..., :-1, :], r[..., 1:, :], v[..., 1:, :]
 
-    def cross(a, b):
-        return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.asarray(a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0])
 
     ml, ml2 = m * l, m * l * l
     swing = ml2 * dphi / 2.0 + ml2 * (dalpha - dbeta) / 12.0  # int (s phi' + eta') m ds

@@ -37,12 +37,14 @@ from rodval.models.assembly.kernels import (
     V_OUTER,
     V_REST,
     V_W,
+    Arr,
     full_forces,
     full_mechanics,
     full_solve,
-    rhs_head,
+    rhs_start,
 )
 from rodval.models.hinge_items.deployment import (
+    Ints,
     hinge_events,
     locked_head,
     small_solve,
@@ -50,41 +52,82 @@ from rodval.models.hinge_items.deployment import (
     unit_moment,
 )
 
-# Rows of V after the full model's (``kernels.full_constants``, rows 0..18), each the same
-# value in every column: the body's mass (kg), inertia (kg m^2), hinge offset (m, body frame)
-# and the chain's mass (kg).
-V_BM, V_BJ, V_HX, V_HY, V_MCH = range(19, 24)
+#: Rows appended to a chain's V (``kernels.full_constants`` here, the ladder's in
+#: ``chain_base``), each the same value in every column: the body's mass (kg), inertia
+#: (kg m^2), hinge offset x, y (m, body frame) and the chain's mass (kg).
+BODY_ROWS = 5
+BODY_MASS, BODY_INERTIA, OFFSET_X, OFFSET_Y, CHAIN_MASS = range(BODY_ROWS)
+#: (cos phi, sin phi, alpha - beta) of the chain at q: what its first mass moment reads.
+Chords = tuple[Arr, Arr, Arr]
+
+
+@njit(cache=True, inline="always")
+def body_value(V: Arr, i: int) -> float:
+    """Body row ``i`` (``BODY_MASS`` ..) of V."""
+    return float(V[V.shape[0] - BODY_ROWS + i, 0])
 
 
 @njit(cache=True)
-def _rho(V, th):
+def offset_vector(V: Arr, th: float) -> tuple[float, float]:
     """rho = R(theta) h (m): node 0 from the body's centre of mass."""
     c, s = np.cos(th), np.sin(th)
-    hx, hy = V[V_HX, 0], V[V_HY, 0]
+    hx, hy = body_value(V, OFFSET_X), body_value(V, OFFSET_Y)
     return c * hx - s * hy, s * hx + c * hy
 
 
 @njit(cache=True)
-def _field_forces(V, c, s, delta, gx, gy, fp, fa, fb):
-    """[fp; fa; fb] += J_S^T g (N m for g in m/s^2: the generalized force of a uniform field), O(n):
+def chain_state(y: Arr, N: int) -> Arr:
+    """[q; q'] of the chain (2N) from a body's state [Q; Q'] (2 (N + 3))."""
+    NQ = N + 3
+    yc = np.empty(2 * N)
+    for i in range(N):  # loops: a slice assignment compiles numba's shape check
+        yc[i] = y[i]
+        yc[N + i] = y[NQ + i]
+    return yc
+
+
+@njit(cache=True)
+def hinge0_moment(V: Arr, D: float, rate: float, damped: bool) -> float:
+    """T_0 (N m): hinge 0's moment on the body, kappa_0 (D_0 - rest_0) + nu_0 dD_0/dt, D_0 =
+    phi_1 + alpha_1 - theta (acting stops in V's kappa, nu, rest)."""
+    T = V[V_KAPPA, 0] * (D - V[V_REST, 0])
+    if damped:
+        T += V[V_NU, 0] * rate
+    return float(T)
+
+
+@njit(cache=True)
+def _chords(V: Arr, q: Arr) -> Chords:
+    """(cos phi, sin phi, delta = alpha - beta) of the chain at the positions ``q``."""
+    n = V.shape[1]
+    return np.cos(q[:n]), np.sin(q[:n]), q[n : 2 * n] - q[2 * n : 3 * n]
+
+
+@njit(cache=True)
+def _field_forces(V: Arr, geo: Chords, gx: float, gy: float, f: Arr) -> None:
+    """f += J_S^T g (N m for g in m/s^2: the generalized force of a uniform field), O(n):
     dS/dphi_k = l_k M_k n_k - w_k delta_k e_k, dS/dalpha_k = w_k n_k = -dS/dbeta_k, delta =
     alpha - beta."""
+    c, s, delta = geo
     l, outer, w = V[V_L], V[V_OUTER], V[V_W]
     for k in range(c.shape[0]):
         ng = c[k] * gy - s[k] * gx
         eg = c[k] * gx + s[k] * gy
-        fp[k] += l[k] * outer[k] * ng - w[k] * delta[k] * eg
-        fa[k] += w[k] * ng
-        fb[k] -= w[k] * ng
+        f[0, k] += l[k] * outer[k] * ng - w[k] * delta[k] * eg
+        f[1, k] += w[k] * ng
+        f[2, k] -= w[k] * ng
 
 
 @njit(cache=True)
-def _first_moment_rate(V, c, s, delta, xp, xa, xb):
-    """J_S x (kg m/s for rates x): the first moment's rate along x = [xp; xa; xb], O(n)."""
+def _first_moment_rate(V: Arr, geo: Chords, x: Arr) -> tuple[float, float]:
+    """J_S x (kg m/s for rates x): the first moment's rate along x = [xp; xa; xb; ..], O(n)."""
+    c, s, delta = geo
+    n = c.shape[0]
+    xp, xa, xb = x[:n], x[n : 2 * n], x[2 * n : 3 * n]
     l, outer, w = V[V_L], V[V_OUTER], V[V_W]
     sx = 0.0
     sy = 0.0
-    for k in range(c.shape[0]):
+    for k in range(n):
         a = l[k] * outer[k] * xp[k] + w[k] * (xa[k] - xb[k])  # along n_k
         b = -w[k] * delta[k] * xp[k]  # along e_k
         sx += b * c[k] - a * s[k]
@@ -93,9 +136,10 @@ def _first_moment_rate(V, c, s, delta, xp, xa, xb):
 
 
 @njit(cache=True)
-def _first_moment_quadratic(V, c, s, delta, ddelta, dphi):
+def _first_moment_quadratic(V: Arr, geo: Chords, ddelta: Arr, dphi: Arr) -> tuple[float, float]:
     """s_2 = S'' - J_S q'' (kg m/s^2): -l M phi'^2 e - 2 w delta' phi' e - w delta phi'^2 n
     summed over the rods, O(n)."""
+    c, s, delta = geo
     l, outer, w = V[V_L], V[V_OUTER], V[V_W]
     sx = 0.0
     sy = 0.0
@@ -109,27 +153,25 @@ def _first_moment_quadratic(V, c, s, delta, ddelta, dphi):
 
 
 @njit(cache=True)
-def field_responses(V, c, s, delta, G):
+def field_responses(V: Arr, geo: Chords, G: Arr) -> Arr:
     """G[j] = M_c^-1 J_S^T e_j (j = x, y; 3n each) and K = J_S G (2 x 2, kg); O(n)."""
-    n = c.shape[0]
-    fp = np.empty(n)
-    fa = np.empty(n)
-    fb = np.empty(n)
+    c, s, _ = geo
+    f = np.empty((3, c.shape[0]))
     K = np.empty((2, 2))
     for j in range(2):
-        fp[:] = 0.0
-        fa[:] = 0.0
-        fb[:] = 0.0
-        _field_forces(V, c, s, delta, 1.0 - j, float(j), fp, fa, fb)
-        full_solve(V, c, s, fp, fa, fb, G[j])
-        kx, ky = _first_moment_rate(V, c, s, delta, G[j, :n], G[j, n : 2 * n], G[j, 2 * n :])
+        f[:] = 0.0
+        _field_forces(V, geo, 1.0 - j, float(j), f)
+        full_solve(V, c, s, f, G[j])
+        kx, ky = _first_moment_rate(V, geo, G[j])
         K[0, j] = kx
         K[1, j] = ky
     return K
 
 
 @njit(cache=True)
-def body_accelerations(K, rx, ry, mch, mb, J, jx, jy, rb):
+def body_accelerations(
+    K: Arr, rx: float, ry: float, mch: float, mb: float, J: float, jx: float, jy: float, rb: Arr
+) -> Arr:
     """(a_c (m/s^2, 2), theta'' (rad/s^2)) of the body: the 3 x 3 Schur complement D - E^T K E
     of the bordered mass matrix (E = [I, rho_perp], K = J_S M_c^-1 J_S^T, kg; rho = (rx, ry) m;
     chain mass mch, body mass mb (kg), inertia J (kg m^2)) solved against rb - E^T (jx, jy)
@@ -158,15 +200,17 @@ def body_accelerations(K, rx, ry, mch, mb, J, jx, jy, rb):
 
 
 @njit(cache=True)
-def base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out):
-    """x = M_tot^-1 [fp; fa; fb; rb] (the bordered total mass matrix, module docstring) into
-    ``out`` (3n + 3): q'' then (a_c (m/s^2), theta'' (rad/s^2)). O(n)."""
+def base_solve(V: Arr, geo: Chords, th: float, G: Arr, K: Arr, f: Arr, rb: Arr, out: Arr) -> None:
+    """x = M_tot^-1 [f; rb] (the bordered total mass matrix, module docstring; f the chain's
+    force rows (3, n)) into ``out`` (3n + 3): q'' then (a_c (m/s^2), theta'' (rad/s^2)). O(n)."""
+    c, s, _ = geo
     n = c.shape[0]
     u = out[: 3 * n]
-    full_solve(V, c, s, fp, fa, fb, u)
-    jx, jy = _first_moment_rate(V, c, s, delta, u[:n], u[n : 2 * n], u[2 * n :])
-    rx, ry = _rho(V, th)
-    xb = body_accelerations(K, rx, ry, V[V_MCH, 0], V[V_BM, 0], V[V_BJ, 0], jx, jy, rb)
+    full_solve(V, c, s, f, u)
+    jx, jy = _first_moment_rate(V, geo, u)
+    rx, ry = offset_vector(V, th)
+    mch, mb, J = body_value(V, CHAIN_MASS), body_value(V, BODY_MASS), body_value(V, BODY_INERTIA)
+    xb = body_accelerations(K, rx, ry, mch, mb, J, jx, jy, rb)
     g0 = xb[0] - xb[2] * ry  # a_0 = a_c + theta'' rho_perp, rho_perp = (-ry, rx)
     g1 = xb[1] + xb[2] * rx
     for i in range(3 * n):
@@ -176,89 +220,56 @@ def base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out):
 
 
 @njit(cache=True)
-def _chain_state(y, n):
-    """[q; q'] of the chain (6n) from the free-base state [Q; Q'] (2 (3n + 3))."""
-    N = 3 * n + 3
-    yc = np.empty(6 * n)
-    for i in range(3 * n):
-        yc[i] = y[i]
-        yc[3 * n + i] = y[N + i]
-    return yc
-
-
-@njit(cache=True)
-def hinge0_moment(V, y, damped):
-    """T_0 (N m): hinge 0's moment on the body, kappa_0 (D_0 - rest_0) + nu_0 dD_0/dt with
-    D_0 = phi_1 + alpha_1 - theta (acting stops are in V's kappa, nu, rest)."""
-    n = V.shape[1]
-    N = 3 * n + 3
-    D = y[0] + y[n] - y[3 * n + 2]
-    T = V[V_KAPPA, 0] * (D - V[V_REST, 0])
-    if damped:
-        T += V[V_NU, 0] * (y[N] + y[N + n] - y[N + 3 * n + 2])
-    return T
-
-
-@njit(cache=True)
-def base_accel(V, y, has_load, SX, SY, damped, out):
+def base_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
     """Q'' (3n + 3) of the full model on a free base at y = [Q; Q'] into ``out`` (module
     docstring); SX, SY the load suffix sums (N). O(n): three chain solves."""
     n = V.shape[1]
     N = 3 * n + 3
-    phi = y[:n]
-    c = np.cos(phi)
-    s = np.sin(phi)
-    delta = y[n : 2 * n] - y[2 * n : 3 * n]
+    geo = _chords(V, y)
     ddelta = y[N + n : N + 2 * n] - y[N + 2 * n : N + 3 * n]
     th, dth = y[3 * n + 2], y[N + 3 * n + 2]
-    fp = np.empty(n)
-    fa = np.empty(n)
-    fb = np.empty(n)
-    full_forces(V, _chain_state(y, n), c, s, has_load, SX, SY, damped, fp, fa, fb)
+    f = np.empty((3, n))
+    full_forces(V, chain_state(y, 3 * n), geo[0], geo[1], has_load, SX, SY, damped, f)
     shift = V[V_KAPPA, 0] * th + (V[V_NU, 0] * dth if damped else 0.0)
-    fp[0] += shift  # hinge 0 measured from the body: D_0 - theta
-    fa[0] += shift
-    rx, ry = _rho(V, th)
+    f[0, 0] += shift  # hinge 0 measured from the body: D_0 - theta
+    f[1, 0] += shift
+    rx, ry = offset_vector(V, th)
     w2 = dth * dth
-    _field_forces(V, c, s, delta, w2 * rx, w2 * ry, fp, fa, fb)  # a_0's -theta'^2 rho part
+    _field_forces(V, geo, w2 * rx, w2 * ry, f)  # a_0's -theta'^2 rho part
     Fx = SX[0] if has_load else 0.0
     Fy = SY[0] if has_load else 0.0
-    qx, qy = _first_moment_quadratic(V, c, s, delta, ddelta, y[N : N + n])
-    mch = V[V_MCH, 0]
+    qx, qy = _first_moment_quadratic(V, geo, ddelta, y[N : N + n])
+    mch = body_value(V, CHAIN_MASS)
     tx = Fx - qx + mch * w2 * rx
     ty = Fy - qy + mch * w2 * ry
-    rb = np.array([tx, ty, hinge0_moment(V, y, damped) - ry * (Fx - qx) + rx * (Fy - qy)])
+    T0 = hinge0_moment(V, y[0] + y[n] - th, y[N] + y[N + n] - dth, damped)
+    rb = np.array([tx, ty, T0 - ry * (Fx - qx) + rx * (Fy - qy)])
     G = np.empty((2, 3 * n))
-    K = field_responses(V, c, s, delta, G)
-    base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, out)
+    K = field_responses(V, geo, G)
+    base_solve(V, geo, th, G, K, f, rb, out)
 
 
 @njit(cache=True)
-def base_unit_responses(V, y, locks, U):
+def base_unit_responses(V: Arr, y: Arr, locks: Ints, U: Arr) -> None:
     """U[j] = M_tot^-1 a_k^T (3n + 3) for k = locks[j]: a unit moment at hinge k (on the body
     as well for k = 0: its row has -1 at theta). O(n) per hinge."""
     n = V.shape[1]
-    c = np.cos(y[:n])
-    s = np.sin(y[:n])
-    delta = y[n : 2 * n] - y[2 * n : 3 * n]
-    th = y[3 * n + 2]
+    geo = _chords(V, y)
     G = np.empty((2, 3 * n))
-    K = field_responses(V, c, s, delta, G)
-    fp = np.empty(n)
-    fa = np.empty(n)
-    fb = np.empty(n)
+    K = field_responses(V, geo, G)
+    f = np.empty((3, n))
     rb = np.zeros(3)
     for j in range(locks.shape[0]):
-        fp[:] = 0.0
-        fa[:] = 0.0
-        fb[:] = 0.0
-        unit_moment(locks[j], fp, fa, fb)
+        f[:] = 0.0
+        unit_moment(locks[j], f)
         rb[2] = -1.0 if locks[j] == 0 else 0.0
-        base_solve(V, c, s, delta, th, G, K, fp, fa, fb, rb, U[j])
+        base_solve(V, geo, y[3 * n + 2], G, K, f, rb, U[j])
 
 
 @njit(cache=True)
-def base_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
+def base_accel_locked(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+) -> None:
     """Q'' with the hinges ``locks`` held (multipliers into ``lam``, N m); O(n m)."""
     n = V.shape[1]
     base_accel(V, y, has_load, SX, SY, damped, out)
@@ -271,68 +282,62 @@ def base_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
 
 
 @njit(cache=True)
-def base_rhs(t, y, P, S, M, L, out):
+def base_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the full model on a free base (compiled integrators' right-hand side)."""
-    n = P.shape[1]
-    SX = np.empty(n)
-    SY = np.empty(n)
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    base_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[3 * n + 3 :])
+    has_load, SX, SY = rhs_start(t, y, P, L, out)
+    base_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[3 * P.shape[1] + 3 :])
 
 
 @njit(cache=True)
-def base_rhs_locked(t, y, P, S, M, L, out):
+def base_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' with the hinges of S held (``deployment.lock_scalars``); O(n m)."""
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
     base_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * P.shape[1] + 3 :], lam)
 
 
 @njit(cache=True)
-def base_hinge_events(t, y, P, S, M, L, E, out):
+def base_hinge_events(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, E: Arr, out: Arr) -> None:
     """Latch and stop events g = D_k - angle, hinge 0 from the body's attitude; O(rows)."""
     n = P.shape[1]
     hinge_events(y[:n], y[n : 2 * n], y[2 * n : 3 * n], E, out, y[3 * n + 2])
 
 
 @njit(cache=True)
-def _root_rates(V, y):
+def _root_rates(V: Arr, y: Arr) -> tuple[float, float, float, float]:
     """(v_0 (m/s), S' (kg m/s)) at y = [Q; Q']: node 0's velocity v_c + theta' k x rho and the
     rate of the chain's first mass moment about it, J_S q'; O(n)."""
     n = V.shape[1]
-    N = 3 * n + 3
-    c = np.cos(y[:n])
-    s = np.sin(y[:n])
-    delta = y[n : 2 * n] - y[2 * n : 3 * n]
-    v = y[N:]
-    jx, jy = _first_moment_rate(V, c, s, delta, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
-    rx, ry = _rho(V, y[3 * n + 2])
+    v = y[3 * n + 3 :]
+    jx, jy = _first_moment_rate(V, _chords(V, y), v)
+    rx, ry = offset_vector(V, y[3 * n + 2])
     dth = v[3 * n + 2]
     return v[3 * n] - dth * ry, v[3 * n + 1] + dth * rx, jx, jy
 
 
 @njit(cache=True)
-def momentum(V, y):
+def momentum(V: Arr, y: Arr) -> tuple[float, float]:
     """P = m_b v_c + M_ch v_0 + S' (N s): the whole system's linear momentum; O(n)."""
     vc = y[-3:-1]  # the body's velocity: Q' ends with x_c', y_c', theta'
     v0x, v0y, jx, jy = _root_rates(V, y)
-    mb, mch = V[V_BM, 0], V[V_MCH, 0]
+    mb, mch = body_value(V, BODY_MASS), body_value(V, CHAIN_MASS)
     return mb * vc[0] + mch * v0x + jx, mb * vc[1] + mch * v0y + jy
 
 
 @njit(cache=True)
-def base_mechanics(t, y, P, S, M, L, out):
+def base_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) into out[:3]: T (J) the whole system's kinetic energy (module
     docstring), P_ext = Q . phi' + F . v_0 (W), P_diss the dampers' power with hinge 0's rate
     from the body (W). O(n)."""
     n = P.shape[1]
-    N = 3 * n + 3
-    full_mechanics(t, _chain_state(y, n), P, S, M, L, out)
-    v = y[N:]
+    v = y[3 * n + 3 :]
+    full_mechanics(t, chain_state(y, 3 * n), P, S, M, L, out)
     dth = v[3 * n + 2]
     v0x, v0y, jx, jy = _root_rates(P, y)
-    mb, mch = P[V_BM, 0], P[V_MCH, 0]
+    mb, mch = body_value(P, BODY_MASS), body_value(P, CHAIN_MASS)
     vc2 = v[3 * n] ** 2 + v[3 * n + 1] ** 2
-    out[0] += 0.5 * (mb * vc2 + P[V_BJ, 0] * dth * dth + mch * (v0x * v0x + v0y * v0y))
+    out[0] += 0.5 * (
+        mb * vc2 + body_value(P, BODY_INERTIA) * dth * dth + mch * (v0x * v0x + v0y * v0y)
+    )
     out[0] += v0x * jx + v0y * jy
     SX = np.empty(n)
     SY = np.empty(n)

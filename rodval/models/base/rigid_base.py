@@ -1,6 +1,6 @@
 """Compiled kernels of the rigid chain on a moving base: ``chain_base``'s free-body and
 prescribed-motion kernels on the rigid constants (``ladder.rigid_constants`` with
-``chain_base.BODY_ROWS`` appended), run on the rigid state [phi; x_c, y_c, theta; phi'; rates]
+``free_base.BODY_ROWS`` appended), run on the rigid state [phi; x_c, y_c, theta; phi'; rates]
 (n + 3 coordinates) through ``rigid_kernels.to_ladder`` / ``state_from_ladder``: the body's
 equations of docs/base.md with the rods' bending first moments A_k = 0, written once, in
 ``chain_base``. O(n) per evaluation (three ladder solves for a free body, one for a prescribed
@@ -12,7 +12,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from rodval.models.assembly.kernels import Arr, Pair
 from rodval.models.base import chain_base as cb
+from rodval.models.hinge_items.deployment import Ints
 from rodval.models.kinematics.rigid_kernels import (
     from_ladder,
     positions_to_ladder,
@@ -22,7 +24,7 @@ from rodval.models.kinematics.rigid_kernels import (
 
 
 @njit(cache=True)
-def free_rhs(t, y, P, S, M, L, out):
+def free_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the rigid chain on a free body (``chain_base.free_rhs``)."""
     z = to_ladder(y, P.shape[1])
     dz = np.empty_like(z)
@@ -31,7 +33,7 @@ def free_rhs(t, y, P, S, M, L, out):
 
 
 @njit(cache=True)
-def free_rhs_locked(t, y, P, S, M, L, out):
+def free_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' on a free body with the hinges of S held (``chain_base.free_rhs_locked``)."""
     z = to_ladder(y, P.shape[1])
     dz = np.empty_like(z)
@@ -40,7 +42,7 @@ def free_rhs_locked(t, y, P, S, M, L, out):
 
 
 @njit(cache=True)
-def prescribed_rhs(t, y, P, S, M, L, out):
+def prescribed_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' on a prescribed base, its laws in M[0] (``chain_base.prescribed_rhs``)."""
     z = to_ladder(y, P.shape[1])
     dz = np.empty_like(z)
@@ -49,32 +51,33 @@ def prescribed_rhs(t, y, P, S, M, L, out):
 
 
 @njit(cache=True)
-def free_mechanics(t, y, P, S, M, L, out):
+def free_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) on a free body (``chain_base.free_mechanics``)."""
     cb.free_mechanics(t, to_ladder(y, P.shape[1]), P, S, M, L, out)
 
 
 @njit(cache=True)
-def prescribed_mechanics(t, y, P, S, M, L, out):
+def prescribed_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext with the drive's power, P_diss) on a prescribed base
     (``chain_base.prescribed_mechanics``)."""
     cb.prescribed_mechanics(t, to_ladder(y, P.shape[1]), P, S, M, L, out)
 
 
 @njit(cache=True)
-def free_hinge_events(t, y, P, S, M, L, E, out):
+def free_hinge_events(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, E: Arr, out: Arr) -> None:
     """g = D_k - angle, hinge 0 from the body's attitude (``chain_base.free_hinge_events``)."""
     cb.free_hinge_events(t, to_ladder(y, P.shape[1]), P, S, M, L, E, out)
 
 
 @njit(cache=True)
-def free_momentum(V, y):
+def free_momentum(V: Arr, y: Arr) -> tuple[float, float]:
     """The whole system's linear momentum (N s) (``chain_base.free_momentum``)."""
-    return cb.free_momentum(V, to_ladder(y, V.shape[1]))
+    px, py = cb.free_momentum(V, to_ladder(y, V.shape[1]))
+    return px, py
 
 
 @njit(cache=True)
-def free_accel(V, y, has_load, SX, SY, damped, out):
+def free_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
     """Q'' (n + 3) on a free body (``chain_base.free_accel``)."""
     n = V.shape[1]
     z = to_ladder(y, n)
@@ -84,7 +87,9 @@ def free_accel(V, y, has_load, SX, SY, damped, out):
 
 
 @njit(cache=True)
-def free_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
+def free_accel_locked(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+) -> None:
     """Q'' (n + 3) on a free body with ``locks`` held (``chain_base.free_accel_locked``)."""
     n = V.shape[1]
     z = to_ladder(y, n)
@@ -94,7 +99,7 @@ def free_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
 
 
 @njit(cache=True)
-def free_unit_responses(V, q, locks, U):
+def free_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
     """U[j] = M_tot^-1 a_k (n + 3) for k = locks[j] (``chain_base.free_unit_responses``)."""
     n = V.shape[1]
     z = positions_to_ladder(q[: U.shape[1]], n)
@@ -105,7 +110,7 @@ def free_unit_responses(V, q, locks, U):
 
 
 @njit(cache=True)
-def prescribed_unit_responses(V, q, locks, U):
+def prescribed_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
     """U[j] = M_c^-1 a_k (n + 3, the body's entries zero) (``chain_base``'s)."""
     n = V.shape[1]
     z = positions_to_ladder(q[: U.shape[1]], n)
@@ -116,16 +121,20 @@ def prescribed_unit_responses(V, q, locks, U):
 
 
 @njit(cache=True)
-def prescribed_accel_locked(V, y, mo, has_load, SX, SY, damped, locks, out, lam):
-    """Q'' (n + 3) on a prescribed base with ``locks`` held (``chain_base``'s)."""
+def prescribed_accel_locked(
+    V: Arr, y: Arr, mo: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Pair
+) -> None:
+    """Q'' (n + 3) on a prescribed base with ``locks`` held and their multipliers into out =
+    (Q'', lam) (``chain_base``'s)."""
     n = V.shape[1]
     z = to_ladder(y, n)
     acc = np.empty(z.shape[0] // 2)
-    cb.prescribed_accel_locked(V, z, mo, has_load, SX, SY, damped, locks, acc, lam)
-    from_ladder(acc, n, out)
+    cb.prescribed_accel_locked(V, z, mo, has_load, SX, SY, damped, locks, (acc, out[1]))
+    from_ladder(acc, n, out[0])
 
 
 @njit(cache=True)
-def drive(V, y, mo, S, L, t):
+def drive(V: Arr, y: Arr, mo: Arr, S: Arr, L: Arr, t: float) -> tuple[float, float, float]:
     """(F_dx, F_dy (N), m_1 (N m)) of the base on the chain (``chain_base.drive``)."""
-    return cb.drive(V, to_ladder(y, V.shape[1]), mo, S, L, t)
+    Fx, Fy, m1 = cb.drive(V, to_ladder(y, V.shape[1]), mo, S, L, t)
+    return Fx, Fy, m1

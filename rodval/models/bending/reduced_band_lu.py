@@ -31,17 +31,18 @@ from rodval.models.assembly.kernels import (
     V_KAPPA,
     V_KB,
     V_L,
-    V_NU,
     V_OUTER,
     V_PPDIAG,
-    V_REST,
     V_W,
+    Arr,
+    Pair,
 )
 
 # Rows of Cst: the first rows are laid out like kernels.V (so that the kernels' O(n) helpers
 # read them), then the bending-row diagonals and the equilibration scales.
-#: number of Cst's leading rows laid out like kernels.V (rows 0 .. N_V_ROWS - 1)
-N_V_ROWS = max(V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB) + 1
+#: number of Cst's leading rows laid out like kernels.V (rows 0 .. N_V_ROWS - 1; V_CB the last
+#: of ``kernels.constant_rows``)
+N_V_ROWS = V_CB + 1
 C_AP, C_BP = N_V_ROWS, N_V_ROWS + 1
 #: 1.0 once the scales below hold the equilibration (``equilibrate``), 0.0 while they are 1
 C_EQUIL = N_V_ROWS + 2
@@ -68,22 +69,22 @@ RMASK = RING - 1
 
 
 @njit(cache=True, inline="always")
-def _put(A, mask, i, j, v):
+def _put(A: Arr, mask: int, i: int, j: int, v: float) -> None:
     """A[i, j] = v in row-relative band storage: row i lives in A[i & mask] (mask = -1: all
     rows; mask = RING - 1: a ring of rows) and keeps column j at offset j - i + KL."""
     A[i & mask, j - i + KL] = v
 
 
 @njit(cache=True)
-def _fill_rod(Cst, k, c, s, A, mask):
+def _fill_rod(Cst: Arr, k: int, c: Arr, s: Arr, A: Arr, mask: int) -> None:
     """Write the 7 equation rows of rod k (rows 7k .. 7k+6) into the band storage ``A``,
     equilibrated (entry (i, j) times row scale R_i and column scale C_j); c, s = cos, sin of
     phi. The rows are zeroed first; row i is stored in A[i & mask] (see _put)."""
     n = Cst.shape[1]
-    r0 = NB * k
+    r0 = here = NB * k  # the rod's first row and first column
+    prev, nxt = here - NB, here + NB
     for i in range(r0, r0 + NB):
-        for o in range(W):
-            A[i & mask, o] = 0.0
+        A[i & mask, :] = 0.0
     R = Cst[C_RSCALE : C_RSCALE + NB, k]  # this rod's row scales
     Ch = Cst[C_CSCALE : C_CSCALE + NB, k]  # column scales: this rod, previous, next
     Cp = Cst[C_CSCALE : C_CSCALE + NB, k - 1] if k > 0 else Ch
@@ -92,9 +93,6 @@ def _fill_rod(Cst, k, c, s, A, mask):
     kap, kb = Cst[V_KAPPA, k], Cst[V_KB, k]
     kap_next = Cst[V_KAPPA, k + 1] if k + 1 < n else 0.0
     ck, sk = c[k], s[k]
-    here = NB * k
-    prev = here - NB
-    nxt = here + NB
     # prefix sums: P_k - P_{k-1} - l_{k-1} e_{k-1} x_{k-1} = 0
     rx, ry = R[E_PX], R[E_PY]
     _put(A, mask, r0 + E_PX, here + U_PX, rx * Ch[U_PX])
@@ -151,7 +149,7 @@ def _fill_rod(Cst, k, c, s, A, mask):
 
 
 @njit(cache=True)
-def _eliminate(A, b, j, U):
+def _eliminate(A: Arr, b: Arr, j: int, U: Arr) -> bool:
     """Column j of banded Gaussian elimination with partial pivoting: pivot among rows
     j .. j+KL, swap, eliminate below (the right-hand side b follows), and move the finished
     row j (diagonal and KL + KU super-diagonals) to U[j]. Active rows live in the ring A
@@ -193,20 +191,28 @@ def _eliminate(A, b, j, U):
 
 
 @njit(cache=True)
-def solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
-    """The banded LU with partial pivoting (module docstring) of the 7n x 7n system. U (7n x
-    11), b (7n + 10), A (RING x W): work storage. False if a pivot column is exactly zero.
-    Its first call on a ``Cst`` writes the equilibration into it (``equilibrate``)."""
+def solve_band(Cst: Arr, c: Arr, s: Arr, f: Arr, work: Arr, out: Pair) -> bool:
+    """The banded LU with partial pivoting (module docstring) of the 7n x 7n system with the
+    right-hand sides f (3, n: phi, alpha, beta rows) into out = (phi'', gamma). ``work``
+    (>= ``band_size(n)``) holds U (7n x 11), b (7n + 10) and A (RING x W). False if a pivot
+    column is exactly zero. Its first call on a ``Cst`` writes the equilibration into it
+    (``equilibrate``)."""
     n = c.shape[0]
     N = NB * n
+    o1 = N * (KL + KU + 1)
+    o2 = o1 + N + KL + KU
+    U = work[:o1].reshape((N, KL + KU + 1))
+    b = work[o1:o2]
+    A = work[o2 : o2 + RING * W].reshape((RING, W))
+    ddphi_out, gamma_out = out
     equilibrate(Cst)
     for k in range(n):
         r0 = NB * k
         for e in range(NB):
             b[r0 + e] = 0.0
-        b[r0 + E_AL] = fa[k] * Cst[C_RSCALE + E_AL, k]
-        b[r0 + E_PHI] = fp[k] * Cst[C_RSCALE + E_PHI, k]
-        b[r0 + E_BE] = fb[k] * Cst[C_RSCALE + E_BE, k]
+        b[r0 + E_AL] = f[1, k] * Cst[C_RSCALE + E_AL, k]
+        b[r0 + E_PHI] = f[0, k] * Cst[C_RSCALE + E_PHI, k]
+        b[r0 + E_BE] = f[2, k] * Cst[C_RSCALE + E_BE, k]
     b[N:] = 0.0  # padding: see _eliminate and the back substitution
     _fill_rod(Cst, 0, c, s, A, RMASK)
     for k in range(n):
@@ -214,8 +220,7 @@ def solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
             _fill_rod(Cst, k + 1, c, s, A, RMASK)
         else:  # KL zero rows past the last equation
             for i in range(N, N + KL):
-                for o in range(W):
-                    A[i & RMASK, o] = 0.0
+                A[i & RMASK, :] = 0.0
         for j in range(NB * k, NB * k + NB):
             if not _eliminate(A, b, j, U):
                 return False
@@ -234,14 +239,14 @@ def solve_band(Cst, c, s, fp, fa, fb, U, b, A, ddphi_out, gamma_out):
 
 
 @njit(cache=True)
-def band_size(n):
+def band_size(n: int) -> int:
     """Length (float64 entries) of the banded LU's work storage for n rods: U (7n x (KL + KU +
     1)), b (7n + KL + KU) and the ring A (RING x W), as ``solve_band`` takes them."""
     return NB * n * (KL + KU + 1) + NB * n + KL + KU + RING * W
 
 
 @njit(cache=True)
-def band_magnitudes(Cst):
+def band_magnitudes(Cst: Arr) -> Arr:
     """Angle-independent coefficient magnitudes |A| of the banded matrix (c = s = 1,
     unit scales), in band storage (7n x W). O(n)."""
     n = Cst.shape[1]
@@ -255,7 +260,7 @@ def band_magnitudes(Cst):
 
 
 @njit(cache=True)
-def ruiz_equilibrate(T, rs, cs, sweeps):
+def ruiz_equilibrate(T: Arr, rs: Arr, cs: Arr, sweeps: int) -> None:
     """Ruiz equilibration of the band magnitudes T (modified in place): after the sweeps
     every row and column of diag(rs) |A| diag(cs) has its largest entry close to 1. Each
     sweep: the row and column maxima, then every nonzero entry divided by the square roots
@@ -290,7 +295,7 @@ def ruiz_equilibrate(T, rs, cs, sweeps):
 
 
 @njit(cache=True)
-def equilibrate(Cst):
+def equilibrate(Cst: Arr) -> None:
     """Write the row and column scales of the banded LU into ``Cst`` (rows C_RSCALE ..,
     C_CSCALE ..; C_EQUIL set to 1), unless done: RUIZ_SWEEPS sweeps of Ruiz equilibration of
     the angle-independent magnitudes (``band_magnitudes``), each scale rounded to the nearest

@@ -1,9 +1,9 @@
 """The reduced model's right-hand side and bending recovery in O(n) time and memory.
 
-API: ``banded_constants`` (once per chain), ``reduced_solve`` (phi'' and gamma at a state),
-``reduced_solve_work`` (the same with a reusable work array and a method choice),
-``reduced_accel_banded`` (phi'' only, the argument list of kernels.reduced_accel with Cst in
-place of (V, Mt)), ``bending_at`` (Python convenience).
+API: ``banded_constants`` (once per chain), ``reduced_solve`` (phi'' and gamma at a state
+y = [phi; phi'] into out = (phi'', gamma)), ``reduced_solve_work`` (the same with a reusable
+work array and a method choice), ``reduced_accel`` (phi'' only, the argument list of
+``kernels.full_accel`` with Cst in place of V), ``bending_at`` (Python convenience).
 
 The dense route (``kernels.reduced_accel``, ``ReducedSystem.recover_bending``) eliminates the
 bending angles first, M_r = M_pp - K_pg B^-1 M_gp, which is a dense n x n matrix (O(n^2) to
@@ -59,6 +59,8 @@ driven near its tip (at n = 1e5, ~120 rods move within 2 s of the paper's pulse)
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numba import njit
 
@@ -71,41 +73,30 @@ from rodval.models.assembly.kernels import (
     V_PPDIAG,
     V_REST,
     V_W,
+    Arr,
+    Pair,
     constant_rows,
     rhs_head,
 )
 from rodval.models.assembly.paper_matrices import DEFAULT_VARIANT, chain_constants
-from rodval.models.bending.reduced_band_lu import (
-    C_AP,
-    C_BP,
-    C_EQUIL,
-    C_RSCALE,
-    KL,
-    KU,
-    N_CST,
-    N_V_ROWS,
-    NB,
-    RING,
-    W,
-    band_size,
-    solve_band,
-)
+from rodval.models.bending import reduced_band_lu as lu
 
 
 @njit(cache=True)
-def reduced_forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec):
-    """Right-hand sides (N m) into vec (length >= 3n): vec[:n] = r_p = Q - G_pp phi'^2
-    - C_pp phi' - K_pp phi, vec[n:2n] = r_alpha, vec[2n:3n] = r_beta, with
-    r_g = -(G_gp phi'^2 + C_gp phi' + K_gp phi) (C only when ``damped``).
+def reduced_forces(
+    Cst: Arr, y: Arr, c: Arr, s: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, f: Arr
+) -> None:
+    """Right-hand sides (N m) at y = [phi; phi'] into the rows f (3, n): f[0] = r_p = Q - G_pp
+    phi'^2 - C_pp phi' - K_pp phi, f[1] = r_alpha, f[2] = r_beta, with r_g = -(G_gp phi'^2 +
+    C_gp phi' + K_gp phi) (C only when ``damped``).
 
     One pass root to tip (the hinge springs and dampers, kernels.hinge_forces with alpha =
     beta = 0; the prefix sums of G_pp and G_pa^T, kernels.gpp_times and upper_t_times) and
     one back (the suffix sums of G_pp, the load), each sum in the order of those kernels.
     O(n)."""
-    n = phi.shape[0]
-    fp = vec[:n]
-    fa = vec[n : 2 * n]
-    fb = vec[2 * n : 3 * n]
+    n = Cst.shape[1]
+    phi, dphi = y[:n], y[n:]
+    fp, fa, fb = f[0], f[1], f[2]
     l, outer, w = Cst[V_L], Cst[V_OUTER], Cst[V_W]
     kap, nu, rest = Cst[V_KAPPA], Cst[V_NU], Cst[V_REST]
     # hinge k: D_k = phi_k - phi_{k-1} - rest_k, torque T_k = kappa_k D_k (Tv: nu_k D_k')
@@ -157,18 +148,18 @@ TINY = 1e-250
 
 
 @njit(cache=True, inline="always")
-def _flush(v):
+def _flush(v: float) -> float:
     return 0.0 if abs(v) < TINY else v
 
 
 @njit(cache=True, inline="always")
-def _local_system(Cst, k, n, c, s, fp, fa, fb, F, G, L, R):
+def _local_system(Cst: Arr, k: int, c: Arr, s: Arr, f: Arr, F: Arr, G: Arr, L: Arr, R: Arr) -> None:
     """Rod k's phi, alpha, beta rows as L u = R [P; beta_{k-1}; 1], u = (x_k, alpha_k,
     beta_k), with S_{k+1}, alpha_{k+1} from the tail relation (F, G) of rod k+1 and
     z_{k+1} = (P_k + l e x_k, beta_k) substituted (all rows in N m). O(1)."""
     l, M, w = Cst[V_L, k], Cst[V_OUTER, k], Cst[V_W, k]
     kap, kb = Cst[V_KAPPA, k], Cst[V_KB, k]
-    kapn = Cst[V_KAPPA, k + 1] if k + 1 < n else 0.0
+    kapn = Cst[V_KAPPA, k + 1] if k + 1 < c.shape[0] else 0.0
     ex, ey = c[k], s[k]
     Fe0 = F[0, 0] * ex + F[0, 1] * ey  # F_P e
     Fe1 = F[1, 0] * ex + F[1, 1] * ey
@@ -184,25 +175,25 @@ def _local_system(Cst, k, n, c, s, fp, fa, fb, F, G, L, R):
     R[0, 0] = kapn * G[0] - l * (M * ex + FTe0)
     R[0, 1] = kapn * G[1] - l * (M * ey + FTe1)
     R[0, 2] = kap
-    R[0, 3] = fp[k] - l * ef + kapn * G[3]
-    L[1, 0] = Cst[C_AP, k]
+    R[0, 3] = f[0, k] - l * ef + kapn * G[3]
+    L[1, 0] = Cst[lu.C_AP, k]
     L[1, 1] = kap + kb
     L[1, 2] = 0.5 * kb
     R[1, 0] = -w * ex
     R[1, 1] = -w * ey
     R[1, 2] = kap
-    R[1, 3] = fa[k]
-    L[2, 0] = Cst[C_BP, k] - kapn * l * Ge
+    R[1, 3] = f[1, k]
+    L[2, 0] = Cst[lu.C_BP, k] - kapn * l * Ge
     L[2, 1] = 0.5 * kb
     L[2, 2] = kb + kapn * (1.0 - G[2])
     R[2, 0] = w * ex + kapn * G[0]
     R[2, 1] = w * ey + kapn * G[1]
     R[2, 2] = 0.0
-    R[2, 3] = fb[k] + kapn * G[3]
+    R[2, 3] = f[2, k] + kapn * G[3]
 
 
 @njit(cache=True, inline="always")
-def _solve_local(L, R, Tk):
+def _solve_local(L: Arr, R: Arr, Tk: Arr) -> bool:
     """Tk = L^-1 R by 3 x 3 Gaussian elimination with partial pivoting (L, R overwritten);
     False if a pivot is zero. O(1)."""
     for j in range(3):
@@ -239,7 +230,7 @@ def _solve_local(L, R, Tk):
 
 
 @njit(cache=True, inline="always")
-def _tail_relation(Cst, k, c, s, Tk, F, G):
+def _tail_relation(Cst: Arr, k: int, c: Arr, s: Arr, Tk: Arr, F: Arr, G: Arr) -> None:
     """Rod k's tail relation from rod k+1's (F, G updated in place): S_k = S_{k+1} + M l e x_k
     = [F_P | 0 | f] + F_b (x) T_k[2] + (l F_P e + M l e) (x) T_k[0]; alpha_k = T_k[1]. O(1)."""
     l, M = Cst[V_L, k], Cst[V_OUTER, k]
@@ -257,7 +248,7 @@ def _tail_relation(Cst, k, c, s, Tk, F, G):
 
 
 @njit(cache=True, inline="always")
-def _quiet_below(Cst, k, c, s, fp, fa, fb, f0, f1):
+def _quiet_below(Cst: Arr, k: int, c: Arr, s: Arr, f: Arr, f0: float, f1: float) -> int:
     """The highest rod j <= k whose local system has a nonzero constant column R[:, 3] when
     the tail's constant part is f = (f0, f1) (N) and its alpha part G[3] is 0, or -1 when rods
     0..k have none (_local_system: R[:, 3] = (fp - l e.f, fa, fb); the same expression, so the
@@ -265,18 +256,19 @@ def _quiet_below(Cst, k, c, s, fp, fa, fb, f0, f1):
     l = Cst[V_L]
     j = k
     while j >= 0:
-        if fa[j] != 0.0 or fb[j] != 0.0 or fp[j] != l[j] * (c[j] * f0 + s[j] * f1):
+        if f[1, j] != 0.0 or f[2, j] != 0.0 or f[0, j] != l[j] * (c[j] * f0 + s[j] * f1):
             return j
         j -= 1
     return -1
 
 
 @njit(cache=True, inline="always")
-def _root_to_tip(Cst, c, s, T, quiet, ddphi_out, gamma_out):
+def _root_to_tip(Cst: Arr, c: Arr, s: Arr, T: Arr, quiet: int, out: Pair) -> bool:
     """u_k = 0 for the quiet rods k <= ``quiet`` (solve_sweep); then z = 0, u_k = T_k [z_k;
-    1], z_{k+1} = (P_k + l_k e_k x_k, beta_k), rod by rod into the outputs; False if a value
-    is not finite. O(n)."""
+    1], z_{k+1} = (P_k + l_k e_k x_k, beta_k), rod by rod into out = (phi'', gamma); False if
+    a value is not finite. O(n)."""
     n = c.shape[0]
+    ddphi_out, gamma_out = out
     for k in range(quiet + 1):
         ddphi_out[k] = 0.0
         gamma_out[k] = 0.0
@@ -301,10 +293,11 @@ def _root_to_tip(Cst, c, s, T, quiet, ddphi_out, gamma_out):
 
 
 @njit(cache=True)
-def solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
-    """The tip-to-root elimination (module docstring, "sweep"), then root to tip. T (n x 3 x
-    4): work storage for u_k = T_k[:, :3] z_k + T_k[:, 3]. False if a local pivot is zero or
-    a result is not finite. O(n): ~250 flops per rod.
+def solve_sweep(Cst: Arr, c: Arr, s: Arr, f: Arr, T: Arr, out: Pair) -> bool:
+    """The tip-to-root elimination (module docstring, "sweep") of the right-hand sides f (3,
+    n), then root to tip into out = (phi'', gamma). T (n x 3 x 4): work storage for u_k =
+    T_k[:, :3] z_k + T_k[:, 3]. False if a local pivot is zero or a result is not finite.
+    O(n): ~250 flops per rod.
 
     The quiet root part: once the constant parts of rods 0..k (T_k[:, 3], from R[:, 3]) are
     all exactly zero, z_0 = 0 gives u_j = 0 and z_{j+1} = 0 rod by rod up to k, whatever the
@@ -323,16 +316,16 @@ def solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
     unchecked = n  # rods >= unchecked were checked for the current (F[:, 3], G[3])
     for k in range(n - 1, -1, -1):
         if k < unchecked and G[3] == 0.0:
-            j = _quiet_below(Cst, k, c, s, fp, fa, fb, F[0, 3], F[1, 3])
+            j = _quiet_below(Cst, k, c, s, f, F[0, 3], F[1, 3])
             if j < 0:
                 quiet = k
                 break
             unchecked = j  # rods j+1..k keep F[:, 3], G[3]: no check until rod j is passed
-        _local_system(Cst, k, n, c, s, fp, fa, fb, F, G, L, R)
+        _local_system(Cst, k, c, s, f, F, G, L, R)
         if not _solve_local(L, R, T[k]):
             return False
         _tail_relation(Cst, k, c, s, T[k], F, G)
-    return _root_to_tip(Cst, c, s, T, quiet, ddphi_out, gamma_out)
+    return _root_to_tip(Cst, c, s, T, quiet, out)
 
 
 #: ``method`` of reduced_solve_work
@@ -340,29 +333,29 @@ METHOD_AUTO, METHOD_BAND, METHOD_SWEEP = 0, 1, 2
 
 
 @njit(cache=True)
-def reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out):
-    """phi'' (rad/s^2, n) into ``ddphi_out`` and gamma = [alpha; beta] (rad, 2n) into
-    ``gamma_out`` of the reduced model at state (phi, phi') (module docstring: the sweep, with
-    the banded LU as fallback). ``Cst`` from ``banded_constants``; SX, SY are the load suffix
-    sums (N, see loads.load_sums), used when ``has_load``; ``damped`` adds the hinge
-    dampers. O(n) time and memory per evaluation. Returns False if the system is singular
-    (outputs then hold NaN)."""
-    work = np.empty(sweep_work_size(phi.shape[0]))  # the fallback allocates its own
-    return reduced_solve_work(
-        Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work, METHOD_AUTO
-    )
+def reduced_solve(
+    Cst: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Pair
+) -> bool:
+    """phi'' (rad/s^2, n) and gamma = [alpha; beta] (rad, 2n) into out = (phi'', gamma) of
+    the reduced model at state y = [phi; phi'] (module docstring: the sweep, with the banded
+    LU as fallback). ``Cst`` from ``banded_constants``; SX, SY are the load suffix sums (N,
+    see loads.load_sums), used when ``has_load``; ``damped`` adds the hinge dampers. O(n)
+    time and memory per evaluation. Returns False if the system is singular (outputs then
+    hold NaN)."""
+    work = np.empty(sweep_work_size(Cst.shape[1]))  # the fallback allocates its own
+    return reduced_solve_work(Cst, y, has_load, SX, SY, damped, out, work, METHOD_AUTO)
 
 
 @njit(cache=True)
-def work_size(n):
+def work_size(n: int) -> int:
     """Length of a float64 work array of ``reduced_solve_work`` that serves every method for
     n rods: 7n scratch, then the larger of the sweep's T (12n) and the banded LU's U
     (7n x 11), right-hand side (7n + 10) and ring of active rows."""
-    return 7 * n + max(12 * n, band_size(n))
+    return 7 * n + max(12 * n, lu.band_size(n))
 
 
 @njit(cache=True)
-def sweep_work_size(n):
+def sweep_work_size(n: int) -> int:
     """Length of a work array that serves METHOD_SWEEP (19n); with METHOD_AUTO the rare
     fallback to the banded LU then allocates what it needs."""
     return 19 * n
@@ -370,15 +363,23 @@ def sweep_work_size(n):
 
 @njit(cache=True)
 def reduced_solve_work(
-    Cst, phi, dphi, has_load, SX, SY, damped, ddphi_out, gamma_out, work, method
-):
+    Cst: Arr,
+    y: Arr,
+    has_load: bool,
+    SX: Arr,
+    SY: Arr,
+    damped: bool,
+    out: Pair,
+    work: Arr,
+    method: int,
+) -> bool:
     """``reduced_solve`` with a caller-provided float64 work array of length >= work_size(n),
     or >= sweep_work_size(n) (then the banded LU, if used, allocates its part), so that a
     caller that evaluates many times, such as an integrator, allocates it once; and a
     ``method``: METHOD_AUTO (the sweep; the banded LU if the sweep meets a zero local pivot
     or a non-finite value), METHOD_BAND or METHOD_SWEEP (one of them only)."""
-    n = phi.shape[0]
-    N = NB * n
+    n = Cst.shape[1]
+    phi = y[:n]
     c = work[:n]
     s = work[n : 2 * n]
     for k in range(n):
@@ -389,40 +390,23 @@ def reduced_solve_work(
         else:
             c[k] = np.cos(p)
             s[k] = np.sin(p)
-    vec = work[2 * n : 7 * n]
-    reduced_forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
-    fp, fa, fb = vec[:n], vec[n : 2 * n], vec[2 * n : 3 * n]
+    f = work[2 * n : 5 * n].reshape((3, n))
+    reduced_forces(Cst, y, c, s, has_load, SX, SY, damped, f)
     rest = work[7 * n :]
     if method != METHOD_BAND:
-        T = rest[: 12 * n].reshape((n, 3, 4))
-        if solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi_out, gamma_out):
+        if solve_sweep(Cst, c, s, f, rest[: 12 * n].reshape((n, 3, 4)), out):
             return True
-        if method == METHOD_SWEEP:
-            ddphi_out[:] = np.nan
-            gamma_out[:] = np.nan
-            return False
-    if rest.shape[0] < band_size(n):
-        rest = np.empty(band_size(n))
-    o1 = N * (KL + KU + 1)
-    o2 = o1 + N + KL + KU
-    U = rest[:o1].reshape((N, KL + KU + 1))
-    A = rest[o2 : o2 + RING * W].reshape((RING, W))
-    if solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi_out, gamma_out):
-        return True
-    ddphi_out[:] = np.nan
-    gamma_out[:] = np.nan
+    if method != METHOD_SWEEP:
+        if rest.shape[0] < lu.band_size(n):
+            rest = np.empty(lu.band_size(n))
+        if lu.solve_band(Cst, c, s, f, rest, out):
+            return True
+    out[0][:] = np.nan
+    out[1][:] = np.nan
     return False
 
 
-@njit(cache=True)
-def reduced_accel_banded(Cst, phi, dphi, has_load, SX, SY, damped, out):
-    """phi'' of the reduced model into ``out`` (the argument list of kernels.reduced_accel
-    with ``Cst`` in place of (V, Mt)); O(n) time and memory."""
-    gamma = np.empty(2 * phi.shape[0])
-    reduced_solve(Cst, phi, dphi, has_load, SX, SY, damped, out, gamma)
-
-
-def banded_constants(cc, chain, variant: str = DEFAULT_VARIANT) -> np.ndarray:
+def banded_constants(cc: Any, chain: Any, variant: str = DEFAULT_VARIANT) -> Arr:
     """Every angle-independent per-rod constant of ``reduced_solve`` as a float64 array
     (N_CST, n); ``cc = paper_matrices.chain_constants(chain, variant)``, or None to compute
     the per-rod constants here for ``variant``. O(n) time and memory.
@@ -436,14 +420,14 @@ def banded_constants(cc, chain, variant: str = DEFAULT_VARIANT) -> np.ndarray:
     n = chain.n
     if cc is None:
         cc = chain_constants(chain, variant)
-    Cst = np.empty((N_CST, n))
+    Cst = np.empty((lu.N_CST, n))
     rows = constant_rows(cc, chain)
-    for i in range(N_V_ROWS):  # row by row: no (N_V_ROWS, n) temporary
+    for i in range(lu.N_V_ROWS):  # row by row: no (N_V_ROWS, n) temporary
         Cst[i] = rows[i]
-    Cst[C_AP] = cc.ap_diag
-    Cst[C_BP] = cc.bp_diag
-    Cst[C_EQUIL] = 0.0
-    Cst[C_RSCALE:] = 1.0
+    Cst[lu.C_AP] = cc.ap_diag
+    Cst[lu.C_BP] = cc.bp_diag
+    Cst[lu.C_EQUIL] = 0.0
+    Cst[lu.C_RSCALE :] = 1.0
     return Cst
 
 
@@ -451,10 +435,10 @@ def bending_at(
     Cst: np.ndarray,
     phi: np.ndarray,
     dphi: np.ndarray,
-    sums,
+    sums: tuple[np.ndarray, np.ndarray] | None,
     damped: bool,
     method: int = METHOD_AUTO,
-) -> tuple[np.ndarray, np.ndarray]:
+) -> Pair:
     """(phi'', gamma) at one state, ``sums`` = LoadSet.suffix_sums(t) (None: no load).
     The O(n) replacement of ReducedSystem.recover_bending (which returns gamma)."""
     n = phi.shape[0]
@@ -466,29 +450,29 @@ def bending_at(
         SX, SY = (np.ascontiguousarray(v, dtype=np.float64) for v in sums)
     ddphi, gamma = np.empty(n), np.empty(2 * n)
     work = np.empty(sweep_work_size(n))  # the banded LU, if needed, allocates its own
-    reduced_solve_work(
-        Cst, phi, dphi, sums is not None, SX, SY, bool(damped), ddphi, gamma, work, method
-    )
+    y = np.concatenate((phi, dphi))
+    reduced_solve_work(Cst, y, sums is not None, SX, SY, bool(damped), (ddphi, gamma), work, method)
     return ddphi, gamma
 
 
 @njit(cache=True)
-def reduced_accel(Cst, y, has_load, SX, SY, damped, out):
+def reduced_accel(
+    Cst: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr
+) -> None:
     """phi'' at y = [phi; phi'] into ``out`` (the argument convention of
-    ``kernels.full_accel``); O(n)."""
-    n = Cst.shape[1]
-    reduced_accel_banded(Cst, y[:n], y[n:], has_load, SX, SY, damped, out)
+    ``kernels.full_accel``); O(n) time and memory."""
+    reduced_solve(Cst, y, has_load, SX, SY, damped, (out, np.empty(2 * Cst.shape[1])))
 
 
 @njit(cache=True)
-def rhs_work_size(n):
+def rhs_work_size(n: int) -> int:
     """Length of ``reduced_rhs``'s work space: load sums (2n), gamma (2n), the sweep (19n),
     and one slot for the largest |gamma| seen (``track_bending``)."""
     return 4 * n + sweep_work_size(n) + 1
 
 
 @njit(cache=True)
-def track_bending(gamma, seen):
+def track_bending(gamma: Arr, seen: float) -> float:
     """max(seen, max |gamma|): the largest bending angle (rad) met by the solves of a run."""
     for v in gamma:
         if abs(v) > seen:
@@ -496,29 +480,25 @@ def track_bending(gamma, seen):
     return seen
 
 
-@njit(cache=True)
-def reduced_rhs(t, y, P, S, M, L, out):
-    """y' of the reduced model (compiled integrators' right-hand side, loads from table L);
-    O(n) time and memory per evaluation, no allocation: ``M[0, 0]`` is its work space
-    (``rhs_work_size``; ``ReducedSystem.compiled_scratch``), whose last slot keeps the largest
-    |alpha|, |beta| of the solves (the run's small-bending check, at no extra solve)."""
+@njit(cache=True, inline="always")
+def rhs_work(t: float, y: Arr, M: Arr, L: Arr, out: Arr) -> tuple[bool, Arr, Arr, Arr, Arr]:
+    """The start of the reduced model's compiled right-hand sides (``rhs_head``) on the work
+    space M[0, 0] (``rhs_work_size``): (has_load, SX, SY, gamma, the solve's work). O(n)."""
     half = y.shape[0] // 2
     work = M[0, 0]
     SX = work[:half]
     SY = work[half : 2 * half]
-    gamma = work[2 * half : 4 * half]
     has_load = rhs_head(t, y, L, SX, SY, out)
-    reduced_solve_work(
-        P,
-        y[:half],
-        y[half:],
-        has_load,
-        SX,
-        SY,
-        S[0] != 0.0,
-        out[half:],
-        gamma,
-        work[4 * half : work.shape[0] - 1],
-        METHOD_AUTO,
-    )
-    work[-1] = track_bending(gamma, work[-1])
+    return has_load, SX, SY, work[2 * half : 4 * half], work[4 * half : work.shape[0] - 1]
+
+
+@njit(cache=True)
+def reduced_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
+    """y' of the reduced model (compiled integrators' right-hand side, loads from table L);
+    O(n) time and memory per evaluation, no allocation: ``M[0, 0]`` is its work space
+    (``rhs_work_size``; ``ReducedSystem.compiled_scratch``), whose last slot keeps the largest
+    |alpha|, |beta| of the solves (the run's small-bending check, at no extra solve)."""
+    has_load, SX, SY, gamma, work = rhs_work(t, y, M, L, out)
+    sol = (out[y.shape[0] // 2 :], gamma)
+    reduced_solve_work(P, y, has_load, SX, SY, S[0] != 0.0, sol, work, METHOD_AUTO)
+    M[0, 0, -1] = track_bending(gamma, M[0, 0, -1])

@@ -24,24 +24,32 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 from scipy.linalg import solveh_banded
 
+from rodval.core.scene import Chain
 from rodval.models.assembly.kernels import (
     V_L,
     V_OUTER,
     V_PPDIAG,
+    Arr,
+    Pair,
     full_accel,
     full_solve,
     generator_solve,
-    rhs_head,
+    rhs_start,
 )
 from rodval.models.bending.reduced_band_lu import band_size, solve_band
 from rodval.models.bending.reduced_banded import (
     reduced_forces,
     reduced_rhs,
+    rhs_work,
     solve_sweep,
     track_bending,
 )
+
+#: Hinge indices (int64), as the kernels take them.
+Ints = NDArray[np.int64]
 
 #: Another armed latch locks together with the one whose crossing was located when its
 #: angle is within this distance (rad) of its latch angle at that time.
@@ -49,17 +57,18 @@ SIMULTANEOUS_RAD = 1e-8
 
 
 @njit(cache=True)
-def unit_moment(k, fp, fa, fb):
-    """fp, fa, fb += a_k (generalized force of a unit moment at hinge k)."""
-    fp[k] += 1.0
-    fa[k] += 1.0
+def unit_moment(k: int, f: Arr) -> None:
+    """f += a_k (generalized force of a unit moment at hinge k) on the force rows f (phi,
+    alpha, beta, ...: ``kernels.full_forces``)."""
+    f[0, k] += 1.0
+    f[1, k] += 1.0
     if k > 0:
-        fp[k - 1] -= 1.0
-        fb[k - 1] -= 1.0
+        f[0, k - 1] -= 1.0
+        f[2, k - 1] -= 1.0
 
 
 @njit(cache=True)
-def _hinge_of(v, k, n, theta=-1):
+def _hinge_of(v: Arr, k: int, n: int, theta: int = -1) -> float:
     """a_k . v for v = [phi; alpha; beta]-shaped (3n); ``theta`` >= 0: the index of a free
     base's attitude in v, which hinge 0 is measured from (``free_base``)."""
     r = v[k] + v[n + k]
@@ -67,11 +76,11 @@ def _hinge_of(v, k, n, theta=-1):
         r -= v[k - 1] + v[2 * n + k - 1]
     elif theta >= 0:
         r -= v[theta]
-    return r
+    return float(r)
 
 
 @njit(cache=True)
-def small_solve(G, r):
+def small_solve(G: Arr, r: Arr) -> Arr:
     """Solve the small dense system G x = r (Gaussian elimination with partial pivoting);
     G and r are overwritten, the solution is returned."""
     m = r.shape[0]
@@ -103,38 +112,32 @@ def small_solve(G, r):
 
 
 @njit(cache=True)
-def full_unit_responses(V, phi, locks, U):
+def full_unit_responses(V: Arr, phi: Arr, locks: Ints, U: Arr) -> None:
     """U[j] = M(phi)^-1 a_{locks[j]} (3n each), O(n) per hinge."""
-    n = V.shape[1]
     c = np.cos(phi)
     s = np.sin(phi)
-    fp = np.empty(n)
-    fa = np.empty(n)
-    fb = np.empty(n)
+    f = np.empty((3, V.shape[1]))
     for j in range(locks.shape[0]):
-        fp[:] = 0.0
-        fa[:] = 0.0
-        fb[:] = 0.0
-        unit_moment(locks[j], fp, fa, fb)
-        full_solve(V, c, s, fp, fa, fb, U[j])
+        f[:] = 0.0
+        unit_moment(locks[j], f)
+        full_solve(V, c, s, f, U[j])
 
 
 @njit(cache=True)
-def full_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
+def full_accel_locked(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+) -> None:
     """q'' (3n) of the full model with the hinges ``locks`` held (a_k^T q'' = 0) into
     ``out``, their multipliers (N m, generalized force a_k lambda_k) into ``lam``; O(n m)."""
-    n = V.shape[1]
-    m = locks.shape[0]
     full_accel(V, y, has_load, SX, SY, damped, out)  # the free accelerations, O(n)
-    if m == 0:
-        return
-    U = np.empty((m, 3 * n))
-    full_unit_responses(V, y[:n], locks, U)
-    superpose(out, U, locks, n, lam)
+    if locks.shape[0] > 0:
+        U = np.empty((locks.shape[0], out.shape[0]))
+        full_unit_responses(V, y[: V.shape[1]], locks, U)
+        superpose(out, U, locks, V.shape[1], lam)
 
 
 @njit(cache=True)
-def superpose(out, U, locks, n, lam, theta=-1):
+def superpose(out: Arr, U: Arr, locks: Ints, n: int, lam: Arr, theta: int = -1) -> None:
     """q'' = u_0 + sum_j lambda_j u_j with the hinges ``locks`` held: ``out`` holds the free
     accelerations u_0 on entry, U[j] = M^-1 a_{locks[j]}; the capacitance system
     (A_L U) lambda = -A_L u_0 (m x m) gives the multipliers (N m) into ``lam``. O(N m + m^3)
@@ -153,50 +156,50 @@ def superpose(out, U, locks, n, lam, theta=-1):
 
 
 @njit(cache=True)
-def _reduced_linear(Cst, c, s, fp, fa, fb, T, ddphi, gamma):
+def _reduced_linear(Cst: Arr, c: Arr, s: Arr, f: Arr, T: Arr, out: Pair) -> bool:
     """The reduced model's unreduced linear solve for given right-hand sides (the sweep, the
-    banded LU as fallback)."""
-    if solve_sweep(Cst, c, s, fp, fa, fb, T, ddphi, gamma):
+    banded LU as fallback) into out = (phi'', gamma)."""
+    if solve_sweep(Cst, c, s, f, T, out):
         return True
-    n = c.shape[0]
-    N = 7 * n
-    rest = np.empty(band_size(n))
-    o1 = N * 11
-    o2 = o1 + N + 10
-    U = rest[:o1].reshape((N, 11))
-    A = rest[o2 : o2 + 16 * 15].reshape((16, 15))
-    return solve_band(Cst, c, s, fp, fa, fb, U, rest[o1:o2], A, ddphi, gamma)
+    return bool(solve_band(Cst, c, s, f, np.empty(band_size(c.shape[0])), out))
 
 
 @njit(cache=True)
 def reduced_solve_locked(
-    Cst, phi, dphi, has_load, SX, SY, damped, locks, angles, ddphi, gamma, lam
-):
-    """phi'' (n), gamma (2n) and the multipliers lambda (m) of the reduced model with the
-    hinges ``locks`` held at ``angles``: D_k = a_p^T phi + a_g^T gamma = angle_k exactly
-    (an algebraic equation of the solve); O(n m). False if a solve is singular."""
-    n = phi.shape[0]
+    Cst: Arr,
+    y: Arr,
+    has_load: bool,
+    SX: Arr,
+    SY: Arr,
+    damped: bool,
+    held: tuple[Ints, Arr],
+    out: Pair,
+    lam: Arr,
+) -> bool:
+    """phi'' (n) and gamma (2n) into out = (phi'', gamma), the multipliers lambda (m) into
+    ``lam`` of the reduced model at y = [phi; phi'] with the hinges held = (locks, angles)
+    held at their angles: D_k = a_p^T phi + a_g^T gamma = angle_k exactly (an algebraic
+    equation of the solve); O(n m). False if a solve is singular."""
+    locks, angles = held
+    ddphi, gamma = out
+    n = Cst.shape[1]
     m = locks.shape[0]
+    phi = y[:n]
     c = np.cos(phi)
     s = np.sin(phi)
-    vec = np.empty(5 * n)
-    reduced_forces(Cst, phi, dphi, c, s, has_load, SX, SY, damped, vec)
+    f = np.empty((3, n))
+    reduced_forces(Cst, y, c, s, has_load, SX, SY, damped, f)
     T = np.empty((n, 3, 4))
-    fp = vec[:n].copy()
-    fa = vec[n : 2 * n].copy()
-    fb = vec[2 * n : 3 * n].copy()
-    if not _reduced_linear(Cst, c, s, fp, fa, fb, T, ddphi, gamma):
+    if not _reduced_linear(Cst, c, s, f, T, out):
         return False
     if m == 0:
         return True
     X = np.empty((m, n))
     Gm = np.empty((m, 2 * n))
     for j in range(m):
-        fp[:] = 0.0
-        fa[:] = 0.0
-        fb[:] = 0.0
-        unit_moment(locks[j], fp, fa, fb)
-        if not _reduced_linear(Cst, c, s, fp, fa, fb, T, X[j], Gm[j]):
+        f[:] = 0.0
+        unit_moment(locks[j], f)
+        if not _reduced_linear(Cst, c, s, f, T, (X[j], Gm[j])):
             return False
     G = np.empty((m, m))
     r = np.empty(m)
@@ -220,7 +223,7 @@ def reduced_solve_locked(
 
 
 @njit(cache=True)
-def mpp_solve(V, phi, r, x):
+def mpp_solve(V: Arr, phi: Arr, r: Arr, x: Arr) -> None:
     """Solve M_pp(phi) x = r (the rigid chords' mass matrix, the reduced model's kinetic
     metric) in O(n): M_pp = diag(pp) + tril(a b^T) + triu(b e^T) with a_k = e_k' = l_k M_k e_k,
     b_k = l_k e_k (e_k = (cos phi_k, sin phi_k))."""
@@ -237,7 +240,7 @@ def mpp_solve(V, phi, r, x):
     generator_solve(V[V_PPDIAG], a, b, a, r, x)
 
 
-def reduced_hinge_gradient(chain, k: int) -> np.ndarray:
+def reduced_hinge_gradient(chain: Chain, k: int) -> np.ndarray:
     """c_k = dD_k/dphi of the reduced model's static hinge angle (gamma at its quasi-static
     value B^-1 (rest terms - K_gp phi)): c_k = a_p,k - K_pg B^-1 a_g,k (n), O(n) by the banded
     solve of B. It is also the generalized force on phi of a unit moment at hinge k once the
@@ -261,7 +264,7 @@ def reduced_hinge_gradient(chain, k: int) -> np.ndarray:
     # (K_pg gamma)_i = kappa_i (alpha_i - beta_{i-1}) - kappa_{i+1} (alpha_{i+1} - beta_i)
     t = kappa * (alpha - np.concatenate([[0.0], beta[:-1]]))
     kpg = t - np.concatenate([t[1:], [0.0]])
-    c = -kpg
+    c: np.ndarray = -kpg
     c[k] += 1.0
     if k > 0:
         c[k - 1] -= 1.0
@@ -274,16 +277,17 @@ def reduced_hinge_gradient(chain, k: int) -> np.ndarray:
 # armed latch or switching stop, g = D_hinge - angle (``PaperSystem.event_rows``).
 
 
-def lock_scalars(damped: float, hinges: np.ndarray, angles: np.ndarray) -> np.ndarray:
+def lock_scalars(damped: float, hinges: np.ndarray, angles: np.ndarray) -> Arr:
     """S of a compiled form with the hinges ``hinges`` held at ``angles`` (rad)."""
     m = len(hinges)
     return np.concatenate([[damped, float(m)], np.asarray(hinges, float), angles]).astype(float)
 
 
 @njit(cache=True)
-def _locks(S):
-    """(hinges, angles) held, from a compiled form's S (``lock_scalars``)."""
-    m = int(S[1])
+def held_hinges(S: Arr) -> tuple[Ints, Arr]:
+    """(hinges, angles) held, from a compiled form's S (``lock_scalars``); none for the
+    unlocked flags [damped]."""
+    m = int(S[1]) if S.shape[0] > 1 else 0
     locks = np.empty(m, np.int64)
     for j in range(m):
         locks[j] = int(S[2 + j])
@@ -291,52 +295,44 @@ def _locks(S):
 
 
 @njit(cache=True, inline="always")
-def locked_head(t, y, P, S, L, out):
-    """The start of a compiled right-hand side with the hinges of S held (``rhs_head``):
+def locked_head(
+    t: float, y: Arr, P: Arr, S: Arr, L: Arr, out: Arr
+) -> tuple[Arr, Arr, bool, Ints, Arr]:
+    """The start of a compiled right-hand side with the hinges of S held (``rhs_start``):
     (SX, SY, has_load, locks, lam): the load suffix sums at t (N), whether a load acts, the
     held hinges and room for their multipliers. O(n)."""
-    n = P.shape[1]
-    SX = np.empty(n)
-    SY = np.empty(n)
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    locks, _ = _locks(S)
+    has_load, SX, SY = rhs_start(t, y, P, L, out)
+    locks, _ = held_hinges(S)
     return SX, SY, has_load, locks, np.empty(locks.shape[0])
 
 
 @njit(cache=True)
-def full_rhs_locked(t, y, P, S, M, L, out):
+def full_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the full model with the hinges of S held (``full_accel_locked``); O(n m)."""
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
     full_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * P.shape[1] :], lam)
 
 
 @njit(cache=True)
-def reduced_rhs_locked(t, y, P, S, M, L, out):
+def reduced_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the reduced model with the hinges of S held at their angles
     (``reduced_solve_locked``); gamma and the largest |gamma| kept in the work space M[0, 0]
     as ``reduced_banded.reduced_rhs`` does; a singular solve gives NaN (the run ends as
     diverged). O(n m)."""
     half = y.shape[0] // 2
-    work = M[0, 0]
-    SX = work[:half]
-    SY = work[half : 2 * half]
-    gamma = work[2 * half : 4 * half]
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    locks, angles = _locks(S)
-    lam = np.empty(locks.shape[0])
+    has_load, SX, SY, gamma, _ = rhs_work(t, y, M, L, out)
+    held = held_hinges(S)
+    lam = np.empty(held[0].shape[0])
     ddphi = np.empty(half)
-    ok = reduced_solve_locked(
-        P, y[:half], y[half:], has_load, SX, SY, S[0] != 0.0, locks, angles, ddphi, gamma, lam
-    )
-    if not ok:
+    if not reduced_solve_locked(P, y, has_load, SX, SY, S[0] != 0.0, held, (ddphi, gamma), lam):
         ddphi[:] = np.nan
     for i in range(half):  # a loop: a slice assignment compiles numba's shape check
         out[half + i] = ddphi[i]
-    work[-1] = track_bending(gamma, work[-1])
+    M[0, 0, -1] = track_bending(gamma, M[0, 0, -1])
 
 
 @njit(cache=True)
-def hinge_events(phi, alpha, beta, E, out, attitude=0.0):
+def hinge_events(phi: Arr, alpha: Arr, beta: Arr, E: Arr, out: Arr, attitude: float = 0.0) -> None:
     """out[i] = D_k - angle for the rows [k, angle] of E, D_k = phi_k + alpha_k - phi_{k-1} -
     beta_{k-1} (rad), D_0 from a free base's ``attitude`` (rad; 0 for a pin); O(rows)."""
     for i in range(E.shape[0]):
@@ -350,14 +346,16 @@ def hinge_events(phi, alpha, beta, E, out, attitude=0.0):
 
 
 @njit(cache=True)
-def full_hinge_events(t, y, P, S, M, L, E, out):
+def full_hinge_events(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, E: Arr, out: Arr) -> None:
     """The full model's latch and stop events: g = D_k - angle from the state's q; O(rows)."""
     n = P.shape[1]
     hinge_events(y[:n], y[n : 2 * n], y[2 * n : 3 * n], E, out)
 
 
 @njit(cache=True)
-def reduced_hinge_events(t, y, P, S, M, L, E, out):
+def reduced_hinge_events(
+    t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, E: Arr, out: Arr
+) -> None:
     """The reduced model's latch and stop events: g = D_k - angle with the quasi-static
     bending gamma of the current mode (one solve of the mode's right-hand side, which leaves
     gamma in M[0, 0]); O(n) (O(n m) with m hinges held)."""

@@ -20,7 +20,6 @@ model's equations are the Newton-Euler equations of that field, and the gap is r
 
 from __future__ import annotations
 
-import functools
 from typing import Any
 
 import numpy as np
@@ -31,13 +30,15 @@ from rodval.mechanics.rigid import node_velocities, rigid_lock
 from rodval.mechanics.root_momentum import root_momentum_fields
 from rodval.models.assembly.paper_matrices import generalized_forces, node_positions, rod_momenta
 
-#: The systems these functions read: ``rodval.models.assembly.paper_system.PaperSystem`` (which imports
-#: this module, so it is not imported here).
+#: The systems these functions read: ``rodval.models.systems.paper_system.PaperSystem`` (which
+#: imports this module, so it is not imported here).
 PaperSystem = Any
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> float:
-    return float(a[0] * b[1] - a[1] * b[0])
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b (z component) of 2-vectors along the last axis."""
+    z: np.ndarray = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return z
 
 
 def outboard_momentum(
@@ -55,7 +56,7 @@ def outboard_momentum(
     r = np.stack([x, yy], axis=-1) + r0
     v_k = v0 + (node_velocities(chain.l, phi, v[: system.n])[k - 1] if k > 0 else 0.0)
     p_out = p[k:].sum(axis=0)
-    return float(h[k:].sum()) - _cross(r[k], p_out), p_out, r, v_k
+    return float(h[k:].sum()) - float(cross(r[k], p_out)), p_out, r, v_k
 
 
 def energy_parts(system: PaperSystem, t: float, y: np.ndarray) -> tuple[float, float, float]:
@@ -76,7 +77,7 @@ def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[
     ch = system.chain  # the mode's effective chain: acting stops are in its kappa, nu, rest
     D = system.hinge_angles_at(t, y)[k]
     rate = system.hinge_rates(y)[k]
-    finite = -(ch.kappa[k] * (D - ch.rest_angle[k]) + ch.nu[k] * rate) - _cross(v_k, p_out)
+    finite = -(ch.kappa[k] * (D - ch.rest_angle[k]) + ch.nu[k] * rate) - float(cross(v_k, p_out))
     forces = system.loads.nodal(t)
     if forces is not None:
         X, Y = forces  # at nodes 1..n
@@ -85,50 +86,23 @@ def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[
     return (float(lam[held.index(k)]), H, float(finite), *system.power(t, y))
 
 
-def _cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b (z-component) per row of (..., 2) arrays."""
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
-@functools.cache
-def _batched(cls: type) -> bool:
-    """Whether ``window_rows`` may evaluate a system of class ``cls`` on whole arrays: its
-    momenta, root motion, attitude and powers are the paper system's own (a ladder rung's,
-    a free or prescribed base's are not; those go state by state through ``window_terms``)."""
-    hooks = {
-        "rod_momenta_at": "PaperEnergy",
-        "root_motion": "PaperEnergy",
-        "attitude": "PaperEnergy",
-        "attitude_rate": "PaperEnergy",
-        "power": "PaperSystem",
-        "damper_power_at": "PaperSystem",
-        "window_terms": "PaperSystem",
-    }
-    # by name: paper_system imports this module (an import back would be a cycle)
-    return all(
-        getattr(getattr(cls, name, None), "__qualname__", "") == f"{owner}.{name}"
-        and getattr(cls, name).__module__.startswith("rodval.models.assembly.paper_")
-        for name, owner in hooks.items()
-    )
-
-
 def window_rows(system: PaperSystem, times: np.ndarray, Y: np.ndarray, k: int) -> np.ndarray:
     """``window_terms`` (lambda, H_out, M_fin, P_ext, P_diss) at the states Y (nt, N) at
     ``times`` (s), all in the current mode, as rows (nt, 5): the same arithmetic on whole
     arrays (one compiled constrained solve per state; the momenta, hinge angles and rates,
     dampers' power vectorized), equal to the per-state values to round-off (the sums over
     rods in another order for n >= 8: a few ulp of the largest term). A system whose
-    momenta or powers are its own (``_batched``) is evaluated state by state."""
+    momenta or powers are its own (``whole_arrays`` false) is evaluated state by state."""
     times = np.asarray(times, float)
     if not times.size:
         return np.zeros((0, 5))
-    if not system.scene.base.moving and _batched(system.__class__):
+    if system.whole_arrays:
         return _window_rows(system, times, np.asarray(Y, float), k)
     return np.array([window_terms(system, float(t), y, k) for t, y in zip(times, Y)])
 
 
 def _window_rows(system: PaperSystem, times: np.ndarray, Y: np.ndarray, k: int) -> np.ndarray:
-    """``window_rows`` of a pinned paper system (its ``_batched`` hooks)."""
+    """``window_rows`` of a pinned paper system (``whole_arrays``)."""
     n = system.n
     j = [int(h) for h in system._lock_h].index(k)
     solve = getattr(system, "solve_locked", None)  # the reduced model: lambda and gamma at once
@@ -149,11 +123,11 @@ def _window_rows(system: PaperSystem, times: np.ndarray, Y: np.ndarray, k: int) 
     x, yy = node_positions(chain.l, phi)
     r = np.stack([x, yy], axis=-1)
     p_out = p[:, k:].sum(axis=1)
-    H = h[:, k:].sum(axis=1) - _cross_rows(r[:, k], p_out)
+    H = h[:, k:].sum(axis=1) - cross(r[:, k], p_out)
     if k > 0:
         nodes = np.stack([-np.sin(phi), np.cos(phi)], axis=-1)
         v_k = np.cumsum((chain.l * dphi_r)[..., None] * nodes, axis=-2)[:, k - 1]
-        finite_v = _cross_rows(v_k, p_out)
+        finite_v = cross(v_k, p_out)
     else:
         finite_v = np.zeros(times.size)  # node 0 is pinned
     ch = system.chain  # the mode's effective chain (acting stops in its kappa, nu, rest)
@@ -238,7 +212,7 @@ def lock_record(
 
 
 def plastic_jump(
-    system: PaperSystem, y: np.ndarray, hinges, angles
+    system: PaperSystem, y: np.ndarray, hinges: Any, angles: Any
 ) -> tuple[np.ndarray, np.ndarray]:
     """The plastic lock of ``hinges`` at ``angles`` (rad) in a model whose state is [q; q']
     (the full model, every ladder rung): Delta q' = M^-1 A^T mu, (A M^-1 A^T) mu = -A q' (the

@@ -4,7 +4,8 @@ the bending coordinates g with phi'^2 or phi'' dropped) or ``"exact"`` (the assu
 kinematics r = r_{k-1} + s e_k + eta n_k kept whole in T, the forces and the momenta, so the
 model is Lagrangian and conserves energy to the integrator's tolerance). docs/model.md ("The
 model ladder") derives it; shapes = 1 with first-order kinematics is the paper's model, which
-``FullSystem`` runs unchanged (the ladder is only built for another rung).
+``FullSystem`` runs unchanged (the ladder is only built for another rung). Its constants and
+dense matrices live here, its system in ``rodval.models.systems.chain_system.LadderSystem``.
 
 Coordinates q = [phi; alpha; beta; g_2; ...; g_p] (each n long), state [q; q'] (2 N, N =
 n (p + 2)); a bubble coordinate g_i (i >= 2, m) scales psi_i, which vanishes with its slope at
@@ -13,11 +14,9 @@ both rod ends: hinge angles, latches, stops and node positions are the paper's.
 
 from __future__ import annotations
 
-from functools import cached_property
-
 import numpy as np
 
-from rodval.core.scene import Chain, Scene
+from rodval.core.scene import Chain
 from rodval.models.assembly.kernels import V_CB, V_EPS, V_KB, V_PI, V_RHO, V_TAU, V_W, constant_rows
 from rodval.models.assembly.paper_matrices import (
     angle_differences,
@@ -25,11 +24,6 @@ from rodval.models.assembly.paper_matrices import (
     hinge_matrix,
     mass_matrix,
 )
-from rodval.models.assembly.paper_matrices import (
-    angular_momentum_rows as momentum_rows,
-)
-from rodval.models.assembly.stacked_system import StackedSystem
-from rodval.models.hinge_items import deployment
 from rodval.models.kinematics.ladder_kernels import (
     BLOCK_A,
     BLOCK_B,
@@ -42,16 +36,7 @@ from rodval.models.kinematics.ladder_kernels import (
     LV_MU,
     LV_P1,
     LV_SHAPES,
-    ladder_accel,
-    ladder_accel_locked,
-    ladder_damper_power,
-    ladder_kinetic,
-    ladder_mechanics,
-    ladder_rhs,
-    ladder_rhs_locked,
-    ladder_unit_responses,
 )
-from rodval.models.kinematics.rungs import check_kinematics, check_rung_options, check_shapes
 from rodval.models.kinematics.shapes import RodShapes, rod_shapes
 
 
@@ -140,24 +125,24 @@ def ladder_stiffness(chain: Chain, p: int, damping: bool = False) -> np.ndarray:
     rod's shape block K_k (C_k); constant."""
     n, P1 = chain.n, p + 1
     sh = shapes_of(chain, p)
-    A = rung_hinge_matrix(n, p)
+    A = np.zeros((n, n * (p + 2)))  # D = A q: the paper's hinge matrix, no bubbles
+    A[:, : 3 * n] = hinge_matrix(n)
     K = A.T @ np.diag(chain.nu if damping else chain.kappa) @ A
     B = sh.C if damping else sh.K
     for k in range(n):
         idx = n * (1 + np.arange(P1)) + k
         K[np.ix_(idx, idx)] += B[k]
-    return K
-
-
-def rung_hinge_matrix(n: int, p: int) -> np.ndarray:
-    """A (n, N): D = A q, the paper's hinge matrix padded with zeros for the bubbles."""
-    A = np.zeros((n, n * (p + 2)))
-    A[:, : 3 * n] = hinge_matrix(n)
-    return A
+    return np.asarray(K)
 
 
 def rod_momenta_exact(
-    chain: Chain, sh: RodShapes, exact: bool, phi, dphi, g, dg
+    chain: Chain,
+    sh: RodShapes,
+    exact: bool,
+    phi: np.ndarray,
+    dphi: np.ndarray,
+    g: np.ndarray,
+    dg: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(p (n, 2) N s, h (n,) N m s about node 0, first moment (n, 2) kg m) of each rod with
     its far node in the rung's velocity field: r = r_{k-1} + z_k (s + i eta), z_k = e^{i phi_k}
@@ -183,90 +168,3 @@ def rod_momenta_exact(
         + chain.mu * np.imag(np.conj(r_nodes) * v_nodes)
     )
     return np.stack([p.real, p.imag], -1), h, np.stack([first.real, first.imag], -1)
-
-
-class LadderSystem(StackedSystem):
-    """A rung of the ladder other than the paper's (``shapes`` p, ``kinematics``); the
-    compiled kernels only (the dense numpy kernel is the paper model's reference)."""
-
-    has_jacobian = False
-    accel_kernel = staticmethod(ladder_accel)
-    locked_kernel = staticmethod(ladder_accel_locked)
-    unit_kernel = staticmethod(ladder_unit_responses)
-    compiled_rhs = staticmethod(ladder_rhs)
-    compiled_mechanics = staticmethod(ladder_mechanics)
-    compiled_rhs_locked = staticmethod(ladder_rhs_locked)
-    compiled_events = staticmethod(deployment.full_hinge_events)  # D from [phi; alpha; beta]
-
-    def __init__(self, scene: Scene, coefficients: str, kernel: str, shapes: int, kinematics: str):
-        check_rung_options(coefficients, kernel)
-        self.p = check_shapes(shapes)
-        self.exact = check_kinematics(kinematics) == "exact"
-        super().__init__(scene, coefficients, kernel)
-        self.Nc = self.n * (self.p + 2)
-        self.N = self.Nc + self.body_coordinates
-        self.setup_base(scene)
-        self.y0 = self.initial_state()
-        self.use_kernel()
-
-    def chain_initial_state(self) -> np.ndarray:
-        """[q; q'] of the chain at t = 0: the paper's coordinates, the bubbles at rest."""
-        i = self.initial
-        bubbles = np.zeros(self.n * (self.p - 1))
-        return np.concatenate(
-            [i["phi"], i["alpha"], i["beta"], bubbles, i["dphi"], i["dalpha"], i["dbeta"], bubbles]
-        )
-
-    @cached_property
-    def shapes(self) -> RodShapes:
-        return shapes_of(self.base_chain, self.p)
-
-    def kernel_constants(self):
-        return ladder_constants(self.chain, self.p, self.exact)
-
-    def _split(self, y: np.ndarray):
-        """(phi, phi', g (p+1, n), g' (p+1, n)) of one state."""
-        n, N, Nc, P1 = self.n, self.N, self.Nc, self.p + 1
-        g = y[n:Nc].reshape(P1, n)
-        return y[:n], y[N : N + n], g, y[N + n : N + Nc].reshape(P1, n)
-
-    def hinge_rows(self, hinges) -> np.ndarray:
-        return rung_hinge_matrix(self.n, self.p)[hinges]
-
-    def kinetic_energy(self, t, y):
-        return float(ladder_kinetic(self.V, y))
-
-    def bubble_energy(self, y: np.ndarray) -> float:
-        """1/2 sum_i>=2 K_ii g_i^2 (J): the bubbles' bending energy (their stiffness block
-        is diagonal and K-orthogonal to the cubic's, whose energy the paper's Pi holds)."""
-        g = self._split(y)[2]
-        return 0.5 * float(np.sum(self._bubble_stiffness * g[2:] ** 2))
-
-    @cached_property
-    def _bubble_stiffness(self) -> np.ndarray:
-        """K_ii (N m) of the bubbles i = 2..p, (p - 1, n)."""
-        return np.einsum("kii->ik", self.shapes.K)[2:]
-
-    def bubble_energies(self, Y: np.ndarray) -> np.ndarray:
-        return np.array([self.bubble_energy(y) for y in Y])
-
-    def energy_rows(self, times, Y):
-        kin = np.array([self.kinetic_energy(t, y) for t, y in zip(times, Y)])
-        alpha, beta = self.bending(times, Y)[:2]
-        return kin, self.potential(self.rigid(Y)[0], alpha, beta) + self.bubble_energies(Y)
-
-    def energy_budget(self, t, y):
-        return float(sum(self.energy_rows(np.array([t]), y[None, :]))[0])
-
-    def bending_energy_at(self, t, y):
-        return super().bending_energy_at(t, y) + self.bubble_energy(y)
-
-    def damper_power_at(self, y: np.ndarray) -> float:
-        return float(ladder_damper_power(self.V, self._flags, y))
-
-    def rod_momenta_at(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        phi, dphi, g, dg = self._split(y)
-        return rod_momenta_exact(self.base_chain, self.shapes, self.exact, phi, dphi, g, dg)
-
-    def angular_momentum_rows(self, times, Y):
-        return np.array([momentum_rows(*self.rod_momenta_at(y), self.base_chain) for y in Y])

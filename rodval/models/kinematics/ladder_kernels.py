@@ -29,17 +29,18 @@ from rodval.models.assembly.kernels import (
     V_KAPPA,
     V_L,
     V_NU,
+    Arr,
     compiled_damper_power,
     generator_solve,
     hinge_forces,
     load_moments,
     load_power,
-    rhs_head,
+    rhs_start,
     schur_generators,
     upper_t_times,
     upper_times,
 )
-from rodval.models.hinge_items.deployment import locked_head, superpose, unit_moment
+from rodval.models.hinge_items.deployment import Ints, locked_head, superpose, unit_moment
 
 #: Rows after the paper model's 19: rod mass m l (kg), node mass mu (kg), the number of
 #: shapes p + 1 and the exact-kinematics flag (the same in every column).
@@ -48,10 +49,12 @@ LV_MASS, LV_MU, LV_P1, LV_EXACT = range(19, 23)
 #: row-major).
 LV_SHAPES = 23
 BLOCK_A, BLOCK_B, BLOCK_P, BLOCK_PINV, BLOCK_K, BLOCK_C = range(6)
+#: The chain at q: (cos phi, sin phi, g (p+1, n), A, Pg (``bending_sums``)); ``ladder_geometry``.
+Geometry = tuple[Arr, Arr, Arr, Arr, Arr]
 
 
 @njit(cache=True, inline="always")
-def shape_row(P1, block, i, j):
+def shape_row(P1: int, block: int, i: int, j: int) -> int:
     """Row of V holding entry (i, j) of a shape block (j = 0 for the vectors a, b)."""
     if block <= BLOCK_B:
         return LV_SHAPES + block * P1 + i
@@ -59,17 +62,17 @@ def shape_row(P1, block, i, j):
 
 
 @njit(cache=True)
-def _quadratic(V, P1, block, k, x, z):
+def _quadratic(V: Arr, P1: int, block: int, k: int, x: Arr, z: Arr) -> float:
     """x^T B_k z for the shape block B of rod k."""
     total = 0.0
     for i in range(P1):
         for j in range(P1):
             total += x[i, k] * V[shape_row(P1, block, i, j), k] * z[j, k]
-    return total
+    return float(total)
 
 
 @njit(cache=True)
-def _block_times(V, P1, block, k, x, out, sign):
+def _block_times(V: Arr, P1: int, block: int, k: int, x: Arr, out: Arr, sign: float) -> None:
     """out[:, k] += sign * B_k x[:, k] for a shape block B (``shape_row``)."""
     for i in range(P1):
         acc = 0.0
@@ -79,16 +82,16 @@ def _block_times(V, P1, block, k, x, out, sign):
 
 
 @njit(cache=True)
-def shape_dot(V, P1, block, k, x):
+def shape_dot(V: Arr, P1: int, block: int, k: int, x: Arr) -> float:
     """v_k . x[:, k] for a shape vector v (a or b) of rod k."""
     total = 0.0
     for i in range(P1):
         total += V[shape_row(P1, block, i, 0), k] * x[i, k]
-    return total
+    return float(total)
 
 
 @njit(cache=True)
-def bending_sums(V, g):
+def bending_sums(V: Arr, g: Arr) -> tuple[Arr, Arr]:
     """(A (n,), Pg (p+1, n)): every rod's bending first moment A_k = a_k . g_k (kg m) and
     P_k g_k (kg m^2), the state-dependent part of exact kinematics; zeros with first-order
     kinematics, which drops every term they carry. O(n p^2), once per evaluation."""
@@ -103,7 +106,20 @@ def bending_sums(V, g):
 
 
 @njit(cache=True)
-def _velocity_terms(V, c, s, phi_rate, dg, A, Pg, fp, fg):
+def ladder_geometry(V: Arr, q: Arr) -> Geometry:
+    """(c, s, g, A, Pg) of the ladder at the positions q: the chords' cosines and sines, the
+    bending coordinates (p+1, n) and their ``bending_sums``. O(n p^2)."""
+    n = V.shape[1]
+    P1 = shape_count(V)
+    g = q[n : n * (P1 + 1)].reshape((P1, n))
+    A, Pg = bending_sums(V, g)
+    return np.cos(q[:n]), np.sin(q[:n]), g, A, Pg
+
+
+@njit(cache=True)
+def _velocity_terms(
+    V: Arr, c: Arr, s: Arr, phi_rate: Arr, dg: Arr, A: Arr, Pg: Arr, fp: Arr, fg: Arr
+) -> None:
     """fp, fg -= c(q, q'), the velocity terms of the ladder (module docstring), O(n p^2);
     A, Pg from ``bending_sums`` (zero for first-order kinematics)."""
     n = c.shape[0]
@@ -143,37 +159,41 @@ def _velocity_terms(V, c, s, phi_rate, dg, A, Pg, fp, fg):
 
 
 @njit(cache=True)
-def ladder_forces(V, y, c, s, A, Pg, has_load, SX, SY, damped, fp, fg):
-    """f = [Q; 0] - dPi/dq - C q' - c(q, q') (N m) into fp (n) and fg (p+1, n), O(n p^2)."""
+def ladder_forces(
+    V: Arr, y: Arr, geo: Geometry, has_load: bool, SX: Arr, SY: Arr, damped: bool, f: Arr
+) -> None:
+    """f = [Q; 0] - dPi/dq - C q' - c(q, q') (N m) into the rows f (p+2, n: phi, then g),
+    ``geo`` the ``ladder_geometry`` at q; O(n p^2)."""
+    c, s, g, A, Pg = geo
     n = c.shape[0]
-    P1 = fg.shape[0]
+    P1 = g.shape[0]
     N = n * (P1 + 1)
     q, v = y[:N], y[N:]
-    g = q[n:].reshape((P1, n))
     dg = v[n:].reshape((P1, n))
-    fp[:] = 0.0
-    fg[:] = 0.0
-    hinge_forces(V, q[:n], g[0], g[1], V_KAPPA, fp, fg[0], fg[1])
+    fp, fg = f[0], f[1:]
+    f[:] = 0.0
+    hinge_forces(V, q[:n], g[0], g[1], V_KAPPA, fp, f[1], f[2])
     if damped:
-        hinge_forces(V, v[:n], dg[0], dg[1], V_NU, fp, fg[0], fg[1])
+        hinge_forces(V, v[:n], dg[0], dg[1], V_NU, fp, f[1], f[2])
     for k in range(n):
         _block_times(V, P1, BLOCK_K, k, g, fg, 1.0)
         if damped:
             _block_times(V, P1, BLOCK_C, k, dg, fg, 1.0)
-    fp *= -1.0
-    fg *= -1.0
+    f *= -1.0
     _velocity_terms(V, c, s, v[:n], dg, A, Pg, fp, fg)
     if has_load:
         load_moments(V, c, s, SX, SY, fp)
 
 
 @njit(cache=True)
-def ladder_solve(V, A, Pg, g, c, s, fp, fg, out):
-    """q'' = M(q)^-1 [fp; fg] into ``out`` (N), O(n p^2): per rod x_g = P^-1 (f_g - M_gp
-    x_p), the Schur complement (``kernels.schur_generators``, with exact kinematics raised
-    by g^T P g on the diagonal and by the bending first moment A = a . g in the generators:
-    M_pp[k, j] = l_j (l_k M_k c_kj - A_k s_kj), k > j) solved in generator form. A, Pg from
-    ``bending_sums`` at q."""
+def ladder_solve(V: Arr, geo: Geometry, f: Arr, out: Arr) -> None:
+    """q'' = M(q)^-1 f (the rows f = [fp; fg]) into ``out`` (N), O(n p^2): per rod x_g = P^-1
+    (f_g - M_gp x_p), the Schur complement (``kernels.schur_generators``, with exact
+    kinematics raised by g^T P g on the diagonal and by the bending first moment A = a . g in
+    the generators: M_pp[k, j] = l_j (l_k M_k c_kj - A_k s_kj), k > j) solved in generator
+    form; ``geo`` the ``ladder_geometry`` at q."""
+    c, s, g, A, Pg = geo
+    fp, fg = f[0], f[1:]
     n = c.shape[0]
     P1 = fg.shape[0]
     G = np.zeros((P1, n))
@@ -212,71 +232,54 @@ def ladder_solve(V, A, Pg, g, c, s, fp, fg, out):
 
 
 @njit(cache=True)
-def shape_count(V):
+def shape_count(V: Arr) -> int:
+    """p + 1: the shapes per rod of V's rung."""
     return int(V[LV_P1, 0])
 
 
 @njit(cache=True)
-def ladder_accel(V, y, has_load, SX, SY, damped, out):
+def ladder_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
     """Accelerations q'' (N) of the ladder at y = [q; q'] into ``out``; SX, SY: the load
     suffix sums (N) when ``has_load``. O(n p^2) time, O(n p) memory."""
-    n = V.shape[1]
-    P1 = shape_count(V)
-    c = np.cos(y[:n])
-    s = np.sin(y[:n])
-    g = y[n : n * (P1 + 1)].reshape((P1, n))
-    A, Pg = bending_sums(V, g)
-    fp = np.empty(n)
-    fg = np.empty((P1, n))
-    ladder_forces(V, y, c, s, A, Pg, has_load, SX, SY, damped, fp, fg)
-    ladder_solve(V, A, Pg, g, c, s, fp, fg, out)
+    geo = ladder_geometry(V, y)
+    f = np.empty((shape_count(V) + 1, V.shape[1]))
+    ladder_forces(V, y, geo, has_load, SX, SY, damped, f)
+    ladder_solve(V, geo, f, out)
 
 
 @njit(cache=True)
-def ladder_unit_responses(V, q, locks, U):
+def ladder_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
     """U[j] = M(q)^-1 a_{locks[j]} (N each), O(n p^2) per hinge."""
-    n = V.shape[1]
-    P1 = shape_count(V)
-    c = np.cos(q[:n])
-    s = np.sin(q[:n])
-    g = q[n:].reshape((P1, n))
-    A, Pg = bending_sums(V, g)
-    fp = np.empty(n)
-    fg = np.empty((P1, n))
+    geo = ladder_geometry(V, q)
+    f = np.empty((shape_count(V) + 1, V.shape[1]))
     for j in range(locks.shape[0]):
-        fp[:] = 0.0
-        fg[:] = 0.0
-        unit_moment(locks[j], fp, fg[0], fg[1])
-        ladder_solve(V, A, Pg, g, c, s, fp, fg, U[j])
+        f[:] = 0.0
+        unit_moment(locks[j], f)
+        ladder_solve(V, geo, f, U[j])
 
 
 @njit(cache=True)
-def ladder_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
+def ladder_accel_locked(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+) -> None:
     """q'' (N) with the hinges ``locks`` held into ``out``, their multipliers (N m) into
     ``lam`` (``deployment.superpose``); O(n p^2 m)."""
-    n = V.shape[1]
     ladder_accel(V, y, has_load, SX, SY, damped, out)
-    m = locks.shape[0]
-    if m == 0:
-        return
-    U = np.empty((m, out.shape[0]))
-    ladder_unit_responses(V, y[: out.shape[0]], locks, U)
-    superpose(out, U, locks, n, lam)
+    if locks.shape[0] > 0:
+        U = np.empty((locks.shape[0], out.shape[0]))
+        ladder_unit_responses(V, y[: out.shape[0]], locks, U)
+        superpose(out, U, locks, V.shape[1], lam)
 
 
 @njit(cache=True)
-def ladder_rhs(t, y, P, S, M, L, out):
+def ladder_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the ladder (compiled integrators' right-hand side, loads from table L)."""
-    n = P.shape[1]
-    SX = np.empty(n)
-    SY = np.empty(n)
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    half = y.shape[0] // 2
-    ladder_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[half:])
+    has_load, SX, SY = rhs_start(t, y, P, L, out)
+    ladder_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[y.shape[0] // 2 :])
 
 
 @njit(cache=True)
-def ladder_rhs_locked(t, y, P, S, M, L, out):
+def ladder_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the ladder with the hinges of S held (``deployment.lock_scalars``)."""
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
     half = y.shape[0] // 2
@@ -284,7 +287,7 @@ def ladder_rhs_locked(t, y, P, S, M, L, out):
 
 
 @njit(cache=True)
-def ladder_kinetic(V, y):
+def ladder_kinetic(V: Arr, y: Arr) -> float:
     """T = 1/2 int |r'|^2 dm + 1/2 sum mu_k |v_k|^2 (J) of the ladder's velocity field
     (first-order kinematics: the terms in g dropped, as in its mass matrix); O(n p^2)."""
     n = V.shape[1]
@@ -313,11 +316,11 @@ def ladder_kinetic(V, y):
         Vx -= l[k] * w * s
         Vy += l[k] * w * c
         T += 0.5 * mu[k] * (Vx * Vx + Vy * Vy)
-    return T
+    return float(T)
 
 
 @njit(cache=True)
-def ladder_damper_power(V, S, y):
+def ladder_damper_power(V: Arr, S: Arr, y: Arr) -> float:
     """The dampers' power (W): the hinges' sum nu (dD/dt)^2 plus every rod's g'^T C g';
     0 unless S[0] (the damped flag). O(n p^2)."""
     n = V.shape[1]
@@ -332,7 +335,7 @@ def ladder_damper_power(V, S, y):
 
 
 @njit(cache=True)
-def ladder_mechanics(t, y, P, S, M, L, out):
+def ladder_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) of the ladder into out[:3]: ``ladder_kinetic`` (J), the load power
     (W) and the dampers' power: hinges sum nu (dD/dt)^2 plus the rods' g'^T C g' (W; 0 unless
     S[0], the damped flag). O(n p^2)."""

@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.models.assembly.kernels import rhs_head
-from rodval.models.hinge_items.deployment import hinge_events, locked_head
+from rodval.models.assembly.kernels import Arr, rhs_start
+from rodval.models.hinge_items.deployment import Ints, hinge_events, locked_head
 from rodval.models.kinematics.ladder_kernels import (
     ladder_accel,
     ladder_accel_locked,
@@ -29,7 +29,7 @@ from rodval.models.kinematics.ladder_kernels import (
 
 
 @njit(cache=True)
-def to_ladder(y, n):
+def to_ladder(y: Arr, n: int) -> Arr:
     """The ladder's state [phi; 0 (2 n); body; phi'; 0 (2 n); body'] of a rigid state y =
     [phi; body; phi'; body'] (``n`` rods, ``b`` = len(y) / 2 - n body coordinates)."""
     half = y.shape[0] // 2
@@ -43,7 +43,7 @@ def to_ladder(y, n):
 
 
 @njit(cache=True)
-def positions_to_ladder(q, n):
+def positions_to_ladder(q: Arr, n: int) -> Arr:
     """The ladder's coordinates [phi; 0 (2 n); body] of rigid coordinates q = [phi; body]."""
     z = np.zeros(q.shape[0] + 2 * n)
     z[:n] = q[:n]
@@ -52,7 +52,7 @@ def positions_to_ladder(q, n):
 
 
 @njit(cache=True)
-def from_ladder(z, n, out):
+def from_ladder(z: Arr, n: int, out: Arr) -> None:
     """out = [z_phi; z_body] (rigid coordinates) of a ladder coordinate vector z = [phi;
     alpha; beta; body] (its bending part dropped: zero for the rigid constants)."""
     out[:n] = z[:n]
@@ -60,7 +60,7 @@ def from_ladder(z, n, out):
 
 
 @njit(cache=True)
-def state_from_ladder(z, n, out):
+def state_from_ladder(z: Arr, n: int, out: Arr) -> None:
     """out = the rigid state of a ladder state (``from_ladder`` on each half)."""
     N = z.shape[0] // 2
     half = out.shape[0] // 2
@@ -69,7 +69,7 @@ def state_from_ladder(z, n, out):
 
 
 @njit(cache=True)
-def rigid_accel(V, y, has_load, SX, SY, damped, out):
+def rigid_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
     """phi'' (n) of the pinned rigid chain at y = [phi; phi'] into ``out`` (``ladder_accel``
     on ``rigid_constants``); O(n)."""
     n = V.shape[1]
@@ -79,7 +79,7 @@ def rigid_accel(V, y, has_load, SX, SY, damped, out):
 
 
 @njit(cache=True)
-def rigid_unit_responses(V, q, locks, U):
+def rigid_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
     """U[j] = M_pp(phi)^-1 a_{locks[j]} (n each, a_k = dD_k/dphi); only phi = q[:n] is read.
     O(n) per hinge."""
     n = V.shape[1]
@@ -90,7 +90,9 @@ def rigid_unit_responses(V, q, locks, U):
 
 
 @njit(cache=True)
-def rigid_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
+def rigid_accel_locked(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+) -> None:
     """phi'' (n) with the hinges ``locks`` held (D_k'' = 0) into ``out``, their multipliers
     (N m) into ``lam`` (``ladder_accel_locked``); O(n m)."""
     n = V.shape[1]
@@ -100,31 +102,28 @@ def rigid_accel_locked(V, y, has_load, SX, SY, damped, locks, out, lam):
 
 
 @njit(cache=True)
-def rigid_rhs(t, y, P, S, M, L, out):
+def rigid_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the pinned rigid chain (compiled integrators' right-hand side)."""
-    n = P.shape[1]
-    SX = np.empty(n)
-    SY = np.empty(n)
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    rigid_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[n:])
+    has_load, SX, SY = rhs_start(t, y, P, L, out)
+    rigid_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[P.shape[1] :])
 
 
 @njit(cache=True)
-def rigid_rhs_locked(t, y, P, S, M, L, out):
+def rigid_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the pinned rigid chain with the hinges of S held (``deployment.lock_scalars``)."""
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
     rigid_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[P.shape[1] :], lam)
 
 
 @njit(cache=True)
-def rigid_mechanics(t, y, P, S, M, L, out):
+def rigid_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) of the pinned rigid chain into out[:3] (``ladder_mechanics``): T =
     1/2 phi'^T M_pp phi' (J), the loads' power (W), the hinge dampers' sum nu (dD/dt)^2 (W)."""
     ladder_mechanics(t, to_ladder(y, P.shape[1]), P, S, M, L, out)
 
 
 @njit(cache=True)
-def rigid_hinge_events(t, y, P, S, M, L, E, out):
+def rigid_hinge_events(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, E: Arr, out: Arr) -> None:
     """Latch and stop events g = D_k - angle, D_k = phi_k - phi_{k-1} (rad); O(rows)."""
     n = P.shape[1]
     zero = np.zeros(n)

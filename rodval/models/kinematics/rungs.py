@@ -1,9 +1,11 @@
 """The rungs of the full model's ladder (docs/model.md, "The model ladder"): the bending shapes
 per rod and the kinematics a rung takes, and the checks of those options. Kept apart from the
-ladder's system and kernels (``rodval.models.kinematics.ladder``) so that a model made on the paper's rung
-imports none of them."""
+ladder's system (``rodval.models.systems.chain_system``), constants and kernels so that a model
+made on the paper's rung imports none of them."""
 
 from __future__ import annotations
+
+from typing import Any
 
 from rodval.core.checks import check_choice, check_number
 from rodval.core.scene import Scene
@@ -21,7 +23,7 @@ AUTO = "auto"
 KINEMATICS_OPTIONS = (*KINEMATICS, AUTO)
 
 
-def check_shapes(shapes) -> int:
+def check_shapes(shapes: Any) -> int:
     """``shapes`` (p, the bending shapes per rod beyond the rigid rotation: p + 1 shape
     coordinates) as an int in 1..MAX_SHAPES, else a ValueError naming the range."""
     allowed = f"an integer in 1..{MAX_SHAPES}"
@@ -30,7 +32,7 @@ def check_shapes(shapes) -> int:
     )
 
 
-def check_kinematics(kinematics, auto: bool = False) -> str:
+def check_kinematics(kinematics: Any, auto: bool = False) -> str:
     """``kinematics`` among KINEMATICS (a rung's), or among KINEMATICS_OPTIONS ("auto"
     included: the option of the full model and its modes) with ``auto``; else a ValueError
     naming the allowed values."""

@@ -52,7 +52,7 @@ MODEL = "full (shapes = 1, first-order kinematics, printed coefficients)"
 #: Converted requests kept in this process (``resolve_damping`` is asked again for the same
 #: scene at each boundary: the models' run, a study's plan, the run folder's record).
 CACHE_SIZE = 64
-_CACHE: dict[tuple, tuple[np.ndarray, dict[str, Any]]] = {}
+_CACHE: dict[tuple[Any, ...], tuple[np.ndarray, dict[str, Any]]] = {}
 
 
 def deployed_scene(scene: Scene, c: Any = None) -> Scene:
@@ -174,7 +174,7 @@ def _unreached(ratio: float, omega: float, zeta: float, beta: float, steps: int)
     )
 
 
-def _key(scene: Scene, ratio: float) -> tuple:
+def _key(scene: Scene, ratio: float) -> tuple[Any, ...]:
     """What the conversion depends on: the deployed structure's chain (but its placeholder
     c), latches and base, and the ratio (a scene and its deployed structure share it)."""
     deployed = deployed_scene(scene, 0.0)

@@ -1,9 +1,8 @@
 """Modes of the full model on a free base (a spacecraft body), on every rung of the ladder.
 
-The system is the one the full model integrates (``FullModel(shapes, kinematics).system``:
-``free_base_system.FreeBaseSystem`` on the paper's rung, ``moving_base.LadderFreeSystem`` on
-the others), coordinates Q = [q; x_c, y_c, theta] (N = Nc + 3, Nc = 3n or n (p + 2)). About
-a configuration Q0 at rest
+The system is the one the full model integrates (``chain_system.chain_system``: the paper's
+rung's ``ChainSystem``, a ``LadderSystem`` on the others), coordinates Q = [q; x_c, y_c,
+theta] (N = Nc + 3, Nc = 3n or n (p + 2)). About a configuration Q0 at rest
 
     M(Q0) dQ'' + C dQ' + K dQ = 0
 
@@ -48,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 
 from rodval.core.modes import Modes
-from rodval.core.scene import Scene
+from rodval.core.scene import Chain, Scene
 from rodval.mechanics.eigen import angular_frequencies, constraint_basis, symmetric_pencil
 from rodval.mechanics.modal import (
     check_no_mechanism,
@@ -62,25 +61,28 @@ from rodval.mechanics.modal import (
 from rodval.models.assembly.paper_matrices import damping_matrix, stiffness_matrix
 from rodval.models.kinematics.ladder import ladder_stiffness
 from rodval.models.kinematics.rungs import check_shapes, resolve_kinematics
-from rodval.models.presets.full import FullModel
+from rodval.models.observation.mode_sets import chain_modes
+from rodval.models.systems.chain_system import ChainSystem, chain_system
 
+#: The model these modes are of (its registry name, ``presets.full.FullModel.name``).
+MODEL = "full"
 #: The coefficients of the full model on a moving base (its compiled kernels).
 FREE_COEFFICIENTS = "printed"
 
 
-def free_system(scene: Scene, shapes: int = 1, kinematics: str = "first-order"):
-    """The full model's system of ``scene`` on a free base (``FullModel.system``)."""
-    return FullModel(shapes=shapes, kinematics=kinematics).system(scene)
+def free_system(scene: Scene, shapes: int = 1, kinematics: str = "first-order") -> ChainSystem:
+    """The full model's system of ``scene`` on a free base (``chain_system``)."""
+    return chain_system(scene, shapes, kinematics)
 
 
-def mass_matrix(system, Q0: np.ndarray) -> np.ndarray:
+def mass_matrix(system: ChainSystem, Q0: np.ndarray) -> np.ndarray:
     """The whole system's M(Q0) (N, N), symmetric, by polarization of the system's
     ``kinetic_energy`` in the rates (module docstring). O(N^2) evaluations of T."""
     N = system.N
     y = np.zeros(2 * N)
     y[:N] = Q0
 
-    def T(v):
+    def T(v: np.ndarray) -> float:
         y[N:] = v
         return system.kinetic_energy(0.0, y)
 
@@ -97,7 +99,9 @@ def mass_matrix(system, Q0: np.ndarray) -> np.ndarray:
     return M
 
 
-def stiffness_and_damping(system, chain, shapes: int) -> tuple[np.ndarray, np.ndarray]:
+def stiffness_and_damping(
+    system: ChainSystem, chain: Chain, shapes: int
+) -> tuple[np.ndarray, np.ndarray]:
     """(K, C) (N, N) of the free system: the chain's hinge springs (dampers) on the system's
     hinge rows (hinge 0 from theta) plus its rods' bending (and bubble) blocks."""
     n, Nc, N = chain.n, system.Nc, system.N
@@ -115,7 +119,9 @@ def stiffness_and_damping(system, chain, shapes: int) -> tuple[np.ndarray, np.nd
     return out[0], out[1]
 
 
-def configuration(system, scene: Scene, about: str, load_at) -> np.ndarray:
+def configuration(
+    system: ChainSystem, scene: Scene, about: str, load_at: float | None
+) -> np.ndarray:
     """Q0 (N): the initial state's positions, or (``about="equilibrium"``, no static loads)
     the body's attitude with straight rods at the hinges' rest angles (a held latch's angle
     on its hinge, ``equilibrium_angles``)."""
@@ -135,7 +141,7 @@ def configuration(system, scene: Scene, about: str, load_at) -> np.ndarray:
     return Q0
 
 
-def held_free_basis(system, scene: Scene) -> np.ndarray | None:
+def held_free_basis(system: ChainSystem, scene: Scene) -> np.ndarray | None:
     """Z (N, N - m): the motions of the free system that keep the scene's m held hinges at
     their angles (``constraint_basis`` of their hinge rows, hinge 0's from the body's
     theta; each eliminates its alpha_k), or None without held latches."""
@@ -143,7 +149,9 @@ def held_free_basis(system, scene: Scene) -> np.ndarray | None:
     return constraint_basis(system.hinge_rows(held)) if held.size else None
 
 
-def free_residual(K: np.ndarray, A: np.ndarray, Q0: np.ndarray, chain, Z) -> float:
+def free_residual(
+    K: np.ndarray, A: np.ndarray, Q0: np.ndarray, chain: Chain, Z: np.ndarray | None
+) -> float:
     """The springs' and bending's static residual max |K Q0 - A^T kappa rest| (N m; K (N, N),
     A (n, N) the hinge rows, Q0 (N)) that no held latch carries (Z^T of it with the held
     basis Z, ``held_free_basis``; None: none held). The caller checked it is small."""
@@ -259,15 +267,12 @@ def free_modes(
     omega = angular_frequencies(lam)
     zeta = np.full(omega.size, np.nan)
     zeta[3:] = damping_ratios(Ms, Cs, Ks, flex, omega[3:])
-    dx, dy, hinge = normalize_shapes(dx, dy, hinge)
-    return Modes(
-        model=FullModel.name,
-        about=about,
-        omega=omega,
-        damping=zeta,
-        dx=dx,
-        dy=dy,
-        hinge=hinge,
+    return chain_modes(
+        MODEL,
+        about,
+        omega,
+        zeta,
+        normalize_shapes(dx, dy, hinge),
         phi0=Q0[:n].copy(),
         l=l.copy(),
         info={

@@ -37,10 +37,10 @@ def held_reduced(
     none = np.zeros((m, n))
 
     def condense(B: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        return B[p, p] - E @ scipy.linalg.lu_solve(lu, np.vstack([B[g, p], rows]))
+        return np.asarray(B[p, p] - E @ scipy.linalg.lu_solve(lu, np.vstack([B[g, p], rows])))
 
     def gamma(dphi: np.ndarray, lam: float) -> np.ndarray:
         rhs = np.concatenate([(K[g, p] - lam * M[g, p]) @ dphi, A[:, p] @ dphi])
-        return -scipy.linalg.lu_solve(lu, rhs)[: 2 * n]
+        return np.asarray(-scipy.linalg.lu_solve(lu, rhs)[: 2 * n])
 
     return condense(M, none), condense(C, none), condense(K, A[:, p]), gamma

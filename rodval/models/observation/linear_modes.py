@@ -88,6 +88,7 @@ from __future__ import annotations
 import numbers
 from collections.abc import Callable
 from functools import partial
+from typing import Any
 
 import numpy as np
 import scipy.linalg
@@ -96,8 +97,8 @@ from scipy.optimize import linear_sum_assignment
 from rodval.core.checks import check_choice, check_type
 from rodval.core.modes import ABOUT, Equilibrium, Modes
 from rodval.core.scene import Chain, InitialState, Scene
-from rodval.mechanics.eigen import angular_frequencies, symmetric_pencil
-from rodval.mechanics.modal import damping_ratios, held_hinges, normalize_shapes, static_loads
+from rodval.mechanics.eigen import symmetric_pencil
+from rodval.mechanics.modal import held_hinges, normalize_shapes, static_loads
 
 # ``mac_matrix`` lives with ``damping_ratios`` in ``rodval.mechanics.modal`` (shared with the
 # free-base modes, ``rodval.models.observation.free_modes``, without an import cycle); re-exported here
@@ -122,6 +123,7 @@ from rodval.models.kinematics.rungs import (
     resolve_kinematics,
 )
 from rodval.models.observation.held import held_reduced
+from rodval.models.observation.mode_sets import chain_modes, lowest
 from rodval.models.observation.statics import (
     balance_residual,
     body_rest_angles,
@@ -164,10 +166,10 @@ def check_arguments(scene: Scene, count: int | None) -> None:
 def linear_system(
     chain: Chain,
     model: str = "full",
-    q0=None,
+    q0: np.ndarray | None = None,
     coefficients: str = DEFAULT_VARIANT,
-    SX=None,
-    SY=None,
+    SX: np.ndarray | None = None,
+    SY: np.ndarray | None = None,
     shapes: int = 1,
     kinematics: str = "first-order",
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -190,14 +192,14 @@ def linear_system(
         q[:n] = phi0
         M = ladder_mass_matrix(chain, p, exact, q)
         K = ladder_stiffness(chain, p)
-        if SX is not None:
+        if SX is not None and SY is not None:
             K[:n, :n] += load_stiffness(chain.l, phi0, SX, SY)
         return M, ladder_stiffness(chain, p, damping=True), K
     if model == "full":
         M = mass_matrix(chain_constants(chain, coefficients), phi0)
         K = stiffness_matrix(chain)
         C = damping_matrix(chain)
-        if SX is not None:
+        if SX is not None and SY is not None:
             K[:n, :n] += load_stiffness(chain.l, phi0, SX, SY)
         return M, C, K
     system = ReducedSystem(
@@ -205,13 +207,13 @@ def linear_system(
     )
     M = system.reduced_matrices(phi0)[0]
     K = system.K_r.copy()
-    if SX is not None:
+    if SX is not None and SY is not None:
         K += load_stiffness(chain.l, phi0, SX, SY)
     return M, system.C_r.copy(), K
 
 
 def linear_matrices(
-    chain: Chain, model: str = "full", phi0=None, coefficients: str = DEFAULT_VARIANT
+    chain: Chain, model: str = "full", phi0: Any = None, coefficients: str = DEFAULT_VARIANT
 ) -> tuple[np.ndarray, np.ndarray]:
     """(M, K) of the unloaded linearized model about phi0 (default straight along x)."""
     M, _, K = linear_system(chain, model, phi0, coefficients)
@@ -230,7 +232,7 @@ def _node_transform(chain: Chain, model: str) -> tuple[np.ndarray, np.ndarray]:
     return T[:, perm], np.repeat(np.arange(n), per)
 
 
-def _qz_run(Kz: np.ndarray, Mz: np.ndarray, rod: np.ndarray, rho: float) -> dict | None:
+def _qz_run(Kz: np.ndarray, Mz: np.ndarray, rod: np.ndarray, rho: float) -> dict[str, Any] | None:
     """QZ of the pencil (Kz, Mz) (rod-major node displacements) under the exact similarity
     diag(rho^rod) (``_general_eig``): its eigenvalues, right eigenvectors, first-order error
     estimates and which are real; None when QZ returns an infinite or NaN eigenvalue. The
@@ -258,7 +260,9 @@ def _qz_run(Kz: np.ndarray, Mz: np.ndarray, rod: np.ndarray, rho: float) -> dict
     return {"rho": rho, "lam": lam, "VR": VR, "err": err, "real": real}
 
 
-def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors: bool = True):
+def _general_eig(
+    K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors: bool = True
+) -> tuple[np.ndarray, np.ndarray | None, dict[str, Any]]:
     """Eigenvalues (and right eigenvectors in q) of K x = lam M x for a non-symmetric M, by QZ
     on the equivalent pencil in rod-major node displacements with the exact similarity
     diag(rho^k) per rod, for each rho of ``RHO`` (see the module docstring).
@@ -282,8 +286,8 @@ def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors
             "is singular to working precision)"
         )
 
-    def rel(r):
-        return np.median(r["err"] / np.maximum(np.abs(r["lam"]), 1e-300))
+    def rel(r: dict[str, Any]) -> float:
+        return float(np.median(r["err"] / np.maximum(np.abs(r["lam"]), 1e-300)))
 
     base = min(runs, key=lambda r: (int(np.sum(~r["real"])), rel(r)))
     lam = base["lam"].copy()
@@ -311,7 +315,9 @@ def _general_eig(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors
     )
 
 
-def eigen(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors: bool = True):
+def eigen(
+    K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors: bool = True
+) -> tuple[np.ndarray, np.ndarray | None]:
     """omega^2 (real, ascending) and the eigenvectors (columns) of K x = omega^2 M x."""
     if np.allclose(M, M.T, rtol=0, atol=1e-13 * np.max(np.abs(M))):
         return symmetric_pencil(K, M, vectors=vectors)
@@ -326,7 +332,7 @@ def eigen(K: np.ndarray, M: np.ndarray, chain: Chain, model: str, vectors: bool 
 
 
 def natural_frequencies(
-    chain: Chain, model: str = "full", phi0=None, coefficients: str = DEFAULT_VARIANT
+    chain: Chain, model: str = "full", phi0: Any = None, coefficients: str = DEFAULT_VARIANT
 ) -> np.ndarray:
     """Natural angular frequencies (rad/s) of the unloaded model about phi0, ascending."""
     M, K = linear_matrices(chain, model, phi0, coefficients)
@@ -344,7 +350,7 @@ def node_shapes(
     M: np.ndarray | None = None,
     coefficients: str = DEFAULT_VARIANT,
     recover: Callable[[np.ndarray, float], np.ndarray] | None = None,
-):
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Node displacements and hinge angles of eigenvectors X (columns); the reduced model's
     bending from its bending rows at each mode's eigenvalue, or by ``recover`` (dphi, lam)
     -> gamma (with held hinges, ``held_reduced``)."""
@@ -460,24 +466,19 @@ def modes_about(
     M, C, K = linear_system(chain, model, q0, coefficients, SX, SY, shapes, kinematics)
     M, C, K, Z, recover = _held_pencil(scene, model, (M, C, K), q0, (coefficients, SX, SY))
     lam, X = eigen(K, M, chain, model)
-    N = lam.size
-    count = N if count is None else min(count, N)
-    lam, X = lam[:count], X[:, :count]
-    omega = angular_frequencies(lam)
-    zeta = damping_ratios(M, C, K, X, omega)
+    assert X is not None
+    lam, X, omega, zeta = lowest(lam, X, (M, C, K), count)
     X = X if Z is None else Z @ X
     # node displacements and hinge angles need phi, alpha, beta only (bubbles: zero at the ends)
-    dx, dy, hinge = node_shapes(
+    displacements = node_shapes(
         chain, model, q0[:n], X[: 3 * n], lam, coefficients=coefficients, recover=recover
     )
-    return Modes(
-        model=model,
-        about=about,
-        omega=omega,
-        damping=zeta,
-        dx=dx,
-        dy=dy,
-        hinge=hinge,
+    return chain_modes(
+        model,
+        about,
+        omega,
+        zeta,
+        displacements,
         phi0=q0[:n].copy(),
         l=chain.l.copy(),
         equilibrium=eq,
@@ -528,8 +529,8 @@ def _configuration(
 
 
 def _held_pencil(
-    scene: Scene, model: str, MCK: tuple[np.ndarray, ...], q0: np.ndarray, variant: tuple
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, Callable | None]:
+    scene: Scene, model: str, MCK: tuple[np.ndarray, ...], q0: np.ndarray, variant: tuple[Any, ...]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, Callable[..., np.ndarray] | None]:
     """The linear system (M, C, K) = ``MCK`` with the scene's held latches held: (M, C, K) in
     the coordinates it is solved in, Z mapping them back to q (None: q itself) and the
     reduced model's bending recovery (None: the model's own). Full model (every rung): the

@@ -18,9 +18,10 @@ import numpy as np
 
 from rodval.core.modes import Modes
 from rodval.core.scene import Scene
-from rodval.mechanics.eigen import angular_frequencies, symmetric_pencil
-from rodval.mechanics.modal import damping_ratios, held_hinges, static_loads
+from rodval.mechanics.eigen import symmetric_pencil
+from rodval.mechanics.modal import held_hinges, static_loads
 from rodval.models.observation.linear_modes import linear_system, node_shapes
+from rodval.models.observation.mode_sets import chain_modes, lowest
 from rodval.models.observation.statics import no_equilibrium, static_equilibrium
 
 #: The name the modes carry.
@@ -71,19 +72,14 @@ def rigid_modes(
     M, C, K = (Z.T @ A @ Z for A in linear_system(chain, "full", q0, "printed", SX, SY))
     lam, X = symmetric_pencil(K, M)
     assert X is not None
-    count = lam.size if count is None else min(count, lam.size)
-    lam, X = lam[:count], X[:, :count]
-    omega = angular_frequencies(lam)
-    zeta = damping_ratios(M, C, K, X, omega)
-    dx, dy, hinge = node_shapes(chain, "full", q0[:n], Z @ X, lam)
-    return Modes(
-        model=RIGID,
-        about=about,
-        omega=omega,
-        damping=zeta,
-        dx=dx,
-        dy=dy,
-        hinge=hinge,
+    lam, X, omega, zeta = lowest(lam, X, (M, C, K), count)
+    shapes = node_shapes(chain, "full", q0[:n], Z @ X, lam)
+    return chain_modes(
+        RIGID,
+        about,
+        omega,
+        zeta,
+        shapes,
         phi0=q0[:n].copy(),
         l=chain.l.copy(),
         equilibrium=eq,

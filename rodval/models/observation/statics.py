@@ -4,6 +4,8 @@ equilibrium by Newton's method with load stepping, and the at-rest check of a co
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from rodval.core.modes import Equilibrium
@@ -38,7 +40,12 @@ def held_basis(scene: Scene, columns: int | None = None) -> np.ndarray | None:
 
 
 def static_residual(
-    chain: Chain, q: np.ndarray, SX=None, SY=None, rest=None, K: np.ndarray | None = None
+    chain: Chain,
+    q: np.ndarray,
+    SX: np.ndarray | None = None,
+    SY: np.ndarray | None = None,
+    rest: Any = None,
+    K: np.ndarray | None = None,
 ) -> np.ndarray:
     """R(q) = K q - A^T (kappa * rest) - [Q(phi); 0; 0] (3n): the gradient of
     Pi(q) - work of the constant loads. ``rest``: hinge rest angles (rad, n; None = 0), the
@@ -51,15 +58,15 @@ def static_residual(
     if SX is not None:
         phi = q[:n]
         R[:n] -= chain.l * (np.cos(phi) * SY - np.sin(phi) * SX)
-    return R
+    return np.asarray(R)
 
 
 def static_equilibrium(
     chain: Chain,
-    SX=None,
-    SY=None,
-    q0=None,
-    rest=None,
+    SX: np.ndarray | None = None,
+    SY: np.ndarray | None = None,
+    q0: np.ndarray | None = None,
+    rest: Any = None,
     *,
     rtol: float = 1e-12,
     max_iter: int = 30,
@@ -235,4 +242,4 @@ def balance_residual(
         return R
     A = hinge_matrix(scene.n)[held]
     lam = np.linalg.lstsq(A.T, R, rcond=None)[0]
-    return R - A.T @ lam
+    return np.asarray(R - A.T @ lam)

@@ -3,10 +3,10 @@ evaluation, on a pinned, free or prescribed base (docs/model.md, "The rigid mode
 
 A named composition of the engine, not a model of its own: the ladder's kernels on zero bending
 mobility (``rodval.models.kinematics.ladder.rigid_constants``, the limit EI -> inf of every
-rung), restricted to the rigid coordinates (``rodval.models.kinematics.rigid``), with the
-stacked systems' hinge items (springs, dampers, stops; latches as exact linear constraints,
-the plastic lock, which is the rigid-panel lock of ``rodval.mechanics.rigid``) and the ladder's
-moving bases (``rodval.models.base.moving_base``). It takes no options.
+rung), restricted to the rigid coordinates (``rodval.models.systems.chain_system.RigidSystem``), with
+the chain systems' hinge items (springs, dampers, stops; latches as exact linear constraints,
+the plastic lock, which is the rigid-panel lock of ``rodval.mechanics.rigid``) and bases. It
+takes no options.
 """
 
 from __future__ import annotations
@@ -32,20 +32,14 @@ class RigidModel(OdeModel):
     MODES_OPTIONS: ClassVar[tuple[str, ...]] = ()
 
     def check_base(self, scene: Scene) -> None:
-        """Every base kind runs (``moving_base``): nothing to refuse."""
+        """Every base kind runs (``chain_system``): nothing to refuse."""
 
     def system(self, scene: Scene) -> OdeSystem:
-        """The rigid chain of ``scene`` on its base; the moving bases' module (and its
-        compiled kernels) imported only by a scene that has one."""
-        if not scene.base.moving:
-            from rodval.models.kinematics.rigid import RigidSystem
+        """The rigid chain of ``scene`` on its base (the chain systems' module, and its
+        compiled kernels, imported only when asked for)."""
+        from rodval.models.systems.chain_system import RigidSystem
 
-            return RigidSystem(scene)
-        from rodval.models.base import moving_base
-
-        if scene.base.free:
-            return moving_base.RigidFreeSystem(scene)
-        return moving_base.RigidPrescribedSystem(scene)
+        return RigidSystem(scene)
 
     def stiffness_fix(self, scene: Scene) -> str:
         """A rigid chain has no bending vibration: what stiffens it is its hinges' springs

@@ -1,62 +1,60 @@
-"""What the full and reduced models share: scene constants, loads and the observation map."""
+"""What every system of the paper's chain shares (the full and reduced models, the chain systems
+of ``chain_system``): scene constants, loads, modes and events, energies and momenta (what the
+energy audit, the observation map and the lock records read, each from one state or a history)
+and the observation map."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from contextlib import contextmanager
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, contextmanager
 from functools import cached_property
-from typing import Any, ClassVar, NamedTuple
+from typing import Any
 
 import numpy as np
 
 from rodval.core.checks import check_choice
-from rodval.core.loads import LoadSet, load_table
-from rodval.core.quantities import tip_deflection
+from rodval.core.loads import LOAD_COLUMNS, LoadSet, load_table
 from rodval.core.scene import Scene, hinge_angles
-from rodval.core.trajectory import Trajectory
-from rodval.core.validity import Check, small_bending
-from rodval.models.assembly.paper_energy import NO_MATRICES, PaperEnergy
 from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
-    VARIANTS,
     ChainConstants,
+    angle_differences,
+    angular_momentum,
+    assemble_mass,
+    bending_energy,
     chain_constants,
     damper_power,
     damping_matrix,
     generalized_forces,
     hinge_matrix,
-    node_positions,
+    potential_energy,
     rest_forces,
+    rod_momenta,
     stiffness_matrix,
 )
-from rodval.models.hinge_items import deployment, lock_records
-from rodval.solvers.ode_model import OdeModel
+from rodval.models.hinge_items import deployment, events, lock_records
+from rodval.models.systems.observed import chain_rows
 from rodval.solvers.signature import EVENTS_SIGNATURE, RHS_SIGNATURE, first_class
-from rodval.solvers.system import CompiledForm, EventRecord, EventSpec, OdeSystem
+from rodval.solvers.system import CompiledForm, EventRecord, EventSpec, Observed, OdeSystem
 
 #: Right-hand-side implementations: "numba" (compiled, structured; default) or "numpy"
 #: (the straightforward dense reference).
 KERNELS = ("numba", "numpy")
+#: Placeholders for the compiled forms' unused arrays (no dense matrices, no loads).
+NO_MATRICES = np.zeros((0, 0, 0))
+NO_LOADS = np.zeros((0, len(LOAD_COLUMNS)))
+#: A mode: which stops act, which latches are locked (in lock order).
+Mode = tuple[tuple[bool, ...], tuple[int, ...]]
 
 
-class EventRow(NamedTuple):
-    """One event of the current mode: a latch or stop (``kind``; ``item``: its index among the
-    scene's latches or stops), on ``hinge``, g = D_hinge - ``angle`` (rad) crossing in ``direction``."""
-
-    kind: str
-    item: int
-    hinge: int
-    angle: float
-    direction: int
-
-
-class PaperSystem(PaperEnergy, OdeSystem):
+class PaperSystem(OdeSystem):
     """Base of the paper's ODE systems. Subclasses provide ``numpy_rhs``, the compiled
     kernels (``accel_kernel``, ``compiled_rhs``) and their constants (``kernel_constants``),
     ``jacobian`` and ``bending`` (alpha, beta, alpha', beta' at output times)."""
 
     has_jacobian = True
     has_energy = True
+    has_momentum = True
     #: True for the full model (state [q; q'], 6n), False for the reduced one ([phi; phi']).
     full: bool
     #: accel(V, y, has_load, SX, SY, damped, out) and the RHS_TYPE functions (rhs, mechanics;
@@ -66,6 +64,10 @@ class PaperSystem(PaperEnergy, OdeSystem):
     compiled_mechanics: Any
     compiled_rhs_locked: Any
     compiled_events: Any
+    #: True when the rods' momenta are the paper's velocity field on a pinned base
+    #: (``paper_matrices.rod_momenta``), so histories are evaluated on whole arrays (the
+    #: momentum audit, ``lock_records.window_rows``); a ladder rung's or a moving base's are not.
+    whole_arrays = True
 
     def __init__(self, scene: Scene, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
         self.kernel = check_choice("kernel", kernel, KERNELS)
@@ -95,12 +97,154 @@ class PaperSystem(PaperEnergy, OdeSystem):
         #: mode: which stops act, which latches are locked (in lock order)
         self.stop_active: tuple[bool, ...] = self._initial_stops
         self.locked: tuple[int, ...] = ()
-        self._history: list[tuple[float, tuple]] = []
+        self._history: list[tuple[float, Mode]] = []
         self._lock_h = np.zeros(0, dtype=np.int64)
         self._lock_a = np.zeros(0)
         self._lam = np.zeros(0)
         if any(self.stop_active):
             self._apply_stops()
+
+    def rigid(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """phi, phi' from a state history Y (nt, N)."""
+        raise NotImplementedError
+
+    def bending(self, times: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, ...]:
+        """alpha, beta, alpha', beta' (each (nt, n)) from a state history."""
+        raise NotImplementedError
+
+    def generalized_rates(self, y: np.ndarray) -> np.ndarray:
+        """q' = [phi'; alpha'; beta'] (3n; a ladder rung: all N) as the model's equations see
+        it at state y."""
+        raise NotImplementedError
+
+    def attitude(self, Y: np.ndarray) -> np.ndarray | None:
+        """The base's attitude theta (rad, (nt,)) from a state history, hinge 0's reference;
+        None on a pinned base (theta = 0)."""
+        return None
+
+    def attitude_rate(self, Y: np.ndarray) -> np.ndarray | None:
+        """theta' (rad/s, (nt,)) from a history; None on a pinned base."""
+        return None
+
+    def root_motion(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(r_0 (m), v_0 (m/s)) of node 0 at one state: zero on a pinned base."""
+        return np.zeros(2), np.zeros(2)
+
+    def _kinetic(self, phi: np.ndarray, v: np.ndarray) -> float:
+        """1/2 v^T M(phi) v with the kinematic mass matrix: the compiled O(n) form, or the
+        dense one with the numpy kernel (the reference)."""
+        if self.kernel == "numba":
+            n = self.n
+            y = (
+                np.concatenate([phi, np.zeros(2 * n), v])
+                if self.full
+                else np.concatenate([phi, v[:n]])
+            )
+            self.compiled_mechanics(0.0, y, self.V, self._flags, NO_MATRICES, NO_LOADS, self._mech)
+            return float(self._mech[0])
+        return 0.5 * float(v @ assemble_mass(self.cc_kinetic, angle_differences(phi)[0]) @ v)
+
+    def kinetic_energy(self, t: float, y: np.ndarray) -> float:
+        """T = 1/2 q'^T M(phi) q' (J) at one state, without recovering bending angles; O(n)
+        with the compiled kernels."""
+        return self._kinetic(self.rigid(y[None, :])[0][0], self.generalized_rates(y))
+
+    def potential(
+        self,
+        phi: np.ndarray,
+        alpha: np.ndarray,
+        beta: np.ndarray,
+        attitude: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Pi (J) per row: the scene chain's springs and bending, plus 1/2 k (D - angle)^2 of
+        every limit stop acting in the current mode; ``attitude``: a free base's theta (rad)
+        per row, hinge 0's reference (``rodval.core.scene.hinge_angles``)."""
+        pot = potential_energy(self.base_chain, phi, alpha, beta, attitude)
+        if any(self.stop_active):
+            D = hinge_angles(phi, alpha, beta, attitude)
+            for st, on in zip(self.stops, self.stop_active):
+                if on:
+                    pot = pot + 0.5 * st.stiffness * (D[..., st.hinge] - st.angle) ** 2
+        return pot
+
+    def energy_rows(self, times: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(T, Pi) (J) per state of a history Y in the current mode: kinetic T = 1/2 q'^T
+        M(phi) q' with the kinematic (printed) mass matrix, and Pi = 1/2 sum kappa (D -
+        rest)^2 + bending (J); O(n) each."""
+        phi, dphi = self.rigid(Y)
+        alpha, beta, dalpha, dbeta = self.bending(times, Y)
+        v = np.concatenate([dphi, dalpha, dbeta], axis=1)
+        kin = np.array([self._kinetic(p, vi) for p, vi in zip(phi, v)])
+        return kin, self.potential(phi, alpha, beta)
+
+    def energy_history(self, times: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        """E = T + Pi (J) per state of a history Y at ``times`` (s), each in the mode in effect
+        at its time (``_mode_for``: an event's time is in the mode before it), as ``observe``
+        reports it: the energy audit's E on its grid (``rodval.solvers.audit``). One
+        ``energy_rows`` per run of states in one mode; O(n) per state."""
+        times = np.asarray(times, float)
+        E = np.empty(times.size)
+        for run in self._mode_runs(times):
+            kin, pot = self.energy_rows(times[run], Y[run])
+            E[run] = kin + pot
+        return E
+
+    def _mode_runs(self, times: np.ndarray) -> Iterator[slice]:
+        """The runs of consecutive ``times`` in one mode (``_mode_for``), each yielded with
+        its mode in effect."""
+        modes = [self._mode_for(float(t)) for t in times]
+        start = 0
+        for i in range(1, len(times) + 1):
+            if i < len(times) and modes[i] == modes[start]:
+                continue
+            with self._mode(modes[start]):
+                yield slice(start, i)
+            start = i
+
+    def bending_energy_at(self, t: float, y: np.ndarray) -> float:
+        """The rods' bending energy (J) at one state."""
+        alpha, beta = self.bending(np.array([t]), y[None, :])[:2]
+        return float(bending_energy(self.base_chain, alpha, beta)[0])
+
+    def rod_momenta_at(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(p (n, 2), h (n,), first (n, 2)) of every rod with its far node at one state, in
+        the model's velocity field (``paper_matrices.rod_momenta``); O(n)."""
+        n = self.n
+        v = self.generalized_rates(y)
+        phi = self.rigid(y[None, :])[0][0]
+        return rod_momenta(self.base_chain, phi, v[:n], v[n : 2 * n], v[2 * n : 3 * n])
+
+    def momenta(self, y: np.ndarray) -> np.ndarray:
+        """Linear momentum (N s, (n, 2)) of everything beyond node k (rods k+1..n and their
+        far nodes), k = 0..n-1; row 0 is the whole chain's."""
+        p = self.rod_momenta_at(y)[0]
+        return np.cumsum(p[::-1], axis=0)[::-1]
+
+    def momentum_rows(self, Y: np.ndarray) -> np.ndarray:
+        """The chain's linear momentum P = sum_k p_k (N s, (nt, 2)) per state of a history, in
+        the model's velocity field (``rod_momenta_at``)."""
+        return np.array([self.rod_momenta_at(y)[0].sum(axis=0) for y in Y])
+
+    def momentum_audit_rows(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(H, G) (N m s, (nt,) each) for the angular-momentum audit of a pinned chain
+        (``rodval.core.validity.momentum_balance``): the angular momentum about node 0 and the
+        gross, sum_k |h_k| of the rods with their far nodes (``rod_momenta_at``). O(n) per
+        state."""
+        if len(Y) and self.whole_arrays:
+            # the paper's velocity field (``rod_momenta_at``) on the whole history at once
+            n = self.n
+            V = np.array([self.generalized_rates(y) for y in Y])
+            phi = self.rigid(Y)[0]
+            h = rod_momenta(self.base_chain, phi, V[:, :n], V[:, n : 2 * n], V[:, 2 * n : 3 * n])[1]
+        else:
+            h = np.array([self.rod_momenta_at(y)[1] for y in Y]).reshape(len(Y), -1)
+        return h.sum(axis=1), np.abs(h).sum(axis=1)
+
+    def angular_momentum_rows(self, times: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        """The ``angular_momentum`` rows (nt, 2) (``paper_matrices.angular_momentum``)."""
+        phi, dphi = self.rigid(Y)
+        dalpha, dbeta = self.bending(times, Y)[2:]
+        return angular_momentum(self.base_chain, phi, dphi, dalpha, dbeta)
 
     # Dense matrices of the numpy reference and the analytic Jacobians (O(n^2) memory): built
     # only when one of those asks; the default O(n) path never does.
@@ -139,7 +283,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
     def numpy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         raise NotImplementedError
 
-    def rhs(self, t, y):
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         if self.locked:
             out = np.empty_like(y)
             half = y.size // 2
@@ -165,7 +309,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
         table = self._load_table
         if table is None:
             return None
-        rows = self.event_rows()
+        rows = events.event_rows(self)
         locked = bool(self.locked)
         rhs = self.compiled_rhs_locked if locked else self.compiled_rhs
         return CompiledForm(
@@ -249,67 +393,18 @@ class PaperSystem(PaperEnergy, OdeSystem):
         theta = None if rate is None else rate[0]
         return damper_power(self.chain, v[:n], v[n : 2 * n], v[2 * n : 3 * n], theta)
 
-    def observe(self, times, Y):
+    def _observe_rows(self, times: np.ndarray, Y: np.ndarray) -> Observed:
+        """The scene's quantities at ``times`` in the current mode (``observed.chain_rows``)."""
+        return chain_rows(self, times, Y)
+
+    def observe(self, times: np.ndarray, Y: np.ndarray) -> Observed:
         """The scene's quantities; each output time is observed in the mode (active stops,
         locked hinges) in effect there (an output time at an event: the mode before it)."""
         times = np.asarray(times, float)
-        modes = [self._mode_for(t) for t in times]
-        out: dict = {}
-        start = 0
-        for i in range(1, len(times) + 1):
-            if i < len(times) and modes[i] == modes[start]:
-                continue
-            with self._mode(modes[start]):
-                part = self._observe_rows(times[start:i], Y[start:i])
-            for key, (v, k) in part.items():
+        out: Observed = {}
+        for run in self._mode_runs(times):
+            for key, (v, k) in self._observe_rows(times[run], Y[run]).items():
                 out[key] = (np.concatenate([out[key][0], v]), k) if key in out else (v, k)
-            start = i
-        return out
-
-    def _observe_rows(self, times, Y):
-        scene, n = self.scene, self.n
-        rods = np.arange(1, n + 1)
-        phi, dphi = self.rigid(Y)
-        out = {}
-        if scene.wants("phi"):
-            out["phi"] = (phi, rods)
-        if scene.wants("dphi"):
-            out["dphi"] = (dphi, rods)
-        if scene.wants(
-            "alpha", "beta", "energy", "hinge_angle", "hinge_moment", "angular_momentum"
-        ):
-            alpha, beta, dalpha, dbeta = self.bending(times, Y)
-            if scene.wants("alpha"):
-                out["alpha"] = (alpha, rods)
-            if scene.wants("beta"):
-                out["beta"] = (beta, rods)
-        if scene.wants("x", "y", "tip_deflection"):
-            x, y = node_positions(self.l, phi)
-            nodes = np.arange(0, n + 1)
-            if scene.wants("x"):
-                out["x"] = (x, nodes)
-            if scene.wants("y"):
-                out["y"] = (y, nodes)
-            if scene.wants("tip_deflection"):
-                tip = tip_deflection(x, y, self.attitude(Y))
-                out["tip_deflection"] = (tip[:, None], np.zeros(1, dtype=int))
-        if scene.wants("hinge_angle", "hinge_moment"):
-            D = hinge_angles(phi, alpha, beta, self.attitude(Y))
-            hinges = np.arange(n)
-            if scene.wants("hinge_angle"):
-                out["hinge_angle"] = (D, hinges)
-            if scene.wants("hinge_moment"):
-                out["hinge_moment"] = (self.hinge_moments(times, Y, D), hinges)
-        if scene.wants("energy"):
-            kin, pot = self.energy_rows(times, Y)
-            zero = np.zeros(1, dtype=int)
-            out["kinetic"] = (kin[:, None], zero)
-            out["potential"] = (pot[:, None], zero)
-            out["energy"] = ((kin + pot)[:, None], zero)
-        if scene.wants("angular_momentum"):
-            out["angular_momentum"] = (self.angular_momentum_rows(times, Y), np.arange(2))
-        if scene.wants("momentum"):
-            out["momentum"] = (self.momentum_rows(Y), np.arange(2))
         return out
 
     # ----------------------------------------------------------------- deployment: modes
@@ -337,7 +432,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
             self.V[:] = self.kernel_constants()
             self._flags[0] = 1.0 if self.damped else 0.0
 
-    def _activate(self, mode: tuple) -> None:
+    def _activate(self, mode: Mode) -> None:
         stops, locked = mode
         if stops != self.stop_active:
             self.stop_active = stops
@@ -349,10 +444,10 @@ class PaperSystem(PaperEnergy, OdeSystem):
             self._lam = np.zeros(len(locked))
 
     @property
-    def mode(self) -> tuple:
+    def mode(self) -> Mode:
         return (self.stop_active, self.locked)
 
-    def _mode_for(self, t: float) -> tuple:
+    def _mode_for(self, t: float) -> Mode:
         """The mode in effect at time t: set by the last event strictly before t."""
         mode = (self._initial_stops, self._initial_locked)
         for ts, m in self._history:
@@ -361,7 +456,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
         return mode
 
     @contextmanager
-    def _mode(self, mode: tuple):
+    def _mode(self, mode: Mode) -> Iterator[None]:
         old = self.mode
         self._activate(mode)
         try:
@@ -369,7 +464,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
         finally:
             self._activate(old)
 
-    def _mode_at(self, t: float):
+    def _mode_at(self, t: float) -> AbstractContextManager[None]:
         return self._mode(self._mode_for(t))
 
     def reset(self) -> None:
@@ -378,21 +473,24 @@ class PaperSystem(PaperEnergy, OdeSystem):
         self._history = []
         self._activate((self._initial_stops, self._initial_locked))
 
-    def _set_mode(self, mode: tuple, t: float) -> None:
+    def set_mode(self, mode: Mode, t: float) -> None:
+        """Enter ``mode`` at time t (an event), recorded for ``_mode_for``."""
         self._history.append((t, mode))
         self._activate(mode)
 
     # ------------------------------------------------------------- deployment: events
-    def hinge_rows(self, hinges) -> np.ndarray:
+    def hinge_rows(self, hinges: Any) -> np.ndarray:
         """Rows a_k of the hinge matrix (D = A q, q = [phi; alpha; beta]) of these hinges."""
-        return hinge_matrix(self.n)[hinges]
+        rows: np.ndarray = hinge_matrix(self.n)[hinges]
+        return rows
 
     def hinge_angles_at(self, t: float, y: np.ndarray) -> np.ndarray:
         """D_k (rad, n) at one state in the current mode."""
         Y = y[None, :]
         phi = self.rigid(Y)[0]
         alpha, beta = self.bending(np.array([t]), Y)[:2]
-        return hinge_angles(phi, alpha, beta, self.attitude(Y))[0]
+        D: np.ndarray = hinge_angles(phi, alpha, beta, self.attitude(Y))[0]
+        return D
 
     def _hinge_crossing(self, hinge: int, angle: float) -> Callable[[float, np.ndarray], float]:
         """The event function g(t, y) = D_hinge - angle (rad) of a latch or stop."""
@@ -412,38 +510,18 @@ class PaperSystem(PaperEnergy, OdeSystem):
             v[:n], v[n : 2 * n], v[2 * n : 3 * n], None if rate is None else rate[0]
         )
 
-    def hinge_moments(self, times, Y, D) -> np.ndarray:
+    def hinge_moments(self, times: np.ndarray, Y: np.ndarray, D: np.ndarray) -> np.ndarray:
         """Hinge moments (N m, (nt, n)), positive when resisting an increase of D: spring
         kappa (D - rest) + damper nu dD/dt + acting stops + the constraint moment -lambda of
         locked hinges (from the constrained acceleration solve)."""
         ch = self.chain
         rates = np.array([self.hinge_rates(y) for y in Y]).reshape(D.shape)
-        M = ch.kappa * (D - ch.rest_angle) + ch.nu * rates
+        M: np.ndarray = ch.kappa * (D - ch.rest_angle) + ch.nu * rates
         if self.locked:
             for i, (t, y) in enumerate(zip(times, Y)):
                 lam = self.accel_locked(t, y)[1]
                 M[i, self._lock_h] -= lam
         return M
-
-    def event_rows(self) -> tuple[EventRow, ...]:
-        """The current mode's events, in one order for the Python event functions and the
-        compiled event table: latches not yet locked (g = D_k - angle in the latch's
-        direction) and limit stops on hinges not locked (g = D_k - angle in the direction
-        that switches the stop: into its side while it is off, out of it while it acts; a
-        root found again just after the switch, where g may sit a rounding error on the old
-        side, then cannot fire twice)."""
-        rows = []
-        held = {self.latches[j].hinge for j in self.locked}
-        for j, la in enumerate(self.latches):
-            if j not in self.locked:
-                rows.append(EventRow("latch", j, la.hinge, la.angle, self.latch_dir[j]))
-        for i, st in enumerate(self.stops):
-            if st.hinge in held:
-                continue
-            entering = 1 if st.side == "upper" else -1
-            direction = -entering if self.stop_active[i] else entering
-            rows.append(EventRow("stop", i, st.hinge, st.angle, direction))
-        return tuple(rows)
 
     def event_functions(self) -> tuple[EventSpec, ...]:
         """The current mode's events (``event_rows``) as g(t, y) = D_k - angle."""
@@ -453,7 +531,7 @@ class PaperSystem(PaperEnergy, OdeSystem):
                 direction=r.direction,
                 label=f"{r.kind} hinge {r.hinge}",
             )
-            for r in self.event_rows()
+            for r in events.event_rows(self)
         )
 
     def apply_event(self, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:
@@ -466,42 +544,12 @@ class PaperSystem(PaperEnergy, OdeSystem):
         quasi-static bending when a moment switches (docs/deployment_native.md, "Energy
         through events")."""
         before = self._energy_in_mode(t, y)
-        y_new, record = self._switch(index, t, y)
+        y_new, record = events.switch(self, index, t, y)
         after = self._energy_in_mode(t, y_new)
         record.data.update(
             energy_before=before, energy_after=after, instant_energy_loss=before - after
         )
         return y_new, record
-
-    def _switch(self, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:
-        """Event ``index`` at (t, y): the new mode, the state after the jump and the record."""
-        row = self.event_rows()[index]
-        kind, j = row.kind, row.item
-        if kind == "stop":
-            st = self.stops[j]
-            on = not self.stop_active[j]  # the event looks for the crossing that switches
-            active = list(self.stop_active)
-            active[j] = on
-            self._set_mode((tuple(active), self.locked), t)
-            return y.copy(), EventRecord(
-                t,
-                f"stop hinge {st.hinge} {'on' if on else 'off'}",
-                {"hinge": st.hinge, "active": on},
-            )
-        D = self.hinge_angles_at(t, y)
-        group = [j] + [
-            i
-            for i, la in enumerate(self.latches)
-            if i != j
-            and i not in self.locked
-            and abs(D[la.hinge] - la.angle) <= deployment.SIMULTANEOUS_RAD
-        ]
-        locked = self.locked + tuple(group)
-        y_new, data = lock_records.lock_record(self, t, y, locked, tuple(group))
-        self._set_mode((self.stop_active, locked), t)
-        hinges = [self.latches[i].hinge for i in group]
-        label = "latch hinge " + ", ".join(str(h) for h in hinges)
-        return y_new, EventRecord(t, label, data)
 
     def window_terms(self, t: float, y: np.ndarray, hinge: int) -> tuple[float, ...]:
         """The lock window's integrands at one state (``lock_records.window_terms``)."""
@@ -515,7 +563,9 @@ class PaperSystem(PaperEnergy, OdeSystem):
         """(kinetic, hinge, bending) energy (J) in the current mode (``lock_records``)."""
         return lock_records.energy_parts(self, t, y)
 
-    def plastic_jump(self, y, hinges, angles) -> tuple[np.ndarray, np.ndarray]:
+    def plastic_jump(
+        self, y: np.ndarray, hinges: Any, angles: Any
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(state after the impact, multiplier impulses mu (N m s))."""
         raise NotImplementedError
 
@@ -534,31 +584,3 @@ class PaperSystem(PaperEnergy, OdeSystem):
     def accel_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(accelerations, multipliers lambda (N m)) with the locked hinges held."""
         raise NotImplementedError
-
-
-class PaperModel(OdeModel):
-    """A model of the paper. ``coefficients``: "printed" (default, from the kinematics) or
-    "published" (the erratum that reproduces the paper's alpha/beta; see paper_matrices).
-    ``kernel``: "numba" (default, compiled O(n) kernels) or "numpy" (the straightforward
-    dense right-hand side, kept as the reference and benchmark baseline)."""
-
-    system_class: type[PaperSystem]
-    OPTIONS: ClassVar[tuple[str, ...]] = ("coefficients", "kernel")
-    MODES_OPTIONS: ClassVar[tuple[str, ...]] = ("coefficients",)
-
-    def __init__(self, coefficients: str = DEFAULT_VARIANT, kernel: str = "numba"):
-        self.coefficients = check_choice("coefficients", coefficients, VARIANTS)
-        self.kernel = check_choice("kernel", kernel, KERNELS)
-
-    def options(self):
-        return {"coefficients": self.coefficients, "kernel": self.kernel}
-
-    def system(self, scene: Scene) -> PaperSystem:
-        return self.system_class(scene, self.coefficients, self.kernel)
-
-    def validity_checks(self, scene: Scene, trajectory: Trajectory) -> list[Check]:
-        """The energy balance (where audited) and the small-bending assumption of the paper's
-        first-order kinematics (largest |alpha|, |beta| over the output times reached)."""
-        return super().validity_checks(scene, trajectory) + small_bending(
-            trajectory.stats.max_bending
-        )

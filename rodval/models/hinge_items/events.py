@@ -1,0 +1,77 @@
+"""A native system's hinge items as events (docs/deployment_native.md): the current mode's
+latches and stops as rows (``event_rows``: the Python event functions and the compiled event
+table read them in one order) and what one does when it fires (``switch``: a stop switching, a
+latch locking with its plastic impact, ``lock_records.lock_record``). The system is a
+``rodval.models.systems.paper_system.PaperSystem`` (which imports this module)."""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from rodval.models.hinge_items import deployment, lock_records
+from rodval.solvers.system import EventRecord
+
+
+class EventRow(NamedTuple):
+    """One event of the current mode: a latch or stop (``kind``; ``item``: its index among the
+    scene's latches or stops), on ``hinge``, g = D_hinge - ``angle`` (rad) crossing in ``direction``."""
+
+    kind: str
+    item: int
+    hinge: int
+    angle: float
+    direction: int
+
+
+def event_rows(system: Any) -> tuple[EventRow, ...]:
+    """The current mode's events: latches not yet locked (g = D_k - angle in the latch's
+    direction) and limit stops on hinges not locked (g = D_k - angle in the direction that
+    switches the stop: into its side while it is off, out of it while it acts; a root found
+    again just after the switch, where g may sit a rounding error on the old side, then
+    cannot fire twice)."""
+    rows = []
+    held = {system.latches[j].hinge for j in system.locked}
+    for j, la in enumerate(system.latches):
+        if j not in system.locked:
+            rows.append(EventRow("latch", j, la.hinge, la.angle, system.latch_dir[j]))
+    for i, st in enumerate(system.stops):
+        if st.hinge in held:
+            continue
+        entering = 1 if st.side == "upper" else -1
+        direction = -entering if system.stop_active[i] else entering
+        rows.append(EventRow("stop", i, st.hinge, st.angle, direction))
+    return tuple(rows)
+
+
+def switch(system: Any, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:
+    """Event ``index`` of ``event_rows`` at (t, y): the system's new mode, the state after the
+    jump and the record."""
+    row = event_rows(system)[index]
+    kind, j = row.kind, row.item
+    if kind == "stop":
+        st = system.stops[j]
+        on = not system.stop_active[j]  # the event looks for the crossing that switches
+        active = list(system.stop_active)
+        active[j] = on
+        system.set_mode((tuple(active), system.locked), t)
+        return y.copy(), EventRecord(
+            t,
+            f"stop hinge {st.hinge} {'on' if on else 'off'}",
+            {"hinge": st.hinge, "active": on},
+        )
+    D = system.hinge_angles_at(t, y)
+    group = [j] + [
+        i
+        for i, la in enumerate(system.latches)
+        if i != j
+        and i not in system.locked
+        and abs(D[la.hinge] - la.angle) <= deployment.SIMULTANEOUS_RAD
+    ]
+    locked = system.locked + tuple(group)
+    y_new, data = lock_records.lock_record(system, t, y, locked, tuple(group))
+    system.set_mode((system.stop_active, locked), t)
+    hinges = [system.latches[i].hinge for i in group]
+    label = "latch hinge " + ", ".join(str(h) for h in hinges)
+    return y_new, EventRecord(t, label, data)
