@@ -95,7 +95,7 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
 #: A prescribed base's body in exudyn: a small positive mass (kg) and inertia (kg m^2) that
 #: keep its node's mass matrix regular; its motion is imposed, so they do not act on the chain
 #: (the constraints' forces carry them). The outputs treat the body as massless, as the native
-#: models do (``rodval.models.base.free_base_system.FreeBody.body_setup``).
+#: models do (``rodval.models.systems.body.Body``).
 PRESCRIBED_MASS = 1.0
 PRESCRIBED_INERTIA = 1.0
 

@@ -10,7 +10,7 @@ quantities every model already observes (node positions, the base's attitude), d
 here and called by every observer.
 
 Adding a quantity (docs/architecture.md): its ``Quantity`` here; its value in the native
-observer (``rodval/models/assembly/paper_system.py::_observe_rows``) and exudyn's
+observer (``rodval/models/systems/observed.py::chain_rows``) and exudyn's
 (``reference_models/exudyn_observe.py::observe``); its row of docs/quantities.md is
 generated (``python -m rodval.core.quantities --write docs/quantities.md``).
 """

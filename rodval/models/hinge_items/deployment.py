@@ -274,7 +274,7 @@ def reduced_hinge_gradient(chain: Chain, k: int) -> np.ndarray:
 # ------------------------------------------------------------------ compiled event forms
 # A mode with locked hinges runs on the compiled integrators with S = [damped, m, hinges (m),
 # angles (m, rad)] (``lock_scalars``); the event table E has one row [hinge, angle (rad)] per
-# armed latch or switching stop, g = D_hinge - angle (``PaperSystem.event_rows``).
+# armed latch or switching stop, g = D_hinge - angle (``rodval.models.hinge_items.events.event_rows``).
 
 
 def lock_scalars(damped: float, hinges: np.ndarray, angles: np.ndarray) -> Arr:

@@ -1,6 +1,6 @@
-"""Compiled kernels of the rigid chain (``rodval.models.kinematics.rigid``): the ladder's kernels
-(``ladder_kernels``) on the rigid constants (``ladder.rigid_constants``: zero bending mobility,
-the limit EI -> inf of every rung), run on the rigid state.
+"""Compiled kernels of the rigid chain (``rodval.models.systems.chain_system.RigidSystem``):
+the ladder's kernels (``ladder_kernels``) on the rigid constants (``ladder.rigid_constants``:
+zero bending mobility, the limit EI -> inf of every rung), run on the rigid state.
 
 The rigid state is y = [phi (n); body (b); phi' (n); body' (b)] (b = 0 on a pinned base, the
 free body's x_c, y_c, theta otherwise): n + b coordinates, the ODE the integrator sees. Each
