@@ -122,3 +122,16 @@ def check_number(
             return v
     words = describe_range(**bounds) if allowed is None else allowed
     raise ValueError(f"{name} must be {words}, got {value!r}")
+
+
+def check_reals(name: str, values: Iterable[Any], allowed: str) -> tuple[float, ...]:
+    """``values`` as floats when each is a real number (inf allowed; never a bool, string,
+    complex or NaN), in one call; else the one-line ValueError "<name>[i] must be <allowed>,
+    got <value>" of ``check_number`` for the first that is not."""
+    out = []
+    for i, value in enumerate(values):
+        if isinstance(value, numbers.Real) and not isinstance(value, bool) and value == value:
+            out.append(float(value))
+        else:
+            check_number(f"{name}[{i}]", value, allowed=allowed)
+    return tuple(out)

@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from rodval.core.checks import as_path, check_number, check_type
+from rodval.core.checks import as_path, check_number, check_reals, check_type
 from rodval.core.status import exception_line
 
 ForceLaw = Callable[[float], float]
@@ -205,12 +205,12 @@ class NodalForce:
             raise ValueError(
                 f"load support must be a pair (t0, t1) of seconds, got {self.support!r}"
             )
-        t0, t1 = (_real_or_inf(f"load support[{i}]", v) for i, v in enumerate(self.support))
+        t0, t1 = check_reals("load support", self.support, "real numbers (s)")
         check_type("load breakpoints", self.breakpoints, (tuple, list), "a tuple of seconds")
         if not (math.isfinite(t0) and t0 >= 0 and t1 > t0):
             raise ValueError(f"load support must satisfy 0 <= t0 < t1, got {self.support}")
-        for i, b in enumerate(self.breakpoints):
-            if _real_or_inf(f"load breakpoints[{i}]", b) < 0 or not math.isfinite(b):
+        for b in check_reals("load breakpoints", self.breakpoints, "real numbers (s)"):
+            if b < 0 or not math.isfinite(b):
                 raise ValueError(
                     f"load breakpoints must be finite and >= 0, got {self.breakpoints}"
                 )

@@ -20,6 +20,7 @@ Conventions (used throughout rodval)
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Iterable
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
@@ -299,11 +300,14 @@ def _scene_outputs(outputs: Any) -> tuple[str, ...]:
 
 
 def check_horizon(t_end: Any) -> float:
-    """The horizon t_end (s) as a float: a finite real number > 0 (the one check of it)."""
+    """The horizon t_end (s) as a float: a finite real number > 0 (the one check of it; the
+    message says "a real number" to a value of another type, "finite and > 0 s" to one out
+    of range)."""
+    real = isinstance(t_end, numbers.Real) and not isinstance(t_end, bool)
+    allowed = "finite and > 0 s" if real else "a real number > 0 s"
     return check_number(
-        "t_end (horizon)", t_end, low=0, low_open=True, finite=True,
-        allowed="a real number, finite and > 0 s",
-    )  # fmt: skip
+        "t_end (horizon)", t_end, low=0, low_open=True, finite=True, allowed=allowed
+    )
 
 
 @dataclass(frozen=True, eq=False)

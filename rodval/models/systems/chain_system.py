@@ -31,9 +31,6 @@ from rodval.models.kinematics.ladder import (
 )
 from rodval.models.kinematics.rungs import (
     PAPER_RUNG,
-    check_kinematics,
-    check_rung_options,
-    check_shapes,
 )
 from rodval.models.kinematics.shapes import RodShapes
 from rodval.models.systems.body import Body, RodMomenta, Rows
@@ -284,9 +281,10 @@ class LadderSystem(ChainSystem):
     rung = "ladder"
 
     def __init__(self, scene: Scene, coefficients: str, kernel: str, shapes: int, kinematics: str):
-        check_rung_options(coefficients, kernel)
-        self.p = check_shapes(shapes)
-        self.exact = check_kinematics(kinematics) == "exact"
+        """The options as ``FullModel`` checked them (``check_shapes``, ``check_kinematics``,
+        ``check_rung_options``: once, when the model is made)."""
+        self.p = int(shapes)
+        self.exact = kinematics == "exact"
         super().__init__(scene, coefficients, kernel)
 
     def chain_size(self) -> int:
