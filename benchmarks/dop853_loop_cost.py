@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 
 from rodval.core.loads import LOAD_COLUMNS
-from rodval.solvers import dop853
+from rodval.solvers import compiled
 from rodval.solvers.guard import GuardSpec
 from rodval.solvers.signature import RHS_SIGNATURE
 from rodval.solvers.system import CompiledForm
@@ -50,9 +50,8 @@ def measure(n: int, repeats: int = 3) -> None:
     best, nfev = np.inf, 0
     for _ in range(repeats):
         start = time.perf_counter()
-        nfev = dop853.integrate_compiled(
-            form, y0, edges, times, 1e-6, 1e-8, np.inf, None, 10**9, guard, Y
-        )[1]
+        controls = compiled.Controls(1e-6, 1e-8, np.inf, None, 10**9)
+        nfev = compiled.integrate_compiled(form, y0, edges, times, Y, controls, guard)[1]
         best = min(best, time.perf_counter() - start)
     out = np.empty(2 * n)
     rhs_loop(1, y0, P, out)

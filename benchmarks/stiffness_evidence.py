@@ -26,7 +26,8 @@ from rodval.bench.stiffness import rigid_latch, stiff_paper
 from rodval.core.settings import IntegratorSettings
 from rodval.models import get_model
 from rodval.solvers import stiffness
-from rodval.solvers.dop853 import RADAU_STEPPER, integrate_compiled
+from rodval.solvers.compiled import Controls, integrate_compiled, packed
+from rodval.solvers.dop853 import RADAU_STEPPER
 from rodval.solvers.guard import GuardSpec
 
 
@@ -47,9 +48,7 @@ def hairer_test(EI: float = 1e9, steps: int = 20_000) -> None:
     y = np.array(system.y0, float)
     f = np.empty(y.size)
     form.rhs(0.0, y, form.P, form.S, form.M, form.L, f)
-    rho = stiffness.spectral_radius(
-        form.rhs, form.P, form.S, form.M, form.L, 0.0, y, f, *(np.empty(y.size) for _ in range(3))
-    )
+    rho = stiffness.spectral_radius(packed(form), 0.0, y, f, *(np.empty(y.size) for _ in range(3)))
     pct = np.percentile(ratios, [10, 50, 90])
     print(f"paper chain, EI = {EI:.0e}: Hairer's h|lambda| 10/50/90 % = {pct.round(2)}")
     print(f"  median step {np.median(sizes):.3g} s, spectral radius {rho:.4g} 1/s,")
@@ -72,10 +71,8 @@ def rigid_latch_vibration() -> None:
     system = get_model("full").system(free)
     Y = np.empty((2, system.y0.size))
     ends = np.array([0.0, 0.01])
-    run = integrate_compiled(
-        system.compiled(), system.y0, ends, ends, 1e-6, 1e-8, np.inf, None, 10**7, GuardSpec(), Y,
-        stepper=RADAU_STEPPER,
-    )  # fmt: skip
+    controls = Controls(1e-6, 1e-8, np.inf, None, 10**7, stepper=RADAU_STEPPER)
+    run = integrate_compiled(system.compiled(), system.y0, ends, ends, Y, controls, GuardSpec())
     print(f"  Radau IIA, rtol 1e-6, 0..0.01 s: {run.nsteps} steps (mean {0.01 / run.nsteps:.3g} s)")
 
 

@@ -88,19 +88,19 @@ def _form(system: OdeSystem) -> CompiledForm:
 def compiled_states(system: OdeSystem, scene: Scene, settings: IntegratorSettings) -> np.ndarray:
     """The full state vectors at the scene's output times, from the compiled DOP853 run with
     ``settings`` (no guard; the driver's own run is timed separately)."""
-    from rodval.solvers import dop853
+    from rodval.solvers import compiled
     from rodval.solvers.driver import segment_edges
 
     times = np.asarray(scene.times, float)
     Y = np.empty((times.size, system.y0.size))
-    controls = dop853.Controls(
+    controls = compiled.Controls(
         settings.rtol,
         settings.atol,
         settings.max_step,
         settings.first_step,
         settings.max_evaluations,
     )
-    n_out = dop853.integrate_compiled(
+    n_out = compiled.integrate_compiled(
         _form(system),
         system.y0,
         segment_edges(scene),

@@ -1,17 +1,18 @@
 """rodval's compiled integrators: whole runs in one compiled loop (``settings.COMPILED_METHODS``).
 
 They take a system's ``CompiledForm`` (its own jitted right-hand side and arrays) and import
-no model. ``run_compiled`` is called by the driver (``rodval.solvers.driver``).
+no model. ``run_compiled`` is called by the driver (``rodval.solvers.driver``);
+``integrate_compiled`` runs ``rodval.solvers.dop853.run`` once (to the end or an event).
 """
 
 from __future__ import annotations
 
+import math
 import time
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from rodval.core.scene import Scene
 from rodval.core.settings import AUTO, IntegratorSettings
 from rodval.core.status import (
     STATUS_BUDGET,
@@ -26,10 +27,14 @@ from rodval.core.status import (
 from rodval.core.trajectory import SolverStats
 from rodval.solvers import budget, dop853, progress, stiffness
 from rodval.solvers.audit import PowerLedger
+from rodval.solvers.budget import EVENT, Settings
+from rodval.solvers.dop853 import DOP853_STEPPER, loop
+from rodval.solvers.dop853_events import no_events
 from rodval.solvers.events import apply_hit
-from rodval.solvers.guard import GuardSpec, diverged_message, verdict
+from rodval.solvers.guard import GuardSpec, diverged_message, new_monitor, verdict
 from rodval.solvers.outputs import Outputs
-from rodval.solvers.system import OdeSystem
+from rodval.solvers.signature import Arr, Form
+from rodval.solvers.system import CompiledForm, OdeSystem
 
 
 def verdict_message(code: int, mon: np.ndarray, t: float, spec: GuardSpec) -> tuple[int, str]:
@@ -127,11 +132,133 @@ def atol_vector(system: OdeSystem, settings: IntegratorSettings) -> float | np.n
     return np.maximum(settings.atol, settings.rtol * scale)
 
 
+class Controls(NamedTuple):
+    """The settings of one ``integrate_compiled`` run."""
+
+    rtol: float  #: relative tolerance
+    #: absolute tolerance: one for every coordinate, or one per coordinate (N,), e.g.
+    #: ``rodval.solvers.compiled.atol_vector``'s
+    atol: float | Arr
+    max_step: float  #: s
+    first_step: float | None  #: s; None: selected (``dop853._initial_step``)
+    max_nfev: int  #: the evaluation budget
+    deadline: float = math.inf  #: a ``time.perf_counter()`` value (s)
+    reporting: bool = False  #: report progress (``rodval.solvers.progress``)
+    audit: bool = False  #: integrate the load and damper powers (the energy audit)
+    #: ``DOP853_STEPPER``, ``RADAU_STEPPER`` or ``SWITCHING_STEPPER``, see ``dop853.run``
+    stepper: int = DOP853_STEPPER
+
+
+class Carry(NamedTuple):
+    """What a run continued after an event carries on from the last (updated in place)."""
+
+    monitor: Arr | None  #: the guard's (``guard_step``); None: a new one
+    total: Arr  #: the audit's running [W_ext, D] (J)
+    switch: Arr  #: the switching stepper's state (``stiffness.new_state``)
+
+
+class CompiledRun(NamedTuple):
+    """What ``integrate_compiled`` returns."""
+
+    n_out: int  #: output times written
+    nfev: int  #: right-hand-side evaluations
+    nsteps: int  #: accepted steps
+    code: int  #: how the loop ended (OK, STEP_TOO_SMALL, ..., EVENT)
+    t: float  #: time reached (s): the event's time for EVENT
+    monitor: Arr  #: the guard's figures (``guard_step``)
+    work: Arr  #: the audit's [W_ext, D] (J) at the output times written, (n_out, 2)
+    event: int  #: the event's index (EVENT), else -1
+    y: Arr  #: the state at the event (before its jump; EVENT), else empty
+    #: the switching stepper's state (``stiffness.new_state``; carried over restarts)
+    switch: Arr
+
+
+def start_monitor(form: CompiledForm, t: float, y: Arr, guard: GuardSpec) -> Arr:
+    """The guard's monitor for a run of ``form`` from (t, y): the load power there in it
+    when the guard checks energy (``rodval.solvers.guard.new_monitor``)."""
+    if form.mechanics is None or not guard.checks_energy:
+        return new_monitor()
+    mech = np.zeros(3)
+    form.mechanics(t, np.array(y, float), form.P, form.S, form.M, form.L, mech)
+    return new_monitor(mech[1])
+
+
+def packed(form: CompiledForm) -> Form:
+    """``form`` as the compiled integrators take it (``signature.FORM_TYPE``); without
+    mechanics its right-hand side stands in for them (never called: no energy check, no
+    audit), without events ``no_events``."""
+    mechanics = form.mechanics if form.mechanics is not None else form.rhs
+    events = form.events if form.events is not None else no_events
+    return (form.P, form.S, form.M, form.L, form.E, form.directions, form.rhs, mechanics, events)
+
+
+def _settings(form: CompiledForm, y0: Arr, controls: Controls, guard: GuardSpec) -> Settings:
+    """The loop's ``budget.Settings`` for ``controls`` and ``guard`` (its energy check off
+    without ``form.mechanics``)."""
+    g = guard.as_array()
+    if form.mechanics is None:
+        g[2] = math.inf
+        if controls.audit:
+            raise ValueError("an energy audit needs the compiled form's mechanics")
+    first = -1.0 if controls.first_step is None else controls.first_step
+    atol = np.array(np.broadcast_to(np.asarray(controls.atol, float), y0.shape))
+    values = (controls.rtol, atol.max(), controls.max_step, first, controls.max_nfev)
+    more = (controls.deadline, controls.stepper, controls.reporting)
+    return np.array(values + more, float), atol, g
+
+
+def integrate_compiled(
+    form: CompiledForm,
+    y0: Arr,
+    edges: Arr,
+    times: Arr,
+    Y: Arr,
+    controls: Controls,
+    guard: GuardSpec,
+    carry: Carry | None = None,
+) -> CompiledRun:
+    """Run ``dop853.run`` on a CompiledForm from (edges[0], y0) (see there; without
+    ``form.mechanics`` there is no blow-up check and no audit), the states at ``times``
+    into Y (len(times), N). A run continued after an event passes the guard's monitor, the
+    audit's running total and the switching state on (``carry``, updated in place); new ones
+    start from (edges[0], y0)."""
+    y0 = np.array(y0, float)
+    settings = _settings(form, y0, controls, guard)
+    carry = carry or Carry(None, np.zeros(2), stiffness.new_state())
+    mon = carry.monitor
+    mon = start_monitor(form, float(edges[0]), y0, guard) if mon is None else mon
+    W = np.zeros((len(times) if controls.audit else 0, 2))
+    hit = np.zeros(y0.size + 1)
+    kernels = packed(form)
+    n_out, nfev, nsteps, code, t = loop()(
+        kernels[:6],
+        *kernels[6:],
+        y0,
+        np.array(edges, float),
+        settings,
+        (np.array(times, float), Y, W),
+        (mon, carry.total, hit, carry.switch),
+    )
+    event = int(hit[0]) if code == EVENT else -1
+    y_event = hit[1:].copy() if code == EVENT else np.zeros(0)
+    return CompiledRun(
+        int(n_out),
+        int(nfev),
+        int(nsteps),
+        int(code),
+        float(t),
+        mon,
+        W[:n_out],
+        event,
+        y_event,
+        carry.switch,
+    )
+
+
 def run_compiled(
     system: OdeSystem,
     y0: np.ndarray,
     edges: np.ndarray,
-    scene: Scene,
     settings: IntegratorSettings,
     guard: GuardSpec,
     out: Outputs,
@@ -149,39 +276,29 @@ def run_compiled(
     the scipy path), its record appended to ``events``; the loop goes on in the new mode.
     The stepper: ``_STEPPERS[settings.method]`` (its switches in ``stats.switch``)."""
     W = np.zeros((out.times.size, 2))
-    total = np.zeros(2)
     deadline = time.perf_counter() + settings.max_wall_s
     t, y = float(edges[0]), np.array(y0, float)
-    monitor = None
-    stepper = _STEPPERS[settings.method]
-    switch = stiffness.new_state()
+    carry = Carry(None, np.zeros(2), stiffness.new_state())
     atol = atol_vector(system, settings)
     while True:
         form = system.compiled()
         assert form is not None  # choose_method took the compiled path for this system
         times = out.remaining()
         buffer = np.empty((times.size, y.size))
+        controls = Controls(
+            settings.rtol,
+            atol,
+            settings.max_step,
+            settings.first_step,
+            settings.max_evaluations - stats.nfev,
+            deadline,
+            progress.reporting(),
+            ledger is not None,
+            _STEPPERS[settings.method],
+        )
+        segments = np.concatenate([[t], edges[edges > t]])
         try:
-            res = dop853.integrate_compiled(
-                form,
-                y,
-                np.concatenate([[t], edges[edges > t]]),
-                times,
-                settings.rtol,
-                atol,
-                settings.max_step,
-                settings.first_step,
-                settings.max_evaluations - stats.nfev,
-                guard,
-                buffer,
-                deadline=deadline,
-                reporting=progress.reporting(),
-                audit=ledger is not None,
-                monitor=monitor,
-                total=total,
-                stepper=stepper,
-                switch=switch,
-            )
+            res = integrate_compiled(form, y, segments, times, buffer, controls, guard, carry)
         except Exception as exc:  # noqa: BLE001 - e.g. a singular mass matrix: reported as data
             # raised by a model's kernel: the loop's time is lost, t_reached stays at its start
             update_status(
@@ -193,21 +310,27 @@ def run_compiled(
         written = out.write(buffer[: res.n_out])
         if ledger is not None:
             W[n_out : out.n] = res.work[written]
-        monitor = res.monitor
+        # a restart goes on with the guard's monitor and the stepper the run ended with
+        carry = Carry(res.monitor, carry.total, res.switch)
         stats.nfev += res.nfev
         stats.nsteps += res.nsteps
         stats.t_reached = t = res.t
-        switch = res.switch  # a restart goes on with the stepper the run ended with
-        stats.switch = switch_record(switch)
+        stats.switch = switch_record(res.switch)
         if res.code != budget.EVENT:
             _ending(res, settings, guard, stats, float(edges[-1]))
             break
-        y = _event(system, res, total, events, out)
+        y = _event(system, res, carry.total, events, out)
     if ledger is not None:
         ledger.replace(W[: out.n])
 
 
-def _event(system: OdeSystem, res, total: np.ndarray, events, out: Outputs) -> np.ndarray:
+def _event(
+    system: OdeSystem,
+    res: CompiledRun,
+    total: np.ndarray,
+    events: list[dict[str, Any]] | None,
+    out: Outputs,
+) -> np.ndarray:
     """The located event of ``res``: the system's jump (its state returned), the impact's
     kinetic energy loss booked as dissipated energy of the audit (``total``), the record
     appended to ``events`` and given to the lock windows."""
@@ -221,7 +344,11 @@ def _event(system: OdeSystem, res, total: np.ndarray, events, out: Outputs) -> n
 
 
 def _ending(
-    res: dop853.CompiledRun, settings: IntegratorSettings, guard, stats, t_end: float
+    res: CompiledRun,
+    settings: IntegratorSettings,
+    guard: GuardSpec,
+    stats: SolverStats,
+    t_end: float,
 ) -> None:
     """Status and message of a compiled run that ended with ``res.code`` (not an event). A
     budget spent on a stiff vibration (``stats.switch``) says which and what the rest of the

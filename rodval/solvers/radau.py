@@ -23,8 +23,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.solvers.budget import OK, next_attempt, smallest_step
+from rodval.solvers.budget import OK, Settings, next_attempt, smallest_step
 from rodval.solvers.dop853_events import interpolate
+from rodval.solvers.signature import Arr, Form, rhs_at
+
+#: The stepper's buffers (``work``).
+Work = tuple[Arr, ...]
+#: A step's arrays, the loop's: (y, f = rhs(t, y), y_new, f_new, F: the dense output).
+Step = tuple[Arr, Arr, Arr, Arr, Arr]
 
 S6 = 6.0**0.5
 #: Collocation nodes (fractions of the step).
@@ -77,7 +83,7 @@ H_OLD, ERR_OLD, CURRENT_JAC, LU_VALID, HAVE_SOL, NLU, NITER = range(7)
 
 
 @njit(cache=True, inline="always")
-def copy_into(dst, src):
+def copy_into(dst: Arr, src: Arr) -> None:
     """dst[:] = src (1-D, same size), as a loop: a slice assignment compiles numba's shape
     check and its message (about 2 s on each first compile, ``benchmarks/first_run.py``)."""
     for i in range(src.shape[0]):
@@ -85,7 +91,7 @@ def copy_into(dst, src):
 
 
 @njit(cache=True, error_model="numpy")
-def lu_factor(A, piv):
+def lu_factor(A: Arr, piv: Arr) -> None:
     """A = P L U in place (Doolittle, partial pivoting), row swaps in piv. O(N^3), real or
     complex. A singular pivot leaves a zero on U's diagonal: the solve gives inf/NaN, which
     the Newton iteration treats as non-convergence."""
@@ -113,7 +119,7 @@ def lu_factor(A, piv):
 
 
 @njit(cache=True, error_model="numpy")
-def lu_solve(A, piv, b):
+def lu_solve(A: Arr, piv: Arr, b: Arr) -> None:
     """Solve (P L U) x = b in place in b with ``lu_factor``'s A and piv. O(N^2)."""
     n = A.shape[0]
     for k in range(n):
@@ -133,12 +139,13 @@ def lu_solve(A, piv, b):
 
 
 @njit(cache=True, error_model="numpy")
-def jacobian(rhs, P_, S, M, L, t, y, f, J, tmp, f1):
+def jacobian(form: Form, t: float, y: Arr, f: Arr, J: Arr, tmp: Arr, f1: Arr) -> None:
     """The Jacobian df/dy at (t, y) by forward differences into J (f = rhs(t, y)): column j
     from an increment sqrt(eps max(1e-5, |y_j|)) (Hairer's RADAU5). N evaluations, O(N^2)."""
     N = y.shape[0]
     for i in range(N):
         tmp[i] = y[i]
+    P_, S, M, L, rhs = form[0], form[1], form[2], form[3], form[6]  # once, not per evaluation
     for j in range(N):
         delta = np.sqrt(_EPS * max(1e-5, abs(y[j])))
         tmp[j] = y[j] + delta
@@ -149,7 +156,7 @@ def jacobian(rhs, P_, S, M, L, t, y, f, J, tmp, f1):
 
 
 @njit(cache=True, error_model="numpy")
-def _factor(J, h, LUr, pr, LUc, pc):
+def _factor(J: Arr, h: float, LUr: Arr, pr: Arr, LUc: Arr, pc: Arr) -> None:
     """The iteration matrices MU_REAL/h I - J and MU_COMPLEX/h I - J, factorized. O(N^3)."""
     N = J.shape[0]
     mr = MU_REAL / h
@@ -165,18 +172,20 @@ def _factor(J, h, LUr, pr, LUc, pc):
 
 
 @njit(cache=True, error_model="numpy")
-def _norm(x, scale):
+def _norm(x: Arr, scale: Arr) -> float:
     """rms of x / scale over all entries (scipy's ``norm``): x (N,) or (3, N), scale (N,)."""
     rows = x.reshape((-1, scale.shape[0]))
     acc = 0.0
     for r in range(rows.shape[0]):
         for i in range(scale.shape[0]):
             acc += (rows[r, i] / scale[i]) ** 2
-    return np.sqrt(acc / rows.size)
+    return float(np.sqrt(acc / rows.size))
 
 
 @njit(cache=True, error_model="numpy")
-def _collocation(rhs, P_, S, M, L, t, y, h, Z, scale, tol, work):
+def _collocation(
+    form: Form, t: float, y: Arr, h: float, Z: Arr, scale: Arr, tol: float, work: Work
+) -> tuple[bool, int, float]:
     """The collocation system by simplified Newton (scipy's ``solve_collocation_system``):
     Z (3, N) holds the guess on entry, the solution on exit. Returns (converged, iterations,
     rate: -1 before two iterations, inf when stage values are not finite); 3 evaluations per
@@ -190,6 +199,7 @@ def _collocation(rhs, P_, S, M, L, t, y, h, Z, scale, tol, work):
             Wt[a, i] = TI[a, 0] * Z[0, i] + TI[a, 1] * Z[1, i] + TI[a, 2] * Z[2, i]
     dW_norm_old = -1.0
     rate = -1.0
+    P_, S, M, L, rhs = form[0], form[1], form[2], form[3], form[6]  # once, not per evaluation
     for k in range(NEWTON_MAXITER):
         for a in range(3):
             for i in range(N):
@@ -230,7 +240,9 @@ def _collocation(rhs, P_, S, M, L, t, y, h, Z, scale, tol, work):
 
 
 @njit(cache=True, error_model="numpy")
-def _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old):
+def _predict_factor(
+    h_abs: float, h_abs_old: float, error_norm: float, error_norm_old: float
+) -> float:
     """Gustafsson's predictive step-size factor (scipy's ``predict_factor``)."""
     if error_norm_old <= 0.0 or h_abs_old <= 0.0 or error_norm == 0.0:
         multiplier = 1.0
@@ -238,11 +250,11 @@ def _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old):
         multiplier = h_abs / h_abs_old * (error_norm_old / error_norm) ** 0.25
     if error_norm == 0.0:
         return MAX_FACTOR
-    return min(1.0, multiplier) * error_norm**-0.25
+    return float(min(1.0, multiplier) * error_norm**-0.25)
 
 
 @njit(cache=True, error_model="numpy")
-def dense_coefficients(Z, F):
+def dense_coefficients(Z: Arr, F: Arr) -> None:
     """The step's cubic dense output (y + sum_k (Z^T P)[:, k] x^(k+1)) in ``dop853``'s
     interpolant form F (7, N): F0 = a1 + a2 + a3, F1 = -(a2 + a3), F2 = -a3, the rest 0,
     so that ``dop853_events.interpolate`` evaluates it. O(N)."""
@@ -259,7 +271,7 @@ def dense_coefficients(Z, F):
 
 
 @njit(cache=True, inline="always")
-def work(N, implicit):
+def work(N: int, implicit: bool) -> Work:
     """The stepper's buffers for N states (all empty unless ``implicit``): [0] Jacobian,
     [1-4] real and complex LU factors and pivots, [5] stage increments Z (3, N), [6-10]
     Newton work (W, stage derivatives, increments (3, N each), real and complex right-hand
@@ -287,17 +299,17 @@ def work(N, implicit):
 
 
 @njit(cache=True, error_model="numpy")
-def start(rhs, P_, S, M, L, t, y, f, rw, sc, cnt):
+def start(form: Form, t: float, y: Arr, f: Arr, rw: Work, sc: Arr, cnt: Arr) -> None:
     """A segment's start from (t, y) with f = rhs(t, y): the Jacobian there (N evaluations,
     counted in cnt[0]), no LU factors, no previous step. O(N^2)."""
     J, tmp, f1 = rw[0], rw[11], rw[12]
-    jacobian(rhs, P_, S, M, L, t, y, f, J, tmp, f1)
+    jacobian(form, t, y, f, J, tmp, f1)
     cnt[0] += y.shape[0]
     sc[H_OLD], sc[ERR_OLD], sc[CURRENT_JAC], sc[LU_VALID], sc[HAVE_SOL] = 0.0, 0.0, 1.0, 0.0, 0.0
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _predict(t, h, y, F, rw, sc):
+def _predict(t: float, h: float, y: Arr, F: Arr, rw: Work, sc: Arr) -> None:
     """The Newton guess Z (3, N): the previous step's dense output extrapolated to the
     collocation times t + C h, minus y (zero without a previous step)."""
     Z, tmp, yp = rw[5], rw[11], rw[13]
@@ -313,13 +325,16 @@ def _predict(t, h, y, F, rw, sc):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _error(rhs, P_, S, M, L, t, y, y_new, f, h, rw, controls, atol, again, cnt):
-    """Hairer's error estimate of the step (its norm): (MU_REAL/h I - J)^-1 (f + Z^T E / h),
-    filtered once more through the right-hand side when ``again`` (after a rejection; one
-    evaluation); scaled by atol[i] + rtol max(|y_i|, |y_new_i|) (``atol``: one per
-    coordinate)."""
+def _error(
+    form: Form, t: float, h: float, state: Step, rw: Work, settings: Settings, again: bool, cnt: Arr
+) -> float:
+    """Hairer's error estimate of the step h (s) from (t, y) to y_new (``state``) (its
+    norm): (MU_REAL/h I - J)^-1 (f + Z^T E / h), filtered once more through the right-hand
+    side when ``again`` (after a rejection; one evaluation); scaled by atol[i] + rtol
+    max(|y_i|, |y_new_i|) (``settings``' atol: one per coordinate)."""
     LUr, pr, Z, tmp, f1, err = rw[1], rw[2], rw[5], rw[11], rw[12], rw[15]
-    rtol = controls[0]
+    y, f, y_new = state[0], state[1], state[2]
+    rtol, atol = settings[0][0], settings[1]
     N = y.shape[0]
     for i in range(N):
         err[i] = f[i] + (E[0] * Z[0, i] + E[1] * Z[1, i] + E[2] * Z[2, i]) / h
@@ -330,7 +345,7 @@ def _error(rhs, P_, S, M, L, t, y, y_new, f, h, rw, controls, atol, again, cnt):
     if again and norm > 1.0:
         for i in range(N):
             f1[i] = y[i] + err[i]
-        rhs(t, f1, P_, S, M, L, err)
+        rhs_at(form, t, f1, err)
         cnt[0] += 1
         for i in range(N):
             err[i] += (E[0] * Z[0, i] + E[1] * Z[1, i] + E[2] * Z[2, i]) / h
@@ -340,13 +355,17 @@ def _error(rhs, P_, S, M, L, t, y, y_new, f, h, rw, controls, atol, again, cnt):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _newton(rhs, P_, S, M, L, t, y, f, h, F, tol, rw, sc, cnt):
-    """The collocation system of the step h (s) from (t, y) from the predicted guess, with
+def _newton(
+    form: Form, t: float, h: float, state: Step, tol: float, rw: Work, sc: Arr, cnt: Arr
+) -> tuple[bool, int, float]:
+    """The collocation system of the step h (s) from (t, y) (``state``: y, f = rhs(t, y),
+    the previous step's dense output F) from the predicted guess, with
     the iteration matrices factorized when they are not valid, and once more with a fresh
     Jacobian when Newton fails on an old one (scipy's inner loop). Returns
     ``_collocation``'s (converged, iterations, rate); evaluations counted in cnt[0]."""
     J, LUr, pr, LUc, pc, Z = rw[0], rw[1], rw[2], rw[3], rw[4], rw[5]
     tmp, f1, scale = rw[11], rw[12], rw[14]
+    y, f, F = state[0], state[1], state[4]
     newton = (LUr, pr, LUc, pc, rw[6], rw[7], rw[8], rw[9], rw[10], tmp)
     while True:
         if sc[LU_VALID] == 0.0:
@@ -354,43 +373,53 @@ def _newton(rhs, P_, S, M, L, t, y, f, h, F, tol, rw, sc, cnt):
             sc[LU_VALID] = 1.0
             sc[NLU] += 1.0
         _predict(t, h, y, F, rw, sc)
-        converged, n_iter, rate = _collocation(rhs, P_, S, M, L, t, y, h, Z, scale, tol, newton)
+        converged, n_iter, rate = _collocation(form, t, y, h, Z, scale, tol, newton)
         cnt[0] += 3 * n_iter
         sc[NITER] += n_iter
         if converged or sc[CURRENT_JAC] == 1.0:
             return converged, n_iter, rate
-        jacobian(rhs, P_, S, M, L, t, y, f, J, tmp, f1)
+        jacobian(form, t, y, f, J, tmp, f1)
         cnt[0] += y.shape[0]
         sc[CURRENT_JAC], sc[LU_VALID] = 1.0, 0.0
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _derivative_at_end(
+    form: Form, t_new: float, state: Step, rw: Work, sc: Arr, refresh: bool, cnt: Arr
+) -> None:
+    """At the accepted step's end: f_new = rhs(t_new, y_new) (``state``) and, when
+    ``refresh``, the Jacobian there (marked current, else marked old); evaluations counted
+    in cnt[0]."""
+    y_new, f_new = state[2], state[3]
+    rhs_at(form, t_new, y_new, f_new)
+    cnt[0] += 1
+    if refresh:
+        jacobian(form, t_new, y_new, f_new, rw[0], rw[11], rw[12])
+        cnt[0] += y_new.shape[0]
+        sc[CURRENT_JAC] = 1.0
+    else:
+        sc[CURRENT_JAC] = 0.0
+
+
 @njit(cache=True, error_model="numpy")
 def step(
-    rhs,
-    P_,
-    S,
-    M,
-    L,
-    t,
-    t_bound,
-    h_abs,
-    y,
-    f,
-    y_new,
-    f_new,
-    F,
-    controls,
-    atol,
-    reporting,
-    cnt,
-    rw,
-    sc,
-):
-    """Attempts from (t, y) (f = rhs(t, y)) to t_bound until one is accepted (scipy's
-    ``Radau._step_impl``): y_new, f_new there, the dense output into F; ``controls``, ``atol``
-    (per coordinate), ``cnt`` as in ``dop853.run``, ``rw``: ``work``, ``sc``: the scalars.
+    form: Form,
+    t: float,
+    t_bound: float,
+    h_abs: float,
+    state: Step,
+    settings: Settings,
+    cnt: Arr,
+    rw: Work,
+    sc: Arr,
+) -> tuple[int, float, float]:
+    """Attempts from (t, y) (``state``: y, f = rhs(t, y), y_new, f_new, F) to t_bound until
+    one is accepted (scipy's ``Radau._step_impl``): y_new, f_new there, the dense output into
+    F; ``settings``, ``cnt`` as in ``dop853.run``, ``rw``: ``work``, ``sc``: the scalars.
     Returns (code, t, next step): OK, or STEP_TOO_SMALL, BUDGET, WALL, NON_FINITE, t kept."""
-    J, Z, tmp, f1, scale = rw[0], rw[5], rw[11], rw[12], rw[14]
+    Z, scale = rw[5], rw[14]
+    y, y_new, F = state[0], state[2], state[4]
+    controls, atol = settings[0], settings[1]
     rtol, max_step = controls[0], controls[2]
     N = y.shape[0]
     tol = max(10.0 * _EPS / rtol, min(0.03, rtol**0.5))
@@ -402,14 +431,14 @@ def step(
     rejected = False
     finite = True  # whether the last attempt's stages were finite
     while True:
-        code, t_new = next_attempt(t, t_bound, h_abs, min_step, finite, controls, reporting, cnt)
+        code, t_new = next_attempt(t, t_bound, h_abs, min_step, finite, controls, cnt)
         if code != OK:
             return code, t, h_abs
         h = t_new - t
         h_abs = h
         for i in range(N):
             scale[i] = atol[i] + abs(y[i]) * rtol
-        converged, n_iter, rate = _newton(rhs, P_, S, M, L, t, y, f, h, F, tol, rw, sc, cnt)
+        converged, n_iter, rate = _newton(form, t, h, state, tol, rw, sc, cnt)
         finite = rate < np.inf
         if not converged:
             h_abs *= 0.5
@@ -417,7 +446,7 @@ def step(
             continue
         for i in range(N):
             y_new[i] = y[i] + Z[2, i]
-        error_norm = _error(rhs, P_, S, M, L, t, y, y_new, f, h, rw, controls, atol, rejected, cnt)
+        error_norm = _error(form, t, h, state, rw, settings, rejected, cnt)
         safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter)
         if error_norm > 1.0 or not np.isfinite(error_norm):
             finite = np.isfinite(error_norm)
@@ -433,14 +462,7 @@ def step(
         factor = 1.0
     else:
         sc[LU_VALID] = 0.0
-    rhs(t_new, y_new, P_, S, M, L, f_new)
-    cnt[0] += 1
-    if recompute_jac:
-        jacobian(rhs, P_, S, M, L, t_new, y_new, f_new, J, tmp, f1)
-        cnt[0] += N
-        sc[CURRENT_JAC] = 1.0
-    else:
-        sc[CURRENT_JAC] = 0.0
+    _derivative_at_end(form, t_new, state, rw, sc, recompute_jac, cnt)
     sc[H_OLD], sc[ERR_OLD], sc[HAVE_SOL] = h_abs, error_norm, 1.0
     copy_into(rw[13], y)
     dense_coefficients(Z, F)

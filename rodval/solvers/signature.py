@@ -24,9 +24,11 @@ import atexit
 import os
 import subprocess
 import sys
+from collections.abc import Callable
 from typing import Any
 
-from numba import types
+import numpy as np
+from numba import njit, types
 
 F1 = types.float64[::1]
 F2 = types.float64[:, ::1]
@@ -36,12 +38,48 @@ RHS_TYPE = types.FunctionType(RHS_SIGNATURE)
 EVENTS_SIGNATURE = types.void(types.float64, F1, F2, F1, F3, F2, F2, F1)
 EVENTS_TYPE = types.FunctionType(EVENTS_SIGNATURE)
 
+
+def tuple_type(*items: Any) -> Any:
+    """numba's type of a tuple of the numba types ``items``."""
+    return types.Tuple(items)  # type: ignore[no-untyped-call]  # numba's types are untyped
+
+
+#: A compiled form as the compiled integrators take it, one tuple: its arrays (P, S, M, L, E,
+#: directions), then its functions (rhs, mechanics, events) (``CompiledForm``). Arrays
+#: first: numba warns of a tuple that starts with a function as an experimental feature.
+FORM_TYPE = tuple_type(F2, F1, F3, F2, F2, F1, RHS_TYPE, RHS_TYPE, EVENTS_TYPE)
+#: An array argument of a compiled function, as mypy sees it.
+Arr = np.ndarray
+#: A compiled function, as mypy sees it.
+Kernel = Callable[..., None]
+#: ``FORM_TYPE`` as mypy sees it.
+Form = tuple[Arr, Arr, Arr, Arr, Arr, Arr, Kernel, Kernel, Kernel]
+
+
+@njit(cache=True, inline="always")
+def rhs_at(form: Form, t: float, y: Arr, out: Arr) -> None:
+    """The form's right-hand side y'(t, y) into ``out``. One evaluation."""
+    form[6](t, y, form[0], form[1], form[2], form[3], out)
+
+
+@njit(cache=True, inline="always")
+def mechanics_at(form: Form, t: float, y: Arr, out: Arr) -> None:
+    """The form's (T, P_ext, P_diss) at (t, y) into ``out`` (3,)."""
+    form[7](t, y, form[0], form[1], form[2], form[3], out)
+
+
+@njit(cache=True, inline="always")
+def events_at(form: Form, t: float, y: Arr, out: Arr) -> None:
+    """The form's event values g_i(t, y), one per row of E, into ``out``."""
+    form[8](t, y, form[0], form[1], form[2], form[3], form[4], out)
+
+
 #: Environment variable: "0" compiles everything in the process that needs it (set in the
 #: background processes themselves, so that they start none).
 BACKGROUND_ENV = "RODVAL_BACKGROUND_COMPILE"
 
 #: The background compilations this process started, by key.
-_BACKGROUND: dict[str, subprocess.Popen] = {}
+_BACKGROUND: dict[str, subprocess.Popen[bytes]] = {}
 
 
 def first_class(kernel: Any, signature: Any) -> Any:

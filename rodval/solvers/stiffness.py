@@ -33,6 +33,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from rodval.solvers.signature import Arr, Form, rhs_at
+
 #: DOP853's stability boundary on the imaginary axis: the largest y with |R(i y')| <= 1 for
 #: all y' <= y, R its stability function (``tests/test_radau.py`` computes it from scipy's
 #: coefficients; a constant here, so that importing the loop does not pay 0.07 s for it).
@@ -78,7 +80,7 @@ POWER_ITERATIONS = 12
 ) = range(15)
 
 
-def new_state() -> np.ndarray:
+def new_state() -> Arr:
     """The switching state of a new run: no estimate, no switch (NaN times)."""
     sw = np.zeros(15)
     sw[[RHO, T_SWITCH, RATE_IMPLICIT, T_FIRST]] = np.nan
@@ -86,7 +88,7 @@ def new_state() -> np.ndarray:
 
 
 @njit(cache=True)
-def implicit_cost(evaluations, factorizations, iterations, N):
+def implicit_cost(evaluations: float, factorizations: float, iterations: float, N: int) -> float:
     """Radau IIA's work in evaluations of an O(N) right-hand side (about 50 N flops): the
     evaluations, each pair of LU factorizations (real and complex, about 3.3 N^3 flops) as
     N^2 / 15 and each Newton iteration's two solves (about 5 N^2 flops) as N / 10."""
@@ -94,40 +96,43 @@ def implicit_cost(evaluations, factorizations, iterations, N):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _unit_product(rhs, P, S, M, L, t, y, f, v, out, tmp, eps):
+def _unit_product(
+    form: Form, t: float, y: Arr, f: Arr, v: Arr, out: Arr, tmp: Arr, eps: float
+) -> float:
     """J v (v a unit vector) by a forward difference of size eps into out; returns |J v|.
     One evaluation, O(N)."""
     N = y.shape[0]
     for i in range(N):
         tmp[i] = y[i] + eps * v[i]
-    rhs(t, tmp, P, S, M, L, out)
+    rhs_at(form, t, tmp, out)
     acc = 0.0
     for i in range(N):
         out[i] = (out[i] - f[i]) / eps
         acc += out[i] * out[i]
-    return np.sqrt(acc)
+    return float(np.sqrt(acc))
 
 
 @njit(cache=True, error_model="numpy")
-def spectral_radius(rhs, P, S, M, L, t, y, f, v, w, tmp):
-    """|lambda|max of df/dy at (t, y) (f = rhs(t, y)) by power iteration on J^2, J v by
-    forward differences: sqrt(|J^2 v|) for unit v. 2 x POWER_ITERATIONS evaluations, O(N)
-    each (v, w, tmp: scratch). From below when the top eigenvalues cluster (n similar rods),
-    within the cluster, which is what the switch needs; NaN if a product is not finite."""
+def spectral_radius(form: Form, t: float, y: Arr, f: Arr, v: Arr, w: Arr, tmp: Arr) -> float:
+    """|lambda|max of df/dy at (t, y) (f = rhs(t, y); ``form``: ``signature.FORM_TYPE``) by
+    power iteration on J^2, J v by forward differences: sqrt(|J^2 v|) for unit v.
+    2 x POWER_ITERATIONS evaluations, O(N) each (v, w, tmp: scratch). From below when the
+    top eigenvalues cluster (n similar rods), within the cluster, which is what the switch
+    needs; NaN if a product is not finite."""
     N = y.shape[0]
     eps = np.sqrt(np.finfo(np.float64).eps) * (1.0 + np.sqrt(np.sum(y * y)))
     for i in range(N):
         v[i] = np.sin(i + 1.0)
     v /= np.sqrt(np.sum(v * v))
-    rho = 0.0
+    rho: float = 0.0
     for _ in range(POWER_ITERATIONS):
-        a = _unit_product(rhs, P, S, M, L, t, y, f, v, w, tmp, eps)
+        a = _unit_product(form, t, y, f, v, w, tmp, eps)
         if not np.isfinite(a):
             return np.nan
         if a == 0.0:
             return rho
         w /= a
-        b = _unit_product(rhs, P, S, M, L, t, y, f, w, v, tmp, eps)
+        b = _unit_product(form, t, y, f, w, v, tmp, eps)
         if not np.isfinite(b):
             return np.nan
         rho = np.sqrt(a * b)
@@ -138,7 +143,7 @@ def spectral_radius(rhs, P, S, M, L, t, y, f, v, w, tmp):
 
 
 @njit(cache=True, inline="always")
-def watch_explicit(sw, h, t_new, cost):
+def watch_explicit(sw: Arr, h: float, t_new: float, cost: float) -> bool:
     """After an accepted DOP853 step h (s) ending at t_new (s), ``cost`` evaluations so far:
     counts the steps spent on the fastest mode (h rho > STIFF_H_RHO) unless a failed trial
     still asks to wait; True when STIFF_STEPS in a row say so: switch now (recorded)."""
@@ -164,7 +169,7 @@ def watch_explicit(sw, h, t_new, cost):
 
 
 @njit(cache=True, inline="always")
-def watch_implicit(sw, t_new, cost):
+def watch_implicit(sw: Arr, t_new: float, cost: float) -> bool:
     """After an accepted Radau step ending at t_new (s), ``cost``: its work so far
     (``implicit_cost``). Radau's cost per simulated second since its first
     TRIAL_STEPS // 2 steps (which pay the start: a Jacobian, steps growing from DOP853's)
