@@ -75,7 +75,7 @@ def measure(repeats: int) -> dict[str, dict[str, float]]:
     """Per scene: best wall (s), locks, probes, bookkeeping per lock (s) on this process's
     rodval."""
     from rodval.models.hinge_items import lock_records
-    from rodval.models.presets.registry import simulate
+    from rodval.models.registry import simulate
     from rodval.solvers import outputs
 
     clock = _Clock()
@@ -105,7 +105,7 @@ def measure(repeats: int) -> dict[str, dict[str, float]]:
 
 def profile(repeats: int, top: int = 12) -> str:
     """cProfile's top entries (cumulative) over ``repeats`` runs of the wing, after a warm-up."""
-    from rodval.models.presets.registry import simulate
+    from rodval.models.registry import simulate
 
     scene = _scene("four_panel_wing")
     simulate(scene, "reduced")

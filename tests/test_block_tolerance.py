@@ -18,7 +18,7 @@ import pytest
 from rodval.core.scene import paper_scene
 from rodval.core.settings import IntegratorSettings
 from rodval.models import simulate
-from rodval.models.presets.registry import model_class
+from rodval.models.registry import model_class
 from rodval.solvers.compiled import atol_vector
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))

@@ -24,7 +24,7 @@ from rodval.models.observation.deployed_damping import (
     deployed_scene,
     resolve_damping,
 )
-from rodval.models.presets.registry import simulate
+from rodval.models.registry import simulate
 
 L = [0.6, 1.1, 1.1, 1.1, 1.1]
 FOLD = np.cumsum([0.0, 2.8, -2.8, 2.8, -2.8]).tolist()  # rad: panels folded, zig-zag

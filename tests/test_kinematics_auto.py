@@ -21,7 +21,7 @@ from rodval.core.validity import MOMENTUM_RESIDUAL_BOUND
 from rodval.models import simulate
 from rodval.models.kinematics.rungs import auto_kinematics
 from rodval.models.presets.full import FullModel
-from rodval.models.presets.registry import model_class
+from rodval.models.registry import model_class
 from rodval.report.error_budget import error_budget, has_ladder
 from rodval.report.run_files import read_run
 

@@ -255,7 +255,7 @@ def test_a_study_the_models_take_is_read():
 def test_simulate_and_the_study_ask_the_one_check():
     """``simulate`` refuses what the study refuses, with the same reason, before any work."""
     from rodval.core.settings import IntegratorSettings
-    from rodval.models.presets.registry import check_scene, get_model
+    from rodval.models.registry import check_scene, get_model
 
     sc = scene("prescribed")
     with pytest.raises(ValueError, match="model 'reduced' has no prescribed base"):

@@ -27,7 +27,7 @@ from rodval.core.quantities import (
     with_doc_table,
 )
 from rodval.core.scene import EXPANDS, QUANTITIES, UNITS, trajectory_quantities
-from rodval.models.presets.registry import MODEL_NAMES, get_model
+from rodval.models.registry import MODEL_NAMES, get_model
 from rodval.report.study_report import peak_hinge_moments
 
 ROOT = Path(__file__).resolve().parents[1]

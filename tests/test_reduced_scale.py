@@ -9,7 +9,7 @@ from rodval.core.scene import paper_scene
 from rodval.models.bending import reduced_band_lu as lu
 from rodval.models.bending import reduced_banded as rb
 from rodval.models.presets.reduced import ReducedSystem
-from rodval.models.presets.registry import simulate
+from rodval.models.registry import simulate
 
 
 def quiet_state(n: int, moving: int, seed: int = 3):

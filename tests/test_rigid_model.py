@@ -23,7 +23,7 @@ from rodval.core.base import Motion  # noqa: E402
 from rodval.core.damping import bending_damping_for_ratio  # noqa: E402
 from rodval.core.scene import Chain, InitialState, Scene  # noqa: E402
 from rodval.mechanics.rigid import rigid_lock  # noqa: E402
-from rodval.models.presets.registry import get_model  # noqa: E402
+from rodval.models.registry import get_model  # noqa: E402
 from rodval.report.tables import read_tables  # noqa: E402
 
 #: rtol = atol = 1e-12 for the conservation tests: DOP853's local error per step is ~1e-12 of

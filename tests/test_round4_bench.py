@@ -13,7 +13,7 @@ from rodval import bench
 from rodval.bench import cost
 from rodval.cli import main
 from rodval.core.scene import paper_scene
-from rodval.models.presets.registry import integrated_models, simulate
+from rodval.models.registry import integrated_models, simulate
 
 #: Two rods over 0.1 s: every benchmark's runs in milliseconds.
 SHORT = paper_scene(2, t_end=0.1, times=np.linspace(0.0, 0.1, 3))

@@ -120,11 +120,11 @@ def test_the_public_api_resolves_lazily():
         import rodval
         assert "simulate" not in vars(rodval)
         from rodval import simulate
-        from rodval.models.presets.registry import simulate as real
+        from rodval.models.registry import simulate as real
         assert simulate is real and rodval.simulate is real
         """
     )
-    assert "rodval.models.presets.registry" in _modules(code)
+    assert "rodval.models.registry" in _modules(code)
 
 
 def test_every_public_name_is_its_module_object_and_listed():

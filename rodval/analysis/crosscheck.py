@@ -17,7 +17,7 @@ from rodval.analysis.metrics import error_metrics
 from rodval.analysis.reproduce import REPRODUCTION_SETTINGS
 from rodval.core.scene import TABLE1_TIMES, paper_scene
 from rodval.core.trajectory import Trajectory
-from rodval.models.presets.registry import simulate
+from rodval.models.registry import simulate
 
 TABLE1_RODS = (2, 4, 6, 8)
 #: Acceptance bounds of the independent model against the native full model (issue 3).

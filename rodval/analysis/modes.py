@@ -26,7 +26,7 @@ from rodval.core.modes import Modes
 from rodval.core.scene import Scene
 from rodval.models.observation.deployed_damping import resolve_damping
 from rodval.models.observation.linear_modes import check_arguments, check_configuration, mac_matrix
-from rodval.models.presets.registry import MODEL_NAMES, modal_options, model_class
+from rodval.models.registry import MODEL_NAMES, modal_options, model_class
 
 
 def model_modes(

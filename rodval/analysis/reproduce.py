@@ -14,7 +14,7 @@ from rodval.analysis.metrics import relative_error
 from rodval.core.scene import TABLE1_TIMES, paper_scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.trajectory import Trajectory
-from rodval.models.presets.registry import simulate
+from rodval.models.registry import simulate
 
 #: Table 1 formulation letters: P = full ("полная"), R = reduced.
 FORMULATIONS = {"P": "full", "R": "reduced"}

@@ -26,7 +26,7 @@ from rodval.bench.precision import (
 from rodval.core.scene import paper_scene
 from rodval.core.settings import IntegratorSettings
 from rodval.models import get_model
-from rodval.models.presets.registry import MODEL_NAMES, integrated_models, uses_integrator
+from rodval.models.registry import MODEL_NAMES, integrated_models, uses_integrator
 from rodval.models.systems.paper_system import PaperSystem
 from rodval.solvers.driver import integrate
 

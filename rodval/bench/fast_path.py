@@ -28,7 +28,7 @@ from rodval.core.loads import constant, pulse
 from rodval.core.scene import Chain, InitialState, Latch, Scene, paper_scene
 from rodval.core.settings import AUTO, IntegratorSettings
 from rodval.core.trajectory import Trajectory
-from rodval.models.presets.registry import integrated_models, simulate
+from rodval.models.registry import integrated_models, simulate
 
 
 def four_panel_wing(latches: bool = True, t_end: float = 2.5, times: int = 501) -> Scene:

@@ -18,7 +18,7 @@ from rodval.core.scene import Scene
 from rodval.core.settings import IntegratorSettings
 from rodval.core.trajectory import Trajectory
 from rodval.models import get_model
-from rodval.models.presets.registry import (
+from rodval.models.registry import (
     integrated_models,
     option_names,
     simulate,

@@ -24,7 +24,7 @@ from rodval.bench.precision import (
 )
 from rodval.core.scene import Scene, paper_scene
 from rodval.core.settings import IntegratorSettings
-from rodval.models.presets.registry import integrated_models, simulate
+from rodval.models.registry import integrated_models, simulate
 from rodval.solvers.driver import integrate
 from rodval.solvers.guard import GuardSpec
 from rodval.solvers.system import CompiledForm, OdeSystem

@@ -29,7 +29,7 @@ from rodval.core.scene import Chain, InitialState, Latch, Scene, paper_scene
 from rodval.core.settings import AUTO, IntegratorSettings
 from rodval.core.status import Status
 from rodval.core.trajectory import Trajectory
-from rodval.models.presets.registry import integrated_models, simulate
+from rodval.models.registry import integrated_models, simulate
 
 #: EI (N m^2) of the paper chain's sweep.
 EI_VALUES = (1e5, 1e6, 1e7, 1e8, 1e9)

@@ -21,7 +21,7 @@ from rodval.core.out_paths import write_file
 from rodval.core.provenance import provenance
 from rodval.core.scene import paper_scene
 from rodval.core.settings import METHODS
-from rodval.models.presets.registry import MODEL_NAMES, integrated_models, uses_integrator
+from rodval.models.registry import MODEL_NAMES, integrated_models, uses_integrator
 from rodval.report.figures import plot_scale, plot_work_precision
 from rodval.report.markdown import to_markdown
 

@@ -26,7 +26,7 @@ DIR/compare.csv: the modes of the other models paired with this model's by MAC (
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    from rodval.models.presets.registry import MODEL_NAMES
+    from rodval.models.registry import MODEL_NAMES
 
     p = sub.add_parser("modes", help=SUMMARIES["modes"], description=DESCRIPTION)
     p.add_argument(
@@ -127,7 +127,7 @@ def _given_options(
     --compare model take (``MODES_OPTIONS``); any other option is refused, naming it, and so
     is an integrator setting (a --set of a scene value is the scene's, ``_scene_and_model``)."""
     from rodval.core.settings import SETTING_NAMES
-    from rodval.models.presets.registry import model_class
+    from rodval.models.registry import model_class
 
     given = model_options(args)
     settings = [k for k, _ in args.options if k in SETTING_NAMES]
@@ -151,7 +151,7 @@ def _given_options(
 
 def _compare_list(text: str | None) -> tuple[str, ...]:
     """--compare MODELS as a tuple of registered model names (ValueError otherwise)."""
-    from rodval.models.presets.registry import MODEL_NAMES
+    from rodval.models.registry import MODEL_NAMES
 
     if not text:
         return ()
@@ -163,7 +163,7 @@ def _compare_list(text: str | None) -> tuple[str, ...]:
 
 def _options_for(model: str, pool: dict[str, Any]) -> dict[str, Any]:
     """The options of ``pool`` (the command line's) that ``model``'s modes take."""
-    from rodval.models.presets.registry import model_class
+    from rodval.models.registry import model_class
 
     accepted = model_class(model).MODES_OPTIONS
     return {k: v for k, v in pool.items() if k in accepted}
@@ -172,7 +172,7 @@ def _options_for(model: str, pool: dict[str, Any]) -> dict[str, Any]:
 def _ran_options(m: Modes) -> dict[str, Any]:
     """The options the modal analysis of ``m`` ran with (its model's ``MODES_OPTIONS``, and
     exudyn's resolved model options)."""
-    from rodval.models.presets.registry import model_class
+    from rodval.models.registry import model_class
 
     options = dict(m.info.get("options", {}))  # exudyn's: the model's resolved options
     options.update({k: m.info[k] for k in model_class(m.model).MODES_OPTIONS if k in m.info})

@@ -145,7 +145,7 @@ def plan(scene: Any, levels: int, elements: int | None, step: float | None) -> l
     without a wall-clock budget: --max-wall bounds the levels' time, not their memory):
     ValueError naming the level."""
     from rodval.core.settings import IntegratorSettings
-    from rodval.models.presets.registry import check_scene, get_model
+    from rodval.models.registry import check_scene, get_model
 
     base = get_model("exudyn")
     e0 = base.options()["elements"] if elements is None else elements
@@ -213,7 +213,7 @@ def run_level(scene: Any, model: Any, settings: Any) -> dict[str, Any]:
     from rodval.analysis.convergence import quantities_of_interest, unmeasured
     from rodval.core.status import Status
     from rodval.core.validity import describe
-    from rodval.models.presets.registry import simulate
+    from rodval.models.registry import simulate
 
     start = time.perf_counter()
     tr = simulate(scene, model, settings=settings)

@@ -36,7 +36,7 @@ from rodval.core.scene_file import (
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.core.validity import describe
 from rodval.models import REGISTRY, simulate
-from rodval.models.presets.registry import uses_integrator
+from rodval.models.registry import uses_integrator
 from rodval.report.run_files import (
     CSV_MAX_VALUES,
     INLINE_MAX,

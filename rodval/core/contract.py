@@ -1,6 +1,6 @@
 """The model contract: every model, native or reference, turns a Scene into a Trajectory.
 
-Models are registered by name (``rodval.models.presets.registry``); a run never raises for a failed
+Models are registered by name (``rodval.models.registry``); a run never raises for a failed
 integration (the Trajectory's stats say how it ended), but a bad option or a setting the
 model cannot honour is a ValueError raised before any work. After every run the model judges
 its own validity (``validity_checks``, ``rodval.core.validity``): ``stats.valid`` and

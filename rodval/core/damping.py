@@ -22,7 +22,7 @@ deployed structure"): c_r = beta EI_r on every rod, one retardation time beta (s
 that that mode has the ratio z. That needs the full model's linearization, which lives in the
 models layer: the scene file records the request (``DampingRequest``, the scene's
 ``damping``) with c = 0 until ``rodval.models.observation.deployed_damping.resolve_damping``
-converts it where a scene enters a model (``rodval.models.presets.registry.simulate`` and
+converts it where a scene enters a model (``rodval.models.registry.simulate`` and
 ``check_scene``, ``rodval.analysis.modes.model_modes``, the run folder's record);
 ``Model.simulate`` and ``Model.modes`` refuse a request not yet converted
 (``check_resolved``), so that no model runs it undamped by omission.

@@ -69,7 +69,7 @@ class Quantity:
     that yields it (its own name, or a group: "energy" yields kinetic, potential, energy);
     ``bases`` the base kinds on which it exists; ``missing_in`` the models that do not
     provide it (every other model does; the model names are the registry's,
-    ``rodval.models.presets.registry``); ``native``, ``exudyn`` how those models compute it;
+    ``rodval.models.registry``); ``native``, ``exudyn`` how those models compute it;
     ``audit`` True for the energy audit's quantities, which the audit adds beside an
     observer's "energy" (not yielded by the observer itself)."""
 

@@ -10,7 +10,7 @@ model loads that model's modules and compiled kernels only."""
 
 from typing import TYPE_CHECKING, Any
 
-from rodval.models.presets.registry import REGISTRY, get_model, model_class, simulate
+from rodval.models.registry import REGISTRY, get_model, model_class, simulate
 
 if TYPE_CHECKING:
     from rodval.models.presets.full import FullModel

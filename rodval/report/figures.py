@@ -26,7 +26,7 @@ from rodval.core.modes import Modes
 from rodval.core.out_paths import write_figure
 from rodval.core.scene import UNITS
 from rodval.core.trajectory import Trajectory
-from rodval.models.presets.registry import integrated_models
+from rodval.models.registry import integrated_models
 
 
 def _figure(nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Figure, Any]:

@@ -40,7 +40,7 @@ from rodval.core.quantities import models_with
 from rodval.core.trajectory import RUN_SETTINGS
 from rodval.mechanics.lock_window import MIN_WINDOW_STEPS
 from rodval.models import get_model
-from rodval.models.presets.registry import uses_integrator
+from rodval.models.registry import uses_integrator
 from rodval.report.acceptance import acceptance_section
 from rodval.report.error_budget import error_budget
 from rodval.report.markdown import to_markdown

@@ -18,7 +18,7 @@ from rodval.core.checks import check_keys, check_number
 from rodval.core.scene import Scene, trajectory_quantities
 from rodval.core.scene_file import scene_from_dict, scene_to_dict
 from rodval.core.scene_keys import set_path
-from rodval.models.presets.registry import check_scene, get_model
+from rodval.models.registry import check_scene, get_model
 from rodval.study.document import key_error
 from rodval.study.model_specs import ModelSpec, model_specs
 
@@ -177,7 +177,7 @@ def check_refusals(
     scene: Scene, models: tuple[ModelSpec, ...], where: str, cid: str
 ) -> dict[str, dict[str, Any]]:
     """Each model of a case against what it refuses for the case's scene before any work
-    (``rodval.models.presets.registry.check_scene``, the check ``simulate`` makes): a
+    (``rodval.models.registry.check_scene``, the check ``simulate`` makes): a
     ValueError naming the study file ``where``, the case ``cid``, the model and the reason,
     when the study is read, so no case runs a model that would refuse it. A model that cannot
     be imported here (exudyn not installed) is not an error of the file: its runs fail and

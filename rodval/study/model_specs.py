@@ -10,7 +10,7 @@ from typing import Any
 from rodval.core.checks import check_keys
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.models import REGISTRY, get_model
-from rodval.models.presets.registry import uses_integrator
+from rodval.models.registry import uses_integrator
 from rodval.study.document import key_error
 
 #: The keys of ``[integrator]`` (and the integrator keys of a model's table).

@@ -21,7 +21,7 @@ from rodval.core.scene_file import scene_from_dict
 from rodval.core.settings import IntegratorSettings
 from rodval.core.status import STATUS_ERROR
 from rodval.core.trajectory import SolverStats, Trajectory
-from rodval.models.presets.registry import modal_options, simulate
+from rodval.models.registry import modal_options, simulate
 
 
 def failed_run(model: dict[str, Any], scene_name: str, status: int, message: str) -> dict[str, Any]:
@@ -39,7 +39,7 @@ def failed_run(model: dict[str, Any], scene_name: str, status: int, message: str
 def iter_case(payload: dict[str, Any]) -> Iterator[dict[str, Any]]:
     """Run every model of a case in turn, yielding one run record per model.
 
-    Each run goes through ``rodval.models.presets.registry.simulate``, the entry point of
+    Each run goes through ``rodval.models.registry.simulate``, the entry point of
     ``rodval simulate`` (the model's options and memory checked before it runs). A model that
     raises (including "not available") yields a failed run with status ``model error``; the
     next model still runs.
