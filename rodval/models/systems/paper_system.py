@@ -303,7 +303,17 @@ class PaperSystem(OdeSystem):
     def compiled(self) -> CompiledForm | None:
         """The compiled form of the current mode (locked hinges in S, the armed latches and
         switching stops as event rows; active stops are in V), or None with the numpy kernel
-        or a load that is a plain Python callable (no load-table form)."""
+        or a load that is a plain Python callable (no load-table form). Built once per mode
+        (``_forms``): the driver's choice of method and the loop's first segment share it."""
+        if self.mode not in self._forms:
+            self._forms[self.mode] = self._compiled_form()
+        return self._forms[self.mode]
+
+    @cached_property
+    def _forms(self) -> dict[Mode, CompiledForm | None]:
+        return {}
+
+    def _compiled_form(self) -> CompiledForm | None:
         if self.kernel != "numba":
             return None
         table = self._load_table
