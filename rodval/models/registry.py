@@ -13,7 +13,7 @@ from rodval.core.contract import Model
 from rodval.core.scene import Scene
 from rodval.core.settings import SETTING_NAMES, IntegratorSettings
 from rodval.core.trajectory import Trajectory
-from rodval.models.observation.deployed_damping import resolve_damping
+from rodval.models.observation.deployed_damping import panel_note, resolve_damping
 
 #: name -> "module:Class". Each class lists its option names in ``OPTIONS``.
 REGISTRY: dict[str, str] = {
@@ -147,6 +147,8 @@ def simulate(
     ``IntegratorSettings``) or as one ``settings`` object, not both. The other keywords are
     model options (e.g. ``coefficients="published"``; exudyn: ``elements``, ``step``).
     A failed integration does not raise: see ``trajectory.stats.status`` / ``message``.
+    A damping ratio of each panel's first mode on a latched scene adds a note with the ratio
+    it gives the deployed structure's first mode (``deployed_damping.panel_note``).
     """
     if not isinstance(scene, Scene):
         raise ValueError(f"scene must be a rodval.Scene, got {type(scene).__name__}")
@@ -164,4 +166,6 @@ def simulate(
             f"both (got settings= and {', '.join(sorted(integ))})"
         )
     # a deployed damping converted to the rods' c; the model refuses the rest (Model.simulate)
-    return scene_model(model, scene, options).simulate(resolve_damping(scene), settings)
+    trajectory = scene_model(model, scene, options).simulate(resolve_damping(scene), settings)
+    trajectory.stats.notes = [*trajectory.stats.notes, *panel_note(scene)]
+    return trajectory

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from rodval.core.damping import DEPLOYED, first_free_free_frequency
 from rodval.core.scene import Scene
 from rodval.core.validity import DAMPING_FIX, setting
 from rodval.models.assembly import kernels
@@ -239,19 +240,33 @@ class FullModel(PaperModel):
         return "a tighter rtol (integration error)"
 
     def stiffness_fix(self, scene: Scene) -> str:
-        """Stiff vibrations of the full model are its rods' bending modes: damp them, or
-        drop them (the reduced model, on a pinned base only; the rigid model)."""
+        """Stiff vibrations of the full model are its rods' bending modes: damp them (more,
+        with the figure of what the scene has: ``damping_figure``), or drop them (the reduced
+        model, on a pinned base only; the rigid model)."""
         drop = (
             "the rigid model (no bending)"
             if scene.base.moving
             else "the reduced model (quasi-static bending, no bending vibrations) or the rigid "
             "model (no bending)"
         )
-        return (
-            f"damp the rods' bending ({DAMPING_FIX}; a ratio of each "
-            f"rod's first mode damps a locked segment's slower modes less, docs/model.md), {drop}, "
-            "or a looser rtol and atol"
-        )
+        c = np.asarray(scene.chain.bending_damping, float)
+        if not np.any(c > 0):
+            damp = (
+                f"damp the rods' bending ({DAMPING_FIX}; a ratio of each rod's first mode damps "
+                "a locked segment's slower modes less, docs/model.md)"
+            )
+        else:
+            request = scene.damping
+            deployed = request is not None and request.of == DEPLOYED
+            damp = (
+                f"the rods' bending is damped already ({damping_figure(scene)}): a larger ratio"
+                + (
+                    ""
+                    if deployed
+                    else ', or of = "deployed" (the deployed structure\'s first mode)'
+                )
+            )
+        return f"{damp}, {drop}, or a looser rtol and atol"
 
     def check_base(self, scene: Scene) -> None:
         """A free or prescribed base runs on every rung with the printed coefficients and the
@@ -282,3 +297,23 @@ class FullModel(PaperModel):
         from rodval.models.systems.chain_system import chain_system
 
         return chain_system(scene, self.shapes, self.kinematics, self.coefficients, self.kernel)
+
+
+def damping_figure(scene: Scene) -> str:
+    """The bending damping ``scene``'s rods have: c (N m^2 s) and the ratio it gives each
+    rod's first free-free mode (zeta = c omega_1 / (2 EI), ``rodval.core.damping``), one
+    figure when every rod has the same, and the request it came from (a deployed one)."""
+    chain = scene.chain
+    c = np.broadcast_to(np.asarray(chain.bending_damping, float), np.shape(chain.EI))
+    zeta = c * first_free_free_frequency(chain.l, chain.m, chain.EI) / (2.0 * chain.EI)
+
+    def figure(values: np.ndarray) -> str:
+        if np.all(values == values[0]):
+            return f"{values[0]:.3g}"
+        return "[" + ", ".join(f"{v:.3g}" for v in values) + "]"
+
+    request = scene.damping
+    stated = ""
+    if request is not None and request.of == DEPLOYED:
+        stated = f'; bending_damping = {{ ratio = {request.ratio:g}, of = "deployed" }}'
+    return f"c = {figure(c)} N m^2 s, a ratio of {figure(zeta)} of each rod's first mode{stated}"
