@@ -111,6 +111,8 @@ def _load(spec: dict[str, Any], n: int, where: str) -> NodalForce:
             f"{where}: unexpected keyword {unknown[0]!r} for load {kind!r} "
             f"(allowed: {', '.join(allowed)})"
         )
+    if "node" not in args:
+        raise ValueError(f"{where}: load {kind!r} needs 'node' (1..n or \"last\")")
     return factory(**args)
 
 

@@ -146,7 +146,9 @@ SCENE_KEYS: dict[str, Key] = {
             "type": Key(
                 STRING, "", "`pulse`, `constant`, `ramp`, `harmonic`, `tabulated`", required=True
             ),
-            "node": Key(NODE, "", '1..n, or `"last"`', required=True),
+            # required, but checked after the load's type (``scene_file._load``): the type says
+            # which keys a load takes, so a bad type is named first
+            "node": Key(NODE, "", '1..n, or `"last"`; required'),
             "Xbar": Key(NUMBER, "N", "finite (pulse)"),
             "Ybar": Key(NUMBER, "N", "finite (pulse)"),
             "T": Key(NUMBER, "s", "> 0 (pulse)"),
