@@ -57,6 +57,7 @@ from rodval.report.tables import (
     read_events,
     read_tables,
     study_constants,
+    unreadable,
 )
 
 #: Columns of the events table shown in the report, when present: the run, the lock and its
@@ -481,7 +482,7 @@ def _read_json(path: Path, keys: tuple[str, ...]) -> dict[str, Any]:
     try:
         doc = json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ValueError(f"{path}: unreadable ({type(exc).__name__}: {exc})") from None
+        raise ValueError(unreadable(path, exc)) from None
     if not isinstance(doc, dict) or any(k not in doc for k in keys):
         missing = next((k for k in keys if not isinstance(doc, dict) or k not in doc), "")
         raise ValueError(f"{path}: key {missing!r} is missing")

@@ -48,6 +48,20 @@ FIXED = frozenset(
 )
 
 
+def unreadable(path: Path, exc: Exception) -> str:
+    """ "<path>: unreadable (...)" in rodval's words, not Python's: a file that is not UTF-8
+    text, not JSON (where the parse stopped), or not readable (the system's reason)."""
+    if isinstance(exc, UnicodeDecodeError):
+        why = f"not UTF-8 text: byte {exc.object[exc.start]:#04x} at position {exc.start}"
+    elif isinstance(exc, json.JSONDecodeError):
+        why = f"not JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}"
+    elif isinstance(exc, OSError):
+        why = exc.strerror or type(exc).__name__
+    else:
+        why = str(exc) or type(exc).__name__
+    return f"{path}: unreadable ({why})"
+
+
 def axis_columns(meta: dict[str, Any]) -> dict[str, str]:
     """Case parameter label -> table column. scene.n and scene.t_end are the n and horizon
     columns already; a label clashing with a fixed column keeps its full grid path."""
@@ -151,7 +165,7 @@ def check_manifest(out: Path) -> None:
         manifest = json.loads(path.read_text())
         wrote = {str(name): (int(e["bytes"]), str(e["sha256"])) for name, e in manifest.items()}
     except (OSError, UnicodeDecodeError, ValueError, TypeError, KeyError, AttributeError) as exc:
-        raise ValueError(f"{path}: unreadable ({type(exc).__name__}: {exc}); {rewrite}") from None
+        raise ValueError(f"{unreadable(path, exc)}; {rewrite}") from None
     missing = [name for name in TABLES if name not in wrote]
     if missing:
         raise ValueError(f"{path}: table {missing[0]!r} is not listed; {rewrite}")
@@ -281,7 +295,7 @@ def read_events(out: Path) -> pd.DataFrame:
     try:
         events = pd.read_csv(path)
     except (OSError, ValueError, pd.errors.ParserError) as exc:
-        raise ValueError(f"{path}: unreadable ({type(exc).__name__}: {exc})") from None
+        raise ValueError(unreadable(path, exc)) from None
     missing = [c for c in ("case", "model", "t", "label") if c not in events]
     if missing:
         raise ValueError(f"{path}: column {missing[0]!r} is missing")
