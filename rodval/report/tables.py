@@ -62,6 +62,14 @@ def unreadable(path: Path, exc: Exception) -> str:
     return f"{path}: unreadable ({why})"
 
 
+def _parse_error(exc: Exception) -> str:
+    """Why pandas could not read a CSV file, in one line."""
+    if isinstance(exc, UnicodeDecodeError):
+        return f"byte {exc.start} is not UTF-8 text; the file is damaged or not a table the study wrote"
+    first = str(exc).splitlines()[0] if str(exc) else ""
+    return f"{type(exc).__name__}: {first}"
+
+
 def axis_columns(meta: dict[str, Any]) -> dict[str, str]:
     """Case parameter label -> table column. scene.n and scene.t_end are the n and horizon
     columns already; a label clashing with a fixed column keeps its full grid path."""
@@ -89,20 +97,8 @@ def read_tables(out: str | Path) -> dict[str, pd.DataFrame]:
             )
         try:
             df = pd.read_csv(path)
-        except UnicodeDecodeError as exc:
-            raise ValueError(
-                f"{path}: not a readable CSV table (byte {exc.start} is not UTF-8 text; the "
-                "file is damaged or not a table the study wrote)"
-            ) from None
-        except (
-            pd.errors.ParserError,
-            pd.errors.EmptyDataError,
-            ValueError,
-        ) as exc:
-            raise ValueError(
-                f"{path}: not a readable CSV table ({type(exc).__name__}: "
-                f"{str(exc).splitlines()[0] if str(exc) else ''})"
-            ) from None
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError) as exc:
+            raise ValueError(_unparsed(out, name, exc)) from None
         missing = [c for c in REQUIRED[name] if c not in df.columns]
         if missing:
             raise ValueError(
@@ -149,41 +145,65 @@ def table_digest(path: Path) -> dict[str, Any]:
     return {"bytes": path.stat().st_size, "sha256": sha.hexdigest()}
 
 
-def check_manifest(out: Path) -> None:
-    """Every table the manifest lists is the file the study wrote (same size and SHA-256);
-    ValueError naming the file and what is wrong otherwise."""
+def _rewrite(out: Path) -> str:
+    return f"run `rodval study FILE --out {out}` again to rewrite the tables from the case records"
+
+
+def _written(out: Path) -> dict[str, tuple[int, str]]:
+    """The manifest: table name -> (bytes, SHA-256) as the study wrote it; ValueError when it
+    is missing or unreadable."""
     path = out / MANIFEST
-    rewrite = (
-        f"run `rodval study FILE --out {out}` again to rewrite the tables from the case records"
-    )
     if not path.is_file():
         raise ValueError(
             f"{path} is missing, so the tables cannot be checked against what the study "
-            f"wrote; {rewrite}"
+            f"wrote; {_rewrite(out)}"
         )
     try:
         manifest = json.loads(path.read_text())
-        wrote = {str(name): (int(e["bytes"]), str(e["sha256"])) for name, e in manifest.items()}
+        return {str(name): (int(e["bytes"]), str(e["sha256"])) for name, e in manifest.items()}
     except (OSError, UnicodeDecodeError, ValueError, TypeError, KeyError, AttributeError) as exc:
-        raise ValueError(f"{unreadable(path, exc)}; {rewrite}") from None
+        raise ValueError(f"{unreadable(path, exc)}; {_rewrite(out)}") from None
+
+
+def _damage(table: Path, size: int, sha: str) -> str:
+    """How ``table`` differs from the file the study wrote (``size`` bytes, SHA-256 ``sha``):
+    '' when it does not."""
+    got = table_digest(table)
+    if got["bytes"] != size:
+        return f"{got['bytes']} bytes, the study wrote {size} (the file is truncated or was edited)"
+    if got["sha256"] != sha:
+        return "checksum mismatch with what the study wrote (the file was edited or damaged)"
+    return ""
+
+
+def check_manifest(out: Path) -> None:
+    """Every table the manifest lists is the file the study wrote (same size and SHA-256);
+    ValueError naming the file and what is wrong otherwise."""
+    wrote = _written(out)
     missing = [name for name in TABLES if name not in wrote]
     if missing:
-        raise ValueError(f"{path}: table {missing[0]!r} is not listed; {rewrite}")
+        raise ValueError(f"{out / MANIFEST}: table {missing[0]!r} is not listed; {_rewrite(out)}")
     for name, (size, sha) in wrote.items():
         table = out / f"{name}.csv"
         if not table.is_file():
-            raise ValueError(f"{table} is missing (the study wrote it); {rewrite}")
-        got = table_digest(table)
-        if got["bytes"] != size:
-            raise ValueError(
-                f"{table}: {got['bytes']} bytes, the study wrote {size} (the file is "
-                f"truncated or was edited); {rewrite}"
-            )
-        if got["sha256"] != sha:
-            raise ValueError(
-                f"{table}: checksum mismatch with what the study wrote (the file was edited "
-                f"or damaged); {rewrite}"
-            )
+            raise ValueError(f"{table} is missing (the study wrote it); {_rewrite(out)}")
+        damage = _damage(table, size, sha)
+        if damage:
+            raise ValueError(f"{table}: {damage}; {_rewrite(out)}")
+
+
+def _unparsed(out: Path, name: str, exc: Exception) -> str:
+    """The one line for a table pandas could not read: why, and, when the manifest can tell,
+    how the file differs from what the study wrote (where a cut lands decides the parser's
+    complaint: inside a quoted message or between rows; the manifest's does not)."""
+    path = out / f"{name}.csv"
+    line = f"{path}: not a readable CSV table ({_parse_error(exc)})"
+    try:
+        wrote = _written(out)
+    except ValueError:
+        return line
+    damage = _damage(path, *wrote[name]) if name in wrote else ""
+    return f"{line}; {damage}; {_rewrite(out)}" if damage else line
 
 
 def _check_compared(disc: pd.DataFrame, path: Path) -> None:
