@@ -1,12 +1,15 @@
-"""The chain's hinge items: latches (a hinge locks at an angle) and one-sided limit stops, each
-a class registered by its scene table's name in ``HINGE_ITEMS`` (as the load laws are in
-``LOAD_FACTORIES``) that declares its keys (``KEYS``: the one list, which
-``scene_keys.SCENE_KEYS`` reads), its checks (``__post_init__``; within a scene, ``check_in``)
-and its scene-file table (``from_tables``, ``as_dict``). Conventions: ``rodval.core.scene``."""
+"""The chain's hinge items: latches (a hinge locks at an angle), one-sided limit stops, motors
+and rate dampers (moments across a hinge, ``HingeTorque``). Each is a class registered by its
+scene table's name in ``HINGE_ITEMS`` (as the load laws are in ``LOAD_FACTORIES``) that
+declares its keys (``KEYS``: the one list, which ``scene_keys.SCENE_KEYS`` reads), its checks
+(``__post_init__``; within a scene, ``check_in``) and its scene-file table (``from_tables``,
+``as_dict``); a torque item also its moment, closed form and compiled rows. Conventions:
+``rodval.core.scene``."""
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import numbers
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -26,25 +29,27 @@ def _keys(hinge: str, **more: Key) -> dict[str, Key]:
     }
 
 
+def _torque_keys(**more: Key) -> dict[str, Key]:
+    """A torque item's keys: ``hinge`` (required), then the kind's own (``more``)."""
+    return {"hinge": Key(INTEGER, "", "0..n-1", required=True), **more}
+
+
 @dataclass(frozen=True)
 class HingeItem:
-    """A part on hinge ``hinge`` (an integer in 0..n-1) acting at the hinge angle ``angle``
-    (rad, finite). A kind is a frozen dataclass subclass that sets ``TABLE``, ``NOUN`` and
-    ``KEYS``, extends ``__post_init__`` and ``check_in`` with its own checks, and is listed
-    in ``HINGE_ITEMS``."""
+    """A part on hinge ``hinge`` (an integer in 0..n-1). A kind is a frozen dataclass
+    subclass that sets ``TABLE``, ``NOUN`` and ``KEYS``, extends ``__post_init__`` and
+    ``check_in`` with its own checks, and is listed in ``HINGE_ITEMS``."""
 
     TABLE: ClassVar[str]  # its scene-file table ([[latches]]), the name of its Scene field
     NOUN: ClassVar[str]  # its name in messages ("latch")
     KEYS: ClassVar[dict[str, Key]]  # its scene-file keys: type, unit, range, required
 
     hinge: int
-    angle: float
 
     def __post_init__(self) -> None:
         hinge = self.hinge
         if isinstance(hinge, bool) or not isinstance(hinge, numbers.Integral) or hinge < 0:
             raise ValueError(f"{self.NOUN} hinge must be an integer >= 0, got {hinge!r}")
-        check_number(f"{self.NOUN} angle", self.angle, finite=True, unit="rad")
 
     def as_dict(self) -> dict[str, Any]:
         """Its scene-file table (``from_tables`` rebuilds the item from it)."""
@@ -84,13 +89,24 @@ class HingeItem:
         return out
 
 
+@dataclass(frozen=True)
+class AtAngle(HingeItem):
+    """An item acting at the hinge angle ``angle`` (rad, finite): latches and stops."""
+
+    angle: float
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_number(f"{self.NOUN} angle", self.angle, finite=True, unit="rad")
+
+
 #: A held latch's hinge must start at its angle (rad) and at rest (rad/s) to this distance: the
 #: initial state is on the constraint (round-off of the angles' sums, 1e-12 rad, with room).
 HELD_START = 1e-9
 
 
 @dataclass(frozen=True)
-class Latch(HingeItem):
+class Latch(AtAngle):
     """A latch on hinge ``hinge`` (0..n-1): the hinge locks when its angle D reaches
     ``angle`` (rad) moving in ``direction`` (+1: D increasing, -1: decreasing; None: towards
     the angle from the initial state). At the lock the hinge's relative rate drops to zero
@@ -168,7 +184,7 @@ class Latch(HingeItem):
 
 
 @dataclass(frozen=True)
-class Stop(HingeItem):
+class Stop(AtAngle):
     """A limit stop on hinge ``hinge``: a one-sided spring-damper acting beyond ``angle``
     (rad) on the ``side`` "upper" (D > angle) or "lower" (D < angle), with moment
     -stiffness (D - angle) - damping dD/dt there (N m; stiffness > 0 in N m/rad, damping >= 0
@@ -223,6 +239,42 @@ class Stop(HingeItem):
                     positive=False,
                 )
         return stops
+
+
+Row = tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class HingeTorque(HingeItem):
+    """An item that applies a moment M(t, dD/dt) (N m) across its hinge, positive driving the
+    hinge angle D up (it acts on rod ``hinge`` with +M and on the rod before it, or the
+    base, with -M). A kind gives its closed form (``moment``: the exudyn model and the
+    Python path evaluate it) and the same law as compiled load-table rows (``rows``:
+    components ``COMP_MOMENT`` and ``COMP_RATE``, ``rodval.core.loads``); every model then
+    applies it with its own hinge rate, and the energy audit books its power M dD/dt as
+    external work."""
+
+    def moment(self, t: float, rate: float) -> float:
+        """M (N m) at time t (s) and hinge rate ``rate`` (rad/s)."""
+        raise NotImplementedError
+
+    def rows(self) -> list[Row]:
+        """The compiled rows of ``moment`` (``rodval.core.loads.LOAD_COLUMNS`` without
+        track_end)."""
+        raise NotImplementedError
+
+    def breakpoints(self) -> tuple[float, ...]:
+        """Times (s) where the moment has kinks or jumps."""
+        return ()
+
+
+def _constant_row(hinge: int, component: str, value: float) -> Row:
+    """The row of a constant ``component`` ("moment", N m, or "rate", N m s/rad) across
+    ``hinge`` (numba is imported with the loads, not at import: `rodval --help`)."""
+    from rodval.core.loads import COMP_MOMENT, COMP_RATE, LAW_CONSTANT
+
+    comp = COMP_MOMENT if component == "moment" else COMP_RATE
+    return (hinge, comp, LAW_CONSTANT, 0.0, math.inf, 1.0, value, 0.0, 0.0)
 
 
 #: The hinge items by scene table (and ``Scene`` field) name, in the scene files' order.

@@ -31,7 +31,7 @@ from rodval.core.base import PINNED, Base
 from rodval.core.bounds import as_rod_array
 from rodval.core.checks import check_keys, check_number
 from rodval.core.damping import DampingRequest
-from rodval.core.hinges import HINGE_ITEMS
+from rodval.core.hinges import HINGE_ITEMS, HingeTorque
 from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
 from rodval.core.hinges import Stop as Stop
 from rodval.core.loads import NodalForce
@@ -403,10 +403,22 @@ class Scene:
         return hinge_angles(init["dphi"], init["dalpha"], init["dbeta"], rate)
 
     @property
+    def torques(self) -> tuple[HingeTorque, ...]:
+        """The items that apply a moment across a hinge (motors, rate dampers), in
+        ``HINGE_ITEMS`` order."""
+        return tuple(
+            item
+            for table in HINGE_ITEMS
+            for item in getattr(self, table)
+            if isinstance(item, HingeTorque)
+        )
+
+    @property
     def breakpoints(self) -> np.ndarray:
         """Sorted load kinks strictly inside (0, t_end), where integration restarts."""
         bps = {b for f in self.loads for b in f.breakpoints if 0 < b < self.t_end}
         bps |= {b for b in self.base.breakpoints if 0 < b < self.t_end}
+        bps |= {b for item in self.torques for b in item.breakpoints() if 0 < b < self.t_end}
         return np.array(sorted(bps))
 
     def with_(self, **changes: Any) -> Scene:
