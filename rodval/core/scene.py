@@ -240,6 +240,17 @@ def output_times(start: float, stop: float, num: int) -> np.ndarray:
     return clean
 
 
+@dataclass(frozen=True)
+class Grid:
+    """Output times given as a grid: ``num`` equally spaced from ``start`` to ``stop`` (s;
+    None: the scene's t_end), resolved by the Scene once its horizon is checked (a scene
+    file's ``times = { start, stop, num }``)."""
+
+    start: float = 0.0
+    stop: float | None = None
+    num: int = DEFAULT_NUM_TIMES
+
+
 def _times_array(value: Any) -> np.ndarray:
     """Output times as given: a 1-D sequence of real numbers (s), nothing converted."""
     if isinstance(value, (str, bytes, dict, set)) or np.ndim(value) != 1:
@@ -269,8 +280,14 @@ def _scene_loads(loads: Any, n: int) -> tuple[NodalForce, ...]:
 
 def _scene_times(times: Any, t_end: float) -> np.ndarray:
     """The output times (s) as a read-only array: finite, strictly increasing, in
-    [0, t_end]; None gives the default grid."""
-    arr = output_times(0.0, t_end, DEFAULT_NUM_TIMES) if times is None else _times_array(times)
+    [0, t_end]; a ``Grid`` is resolved on the horizon, None gives the default grid."""
+    if times is None:
+        times = Grid()
+    if isinstance(times, Grid):
+        stop = t_end if times.stop is None else times.stop
+        arr = output_times(float(times.start), float(stop), times.num)
+    else:
+        arr = _times_array(times)
     if arr.ndim != 1 or arr.size == 0:
         raise ValueError("times (output times) must be a non-empty 1-D sequence of seconds")
     if not np.all(np.isfinite(arr)):

@@ -36,10 +36,9 @@ from rodval.core.scene import (
     MAX_TIMES,
     UNIFORM_DEFAULTS,
     Chain,
+    Grid,
     InitialState,
     Scene,
-    check_horizon,
-    output_times,
 )
 from rodval.core.scene_keys import SCENE_KEYS, check_types, merge_documents, missing_key, set_path
 from rodval.core.settings import SETTING_NAMES
@@ -74,9 +73,10 @@ INITIAL_KEYS = set(InitialState.KEYS)
 TIMES_KEYS = {"start", "stop", "num"}
 
 
-def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
+def _times(value: Any, where: str) -> np.ndarray | Grid | None:
     """The output times (s) of ``times`` (its type checked, ``check_types``): a list, a table
-    {start, stop, num} (``output_times``), or None (the scene's default grid)."""
+    {start, stop, num} (a ``Grid`` the Scene resolves on its horizon), or None (the scene's
+    default grid)."""
     if value is None:
         return None
     if isinstance(value, list):
@@ -89,7 +89,7 @@ def _times(value: Any, t_end: float, where: str) -> np.ndarray | None:
     num = value.get("num", DEFAULT_NUM_TIMES)
     if not 1 <= num <= MAX_TIMES:
         raise ValueError(f"{where} key 'times': num must be >= 1 and <= {MAX_TIMES}, got {num}")
-    return output_times(float(value.get("start", 0.0)), float(value.get("stop", t_end)), num)
+    return Grid(float(value.get("start", 0.0)), value.get("stop"), num)
 
 
 def _load(spec: dict[str, Any], n: int, where: str) -> NodalForce:
@@ -169,11 +169,12 @@ def _count(d: dict[str, Any], based_on: str | None) -> int:
     return n
 
 
-def _horizon(d: dict[str, Any], based_on: str | None) -> float:
-    """``t_end``, the horizon (s): a finite number > 0 (the paper's 2 s with ``based_on``)."""
+def _horizon(d: dict[str, Any], based_on: str | None) -> Any:
+    """``t_end``, the horizon (s), as given (the Scene checks it: ``check_horizon``); the
+    paper's 2 s with ``based_on``."""
     if "t_end" not in d and based_on is None:
         raise _missing("t_end", "horizon, s")
-    return check_horizon(d.get("t_end", PAPER_T_END))
+    return d.get("t_end", PAPER_T_END)
 
 
 def _chain(
@@ -266,7 +267,7 @@ def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
             loads=loads,
             **items,
             t_end=t_end,
-            times=_times(d.get("times"), t_end, where),
+            times=_times(d.get("times"), where),
             outputs=tuple(outputs),
             initial=InitialState(**init_spec),
             name=d.get("name", f"paper-n{n}" if based_on == "paper" else "scene"),
