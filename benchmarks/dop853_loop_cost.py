@@ -14,7 +14,7 @@ import time
 import numpy as np
 from numba import njit
 
-from rodval.core.loads import LOAD_COLUMNS
+from rodval.core.load_table import LOAD_COLUMNS
 from rodval.solvers import compiled
 from rodval.solvers.guard import GuardSpec
 from rodval.solvers.signature import RHS_SIGNATURE

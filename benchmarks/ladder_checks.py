@@ -55,6 +55,7 @@ def lagrangian() -> None:
                 True,
                 np.cumsum(X[::-1])[::-1],
                 np.cumsum(Y[::-1])[::-1],
+                np.empty(0),
                 True,
                 acc,
             )

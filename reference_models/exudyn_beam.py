@@ -1,7 +1,7 @@
 """The exudyn beam model's kinematics, shared by its build, guard, latches and observation:
-the cubic Hermite shape functions, the initial bent-rod node states, the stop and load laws
-as exudyn user functions, and the beam-field quadratures of energy and angular momentum
-(see ``reference_models.exudyn_chain``'s module docstring for the model)."""
+the cubic Hermite shape functions, the initial bent-rod node states, the stop, torque (motor,
+rate damper) and load laws as exudyn user functions, and the beam-field quadratures of energy
+and angular momentum (see ``reference_models.exudyn_chain``'s module docstring for the model)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from rodval.core.hinges import Stop
-from rodval.core.loads import NodalForce
+from rodval.core.hinges import HingeTorque, Stop
+from rodval.core.loads import LoadSet, NodalForce
 from rodval.core.scene import Chain, Scene, hinge_angles
 
 #: 5-point Gauss-Legendre points on [-1, 1] and their weights, (5,) each (exact to degree 9).
@@ -227,6 +227,35 @@ def stop_law(side: str) -> Callable[..., float]:
         return 0.0
 
     return law
+
+
+def torque_law(item: HingeTorque, errors: list[Exception]) -> Callable[..., float]:
+    """springTorqueUserFunction of a torque item (motor, rate damper) on a zero-stiffness,
+    zero-damping torsional connector across its hinge: exudyn's restoring torque is -M, M =
+    ``item.moment(t, dD/dt)`` (N m, positive driving the hinge angle up) at the connector's
+    relative rate (rad/s: the rate the hinge dampers see); exceptions are recorded in
+    ``errors`` and re-raised."""
+
+    def law(mbs: Any, t: float, index: int, *spring: float) -> float:
+        try:
+            return -item.moment(t, spring[1])
+        except Exception as exc:
+            errors.append(exc)
+            raise
+
+    return law
+
+
+def torque_moments(scene: Scene, times: Array, dD: Array) -> Array | None:
+    """The torque items' moments (N m, (nt, n), positive driving D_k up; ``HingeTorque.moment``
+    through ``LoadSet.hinge_moments``) at ``times`` (s) and hinge rates ``dD`` (rad/s, (nt,
+    n)); None without torque items. O(nt x (items + n))."""
+    if not scene.torques:
+        return None
+    loads = LoadSet((), scene.n, torques=scene.torques)
+    return np.array(
+        [loads.hinge_moments(float(t), rates) for t, rates in zip(times, dD, strict=True)]
+    ).reshape(len(times), scene.n)
 
 
 def stop_moment(stop: Stop, D: Any, dD: Any) -> Array:

@@ -1,5 +1,6 @@
 """Building the exudyn beam model of a scene: nodes, ANCF cable elements, a free or prescribed
-base's rigid body, hinges (joints, spring-dampers, stops, latch joints), point masses, loads and sensors
+base's rigid body, hinges (joints, spring-dampers, stops, torque items, latch joints), point
+masses, loads and sensors
 (``build``), and a run's records read back from the sensors (``read_records``)."""
 
 from __future__ import annotations
@@ -18,8 +19,9 @@ from reference_models.exudyn_beam import (
     load_function,
     revolutions,
     stop_law,
+    torque_law,
 )
-from rodval.core.hinges import Stop
+from rodval.core.hinges import HingeTorque, Stop
 from rodval.core.scene import Scene
 from rodval.core.validity import momentum_point
 
@@ -53,7 +55,8 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     stiffness EA (N), assembled: O(n E) items. Hinges are a position joint plus a torsional
     spring-damper on the end tangents (relaxed at the rest angle: exudyn's ``offset``); limit
     stops a second spring-damper with a one-sided user law; latches a rotation-locking
-    ObjectJointGeneric, inactive until the pre-step function (``Latches``) switches it on.
+    ObjectJointGeneric, inactive until the pre-step function (``Latches``) switches it on;
+    a torque item (motor, rate damper) a zero spring-damper whose user law is its moment.
     A free base is a NodeRigidBody2D (reference coordinates [x_c, y_c, theta] at the initial
     position and attitude) with an ObjectRigidBody2D of the body's mass and inertia; hinge 0
     joins it, at the hinge offset, to rod 1 (instead of the ground). A prescribed base is the
@@ -70,12 +73,12 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     nodes, elems = _add_rods(mbs, scene, E, EA, (ref, q0, v0))
     body_node, root_body = _add_body(mbs, scene, ground)
     drives = _add_drives(mbs, scene, body_node)
-    latch_joints = _add_hinges(mbs, scene, E, root_body, nodes, elems)
+    load_errors: list[Exception] = []
+    latch_joints = _add_hinges(mbs, scene, E, root_body, (nodes, elems), load_errors)
     it = _items()
     for k in range(chain.n):
         if chain.mu[k] > 0:
             mbs.AddObject(it.ObjectMassPoint2D(nodeNumber=nodes[k][-1], mass=float(chain.mu[k])))
-    load_errors: list[Exception] = []
     for f in scene.loads:
         marker = mbs.AddMarker(it.MarkerNodePosition(nodeNumber=nodes[f.node - 1][-1]))
         mbs.AddLoad(
@@ -216,13 +219,21 @@ def _add_rods(
 
 
 def _add_hinges(
-    mbs: Any, scene: Scene, E: int, root_body: int, nodes: list[list[int]], elems: list[list[int]]
+    mbs: Any,
+    scene: Scene,
+    E: int,
+    root_body: int,
+    mesh: tuple[list[list[int]], list[list[int]]],
+    errors: list[Exception],
 ) -> dict[int, int]:
-    """Hinge k's joint, spring-damper, stops and latch joint; returns hinge -> latch joint.
-    Hinge 0 joins ``root_body`` (the ground, or a free base's body at its hinge offset, the
-    angle measured from the body frame; a free or prescribed base) to rod 1. A held latch's
-    joint is active from the start."""
+    """Hinge k's joint, spring-damper, stops, torque items and latch joint; returns hinge ->
+    latch joint. ``mesh`` = (the rods' beam nodes, their elements); a torque law's exceptions
+    go to ``errors``. Hinge 0 joins ``root_body`` (the ground, or a free base's body at its
+    hinge offset, the angle measured from the body frame; a free or prescribed base) to rod 1:
+    a torque item's moment M acts on rod k+1's root, -M on rod k's tip (hinge 0: on the ground
+    or the body). A held latch's joint is active from the start."""
     it = _items()
+    nodes, elems = mesh
     chain = scene.chain
     ini = scene.initial.resolve(chain.n)
     tangent_left = ini["phi"] + ini["alpha"]
@@ -231,6 +242,9 @@ def _add_hinges(
     stops_of: dict[int, list[Stop]] = {}
     for stop in scene.stops:
         stops_of.setdefault(stop.hinge, []).append(stop)
+    torques_of: dict[int, list[HingeTorque]] = {}
+    for item in scene.torques:
+        torques_of.setdefault(item.hinge, []).append(item)
     latch_joints: dict[int, int] = {}
     for k in range(chain.n):
         if k == 0 and scene.base.moving:
@@ -260,6 +274,7 @@ def _add_hinges(
             (stop.stiffness, stop.damping, stop.angle, stop_law(stop.side))
             for stop in stops_of.get(k, [])
         ]
+        springs += [(0.0, 0.0, 0.0, torque_law(item, errors)) for item in torques_of.get(k, [])]
         _add_springs(mbs, (rot0, rot1), angle0, springs)
         if k in latch_of:
             latch = latch_of[k]
@@ -273,11 +288,12 @@ def _add_springs(
     angle0: float,
     springs: list[tuple[float, float, float, Any]],
 ) -> None:
-    """Torsional spring-dampers (stiffness N m/rad, damping N m s/rad, offset rad, user law)
-    between the two rotation markers, each with its revolution counter from angle0 (rad)."""
+    """Torsional spring-dampers (stiffness N m/rad, damping N m s/rad, offset rad, user law
+    or 0) between the two rotation markers, each with its revolution counter from angle0
+    (rad); one without stiffness, damping and law is left out."""
     it = _items()
     for stiffness, damping, offset, law in springs:
-        if stiffness == 0 and damping == 0:
+        if stiffness == 0 and damping == 0 and not law:
             continue
         turns = mbs.AddNode(
             it.NodeGenericData(numberOfDataCoordinates=1, initialCoordinates=[revolutions(angle0)])

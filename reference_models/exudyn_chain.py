@@ -15,7 +15,8 @@ outputs treat it as massless, as the native models do, and its run has no energy
 drive's work is not measured). The torsional springs use
 a NodeGenericData to keep their angle continuous beyond +-pi (hinge 0 turns past pi in the
 paper's example). Point masses mu_k sit on the end node of rod k; the scene's nodal forces act
-there through exudyn load user functions, exactly zero outside each force's support.
+there through exudyn load user functions, exactly zero outside each force's support; motors,
+rate dampers through torque user laws across their hinges (``exudyn_beam.torque_law``).
 
 Nothing of the paper's equations is used: the quantities are measured on the beam solution by
 their definitions (see ``rodval.core.scene``):

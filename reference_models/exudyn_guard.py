@@ -19,6 +19,7 @@ from reference_models.exudyn_beam import (
     system_energies,
 )
 from reference_models.exudyn_build import BuiltSystem
+from rodval.core.loads import LoadSet
 from rodval.core.scene import Scene
 from rodval.core.status import (
     STATUS_DIVERGED,
@@ -76,8 +77,8 @@ class Guard:
     * kinetic energy T = v^T M v / 2 (consistent mass of the cubic elements plus the point
       masses and a free base's body, diag(m, m, J); the hinge data nodes carry no mass)
       above ``factor`` x the budget of ``rodval.solvers.guard`` (``GuardSpec``, ``Monitor``:
-      W+ on the load power at the checked states), E(0) the initial T + Pi (``system_energies``):
-      STATUS_BLOWUP;
+      W+ on the power of the loads and torque items (``_power``) at the checked states),
+      E(0) the initial T + Pi (``system_energies``): STATUS_BLOWUP;
     * max_k |dphi_k| x step above ``max_rotation``: STATUS_FAILED (under-resolved)."""
 
     def __init__(
@@ -124,6 +125,7 @@ class Guard:
         self._root = np.array([[ltg[k][0][c] for k in range(chain.n)] for c in range(2)], int)
         self._d_ref = self.ref[self._end] - self.ref[self._root]
         self.loads = [(f, ltg[f.node - 1][E][:2]) for f in scene.loads]
+        self._torques = _TorqueRates(scene, ltg, built, mbs) if scene.torques else None
         ini = scene.initial.resolve(chain.n)
         at0: dict[tuple[int, int], tuple[Array, ...]] = {
             (k, j): ((ref + q0)[k, j][None], v0[k, j][None])
@@ -155,8 +157,9 @@ class Guard:
         self.M[idx, idx] += np.array([mass, mass, inertia])
         return state, np.array([[b.velocity[0], b.velocity[1], b.rate]])
 
-    def _power(self, t: float, v: Array) -> float:
-        p = 0.0
+    def _power(self, t: float, q: Array, v: Array) -> float:
+        """The power (W) of the loads and torque items at the state (q - ref, v) at t (s)."""
+        p = 0.0 if self._torques is None else self._torques.power(t, self.ref + q, v)
         for f, idx in self.loads:
             if f.active(t):
                 fx, fy = force_at(f, t)
@@ -185,7 +188,7 @@ class Guard:
                 self.verdict = (STATUS_DIVERGED, diverged_message(t), t, False)
                 return False
             if self._checks_energy:
-                p = self._power(t, v)
+                p = self._power(t, q, v)
                 if not math.isfinite(p):
                     self.verdict = (
                         STATUS_ERROR,
@@ -222,3 +225,33 @@ class Guard:
             self.verdict = (status, message, t, True)
             return False
         return True
+
+
+class _TorqueRates:
+    """The torque items' power sum_k M_k dD_k/dt (W) at an exudyn state: dD_k the rate of rod
+    k+1's root tangent minus rod k's tip tangent (hinge 0: minus a moving base's attitude
+    rate, 0 on a pinned base), as ``exudyn_observe.hinge_rates`` measures it. O(n + items)."""
+
+    def __init__(self, scene: Scene, ltg: list[list[Array]], built: BuiltSystem, mbs: Any) -> None:
+        E = len(ltg[0]) - 1
+        self.loads = LoadSet((), scene.n, torques=scene.torques)
+        self.root = np.array([rod[0][2:] for rod in ltg])  # (n, 2): slope x, y indices
+        self.tip = np.array([rod[E][2:] for rod in ltg])
+        body = built.body
+        self.attitude = (
+            None if body is None else int(np.asarray(mbs.systemData.GetNodeLTGODE2(body))[2])
+        )
+
+    def power(self, t: float, x: Array, v: Array) -> float:
+        """At the coordinates x (total) and their rates v (ODE2 vectors)."""
+
+        def rate(idx: Array) -> Array:
+            sx, sy, wx, wy = x[idx[:, 0]], x[idx[:, 1]], v[idx[:, 0]], v[idx[:, 1]]
+            return np.asarray((sx * wy - sy * wx) / (sx * sx + sy * sy))
+
+        dD = rate(self.root)
+        dD[1:] -= rate(self.tip)[:-1]
+        if self.attitude is not None:
+            dD[0] -= v[self.attitude]
+        M = self.loads.hinge_moments(t, dD)
+        return 0.0 if M is None else float(M @ dD)

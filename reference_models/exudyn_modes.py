@@ -207,7 +207,8 @@ def _linear_system(
     """The system the modes are about: (the scene as assembled, exudyn's mbs, its beam nodes,
     ``_linearized``), the static ``loads`` held as constant nodal forces; ``about`` = (about,
     load_steps): about "equilibrium" a loaded or pre-stressed scene is solved statically in
-    load_steps steps, starting from the hinges' rest angles when pre-stressed."""
+    load_steps steps, starting from the hinges' rest angles when pre-stressed. Motors and rate
+    dampers are left out, as the native models' modes leave them (``damping_matrix``: nu)."""
     (about_what, load_steps), held = about, _held_forces(loads)
     equilibrium = about_what == "equilibrium"
     if scene.base.free:
@@ -215,7 +216,7 @@ def _linear_system(
     prestressed = _springs_loaded(scene)
     if equilibrium and prestressed:
         scene = _at_rest_angles(scene)  # the static solve starts where the springs relax
-    _, mbs, nodes = model.assembled(scene.with_(loads=held))
+    _, mbs, nodes = model.assembled(scene.with_(loads=held, motors=(), rate_dampers=()))
     _check_nodes(mbs, nodes)
     # on a free base without loads the start at the rest angles is the equilibrium (a static
     # solve of the unsupported body would be singular)

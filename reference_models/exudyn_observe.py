@@ -19,6 +19,7 @@ from reference_models.exudyn_beam import (
     stop_moment,
     system_energies,
     system_momenta,
+    torque_moments,
     wrap_angle,
 )
 from rodval.core.base import Base
@@ -90,7 +91,9 @@ def observe(
 
     "hinge_angle": D_k (k = 0..n-1) from the continuous tangent angles; "hinge_moment" (N m):
     the moment of hinge k, in the sense of its spring's kappa (D - rest): the spring, damper
-    and stop laws at the measured D and dD while the hinge is free, and from the state
+    and stop laws at the measured D and dD, less the torque items' moments (motors, rate
+    dampers: ``HingeTorque.moment``, positive driving D up), while the hinge is free, and
+    from the state
     where its latch was switched on (``lock_steps``: hinge -> time, s) the beam's own bending
     moment EI kappa_b at the root of rod k+1 (the hinge has no inertia: it transmits that
     moment), kappa_b the curvature of the cable's field there. Hinge 0 is measured from a free
@@ -234,6 +237,9 @@ def _hinge_quantities(
         M = chain.kappa * (D - chain.rest_angle) + chain.nu * dD
         for stop in scene.stops:
             M[:, stop.hinge] += stop_moment(stop, D[:, stop.hinge], dD[:, stop.hinge])
+        driving = torque_moments(scene, times, dD)
+        if driving is not None:
+            M -= driving
         for k, t_on in (lock_steps or {}).items():
             after = times >= t_on - 1e-12
             if after.any():

@@ -16,9 +16,14 @@ JAC_PER_STEP = True
 
 def initial_kick(scene: Scene) -> bool:
     """Whether generalized-alpha's first step from computed initial accelerations would kick
-    the element-scale modes (any rod with bending damping): such a run starts from a = 0
-    (docs/deployment.md, "exudyn's start-up with bending damping")."""
-    return bool(scene.chain.bending_damping.any())
+    the element-scale modes: any rod with bending damping (docs/deployment.md, "exudyn's
+    start-up with bending damping"), or a torque item (motor, rate damper) with a moment at
+    rest at t = 0 on a hinge between two rods (k >= 1): that step moment on two beam ends
+    gives element-scale initial accelerations (on hinge 0 it does not; docs/reference_model.md,
+    "Motors and rate dampers"). Such a run starts from a = 0."""
+    return bool(scene.chain.bending_damping.any()) or any(
+        item.hinge > 0 and item.moment(0.0, 0.0) != 0.0 for item in scene.torques
+    )
 
 
 def simulation_settings(
@@ -46,8 +51,9 @@ def simulation_settings(
     ti.newton.relativeTolerance, ti.newton.absoluteTolerance = newton
     ti.newton.modifiedNewtonJacUpdatePerStep = bool(scene.latches) and JAC_PER_STEP
     ti.generalizedAlpha.spectralRadius = spectral_radius
-    # with bending damping, generalized-alpha's step from computed initial accelerations
-    # kicks the overdamped element-scale modes by 5-45 J on a stowed wing; start from a = 0
+    # with bending damping (or a step moment across a hinge at t = 0), generalized-alpha's
+    # step from computed initial accelerations kicks the element-scale modes (by 5-45 J on
+    # a stowed wing); start from a = 0
     ti.generalizedAlpha.computeInitialAccelerations = not initial_kick(scene)
     s.solution.file.write = False
     s.solution.sensors.writePeriod = 0.25 * t_end / planned

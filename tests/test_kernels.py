@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from rodval import paper_scene
-from rodval.core.loads import LoadSet, NodalForce, constant, load_sums, load_table, pulse
+from rodval.core.load_table import load_sums, load_table
+from rodval.core.loads import LoadSet, NodalForce, constant, pulse
 from rodval.core.scene import Chain, Scene
 from rodval.models.presets.full import FullSystem
 from rodval.models.presets.reduced import ReducedSystem

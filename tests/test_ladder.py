@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from ladder_lagrangian import HD, equations, kinetic_energy
 from ladder_lagrangian import Chain as IndependentChain
-from ladder_lagrangian import equations, kinetic_energy
 
 import rodval
 from rodval import simulate
@@ -39,11 +39,24 @@ def random_chain(rng, n):
     )
 
 
+def hinge_moment_forces(ref, q, Tq):
+    """sum_k Tq_k dD_k/dq_i (N m) for every coordinate i: the generalized forces of moments
+    Tq across the hinges, from the reference's hinge angles by dual differentiation."""
+    N = q.size
+    return np.array(
+        [
+            sum(Tq[k] * float(D.b) for k, D in enumerate(ref.hinge_angles(HD(q, np.eye(N)[i]))))
+            for i in range(N)
+        ]
+    )
+
+
 @pytest.mark.parametrize("p", [1, 2, 3, 4])
 def test_exact_kinematics_equals_an_independent_lagrangian(p):
     """Random non-uniform chains (n = 3), random states, loads on every node, hinge and rod
-    damping: the compiled right-hand side against Lagrange's equations of the exact T, V and
-    the Rayleigh function by hyper-dual differentiation. The residual M_ref q''_kernel - f_ref,
+    damping and moments across the hinges (motors): the compiled right-hand side against
+    Lagrange's equations of the exact T, V and the Rayleigh function by hyper-dual
+    differentiation. The residual M_ref q''_kernel - f_ref,
     relative to |f| + |M| |q''|, is a backward error: a stable O(N) solve leaves a few N eps
     (N <= 18 coordinates: ~2e-15), bound 1e-13. The forward error is bounded by cond(M) times
     that (cond(M) up to 1e7 at p = 4: the bubbles' Gram entries are 1e-3 of the cubic's)."""
@@ -63,10 +76,12 @@ def test_exact_kinematics_equals_an_independent_lagrangian(p):
         q, v = rng.uniform(-1.0, 1.0, N), rng.uniform(-2.0, 2.0, N)
         X, Y = rng.uniform(-5.0, 5.0, n), rng.uniform(-5.0, 5.0, n)
         SX, SY = np.cumsum(X[::-1])[::-1], np.cumsum(Y[::-1])[::-1]
+        Tq = rng.uniform(-5.0, 5.0, n)
         acc = np.empty(N)
         y = np.concatenate([q, v])
-        ladder_accel(V, y, True, SX, SY, True, acc)
+        ladder_accel(V, y, True, SX, SY, Tq, True, acc)
         M, f = equations(ref, q, v, X, Y)
+        f += hinge_moment_forces(ref, q, Tq)
         scale = np.max(np.abs(f)) + np.max(np.abs(M)) * np.max(np.abs(acc))
         assert np.max(np.abs(M @ acc - f)) / scale < 1e-13
         forward = np.max(np.abs(acc - np.linalg.solve(M, f))) / np.max(np.abs(acc))

@@ -149,7 +149,7 @@ KEYED = textwrap.dedent(
     import sys
     from pathlib import Path
     {first}
-    import rodval.core.loads as loads
+    import rodval.core.load_table as loads
     from numba.core.registry import CPUDispatcher
     from rodval.core import jit_cache
     stamps = [
@@ -157,7 +157,7 @@ KEYED = textwrap.dedent(
         for f in vars(loads).values()
         if isinstance(f, CPUDispatcher) and hasattr(f._cache, "_cache_file")
     ]
-    assert stamps, "no cached kernel in rodval.core.loads"
+    assert stamps, "no cached kernel in rodval.core.load_table"
     digest = jit_cache.closure_digest(Path(loads.__file__).resolve())
     assert all(s == ("sources", digest) for s in stamps), stamps
     print("keyed", len(stamps))

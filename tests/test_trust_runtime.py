@@ -13,7 +13,8 @@ from checks import TimeLimit, one_line
 
 from rodval import InitialState, Scene, paper_scene, simulate
 from rodval.cli import main
-from rodval.core.loads import LOAD_COLUMNS, LoadSet, load_sums, load_table, tabulated
+from rodval.core.load_table import LOAD_COLUMNS, load_sums, load_table
+from rodval.core.loads import LoadSet, tabulated
 from rodval.core.scene import Stop
 from rodval.core.status import (
     STATUS_BLOWUP,

@@ -23,7 +23,8 @@ from rodval import (
     tabulated,
 )
 from rodval.cli import main
-from rodval.core.loads import LoadSet, load_sums, load_table
+from rodval.core.load_table import load_sums, load_table
+from rodval.core.loads import LoadSet
 from rodval.core.scene_file import scene_from_dict, scene_to_dict
 
 BOOM = """

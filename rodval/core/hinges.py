@@ -9,7 +9,6 @@ declares its keys (``KEYS``: the one list, which ``scene_keys.SCENE_KEYS`` reads
 from __future__ import annotations
 
 import dataclasses
-import math
 import numbers
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -27,11 +26,6 @@ def _keys(hinge: str, **more: Key) -> dict[str, Key]:
         "angle": Key(NUMBER, "rad", "finite", required=True),
         **more,
     }
-
-
-def _torque_keys(**more: Key) -> dict[str, Key]:
-    """A torque item's keys: ``hinge`` (required), then the kind's own (``more``)."""
-    return {"hinge": Key(INTEGER, "", "0..n-1", required=True), **more}
 
 
 @dataclass(frozen=True)
@@ -250,7 +244,7 @@ class HingeTorque(HingeItem):
     hinge angle D up (it acts on rod ``hinge`` with +M and on the rod before it, or the
     base, with -M). A kind gives its closed form (``moment``: the exudyn model and the
     Python path evaluate it) and the same law as compiled load-table rows (``rows``:
-    components ``COMP_MOMENT`` and ``COMP_RATE``, ``rodval.core.loads``); every model then
+    components ``COMP_MOMENT`` and ``COMP_RATE``, ``rodval.core.load_table``); every model then
     applies it with its own hinge rate, and the energy audit books its power M dD/dt as
     external work."""
 
@@ -259,22 +253,13 @@ class HingeTorque(HingeItem):
         raise NotImplementedError
 
     def rows(self) -> list[Row]:
-        """The compiled rows of ``moment`` (``rodval.core.loads.LOAD_COLUMNS`` without
+        """The compiled rows of ``moment`` (``rodval.core.load_table.LOAD_COLUMNS`` without
         track_end)."""
         raise NotImplementedError
 
     def breakpoints(self) -> tuple[float, ...]:
         """Times (s) where the moment has kinks or jumps."""
         return ()
-
-
-def _constant_row(hinge: int, component: str, value: float) -> Row:
-    """The row of a constant ``component`` ("moment", N m, or "rate", N m s/rad) across
-    ``hinge`` (numba is imported with the loads, not at import: `rodval --help`)."""
-    from rodval.core.loads import COMP_MOMENT, COMP_RATE, LAW_CONSTANT
-
-    comp = COMP_MOMENT if component == "moment" else COMP_RATE
-    return (hinge, comp, LAW_CONSTANT, 0.0, math.inf, 1.0, value, 0.0, 0.0)
 
 
 #: The hinge items by scene table (and ``Scene`` field) name, in the scene files' order.

@@ -1,6 +1,6 @@
 """Prescribed motions of a base (``rodval.core.base.Base`` of kind "prescribed"): laws of time
 f(t) for the body's centre x, y (m) and attitude (rad), twice differentiable, with f' and f''
-in closed form. A law's compiled rows are a load law's (``rodval.core.loads.LOAD_COLUMNS``; the
+in closed form. A law's compiled rows are a load law's (``rodval.core.load_table.LOAD_COLUMNS``; the
 component is the axis 0, 1, 2 = x, y, attitude) and its values are the load laws' formulas,
 evaluated with both derivatives by ``law_motion``.
 """
@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 
 from rodval.core.checks import check_choice, check_keys, check_number, check_type
-from rodval.core.loads import LAW_CONSTANT, LAW_HARMONIC, LAW_LINEAR, LAW_RAISED_COSINE
+from rodval.core.load_table import LAW_CONSTANT, LAW_HARMONIC, LAW_LINEAR, LAW_RAISED_COSINE
 
 #: Kane, Ryan and Banerjee's smooth spin-up (on [0, p1)): p0 / p1 (t^2 / 2 + (p1 / 2 pi)^2
 #: (cos(2 pi t / p1) - 1)), rate p0 reached at t = p1 with zero acceleration.
@@ -85,7 +85,7 @@ class Motion:
         return {"law": self.law, **dict(zip(MOTION_LAWS[self.law][0], self.params))}
 
     def rows(self, axis: int) -> list[tuple[float, ...]]:
-        """The law's rows of a base-motion table (``loads.LOAD_COLUMNS``; component = the
+        """The law's rows of a base-motion table (``load_table.LOAD_COLUMNS``; component = the
         axis 0, 1, 2 = x, y, attitude)."""
         code = MOTION_LAWS[self.law][1]
         p = self.params

@@ -40,7 +40,7 @@ class CompiledForm:
     hold is the model's business: ``P`` (rows of per-rod constants, float64 2-D), ``S``
     (scalars, float64 1-D), ``M`` (dense matrices or work space the rhs reuses, float64 3-D,
     may be empty), ``L`` (the load
-    table, ``rodval.core.loads.load_table``). The integrator passes them through untouched.
+    table, ``rodval.core.load_table.load_table``). The integrator passes them through untouched.
 
     ``mechanics`` (optional, same type): writes (T, P_ext, P_diss) — kinetic energy (J), power
     of the loads (W) and power taken out by the dampers (W, ``OdeSystem.power``) — into a

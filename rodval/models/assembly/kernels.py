@@ -17,12 +17,16 @@ exploited (``kernel="numba"``, the default):
   by Foreman-Mackey et al. 2017, "celerite", generalised to a non-symmetric matrix for the
   ``published`` coefficients).
 
-Argument conventions: ``full_accel(V, y, has_load, SX, SY, damped, out)`` for the Python-side
-right-hand side (whose loads may be any callable); ``full_rhs`` and ``*_mechanics`` have the
-compiled integrators' type ``rodval.solvers.signature.RHS_TYPE`` (loads from the compiled load
-table, ``rodval.core.loads.load_sums``, O(log rows) per evaluation). ``V`` holds rows of
-length-n vectors (layout ``V_*`` below), ``S = [damped]``. Generalized forces are one array
-``f`` of rows (n each): f[0] on phi, then one row per bending coordinate (alpha, beta).
+Argument conventions: ``full_accel(V, y, has_load, SX, SY, Tq, damped, out)`` for the
+Python-side right-hand side (whose loads may be any callable); ``full_rhs`` and ``*_mechanics``
+have the compiled integrators' type ``rodval.solvers.signature.RHS_TYPE`` (loads and hinge
+moments from the compiled load table, ``rodval.core.load_table.load_sums`` and ``hinge_torques``,
+O(log rows) per evaluation). ``V`` holds rows of length-n vectors (layout ``V_*`` below),
+``S = [damped]``. Generalized forces are one array ``f`` of rows (n each): f[0] on phi, then
+one row per bending coordinate (alpha, beta). ``Tq`` (N m): the motors' and rate dampers'
+moments across the hinges (positive driving D_k up), length n, or length 0 for none (then
+nothing is added: ``hinge_moments_at``); their generalized force A^T Tq is external
+(``hinge_moments_into``) and their power sum_k Tq_k dD_k/dt is booked in P_ext.
 """
 
 from __future__ import annotations
@@ -33,7 +37,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from rodval.core.loads import load_sums
+from rodval.core.load_table import applied_torques, hinge_torques, load_sums
 
 #: A float64 array (numba reads no annotation: they are mypy's); two of them, a kernel's outputs.
 Arr = NDArray[np.float64]
@@ -108,6 +112,77 @@ def hinge_forces(
         if i > 0:
             out_p[i - 1] -= T
             out_b[i - 1] -= T
+
+
+@njit(cache=True)
+def add_moment(k: int, T: float, f: Arr) -> None:
+    """f += a_k T: the generalized force of a moment T (N m) across hinge k (a_k the k-th row
+    of the hinge matrix A: +1 on phi_k, alpha_k, -1 on phi_{k-1}, beta_{k-1}) on the force
+    rows f (phi, alpha, beta, ...: ``full_forces``). O(1)."""
+    f[0, k] += T
+    f[1, k] += T
+    if k > 0:
+        f[0, k - 1] -= T
+        f[2, k - 1] -= T
+
+
+@njit(cache=True)
+def hinge_moments_into(Tq: Arr, f: Arr) -> None:
+    """f += A^T Tq (``add_moment`` per hinge): the hinge moments Tq (N m, positive driving
+    D_k up; empty: nothing) as external generalized forces on the rows f. O(n)."""
+    for k in range(Tq.shape[0]):
+        add_moment(k, Tq[k], f)
+
+
+@njit(cache=True)
+def hinge_of(v: Arr, k: int, n: int, theta: int = -1) -> float:
+    """a_k . v: hinge k's angle (rad) or rate (rad/s) from v = [phi; alpha; beta; ...]
+    (3n or more), or from v = phi (n: the chord angle phi_k - phi_{k-1}, the reduced and
+    rigid rungs'); ``theta`` >= 0: the index of a free base's attitude in v, which hinge 0 is
+    measured from (``free_base``). O(1)."""
+    if v.shape[0] > n:
+        r = v[k] + v[n + k]
+        if k > 0:
+            r -= v[k - 1] + v[2 * n + k - 1]
+    else:
+        r = v[k]
+        if k > 0:
+            r -= v[k - 1]
+    if k == 0 and theta >= 0:
+        r -= v[theta]
+    return float(r)
+
+
+@njit(cache=True)
+def hinge_rates(v: Arr, n: int, theta: int = -1) -> Arr:
+    """dD_k/dt (rad/s, n) of every hinge from the rates v (``hinge_of``: a_k q' for v =
+    q' = [phi'; alpha'; beta'; ...], the chord rates for v = phi'). O(n)."""
+    rates = np.empty(n)
+    for k in range(n):
+        rates[k] = hinge_of(v, k, n, theta)
+    return rates
+
+
+@njit(cache=True)
+def hinge_moments_at(L: Arr, t: float, v: Arr, n: int) -> Pair:
+    """(Tq, rates): the hinge moments Tq (N m, positive driving D_k up) of the load table L's
+    hinge rows at t (``hinge_torques``, ``applied_torques``) at the hinge rates (rad/s) from
+    the rates v (``hinge_rates``: the full model's a_k q', the reduced model's chord rates);
+    both empty when no hinge row acts at t (no rate computed). O(n)."""
+    T, C = hinge_torques(L, t, n)
+    if T.shape[0] == 0:
+        return T, T
+    rates = hinge_rates(v, n)
+    return applied_torques(T, C, rates), rates
+
+
+@njit(cache=True)
+def torque_power(Tq: Arr, rates: Arr) -> float:
+    """sum_k Tq_k dD_k/dt (W): the hinge moments' power, external work; 0 for none. O(n)."""
+    p = 0.0
+    for k in range(Tq.shape[0]):
+        p += Tq[k] * rates[k]
+    return p
 
 
 @njit(cache=True)
@@ -235,11 +310,20 @@ def schur_generators(V: Arr, c: Arr, s: Arr) -> tuple[Arr, Arr, Arr, Arr]:
 
 @njit(cache=True)
 def full_forces(
-    V: Arr, y: Arr, c: Arr, s: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, f: Arr
+    V: Arr,
+    y: Arr,
+    c: Arr,
+    s: Arr,
+    has_load: bool,
+    SX: Arr,
+    SY: Arr,
+    Tq: Arr,
+    damped: bool,
+    f: Arr,
 ) -> None:
-    """f = [Q; 0; 0] - h - C q' - K q + A^T kappa rest of the full model (N m) into the rows
-    f (3, n) (zeroed here), O(n). C q' (hinge dampers and the rods' bending damping) only when
-    ``damped``."""
+    """f = [Q; 0; 0] + A^T Tq - h - C q' - K q + A^T kappa rest of the full model (N m) into
+    the rows f (3, n) (zeroed here), O(n). C q' (hinge dampers and the rods' bending damping)
+    only when ``damped``; Tq the hinge moments (N m, empty: none; module docstring)."""
     n = V.shape[1]
     q, v = y[: 3 * n], y[3 * n :]
     phi, alpha, beta = q[:n], q[n : 2 * n], q[2 * n :]
@@ -266,6 +350,7 @@ def full_forces(
     upper_t_times(V, c, s, w2, False, fb, -1.0)
     if has_load:
         load_moments(V, c, s, SX, SY, fp)
+    hinge_moments_into(Tq, f)
 
 
 @njit(cache=True)
@@ -308,15 +393,17 @@ def full_solve(V: Arr, c: Arr, s: Arr, f: Arr, out: Arr) -> None:
 
 
 @njit(cache=True)
-def full_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
+def full_accel(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
+) -> None:
     """Accelerations q'' (3n) of the full model at y = [q; q'] into ``out``: M(phi) q'' =
-    [Q; 0; 0] - h - C q' - K q. SX, SY are the load suffix sums (N), used when ``has_load``.
-    O(n) time and memory."""
+    [Q; 0; 0] + A^T Tq - h - C q' - K q. SX, SY are the load suffix sums (N), used when
+    ``has_load``; Tq the hinge moments (N m, empty: none). O(n) time and memory."""
     n = V.shape[1]
     c = np.cos(y[:n])
     s = np.sin(y[:n])
     f = np.empty((3, n))
-    full_forces(V, y, c, s, has_load, SX, SY, damped, f)
+    full_forces(V, y, c, s, has_load, SX, SY, Tq, damped, f)
     full_solve(V, c, s, f, out)
 
 
@@ -342,9 +429,12 @@ def rhs_start(t: float, y: Arr, P: Arr, L: Arr, out: Arr) -> tuple[bool, Arr, Ar
 
 @njit(cache=True)
 def full_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
-    """y' of the full model (compiled integrators' right-hand side, loads from table L)."""
+    """y' of the full model (compiled integrators' right-hand side, loads and hinge moments
+    from table L)."""
+    n = P.shape[1]
     has_load, SX, SY = rhs_start(t, y, P, L, out)
-    full_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[3 * P.shape[1] :])
+    Tq = hinge_moments_at(L, t, y[3 * n :], n)[0]
+    full_accel(P, y, has_load, SX, SY, Tq, S[0] != 0.0, out[3 * n :])
 
 
 @njit(cache=True)
@@ -399,9 +489,23 @@ def compiled_damper_power(V: Arr, S: Arr, dphi: Arr, dalpha: Arr, dbeta: Arr) ->
 
 
 @njit(cache=True)
+def external_power(V: Arr, c: Arr, s: Arr, v: Arr, L: Arr, t: float) -> float:
+    """P_ext (W) at rates v (q' = [phi'; alpha'; beta'], or the reduced model's phi'): the
+    loads' power (``load_power``) plus the hinge moments' sum_k Tq_k dD_k/dt
+    (``hinge_moments_at``, ``torque_power``; added only when a hinge row acts). O(n)."""
+    n = c.shape[0]
+    p = load_power(V, c, s, v[:n], L, t)
+    Tq, rates = hinge_moments_at(L, t, v, n)
+    if Tq.shape[0] > 0:
+        p += torque_power(Tq, rates)
+    return p
+
+
+@njit(cache=True)
 def full_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) of the full model into out[:3]: T = 1/2 q'^T M q' (J) with the
-    kinematic (printed, symmetric) mass matrix, the load power (W) and the damper power
+    kinematic (printed, symmetric) mass matrix, the external power (W: loads and hinge
+    moments, ``external_power``) and the damper power
     sum_k nu_k (dD_k/dt)^2 (W; 0 unless S[0], the damped flag). O(n)."""
     n = P.shape[1]
     phi, dphi = y[:n], y[3 * n : 4 * n]
@@ -416,7 +520,7 @@ def full_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -
         T += 2.0 * dphi[k] * (u[k] + P[V_PA, k] * va[k] + P[V_PB, k] * vb[k])
         T += aa[k] * (va[k] * va[k] + vb[k] * vb[k]) + 2.0 * ab[k] * va[k] * vb[k]
     out[0] = 0.5 * T
-    out[1] = load_power(P, c, s, dphi, L, t)
+    out[1] = external_power(P, c, s, y[3 * n :], L, t)
     out[2] = compiled_damper_power(P, S, dphi, va, vb)
 
 
@@ -424,12 +528,13 @@ def full_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -
 def reduced_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) of the reduced model into out[:3]: T = 1/2 phi'^T M_pp phi' (J; its
     bending rates are dropped, in its dampers too: P_diss = sum_k nu_k (phi'_k -
-    phi'_{k-1})^2, W), the load power (W). O(n)."""
+    phi'_{k-1})^2, W), the external power (W: loads and hinge moments at the chord rates,
+    ``external_power``). O(n)."""
     n = P.shape[1]
     phi, dphi = y[:n], y[n:]
     c = np.cos(phi)
     s = np.sin(phi)
     out[0] = 0.5 * _mpp_quadratic(P, c, s, dphi)
-    out[1] = load_power(P, c, s, dphi, L, t)
+    out[1] = external_power(P, c, s, dphi, L, t)
     zero = np.zeros(n)
     out[2] = compiled_damper_power(P, S, dphi, zero, zero)

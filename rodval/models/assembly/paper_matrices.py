@@ -181,6 +181,20 @@ def hinge_matrix(n: int) -> np.ndarray:
     return A
 
 
+def rate_damping_matrix(torques: Any, t: float, n: int) -> np.ndarray | None:
+    """A^T diag(c) A (N m s, 3n x 3n): the hinge torque items' rate coefficients c_k =
+    -dTq_k/d(dD_k/dt) at t on q' (every law is affine in the rate: c = M(t, 0) - M(t, 1)),
+    for the analytic Jacobians; None without items (``rodval.core.hinges.HingeTorque``)."""
+    if not torques:
+        return None
+    c = np.zeros(n)
+    for item in torques:
+        c[item.hinge] += item.moment(t, 0.0) - item.moment(t, 1.0)
+    A = hinge_matrix(n)
+    damping: np.ndarray = A.T @ (c[:, None] * A)
+    return damping
+
+
 def bending_blocks(coefficient: np.ndarray, l: np.ndarray, n: int) -> np.ndarray:
     """(4 c/l) [[1, 1/2], [1/2, 1]] on each rod's (alpha_k, beta_k) (3n, 3n; zero elsewhere):
     the cubic shape's integral of c kappa_b^2 over the rod, 1/2 x^T B x = (2 c/l)(a^2 + a b +

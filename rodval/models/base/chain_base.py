@@ -21,8 +21,13 @@ A_k = w_k (alpha_k - beta_k): ``free_base`` is this module's p = 1, first-order 
   theta follow the laws to the integration's tolerance): M_c q'' = f_c - J_S^T a_0, a_0 = a_c
   + theta'' rho_perp - theta'^2 rho, hinge 0 measured from theta. The base's force on the chain at
   node 0 is F_d = M a_0 + S'' - F, and the moment it passes through hinge 0 is m_1 = lambda_0 -
-  T_0 (lambda_0: hinge 0's multiplier when held); their power F_d . v_0 + m_1 theta' is the
-  drive's, booked as external in the energy audit.
+  T_0 (lambda_0: hinge 0's multiplier when held; T_0 with -Tq_0, a motor's reaction); their
+  power F_d . v_0 + m_1 theta' is the drive's, booked as external in the energy audit.
+
+Hinge moments (motors, rate dampers; Tq, N m) act on the chain as A^T Tq (``ladder_forces``)
+at the hinge rates a_k q', hinge 0's measured from theta' (``free_base.rhs_torques``); the
+body (or the drive) takes hinge 0's reaction -Tq_0, and their power sum_k Tq_k dD_k/dt is
+external work in the audit.
 
 V is the ladder's (``ladder.ladder_constants``) with ``free_base.BODY_ROWS`` rows appended: the
 body's mass (kg) and inertia (kg m^2) (zero for a prescribed base), the hinge offset h (m) and
@@ -35,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.core.loads import load_sums
+from rodval.core.load_table import load_sums
 from rodval.core.motion import motion_at
 from rodval.models.assembly.kernels import (
     V_KAPPA,
@@ -46,6 +51,7 @@ from rodval.models.assembly.kernels import (
     Pair,
     load_power,
     rhs_start,
+    torque_power,
 )
 from rodval.models.base.free_base import (
     BODY_INERTIA,
@@ -56,6 +62,7 @@ from rodval.models.base.free_base import (
     chain_state,
     hinge0_moment,
     offset_vector,
+    rhs_torques,
 )
 from rodval.models.hinge_items.deployment import (
     Ints,
@@ -167,15 +174,17 @@ def chain_forces(
     has_load: bool,
     SX: Arr,
     SY: Arr,
+    Tq: Arr,
     damped: bool,
-    th: float,
-    dth: float,
+    attitude: tuple[float, float],
 ) -> Arr:
     """The force rows f (p+2, n) of the pinned ladder at the chain state yc with hinge 0
-    measured from the attitude theta (rate theta'). O(n p^2)."""
+    measured from the ``attitude`` (theta (rad), theta' (rad/s)); Tq the hinge moments (N m,
+    ``free_base.rhs_torques``, or empty: A^T Tq on the chain). O(n p^2)."""
     n, P1, N = chain_size(V)
+    th, dth = attitude
     f = np.empty((P1 + 1, n))
-    ladder_forces(V, yc, parts[0], has_load, SX, SY, damped, f)
+    ladder_forces(V, yc, parts[0], has_load, SX, SY, Tq, damped, f)
     shift = V[V_KAPPA, 0] * th + (V[V_NU, 0] * dth if damped else 0.0)
     f[0, 0] += shift  # -kappa_0 (D_0 - theta - rest) on phi_1 and alpha_1
     f[1, 0] += shift
@@ -219,15 +228,18 @@ def body_solve(V: Arr, parts: Parts, th: float, G: Arr, K: Arr, f: Arr, rb: Arr,
 
 
 @njit(cache=True)
-def free_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
+def free_accel(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
+) -> None:
     """Q'' (N + 3) of a ladder rung on a free body at y = [Q; Q'] into ``out``; SX, SY the
-    load suffix sums (N). O(n p^2): three ladder solves."""
+    load suffix sums (N), Tq the hinge moments (N m, ``free_base.rhs_torques``: A^T Tq on the
+    chain, -Tq_0 on the body's attitude). O(n p^2): three ladder solves."""
     n, P1, N = chain_size(V)
     NQ = N + 3
     yc = chain_state(y, N)
     parts = chain_parts(V, yc[:N], yc[N:])
     th, dth = y[N + 2], y[NQ + N + 2]
-    f = chain_forces(V, yc, parts, has_load, SX, SY, damped, th, dth)
+    f = chain_forces(V, yc, parts, has_load, SX, SY, Tq, damped, (th, dth))
     rx, ry = offset_vector(V, th)
     w2 = dth * dth
     field_forces(V, parts, w2 * rx, w2 * ry, f)  # a_0's -theta'^2 rho part
@@ -235,7 +247,7 @@ def free_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, o
     Fy = SY[0] if has_load else 0.0
     qx, qy = first_moment_quadratic(V, parts, yc[N : N + n])
     mch = body_value(V, CHAIN_MASS)
-    T0 = hinge0_moment(V, y[0] + y[n] - th, y[NQ] + y[NQ + n] - dth, damped)
+    T0 = hinge0_moment(V, y[0] + y[n] - th, y[NQ] + y[NQ + n] - dth, damped, Tq)
     rb = np.array(
         [
             Fx - qx + mch * w2 * rx,
@@ -267,10 +279,20 @@ def free_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def free_accel_locked(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+    V: Arr,
+    y: Arr,
+    has_load: bool,
+    SX: Arr,
+    SY: Arr,
+    Tq: Arr,
+    damped: bool,
+    locks: Ints,
+    out: Arr,
+    lam: Arr,
 ) -> None:
-    """Q'' with the hinges ``locks`` held (multipliers into ``lam``, N m); O(n p^2 m)."""
-    free_accel(V, y, has_load, SX, SY, damped, out)
+    """Q'' with the hinges ``locks`` held (multipliers into ``lam``, N m; Tq acts in the
+    free accelerations, so a held hinge's multiplier holds its motor too); O(n p^2 m)."""
+    free_accel(V, y, has_load, SX, SY, Tq, damped, out)
     if locks.shape[0] > 0:
         U = np.empty((locks.shape[0], out.shape[0]))
         free_unit_responses(V, y, locks, U)
@@ -281,14 +303,17 @@ def free_accel_locked(
 def free_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of a ladder rung on a free body (compiled integrators' right-hand side)."""
     has_load, SX, SY = rhs_start(t, y, P, L, out)
-    free_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[y.shape[0] // 2 :])
+    Tq = rhs_torques(t, y, P, L)[0]
+    free_accel(P, y, has_load, SX, SY, Tq, S[0] != 0.0, out[y.shape[0] // 2 :])
 
 
 @njit(cache=True)
 def free_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' with the hinges of S held; O(n p^2 m)."""
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
-    free_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[y.shape[0] // 2 :], lam)
+    Tq = rhs_torques(t, y, P, L)[0]
+    acc = out[y.shape[0] // 2 :]
+    free_accel_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, locks, acc, lam)
 
 
 @njit(cache=True)
@@ -352,11 +377,13 @@ def moving_mechanics(
 @njit(cache=True)
 def free_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) of a ladder rung on a free body into out[:3] (``moving_mechanics``
-    plus the body's 1/2 m_b |v_c|^2 + 1/2 J theta'^2). O(n p^2)."""
+    plus the body's 1/2 m_b |v_c|^2 + 1/2 J theta'^2 and the hinge moments' power sum_k Tq_k
+    dD_k/dt, hinge 0's rate from the body, W). O(n p^2)."""
     n, P1, N = chain_size(P)
     NQ = N + 3
     dth = y[NQ + N + 2]
     moving_mechanics(t, chain_state(y, N), P, S, L, free_root_rates(P, y), dth, out)
+    out[1] += torque_power(*rhs_torques(t, y, P, L))
     vc2 = y[NQ + N] ** 2 + y[NQ + N + 1] ** 2
     out[0] += 0.5 * (body_value(P, BODY_MASS) * vc2 + body_value(P, BODY_INERTIA) * dth * dth)
 
@@ -364,18 +391,19 @@ def free_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -
 # ---------------------------------------------------------------------- prescribed motion
 @njit(cache=True)
 def prescribed_accel(
-    V: Arr, y: Arr, mo: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr
+    V: Arr, y: Arr, mo: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
 ) -> None:
     """Q'' (N + 3) of a ladder rung on a prescribed base at y = [Q; Q'] into ``out``: the
     body's accelerations are the laws' (``mo``: ``loads.motion_at`` at t), the chain's solve
     M_c q'' = f_c - J_S^T a_0 with a_0 = a_c + theta'' rho_perp - theta'^2 rho (theta, theta'
-    from the state, which follows the laws). O(n p^2): one ladder solve."""
+    from the state, which follows the laws; Tq the hinge moments, N m, on the chain). O(n p^2):
+    one ladder solve."""
     n, P1, N = chain_size(V)
     NQ = N + 3
     yc = chain_state(y, N)
     parts = chain_parts(V, yc[:N], yc[N:])
     th, dth, ddth = y[N + 2], y[NQ + N + 2], mo[2, 2]
-    f = chain_forces(V, yc, parts, has_load, SX, SY, damped, th, dth)
+    f = chain_forces(V, yc, parts, has_load, SX, SY, Tq, damped, (th, dth))
     rx, ry = offset_vector(V, th)
     ax = mo[0, 2] - ddth * ry - dth * dth * rx
     ay = mo[1, 2] + ddth * rx - dth * dth * ry
@@ -399,13 +427,22 @@ def prescribed_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def prescribed_accel_locked(
-    V: Arr, y: Arr, mo: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Pair
+    V: Arr,
+    y: Arr,
+    mo: Arr,
+    has_load: bool,
+    SX: Arr,
+    SY: Arr,
+    Tq: Arr,
+    damped: bool,
+    locks: Ints,
+    out: Pair,
 ) -> None:
     """Q'' with the hinges ``locks`` held and their multipliers (N m) into out = (Q'', lam);
     hinge 0's row has -1 at theta, whose acceleration is the law's, so it holds D_0 = phi_1 +
     alpha_1 - theta(t). O(n p^2 m)."""
     acc, lam = out
-    prescribed_accel(V, y, mo, has_load, SX, SY, damped, acc)
+    prescribed_accel(V, y, mo, has_load, SX, SY, Tq, damped, acc)
     if locks.shape[0] > 0:
         U = np.empty((locks.shape[0], acc.shape[0]))
         prescribed_unit_responses(V, y, locks, U)
@@ -416,26 +453,30 @@ def prescribed_accel_locked(
 def prescribed_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of a ladder rung on a prescribed base (its laws in M[0]); the held hinges of S."""
     has_load, SX, SY = rhs_start(t, y, P, L, out)
+    Tq = rhs_torques(t, y, P, L)[0]
     locks = held_hinges(S)[0]
     acc = (out[y.shape[0] // 2 :], np.empty(locks.shape[0]))
-    prescribed_accel_locked(P, y, motion_at(M[0], t), has_load, SX, SY, S[0] != 0.0, locks, acc)
+    mo = motion_at(M[0], t)
+    prescribed_accel_locked(P, y, mo, has_load, SX, SY, Tq, S[0] != 0.0, locks, acc)
 
 
 @njit(cache=True)
 def drive(V: Arr, y: Arr, mo: Arr, S: Arr, L: Arr, t: float) -> tuple[float, float, float]:
     """(F_dx, F_dy (N), m_1 (N m)): the base's force on the chain at node 0, F_d = M a_0 + S''
-    - F, and the moment it passes through hinge 0, m_1 = lambda_0 - T_0, in the mode of S (its
-    held hinges). O(n p^2 m)."""
+    - F, and the moment it passes through hinge 0, m_1 = lambda_0 - T_0 (T_0 with the hinge
+    moment's reaction -Tq_0, ``hinge0_moment``), in the mode of S (its held hinges).
+    O(n p^2 m)."""
     n, P1, N = chain_size(V)
     NQ = N + 3
     SX = np.zeros(n)  # left zero when no load acts
     SY = np.zeros(n)
     has_load = load_sums(L, t, SX, SY)
+    Tq = rhs_torques(t, y, V, L)[0]
     damped = S[0] != 0.0
     locks = held_hinges(S)[0]
     lam = np.zeros(locks.shape[0])
     acc = np.empty(N + 3)
-    prescribed_accel_locked(V, y, mo, has_load, SX, SY, damped, locks, (acc, lam))
+    prescribed_accel_locked(V, y, mo, has_load, SX, SY, Tq, damped, locks, (acc, lam))
     yc = chain_state(y, N)
     parts = chain_parts(V, yc[:N], yc[N:])
     jx, jy = first_moment_rate(V, parts, acc)
@@ -445,7 +486,7 @@ def drive(V: Arr, y: Arr, mo: Arr, S: Arr, L: Arr, t: float) -> tuple[float, flo
     mch = body_value(V, CHAIN_MASS)
     Fx = mch * (mo[0, 2] - ddth * ry - dth * dth * rx) + jx + qx - SX[0]
     Fy = mch * (mo[1, 2] + ddth * rx - dth * dth * ry) + jy + qy - SY[0]
-    m1 = -hinge0_moment(V, y[0] + y[n] - th, y[NQ] + y[NQ + n] - dth, damped)
+    m1 = -hinge0_moment(V, y[0] + y[n] - th, y[NQ] + y[NQ + n] - dth, damped, Tq)
     for j in range(locks.shape[0]):
         if locks[j] == 0:
             m1 += lam[j]

@@ -11,10 +11,11 @@ chain's first mass moment about node 0, S = sum_k [l_k M_k e_k + w_k (alpha_k - 
 vectors), J_S = dS/dq, and T_chain the pinned chain's kinetic energy. Lagrange's equations:
 
 * chain: M_c q'' + J_S^T a_0 = f_c (the pinned chain's forces, hinge 0 measured from the body:
-  D_0 = phi_1 + alpha_1 - theta), a_0 = a_c + theta'' rho_perp - theta'^2 rho;
+  D_0 = phi_1 + alpha_1 - theta; the hinge moments of motors and rate dampers, A^T Tq, with
+  their rates a_k q', hinge 0's minus theta'), a_0 = a_c + theta'' rho_perp - theta'^2 rho;
 * translation: M_ch a_0 + S'' + m_b a_c = F (the loads' resultant), S'' = J_S q'' + s_2(q, q');
 * attitude: J theta'' + rho_perp . (M_ch a_0 + S'') = T_0 + rho_perp . F, T_0 the moment of
-  hinge 0 (spring, damper, acting stops) on the body.
+  hinge 0 (spring, damper, acting stops, and -Tq_0: a hinge moment's reaction) on the body.
 
 The translation equation is d P / dt = F for P = m_b v_c + M_ch v_0 + S', whatever the chain's
 kinematics: the linear momentum is kept exactly. The total mass matrix is bordered,
@@ -29,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.core.loads import load_sums
+from rodval.core.load_table import applied_torques, hinge_torques, load_sums
 from rodval.models.assembly.kernels import (
     V_KAPPA,
     V_L,
@@ -38,9 +39,11 @@ from rodval.models.assembly.kernels import (
     V_REST,
     V_W,
     Arr,
+    Pair,
     full_forces,
     full_mechanics,
     full_solve,
+    hinge_rates,
     rhs_start,
 )
 from rodval.models.hinge_items.deployment import (
@@ -87,12 +90,15 @@ def chain_state(y: Arr, N: int) -> Arr:
 
 
 @njit(cache=True)
-def hinge0_moment(V: Arr, D: float, rate: float, damped: bool) -> float:
-    """T_0 (N m): hinge 0's moment on the body, kappa_0 (D_0 - rest_0) + nu_0 dD_0/dt, D_0 =
-    phi_1 + alpha_1 - theta (acting stops in V's kappa, nu, rest)."""
+def hinge0_moment(V: Arr, D: float, rate: float, damped: bool, Tq: Arr) -> float:
+    """T_0 (N m): hinge 0's moment on the body, kappa_0 (D_0 - rest_0) + nu_0 dD_0/dt - Tq_0,
+    D_0 = phi_1 + alpha_1 - theta (acting stops in V's kappa, nu, rest; Tq the hinge moments
+    driving D up, ``rhs_torques``, or empty)."""
     T = V[V_KAPPA, 0] * (D - V[V_REST, 0])
     if damped:
         T += V[V_NU, 0] * rate
+    if Tq.shape[0] > 0:
+        T -= Tq[0]
     return float(T)
 
 
@@ -220,16 +226,19 @@ def base_solve(V: Arr, geo: Chords, th: float, G: Arr, K: Arr, f: Arr, rb: Arr, 
 
 
 @njit(cache=True)
-def base_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
+def base_accel(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
+) -> None:
     """Q'' (3n + 3) of the full model on a free base at y = [Q; Q'] into ``out`` (module
-    docstring); SX, SY the load suffix sums (N). O(n): three chain solves."""
+    docstring); SX, SY the load suffix sums (N), Tq the hinge moments (N m, ``rhs_torques``:
+    A^T Tq on the chain, -Tq_0 on the body's attitude). O(n): three chain solves."""
     n = V.shape[1]
     N = 3 * n + 3
     geo = _chords(V, y)
     ddelta = y[N + n : N + 2 * n] - y[N + 2 * n : N + 3 * n]
     th, dth = y[3 * n + 2], y[N + 3 * n + 2]
     f = np.empty((3, n))
-    full_forces(V, chain_state(y, 3 * n), geo[0], geo[1], has_load, SX, SY, damped, f)
+    full_forces(V, chain_state(y, 3 * n), geo[0], geo[1], has_load, SX, SY, Tq, damped, f)
     shift = V[V_KAPPA, 0] * th + (V[V_NU, 0] * dth if damped else 0.0)
     f[0, 0] += shift  # hinge 0 measured from the body: D_0 - theta
     f[1, 0] += shift
@@ -242,7 +251,7 @@ def base_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, o
     mch = body_value(V, CHAIN_MASS)
     tx = Fx - qx + mch * w2 * rx
     ty = Fy - qy + mch * w2 * ry
-    T0 = hinge0_moment(V, y[0] + y[n] - th, y[N] + y[N + n] - dth, damped)
+    T0 = hinge0_moment(V, y[0] + y[n] - th, y[N] + y[N + n] - dth, damped, Tq)
     rb = np.array([tx, ty, T0 - ry * (Fx - qx) + rx * (Fy - qy)])
     G = np.empty((2, 3 * n))
     K = field_responses(V, geo, G)
@@ -268,11 +277,20 @@ def base_unit_responses(V: Arr, y: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def base_accel_locked(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+    V: Arr,
+    y: Arr,
+    has_load: bool,
+    SX: Arr,
+    SY: Arr,
+    Tq: Arr,
+    damped: bool,
+    locks: Ints,
+    out: Arr,
+    lam: Arr,
 ) -> None:
     """Q'' with the hinges ``locks`` held (multipliers into ``lam``, N m); O(n m)."""
     n = V.shape[1]
-    base_accel(V, y, has_load, SX, SY, damped, out)
+    base_accel(V, y, has_load, SX, SY, Tq, damped, out)
     m = locks.shape[0]
     if m == 0:
         return
@@ -282,17 +300,36 @@ def base_accel_locked(
 
 
 @njit(cache=True)
+def rhs_torques(t: float, y: Arr, P: Arr, L: Arr) -> Pair:
+    """(Tq, rates) at t of a body's state y = [Q; Q'] (the chain's [phi; alpha; beta; ..]
+    first in Q, the attitude theta last): the hinge moments of L's hinge rows (N m, positive
+    driving D_k up; ``loads.applied_torques``) at the hinge rates a_k Q' (rad/s), hinge 0's
+    from the body's theta'; both empty when no hinge row acts at t (``kernels.
+    hinge_moments_at`` with hinge 0 from the body). O(n)."""
+    n = P.shape[1]
+    T, C = hinge_torques(L, t, n)
+    if T.shape[0] == 0:
+        return T, T
+    v = y[y.shape[0] // 2 :]
+    rates = hinge_rates(v, n, v.shape[0] - 1)
+    return applied_torques(T, C, rates), rates
+
+
+@njit(cache=True)
 def base_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the full model on a free base (compiled integrators' right-hand side)."""
     has_load, SX, SY = rhs_start(t, y, P, L, out)
-    base_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[3 * P.shape[1] + 3 :])
+    Tq = rhs_torques(t, y, P, L)[0]
+    base_accel(P, y, has_load, SX, SY, Tq, S[0] != 0.0, out[3 * P.shape[1] + 3 :])
 
 
 @njit(cache=True)
 def base_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' with the hinges of S held (``deployment.lock_scalars``); O(n m)."""
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
-    base_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * P.shape[1] + 3 :], lam)
+    Tq = rhs_torques(t, y, P, L)[0]
+    acc = out[3 * P.shape[1] + 3 :]
+    base_accel_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, locks, acc, lam)
 
 
 @njit(cache=True)
@@ -326,8 +363,8 @@ def momentum(V: Arr, y: Arr) -> tuple[float, float]:
 @njit(cache=True)
 def base_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) into out[:3]: T (J) the whole system's kinetic energy (module
-    docstring), P_ext = Q . phi' + F . v_0 (W), P_diss the dampers' power with hinge 0's rate
-    from the body (W). O(n)."""
+    docstring), P_ext = Q . phi' + F . v_0 + sum_k Tq_k dD_k/dt (W), P_diss the dampers' power
+    (W), hinge 0's rate from the body. O(n)."""
     n = P.shape[1]
     v = y[3 * n + 3 :]
     full_mechanics(t, chain_state(y, 3 * n), P, S, M, L, out)
@@ -343,6 +380,9 @@ def base_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -
     SY = np.empty(n)
     if load_sums(L, t, SX, SY):
         out[1] += SX[0] * v0x + SY[0] * v0y
+    r = v[0] + v[n]  # hinge 0's rate from a pin, as full_mechanics books it
+    T, C = hinge_torques(L, t, n)
+    if T.shape[0] > 0:  # hinge 0's moment power from the body in place of the pin's
+        out[1] += (T[0] - C[0] * (r - dth)) * (r - dth) - (T[0] - C[0] * r) * r
     if S[0] != 0.0:
-        r = v[0] + v[n]
         out[2] += P[V_NU, 0] * ((r - dth) ** 2 - r * r)

@@ -3,7 +3,9 @@
 API: ``banded_constants`` (once per chain), ``reduced_solve`` (phi'' and gamma at a state
 y = [phi; phi'] into out = (phi'', gamma)), ``reduced_solve_work`` (the same with a reusable
 work array and a method choice), ``reduced_accel`` (phi'' only, the argument list of
-``kernels.full_accel`` with Cst in place of V), ``bending_at`` (Python convenience).
+``kernels.full_accel`` with Cst in place of V), ``bending_at`` (Python convenience). Each
+takes the hinge moments ``Tq`` (N m, empty for none; ``kernels`` module docstring) right
+after the load sums: their generalized force A^T Tq joins the right-hand sides r_p, r_g.
 
 The dense route (``kernels.reduced_accel``, ``ReducedSystem.recover_bending``) eliminates the
 bending angles first, M_r = M_pp - K_pg B^-1 M_gp, which is a dense n x n matrix (O(n^2) to
@@ -76,6 +78,8 @@ from rodval.models.assembly.kernels import (
     Arr,
     Pair,
     constant_rows,
+    hinge_moments_at,
+    hinge_moments_into,
     rhs_head,
 )
 from rodval.models.assembly.paper_matrices import DEFAULT_VARIANT, chain_constants
@@ -84,16 +88,18 @@ from rodval.models.bending import reduced_band_lu as lu
 
 @njit(cache=True)
 def reduced_forces(
-    Cst: Arr, y: Arr, c: Arr, s: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, f: Arr
+    Cst: Arr, y: Arr, geo: Pair, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, f: Arr
 ) -> None:
     """Right-hand sides (N m) at y = [phi; phi'] into the rows f (3, n): f[0] = r_p = Q - G_pp
     phi'^2 - C_pp phi' - K_pp phi, f[1] = r_alpha, f[2] = r_beta, with r_g = -(G_gp phi'^2 +
-    C_gp phi' + K_gp phi) (C only when ``damped``).
+    C_gp phi' + K_gp phi) (C only when ``damped``), plus A^T Tq (the hinge moments, N m;
+    empty: none). geo = (cos phi, sin phi).
 
     One pass root to tip (the hinge springs and dampers, kernels.hinge_forces with alpha =
     beta = 0; the prefix sums of G_pp and G_pa^T, kernels.gpp_times and upper_t_times) and
     one back (the suffix sums of G_pp, the load), each sum in the order of those kernels.
     O(n)."""
+    c, s = geo
     n = Cst.shape[1]
     phi, dphi = y[:n], y[n:]
     fp, fa, fb = f[0], f[1], f[2]
@@ -136,6 +142,7 @@ def reduced_forces(
         ss += outer[k] * l[k] * s[k] * x
         if has_load:
             fp[k] += l[k] * (c[k] * SY[k] - s[k] * SX[k])
+    hinge_moments_into(Tq, f)
 
 
 #: Magnitudes below this are set to zero in the sweep (physical units: N, rad, rad/s^2). Far
@@ -334,16 +341,16 @@ METHOD_AUTO, METHOD_BAND, METHOD_SWEEP = 0, 1, 2
 
 @njit(cache=True)
 def reduced_solve(
-    Cst: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Pair
+    Cst: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Pair
 ) -> bool:
     """phi'' (rad/s^2, n) and gamma = [alpha; beta] (rad, 2n) into out = (phi'', gamma) of
     the reduced model at state y = [phi; phi'] (module docstring: the sweep, with the banded
     LU as fallback). ``Cst`` from ``banded_constants``; SX, SY are the load suffix sums (N,
-    see loads.load_sums), used when ``has_load``; ``damped`` adds the hinge dampers. O(n)
-    time and memory per evaluation. Returns False if the system is singular (outputs then
-    hold NaN)."""
+    see load_table.load_sums), used when ``has_load``; Tq the hinge moments (N m, empty: none);
+    ``damped`` adds the hinge dampers. O(n) time and memory per evaluation. Returns False if
+    the system is singular (outputs then hold NaN)."""
     work = np.empty(sweep_work_size(Cst.shape[1]))  # the fallback allocates its own
-    return reduced_solve_work(Cst, y, has_load, SX, SY, damped, out, work, METHOD_AUTO)
+    return reduced_solve_work(Cst, y, has_load, SX, SY, Tq, damped, out, work, METHOD_AUTO)
 
 
 @njit(cache=True)
@@ -368,6 +375,7 @@ def reduced_solve_work(
     has_load: bool,
     SX: Arr,
     SY: Arr,
+    Tq: Arr,
     damped: bool,
     out: Pair,
     work: Arr,
@@ -391,7 +399,7 @@ def reduced_solve_work(
             c[k] = np.cos(p)
             s[k] = np.sin(p)
     f = work[2 * n : 5 * n].reshape((3, n))
-    reduced_forces(Cst, y, c, s, has_load, SX, SY, damped, f)
+    reduced_forces(Cst, y, (c, s), has_load, SX, SY, Tq, damped, f)
     rest = work[7 * n :]
     if method != METHOD_BAND:
         if solve_sweep(Cst, c, s, f, rest[: 12 * n].reshape((n, 3, 4)), out):
@@ -436,11 +444,13 @@ def bending_at(
     phi: np.ndarray,
     dphi: np.ndarray,
     sums: tuple[np.ndarray, np.ndarray] | None,
+    Tq: np.ndarray,
     damped: bool,
     method: int = METHOD_AUTO,
 ) -> Pair:
-    """(phi'', gamma) at one state, ``sums`` = LoadSet.suffix_sums(t) (None: no load).
-    The O(n) replacement of ReducedSystem.recover_bending (which returns gamma)."""
+    """(phi'', gamma) at one state, ``sums`` = LoadSet.suffix_sums(t) (None: no load), Tq
+    the hinge moments (N m, length 0: none). The O(n) replacement of
+    ReducedSystem.recover_bending (which returns gamma)."""
     n = phi.shape[0]
     phi = np.ascontiguousarray(phi, dtype=np.float64)
     dphi = np.ascontiguousarray(dphi, dtype=np.float64)
@@ -451,17 +461,19 @@ def bending_at(
     ddphi, gamma = np.empty(n), np.empty(2 * n)
     work = np.empty(sweep_work_size(n))  # the banded LU, if needed, allocates its own
     y = np.concatenate((phi, dphi))
-    reduced_solve_work(Cst, y, sums is not None, SX, SY, bool(damped), (ddphi, gamma), work, method)
+    Tq = np.ascontiguousarray(Tq, dtype=np.float64)
+    sol = (ddphi, gamma)
+    reduced_solve_work(Cst, y, sums is not None, SX, SY, Tq, bool(damped), sol, work, method)
     return ddphi, gamma
 
 
 @njit(cache=True)
 def reduced_accel(
-    Cst: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr
+    Cst: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
 ) -> None:
     """phi'' at y = [phi; phi'] into ``out`` (the argument convention of
     ``kernels.full_accel``); O(n) time and memory."""
-    reduced_solve(Cst, y, has_load, SX, SY, damped, (out, np.empty(2 * Cst.shape[1])))
+    reduced_solve(Cst, y, has_load, SX, SY, Tq, damped, (out, np.empty(2 * Cst.shape[1])))
 
 
 @njit(cache=True)
@@ -494,11 +506,14 @@ def rhs_work(t: float, y: Arr, M: Arr, L: Arr, out: Arr) -> tuple[bool, Arr, Arr
 
 @njit(cache=True)
 def reduced_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
-    """y' of the reduced model (compiled integrators' right-hand side, loads from table L);
-    O(n) time and memory per evaluation, no allocation: ``M[0, 0]`` is its work space
-    (``rhs_work_size``; ``ReducedSystem.compiled_scratch``), whose last slot keeps the largest
-    |alpha|, |beta| of the solves (the run's small-bending check, at no extra solve)."""
+    """y' of the reduced model (compiled integrators' right-hand side, loads and hinge moments
+    from table L, the moments at the chord rates); O(n) time and memory per evaluation, no
+    allocation without hinge moments: ``M[0, 0]`` is its work space (``rhs_work_size``;
+    ``ReducedSystem.compiled_scratch``), whose last slot keeps the largest |alpha|, |beta| of
+    the solves (the run's small-bending check, at no extra solve)."""
+    half = y.shape[0] // 2
     has_load, SX, SY, gamma, work = rhs_work(t, y, M, L, out)
-    sol = (out[y.shape[0] // 2 :], gamma)
-    reduced_solve_work(P, y, has_load, SX, SY, S[0] != 0.0, sol, work, METHOD_AUTO)
+    Tq = hinge_moments_at(L, t, y[half:], half)[0]
+    sol = (out[half:], gamma)
+    reduced_solve_work(P, y, has_load, SX, SY, Tq, S[0] != 0.0, sol, work, METHOD_AUTO)
     M[0, 0, -1] = track_bending(gamma, M[0, 0, -1])

@@ -18,6 +18,9 @@ Conventions (docs/deployment_native.md has the derivations):
   unknown of the same linear solve as phi''. A locked hinge adds the unknown lambda_k and the
   equation a_g^T gamma = angle_k - a_p^T phi to that solve (the kappa_k -> infinity limit of
   the reduced model); solved again by superposition, m + 1 O(n) sweeps.
+* Motors and rate dampers (``Tq``, ``kernels`` module docstring) act in the free
+  accelerations u_0 (the reduced model: in the first solve's right-hand sides), before the
+  superposition: a held hinge's multiplier holds its motor too.
 """
 
 from __future__ import annotations
@@ -34,9 +37,12 @@ from rodval.models.assembly.kernels import (
     V_PPDIAG,
     Arr,
     Pair,
+    add_moment,
     full_accel,
     full_solve,
     generator_solve,
+    hinge_moments_at,
+    hinge_of,
     rhs_start,
 )
 from rodval.models.bending.reduced_band_lu import band_size, solve_band
@@ -59,24 +65,8 @@ SIMULTANEOUS_RAD = 1e-8
 @njit(cache=True)
 def unit_moment(k: int, f: Arr) -> None:
     """f += a_k (generalized force of a unit moment at hinge k) on the force rows f (phi,
-    alpha, beta, ...: ``kernels.full_forces``)."""
-    f[0, k] += 1.0
-    f[1, k] += 1.0
-    if k > 0:
-        f[0, k - 1] -= 1.0
-        f[2, k - 1] -= 1.0
-
-
-@njit(cache=True)
-def _hinge_of(v: Arr, k: int, n: int, theta: int = -1) -> float:
-    """a_k . v for v = [phi; alpha; beta]-shaped (3n); ``theta`` >= 0: the index of a free
-    base's attitude in v, which hinge 0 is measured from (``free_base``)."""
-    r = v[k] + v[n + k]
-    if k > 0:
-        r -= v[k - 1] + v[2 * n + k - 1]
-    elif theta >= 0:
-        r -= v[theta]
-    return float(r)
+    alpha, beta, ...: ``kernels.full_forces``; ``kernels.add_moment``)."""
+    add_moment(k, 1.0, f)
 
 
 @njit(cache=True)
@@ -125,11 +115,21 @@ def full_unit_responses(V: Arr, phi: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def full_accel_locked(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+    V: Arr,
+    y: Arr,
+    has_load: bool,
+    SX: Arr,
+    SY: Arr,
+    Tq: Arr,
+    damped: bool,
+    locks: Ints,
+    out: Arr,
+    lam: Arr,
 ) -> None:
     """q'' (3n) of the full model with the hinges ``locks`` held (a_k^T q'' = 0) into
-    ``out``, their multipliers (N m, generalized force a_k lambda_k) into ``lam``; O(n m)."""
-    full_accel(V, y, has_load, SX, SY, damped, out)  # the free accelerations, O(n)
+    ``out``, their multipliers (N m, generalized force a_k lambda_k) into ``lam``; the hinge
+    moments Tq (N m, empty: none) in the free accelerations. O(n m)."""
+    full_accel(V, y, has_load, SX, SY, Tq, damped, out)  # the free accelerations, O(n)
     if locks.shape[0] > 0:
         U = np.empty((locks.shape[0], out.shape[0]))
         full_unit_responses(V, y[: V.shape[1]], locks, U)
@@ -141,14 +141,14 @@ def superpose(out: Arr, U: Arr, locks: Ints, n: int, lam: Arr, theta: int = -1) 
     """q'' = u_0 + sum_j lambda_j u_j with the hinges ``locks`` held: ``out`` holds the free
     accelerations u_0 on entry, U[j] = M^-1 a_{locks[j]}; the capacitance system
     (A_L U) lambda = -A_L u_0 (m x m) gives the multipliers (N m) into ``lam``. O(N m + m^3)
-    for N coordinates ordered [phi; alpha; beta; ...] (``theta``: see ``_hinge_of``)."""
+    for N coordinates ordered [phi; alpha; beta; ...] (``theta``: see ``kernels.hinge_of``)."""
     m = locks.shape[0]
     G = np.empty((m, m))
     r = np.empty(m)
     for i in range(m):
-        r[i] = -_hinge_of(out, locks[i], n, theta)
+        r[i] = -hinge_of(out, locks[i], n, theta)
         for j in range(m):
-            G[i, j] = _hinge_of(U[j], locks[i], n, theta)
+            G[i, j] = hinge_of(U[j], locks[i], n, theta)
     x = small_solve(G, r)
     for j in range(m):
         lam[j] = x[j]
@@ -171,6 +171,7 @@ def reduced_solve_locked(
     has_load: bool,
     SX: Arr,
     SY: Arr,
+    Tq: Arr,
     damped: bool,
     held: tuple[Ints, Arr],
     out: Pair,
@@ -179,7 +180,8 @@ def reduced_solve_locked(
     """phi'' (n) and gamma (2n) into out = (phi'', gamma), the multipliers lambda (m) into
     ``lam`` of the reduced model at y = [phi; phi'] with the hinges held = (locks, angles)
     held at their angles: D_k = a_p^T phi + a_g^T gamma = angle_k exactly (an algebraic
-    equation of the solve); O(n m). False if a solve is singular."""
+    equation of the solve); the hinge moments Tq (N m, empty: none) in the first solve's
+    right-hand sides. O(n m). False if a solve is singular."""
     locks, angles = held
     ddphi, gamma = out
     n = Cst.shape[1]
@@ -188,7 +190,7 @@ def reduced_solve_locked(
     c = np.cos(phi)
     s = np.sin(phi)
     f = np.empty((3, n))
-    reduced_forces(Cst, y, c, s, has_load, SX, SY, damped, f)
+    reduced_forces(Cst, y, (c, s), has_load, SX, SY, Tq, damped, f)
     T = np.empty((n, 3, 4))
     if not _reduced_linear(Cst, c, s, f, T, out):
         return False
@@ -308,23 +310,28 @@ def locked_head(
 
 @njit(cache=True)
 def full_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
-    """y' of the full model with the hinges of S held (``full_accel_locked``); O(n m)."""
+    """y' of the full model with the hinges of S held (``full_accel_locked``), the hinge
+    moments at the rates a_k q' (``kernels.hinge_moments_at``); O(n m)."""
+    n = P.shape[1]
     SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
-    full_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[3 * P.shape[1] :], lam)
+    Tq = hinge_moments_at(L, t, y[3 * n :], n)[0]
+    full_accel_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, locks, out[3 * n :], lam)
 
 
 @njit(cache=True)
 def reduced_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the reduced model with the hinges of S held at their angles
     (``reduced_solve_locked``); gamma and the largest |gamma| kept in the work space M[0, 0]
-    as ``reduced_banded.reduced_rhs`` does; a singular solve gives NaN (the run ends as
-    diverged). O(n m)."""
+    as ``reduced_banded.reduced_rhs`` does, the hinge moments at the chord rates; a singular
+    solve gives NaN (the run ends as diverged). O(n m)."""
     half = y.shape[0] // 2
     has_load, SX, SY, gamma, _ = rhs_work(t, y, M, L, out)
+    Tq = hinge_moments_at(L, t, y[half:], half)[0]
     held = held_hinges(S)
     lam = np.empty(held[0].shape[0])
     ddphi = np.empty(half)
-    if not reduced_solve_locked(P, y, has_load, SX, SY, S[0] != 0.0, held, (ddphi, gamma), lam):
+    sol = (ddphi, gamma)
+    if not reduced_solve_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, held, sol, lam):
         ddphi[:] = np.nan
     for i in range(half):  # a loop: a slice assignment compiles numba's shape check
         out[half + i] = ddphi[i]

@@ -1,17 +1,19 @@
 """A native system's hinge items as events (docs/deployment_native.md): the current mode's
-latches and stops as rows (``event_rows``: the Python event functions and the compiled event
-table read them in one order) and what one does when it fires (``switch``: a stop switching, a
-latch locking with its plastic impact, ``lock_records.lock_record``). The system is a
+latches and stops as rows (``event_rows``: the Python event functions, ``event_specs``, and
+the compiled event table read them in one order) and what one does when it fires
+(``switch``: a stop switching, a latch locking with its plastic impact,
+``lock_records.lock_record``). The system is a
 ``rodval.models.systems.paper_system.PaperSystem`` (which imports this module)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, NamedTuple
 
 import numpy as np
 
 from rodval.models.hinge_items import deployment, lock_records
-from rodval.solvers.system import EventRecord
+from rodval.solvers.system import EventRecord, EventSpec
 
 
 class EventRow(NamedTuple):
@@ -43,6 +45,27 @@ def event_rows(system: Any) -> tuple[EventRow, ...]:
         direction = -entering if system.stop_active[i] else entering
         rows.append(EventRow("stop", i, st.hinge, st.angle, direction))
     return tuple(rows)
+
+
+def _hinge_crossing(system: Any, hinge: int, angle: float) -> Callable[[float, np.ndarray], float]:
+    """The event function g(t, y) = D_hinge - angle (rad) of a latch or stop."""
+
+    def g(t: float, y: np.ndarray) -> float:
+        return float(system.hinge_angles_at(t, y)[hinge] - angle)
+
+    return g
+
+
+def event_specs(system: Any) -> tuple[EventSpec, ...]:
+    """The current mode's events (``event_rows``) as g(t, y) = D_k - angle."""
+    return tuple(
+        EventSpec(
+            g=_hinge_crossing(system, r.hinge, r.angle),
+            direction=r.direction,
+            label=f"{r.kind} hinge {r.hinge}",
+        )
+        for r in event_rows(system)
+    )
 
 
 def switch(system: Any, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:

@@ -10,9 +10,10 @@ lock impulse"):
   counter-clockwise positive);
 * ``impulse_momentum``: the same from the outboard part's angular momentum about the hinge
   node k, H_out, whose rate is lambda plus the finite moments on it,
-  M_fin = -(hinge k's spring, damper and acting stops) - v_k x p_out + the moments of the
-  loads on nodes beyond k about node k (v_k: node k's velocity, p_out: the outboard linear
-  momentum); the window mean of H_out(tau) - H_out(0-) - int_0^tau M_fin ds.
+  M_fin = -(hinge k's spring, damper and acting stops) + Tq_k (hinge k's motors and rate
+  dampers) - v_k x p_out + the moments of the loads on nodes beyond k about node k (v_k: node
+  k's velocity, p_out: the outboard linear momentum); the window mean of H_out(tau) -
+  H_out(0-) - int_0^tau M_fin ds.
 
 Both use the model's velocity field (its ``rod_momenta_at``); they agree when the
 model's equations are the Newton-Euler equations of that field, and the gap is reported.
@@ -69,8 +70,8 @@ def energy_parts(system: PaperSystem, t: float, y: np.ndarray) -> tuple[float, f
 
 def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[float, ...]:
     """(lambda (N m): the held hinge k's reaction on the outboard rod; H_out (N m s); M_fin
-    (N m); P_ext, P_diss (W): the power of the loads and of the dampers (``power``)) at one
-    state in the current mode (see the module docstring). O(n)."""
+    (N m); P_ext, P_diss (W): the power of the loads, motors and rate dampers and of the hinge
+    dampers (``power``)) at one state in the current mode (see the module docstring). O(n)."""
     lam = system.accel_locked(t, y)[1]
     held = [int(h) for h in system._lock_h]
     H, p_out, r, v_k = outboard_momentum(system, y, k)
@@ -78,6 +79,9 @@ def window_terms(system: PaperSystem, t: float, y: np.ndarray, k: int) -> tuple[
     D = system.hinge_angles_at(t, y)[k]
     rate = system.hinge_rates(y)[k]
     finite = -(ch.kappa[k] * (D - ch.rest_angle[k]) + ch.nu[k] * rate) - float(cross(v_k, p_out))
+    Tq = system.torques_at(t, y)
+    if Tq.size:
+        finite += float(Tq[k])
     forces = system.loads.nodal(t)
     if forces is not None:
         X, Y = forces  # at nodes 1..n
@@ -144,6 +148,10 @@ def _window_rows(system: PaperSystem, times: np.ndarray, Y: np.ndarray, k: int) 
         finite[i] += float(np.sum(arm[:, 0] * Yf[k:] - arm[:, 1] * X[k:]))
         sums = system.loads.suffix_sums(float(t))
         p_ext[i] = float(generalized_forces(system.l, phi[i], *sums) @ dphi[i])
+    if system.loads.torques:  # motors and rate dampers: Tq_k on the outboard part, power
+        Tq = np.array([system.loads.hinge_moments(float(t), r) for t, r in zip(times, rates)])
+        finite += Tq[:, k]
+        p_ext += np.sum(Tq * rates, axis=-1)
     if system.damped:
         cb = 4.0 * ch.bending_damping / ch.l
         bending = cb * (dalpha * dalpha + dalpha * dbeta + dbeta * dbeta)

@@ -5,7 +5,10 @@ Coordinates q = [phi (n); g_0 (n); g_1 (n); ...; g_p (n)] (g_0 = alpha, g_1 = be
 component-major, so alpha, beta sit where the paper's model has them), state y = [q; q'],
 N = n (p + 2) coordinates. docs/model.md ("The model ladder") derives every term:
 
-* the generalized forces f = [Q; 0] - dPi/dq - C q' - c(q, q'), where the velocity terms
+* the generalized forces f = [Q; 0] + A^T Tq - dPi/dq - C q' - c(q, q'), where Tq are the
+  motors' and rate dampers' moments across the hinges (N m, positive driving D_k up, on the
+  rows the hinge springs act on: phi, alpha, beta; at the hinge rates a_k q' the hinge
+  dampers see, ``kernels.hinge_moments_at``) and the velocity terms
   c_i = sum int dm (dr/dq_i) . a_v are accumulated along the chain (a_v: the acceleration of
   each material point at q'' = 0; node accelerations by a forward sweep, the inertia of
   everything beyond a node by a backward one): O(n p^2);
@@ -31,10 +34,12 @@ from rodval.models.assembly.kernels import (
     V_NU,
     Arr,
     compiled_damper_power,
+    external_power,
     generator_solve,
     hinge_forces,
+    hinge_moments_at,
+    hinge_moments_into,
     load_moments,
-    load_power,
     rhs_start,
     schur_generators,
     upper_t_times,
@@ -160,10 +165,12 @@ def _velocity_terms(
 
 @njit(cache=True)
 def ladder_forces(
-    V: Arr, y: Arr, geo: Geometry, has_load: bool, SX: Arr, SY: Arr, damped: bool, f: Arr
+    V: Arr, y: Arr, geo: Geometry, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, f: Arr
 ) -> None:
-    """f = [Q; 0] - dPi/dq - C q' - c(q, q') (N m) into the rows f (p+2, n: phi, then g),
-    ``geo`` the ``ladder_geometry`` at q; O(n p^2)."""
+    """f = [Q; 0] + A^T Tq - dPi/dq - C q' - c(q, q') (N m) into the rows f (p+2, n: phi,
+    then g), ``geo`` the ``ladder_geometry`` at q; Tq: the hinge moments (N m, n, or empty for
+    none) on the rows the hinge springs act on (phi, alpha, beta:
+    ``kernels.hinge_moments_into``). O(n p^2)."""
     c, s, g, A, Pg = geo
     n = c.shape[0]
     P1 = g.shape[0]
@@ -183,6 +190,7 @@ def ladder_forces(
     _velocity_terms(V, c, s, v[:n], dg, A, Pg, fp, fg)
     if has_load:
         load_moments(V, c, s, SX, SY, fp)
+    hinge_moments_into(Tq, f)
 
 
 @njit(cache=True)
@@ -238,12 +246,15 @@ def shape_count(V: Arr) -> int:
 
 
 @njit(cache=True)
-def ladder_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
+def ladder_accel(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
+) -> None:
     """Accelerations q'' (N) of the ladder at y = [q; q'] into ``out``; SX, SY: the load
-    suffix sums (N) when ``has_load``. O(n p^2) time, O(n p) memory."""
+    suffix sums (N) when ``has_load``; Tq: the hinge moments (N m, empty for none). O(n p^2)
+    time, O(n p) memory."""
     geo = ladder_geometry(V, y)
     f = np.empty((shape_count(V) + 1, V.shape[1]))
-    ladder_forces(V, y, geo, has_load, SX, SY, damped, f)
+    ladder_forces(V, y, geo, has_load, SX, SY, Tq, damped, f)
     ladder_solve(V, geo, f, out)
 
 
@@ -260,11 +271,21 @@ def ladder_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def ladder_accel_locked(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+    V: Arr,
+    y: Arr,
+    has_load: bool,
+    SX: Arr,
+    SY: Arr,
+    Tq: Arr,
+    damped: bool,
+    locks: Ints,
+    out: Arr,
+    lam: Arr,
 ) -> None:
     """q'' (N) with the hinges ``locks`` held into ``out``, their multipliers (N m) into
-    ``lam`` (``deployment.superpose``); O(n p^2 m)."""
-    ladder_accel(V, y, has_load, SX, SY, damped, out)
+    ``lam`` (``deployment.superpose``: the hinge moments Tq act in the free accelerations, so
+    a held hinge's multiplier holds its motor too); O(n p^2 m)."""
+    ladder_accel(V, y, has_load, SX, SY, Tq, damped, out)
     if locks.shape[0] > 0:
         U = np.empty((locks.shape[0], out.shape[0]))
         ladder_unit_responses(V, y[: out.shape[0]], locks, U)
@@ -273,17 +294,21 @@ def ladder_accel_locked(
 
 @njit(cache=True)
 def ladder_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
-    """y' of the ladder (compiled integrators' right-hand side, loads from table L)."""
+    """y' of the ladder (compiled integrators' right-hand side, loads and hinge moments from
+    table L: ``kernels.hinge_moments_at`` on the hinge rates a_k q' its dampers see)."""
+    half = y.shape[0] // 2
     has_load, SX, SY = rhs_start(t, y, P, L, out)
-    ladder_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[y.shape[0] // 2 :])
+    Tq = hinge_moments_at(L, t, y[half:], P.shape[1])[0]
+    ladder_accel(P, y, has_load, SX, SY, Tq, S[0] != 0.0, out[half:])
 
 
 @njit(cache=True)
 def ladder_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the ladder with the hinges of S held (``deployment.lock_scalars``)."""
-    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
     half = y.shape[0] // 2
-    ladder_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[half:], lam)
+    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
+    Tq = hinge_moments_at(L, t, y[half:], P.shape[1])[0]
+    ladder_accel_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, locks, out[half:], lam)
 
 
 @njit(cache=True)
@@ -336,11 +361,12 @@ def ladder_damper_power(V: Arr, S: Arr, y: Arr) -> float:
 
 @njit(cache=True)
 def ladder_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
-    """(T, P_ext, P_diss) of the ladder into out[:3]: ``ladder_kinetic`` (J), the load power
-    (W) and the dampers' power: hinges sum nu (dD/dt)^2 plus the rods' g'^T C g' (W; 0 unless
+    """(T, P_ext, P_diss) of the ladder into out[:3]: ``ladder_kinetic`` (J), the external
+    power (W: the loads' and the hinge moments' sum Tq_k dD_k/dt, ``kernels.external_power``)
+    and the dampers' power: hinges sum nu (dD/dt)^2 plus the rods' g'^T C g' (W; 0 unless
     S[0], the damped flag). O(n p^2)."""
     n = P.shape[1]
     phi, v = y[:n], y[y.shape[0] // 2 :]
     out[0] = ladder_kinetic(P, y)
-    out[1] = load_power(P, np.cos(phi), np.sin(phi), v[:n], L, t)
+    out[1] = external_power(P, np.cos(phi), np.sin(phi), v, L, t)
     out[2] = ladder_damper_power(P, S, y)

@@ -9,7 +9,8 @@ bending coordinates zero (``to_ladder``), runs the ladder's kernel, and takes th
 coordinates back (``from_ladder``). With zero mobility the ladder's bending accelerations are
 exactly 0, so the bending coordinates the ladder sees stay zero, and nothing of the rigid
 chain's equations is written twice: M_pp(phi) phi'' = Q - G_pp phi'^2 - A^T (kappa (D - rest)
-+ nu D'), D_k = phi_k - phi_{k-1}, with every lock, stop and base of the ladder.
++ nu D' - Tq), D_k = phi_k - phi_{k-1} (Tq: the motors' and rate dampers' moments, N m, at
+the chord rates D'), with every lock, stop and base of the ladder.
 Cost: the ladder's O(n) evaluation on 3 n coordinates plus two copies of the state.
 """
 
@@ -18,12 +19,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.models.assembly.kernels import Arr, rhs_start
-from rodval.models.hinge_items.deployment import Ints, hinge_events, locked_head
+from rodval.models.assembly.kernels import Arr
+from rodval.models.hinge_items.deployment import Ints, hinge_events
 from rodval.models.kinematics.ladder_kernels import (
     ladder_accel,
     ladder_accel_locked,
     ladder_mechanics,
+    ladder_rhs_locked,
     ladder_unit_responses,
 )
 
@@ -69,12 +71,14 @@ def state_from_ladder(z: Arr, n: int, out: Arr) -> None:
 
 
 @njit(cache=True)
-def rigid_accel(V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, out: Arr) -> None:
+def rigid_accel(
+    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
+) -> None:
     """phi'' (n) of the pinned rigid chain at y = [phi; phi'] into ``out`` (``ladder_accel``
-    on ``rigid_constants``); O(n)."""
+    on ``rigid_constants``; Tq the hinge moments, N m, empty for none); O(n)."""
     n = V.shape[1]
     acc = np.empty(3 * n)
-    ladder_accel(V, to_ladder(y, n), has_load, SX, SY, damped, acc)
+    ladder_accel(V, to_ladder(y, n), has_load, SX, SY, Tq, damped, acc)
     out[:] = acc[:n]
 
 
@@ -91,34 +95,46 @@ def rigid_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def rigid_accel_locked(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, damped: bool, locks: Ints, out: Arr, lam: Arr
+    V: Arr,
+    y: Arr,
+    has_load: bool,
+    SX: Arr,
+    SY: Arr,
+    Tq: Arr,
+    damped: bool,
+    locks: Ints,
+    out: Arr,
+    lam: Arr,
 ) -> None:
     """phi'' (n) with the hinges ``locks`` held (D_k'' = 0) into ``out``, their multipliers
-    (N m) into ``lam`` (``ladder_accel_locked``); O(n m)."""
+    (N m) into ``lam`` (``ladder_accel_locked``, Tq the hinge moments); O(n m)."""
     n = V.shape[1]
     acc = np.empty(3 * n)
-    ladder_accel_locked(V, to_ladder(y, n), has_load, SX, SY, damped, locks, acc, lam)
+    ladder_accel_locked(V, to_ladder(y, n), has_load, SX, SY, Tq, damped, locks, acc, lam)
     out[:] = acc[:n]
 
 
 @njit(cache=True)
 def rigid_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
-    """y' of the pinned rigid chain (compiled integrators' right-hand side)."""
-    has_load, SX, SY = rhs_start(t, y, P, L, out)
-    rigid_accel(P, y, has_load, SX, SY, S[0] != 0.0, out[P.shape[1] :])
+    """y' of the pinned rigid chain (compiled integrators' right-hand side) with the hinges
+    of S held, if any (``deployment.lock_scalars``; S = [damped]: none):
+    ``ladder_rhs_locked`` on the ladder's state, its hinge moments on the chord rates
+    phi'_k - phi'_{k-1}; with no hinge held it is ``ladder_rhs``'s arithmetic. O(n m)."""
+    z = to_ladder(y, P.shape[1])
+    dz = np.empty_like(z)
+    ladder_rhs_locked(t, z, P, S, M, L, dz)
+    state_from_ladder(dz, P.shape[1], out)
 
 
-@njit(cache=True)
-def rigid_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
-    """y' of the pinned rigid chain with the hinges of S held (``deployment.lock_scalars``)."""
-    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
-    rigid_accel_locked(P, y, has_load, SX, SY, S[0] != 0.0, locks, out[P.shape[1] :], lam)
+#: The right-hand side with hinges held: ``rigid_rhs``, which reads them from S.
+rigid_rhs_locked = rigid_rhs
 
 
 @njit(cache=True)
 def rigid_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """(T, P_ext, P_diss) of the pinned rigid chain into out[:3] (``ladder_mechanics``): T =
-    1/2 phi'^T M_pp phi' (J), the loads' power (W), the hinge dampers' sum nu (dD/dt)^2 (W)."""
+    1/2 phi'^T M_pp phi' (J), the loads' and hinge moments' power (W), the hinge dampers' sum
+    nu (dD/dt)^2 (W)."""
     ladder_mechanics(t, to_ladder(y, P.shape[1]), P, S, M, L, out)
 
 

@@ -22,6 +22,7 @@ from rodval.models.assembly.paper_matrices import (
     assemble_mass,
     convective_terms,
     hinge_matrix,
+    rate_damping_matrix,
 )
 from rodval.models.hinge_items import deployment
 from rodval.models.hinge_items.lock_records import plastic_jump
@@ -57,7 +58,8 @@ class FullSystem(PaperSystem):
         return kernels.full_constants(self.cc, self.chain)
 
     def forces(self, t: float, q: np.ndarray, v: np.ndarray, skj: np.ndarray) -> np.ndarray:
-        """Right-hand side f = [Q; 0; 0] - h - C q' - K q of M q'' = f (3n)."""
+        """Right-hand side f = [Q; 0; 0] + A^T Tq - h - C q' - K q of M q'' = f (3n), Tq the
+        motors' and rate dampers' hinge moments (``torque_forces``)."""
         n = self.n
         h_phi, h_gamma = convective_terms(self.cc, skj, v[:n], v[n : 2 * n], v[2 * n :])
         f: np.ndarray = self.rest - self.K @ q
@@ -68,6 +70,9 @@ class FullSystem(PaperSystem):
         Q = self.generalized_force(t, q[:n])
         if Q is not None:
             f[:n] += Q
+        tau = self.torque_forces(t, np.concatenate([q, v]))
+        if tau is not None:
+            f += tau
         return f
 
     def numpy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -121,6 +126,9 @@ class FullSystem(PaperSystem):
         dhdv[n : 2 * n, :n] = -2 * G_pa.T * dphi
         dhdv[2 * n :, :n] = 2 * G_pa.T * dphi
         dfdv = -dhdv - self.C if self.damped else -dhdv
+        rate_damping = rate_damping_matrix(self.loads.torques, t, n)
+        if rate_damping is not None:  # the torque items' rate coefficients
+            dfdv = dfdv - rate_damping
         J = np.zeros((6 * n, 6 * n))
         J[: 3 * n, 3 * n :] = np.eye(3 * n)
         J[3 * n :] = np.linalg.solve(M, np.hstack([dfdq, dfdv]))
@@ -139,8 +147,9 @@ class FullSystem(PaperSystem):
             SX, SY = (self._no_load, self._no_load) if sums is None else sums
             out = np.empty(3 * n)
             lam = np.empty(h.size)
+            Tq = self.torques_at(t, y)
             deployment.full_accel_locked(
-                self.V, y, sums is not None, SX, SY, self.damped, h, out, lam
+                self.V, y, sums is not None, SX, SY, Tq, self.damped, h, out, lam
             )
             return out, lam
         q, v = y[: 3 * n], y[3 * n :]

@@ -31,6 +31,7 @@ from rodval.models.assembly.paper_matrices import (
     convective_terms,
     hinge_matrix,
     quasi_static_bending,
+    rate_damping_matrix,
 )
 from rodval.models.bending import reduced_banded
 from rodval.models.hinge_items import deployment
@@ -82,6 +83,7 @@ class ReducedSystem(PaperSystem):
             sums is not None,
             np.ascontiguousarray(SX),
             np.ascontiguousarray(SY),
+            self.torques_at(t, y),
             self.damped,
             (out[n:], self._gamma),
             self._work,
@@ -153,8 +155,16 @@ class ReducedSystem(PaperSystem):
         G_r = cc.pp_scale * skj + d.P_diff @ G_pa.T
         return M_r, G_r, U, G_pa
 
+    def reduce(self, F: np.ndarray) -> np.ndarray:
+        """F_p - K_pg B^-1 F_g: generalized forces F (3n, ...) on q = [phi; alpha; beta] as
+        the reduced model's phi rows take them (the bending rows eliminated)."""
+        n, d = self.n, self._dense
+        reduced: np.ndarray = F[:n] - d.P_a @ F[n : 2 * n] - d.P_b @ F[2 * n :]
+        return reduced
+
     def forces(self, t: float, phi: np.ndarray, dphi: np.ndarray, G_r: np.ndarray) -> np.ndarray:
-        """f_r = Q - G_r phi'^2 - C_r phi' - K_r phi + rest_r of M_r phi'' = f_r (n)."""
+        """f_r = Q + reduce(A^T Tq) - G_r phi'^2 - C_r phi' - K_r phi + rest_r of M_r phi'' =
+        f_r (n), Tq the motors' and rate dampers' hinge moments (``torque_forces``)."""
         d = self._dense
         f: np.ndarray = d.rest_r - d.K_r @ phi - G_r @ (dphi * dphi)
         if self.damped:
@@ -162,6 +172,9 @@ class ReducedSystem(PaperSystem):
         Q = self.generalized_force(t, phi)
         if Q is not None:
             f += Q
+        tau = self.torque_forces(t, np.concatenate([phi, dphi]))
+        if tau is not None:
+            f += self.reduce(tau)
         return f
 
     def numpy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -190,6 +203,9 @@ class ReducedSystem(PaperSystem):
             SX, SY = sums
             dfdphi[np.arange(n), np.arange(n)] -= self.l * (np.sin(phi) * SY + np.cos(phi) * SX)
         dfdv = -2.0 * G_r * dphi - (d.C_r if self.damped else 0.0)
+        rate_damping = rate_damping_matrix(self.loads.torques, t, n)
+        if rate_damping is not None:  # the torque items' rate coefficients, on the chord rates
+            dfdv = dfdv - self.reduce(rate_damping[:, :n])
         J = np.zeros((2 * n, 2 * n))
         J[:n, n:] = np.eye(n)
         J[n:] = np.linalg.solve(M_r, np.hstack([dfdphi, dfdv]))
@@ -203,9 +219,9 @@ class ReducedSystem(PaperSystem):
         if self.locked:
             return self.solve_locked(t, y)[1]
         if self.kernel == "numba":
-            return reduced_banded.bending_at(
-                self.V, phi, dphi, self.loads.suffix_sums(t), self.damped
-            )[1]
+            sums = self.loads.suffix_sums(t)
+            Tq = self.torques_at(t, y)
+            return reduced_banded.bending_at(self.V, phi, dphi, sums, Tq, self.damped)[1]
         cc, d = self.cc, self._dense
         M_r, G_r, U, G_pa = self.reduced_matrices(phi)  # once: phi'' and gamma share them
         ddphi = np.linalg.solve(M_r, self.forces(t, phi, dphi, G_r))
@@ -218,6 +234,9 @@ class ReducedSystem(PaperSystem):
         r += d.K_gp @ phi - d.rest_g
         if self.damped:
             r += d.C_gp @ dphi
+        tau = self.torque_forces(t, y)
+        if tau is not None:
+            r -= tau[n:]
         gamma: np.ndarray = -d.B_inv @ r
         return gamma
 
@@ -240,6 +259,7 @@ class ReducedSystem(PaperSystem):
                 sums is not None,
                 SX,
                 SY,
+                self.torques_at(t, y),
                 self.damped,
                 (h, self._lock_a),
                 (x, gamma),
@@ -256,6 +276,9 @@ class ReducedSystem(PaperSystem):
         Q = self.generalized_force(t, phi)
         if Q is not None:
             r[:n] += Q
+        tau = self.torque_forces(t, y)
+        if tau is not None:
+            r += tau
         A = hinge_matrix(n)[h]
         Kz = np.zeros((3 * n + m, 3 * n + m))
         Kz[: 3 * n, :n] = assemble_mass(self.cc, ckj)[:, :n]

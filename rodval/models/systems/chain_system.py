@@ -153,12 +153,13 @@ class ChainSystem(PaperSystem):
         SX, SY = (self._no_load, self._no_load) if sums is None else sums
         out = np.empty(self.N)
         lam = np.empty(self._lock_h.size)
-        args = (sums is not None, SX, SY, self.damped, self._lock_h, out, lam)
+        Tq = self.torques_at(t, y)
+        args = (sums is not None, SX, SY, Tq, self.damped, self._lock_h, out, lam)
         if self.kernels.drive is None:
             self.kernels.locked(self.V, y, *args)
         else:
             mo = motion_at(self.compiled_scratch()[0], t)
-            self.kernels.locked(self.V, y, mo, *args[:5], (out, lam))  # out = (q'', lam)
+            self.kernels.locked(self.V, y, mo, *args[:6], (out, lam))  # out = (q'', lam)
         return out, lam
 
     def unit_responses(self, q: np.ndarray, hinges: Any) -> np.ndarray:

@@ -14,6 +14,25 @@ from rodval.models.assembly.paper_matrices import node_positions
 from rodval.solvers.system import Observed
 
 
+def hinge_moments(system: Any, times: np.ndarray, Y: np.ndarray, D: np.ndarray) -> np.ndarray:
+    """Hinge moments (N m, (nt, n)) at the hinge angles D, positive when resisting an increase
+    of D: spring kappa (D - rest) + damper nu dD/dt + acting stops (the mode's chain) - the
+    motors' and rate dampers' Tq (``PaperSystem.torques_at``: a motor driving D up is a
+    negative resisting moment) + the constraint moment -lambda of locked hinges (from the
+    constrained acceleration solve)."""
+    ch = system.chain
+    rates = np.array([system.hinge_rates(y) for y in Y]).reshape(D.shape)
+    M: np.ndarray = ch.kappa * (D - ch.rest_angle) + ch.nu * rates
+    if system.loads.torques:
+        Tq = [system.loads.hinge_moments(t, r) for t, r in zip(times, rates)]
+        M -= np.array(Tq).reshape(M.shape)
+    if system.locked:
+        for i, (t, y) in enumerate(zip(times, Y)):
+            lam = system.accel_locked(t, y)[1]
+            M[i, system._lock_h] -= lam
+    return M
+
+
 def chain_rows(system: Any, times: np.ndarray, Y: np.ndarray) -> Observed:
     """The chain's quantities the scene wants, at the states Y (nt, 2N) at ``times`` (s), all
     in the current mode: angles, rates, node positions, hinge angles and moments, energies
@@ -48,7 +67,7 @@ def chain_rows(system: Any, times: np.ndarray, Y: np.ndarray) -> Observed:
         if scene.wants("hinge_angle"):
             out["hinge_angle"] = (D, hinges)
         if scene.wants("hinge_moment"):
-            out["hinge_moment"] = (system.hinge_moments(times, Y, D), hinges)
+            out["hinge_moment"] = (hinge_moments(system, times, Y, D), hinges)
     if scene.wants("energy"):
         kin, pot = system.energy_rows(times, Y)
         zero = np.zeros(1, dtype=int)

@@ -5,7 +5,7 @@ and the observation map."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import AbstractContextManager, contextmanager
 from functools import cached_property
 from typing import Any
@@ -13,7 +13,8 @@ from typing import Any
 import numpy as np
 
 from rodval.core.checks import check_choice
-from rodval.core.loads import LOAD_COLUMNS, LoadSet, load_table
+from rodval.core.load_table import LOAD_COLUMNS, load_table
+from rodval.core.loads import LoadSet
 from rodval.core.scene import Scene, hinge_angles
 from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
@@ -40,9 +41,11 @@ from rodval.solvers.system import CompiledForm, EventRecord, EventSpec, Observed
 #: Right-hand-side implementations: "numba" (compiled, structured; default) or "numpy"
 #: (the straightforward dense reference).
 KERNELS = ("numba", "numpy")
-#: Placeholders for the compiled forms' unused arrays (no dense matrices, no loads).
+#: Placeholders for the compiled forms' unused arrays (no dense matrices, no loads) and the
+#: kernels' "no hinge moments" (``Tq`` of length 0).
 NO_MATRICES = np.zeros((0, 0, 0))
 NO_LOADS = np.zeros((0, len(LOAD_COLUMNS)))
+NO_TORQUES = np.zeros(0)
 #: A mode: which stops act, which latches are locked (in lock order).
 Mode = tuple[tuple[bool, ...], tuple[int, ...]]
 
@@ -57,7 +60,7 @@ class PaperSystem(OdeSystem):
     has_momentum = True
     #: True for the full model (state [q; q'], 6n), False for the reduced one ([phi; phi']).
     full: bool
-    #: accel(V, y, has_load, SX, SY, damped, out) and the RHS_TYPE functions (rhs, mechanics;
+    #: accel(V, y, has_load, SX, SY, Tq, damped, out) and the RHS_TYPE functions (rhs, mechanics;
     #: rhs with locked hinges, ``deployment.lock_scalars``) and the EVENTS_TYPE one.
     accel_kernel: Any
     compiled_rhs: Any
@@ -82,7 +85,7 @@ class PaperSystem(OdeSystem):
         self.l = chain.l
         self.cc = chain_constants(chain, coefficients)
         self.damped = chain.damped
-        self.loads = LoadSet(scene.loads, chain.n)
+        self.loads = LoadSet(scene.loads, chain.n, scene.torques)
         self.initial = scene.initial.resolve(chain.n)
         self.latches = tuple(scene.latches)
         self.stops = tuple(scene.stops)
@@ -297,7 +300,8 @@ class PaperSystem(OdeSystem):
         half = y.size // 2
         out = np.empty_like(y)
         out[:half] = y[half:]
-        self.accel_kernel(self.V, y, sums is not None, SX, SY, self.damped, out[half:])
+        Tq = self.torques_at(t, y)
+        self.accel_kernel(self.V, y, sums is not None, SX, SY, Tq, self.damped, out[half:])
         return out
 
     def compiled(self) -> CompiledForm | None:
@@ -340,8 +344,9 @@ class PaperSystem(OdeSystem):
 
     @cached_property
     def _load_table(self) -> np.ndarray | None:
-        """The scene's compiled load table (built once: O(rows), ~1 s per 1e5 samples)."""
-        return load_table(self.scene.loads)
+        """The scene's compiled load table, its hinge items' moments and rate coefficients
+        after the nodal loads' rows (built once: O(rows), ~1 s per 1e5 samples)."""
+        return load_table(self.scene.loads, [r for it in self.scene.torques for r in it.rows()])
 
     def compiled_scratch(self) -> np.ndarray:
         """The compiled form's M: work space its right-hand side reuses (none by default)."""
@@ -351,6 +356,22 @@ class PaperSystem(OdeSystem):
         """Q(phi, t) (N m) on the phi coordinates, or None when no load acts at t."""
         sums = self.loads.suffix_sums(t)
         return None if sums is None else generalized_forces(self.l, phi, *sums)
+
+    def torques_at(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Tq (N m, n): the motors' and rate dampers' moments across the hinges at one state
+        (positive driving D_k up; ``LoadSet.hinge_moments`` at the rates the model's dampers
+        see, ``hinge_rates``), or ``NO_TORQUES`` (length 0, the kernels' "none") without
+        torque items. O(n)."""
+        if not self.loads.torques:
+            return NO_TORQUES
+        Tq = self.loads.hinge_moments(t, self.hinge_rates(y))
+        return NO_TORQUES if Tq is None else Tq
+
+    def torque_forces(self, t: float, y: np.ndarray) -> np.ndarray | None:
+        """A^T Tq (N m, 3n): the hinge moments' generalized forces on q = [phi; alpha; beta]
+        (the dense reference's; ``torques_at``), None without torque items. O(n^2)."""
+        Tq = self.torques_at(t, y)
+        return hinge_matrix(self.n).T @ Tq if Tq.size else None
 
     def max_bending(self, times: np.ndarray, Y: np.ndarray) -> float | None:
         """max |alpha|, |beta| (rad) over the states Y (the reduced model's: O(n) per state)."""
@@ -384,14 +405,19 @@ class PaperSystem(OdeSystem):
 
     def power(self, t: float, y: np.ndarray) -> tuple[float, float]:
         """(P_ext, P_diss) (W): P_ext = Q(phi, t) . phi' (Q on the phi coordinates only, see
-        paper_matrices.generalized_forces); P_diss = q'^T C q' = sum_k nu_k (dD_k/dt)^2 >= 0,
-        the power taken out by the hinge dampers (D_k: hinge angles)."""
+        paper_matrices.generalized_forces) + sum_k Tq_k dD_k/dt (the motors' and rate
+        dampers' power, booked as external work: ``torques_at``); P_diss = q'^T C q' =
+        sum_k nu_k (dD_k/dt)^2 >= 0, the power taken out by the hinge dampers (D_k: hinge
+        angles)."""
         phi, dphi = (a[0] for a in self.rigid(y[None, :]))
         sums = self.loads.suffix_sums(t)
         p_ext = 0.0 if sums is None else float(generalized_forces(self.l, phi, *sums) @ dphi)
         if sums is not None and self.scene.base.free:  # the loads' resultant on node 0's motion
             v0 = self.root_motion(y)[1]
             p_ext += float(sums[0][0] * v0[0] + sums[1][0] * v0[1])
+        Tq = self.torques_at(t, y)
+        if Tq.size:
+            p_ext += float(Tq @ self.hinge_rates(y))
         with self._mode_at(t):
             return p_ext, self.damper_power_at(y) if self.damped else 0.0
 
@@ -502,14 +528,6 @@ class PaperSystem(OdeSystem):
         D: np.ndarray = hinge_angles(phi, alpha, beta, self.attitude(Y))[0]
         return D
 
-    def _hinge_crossing(self, hinge: int, angle: float) -> Callable[[float, np.ndarray], float]:
-        """The event function g(t, y) = D_hinge - angle (rad) of a latch or stop."""
-
-        def g(t: float, y: np.ndarray) -> float:
-            return float(self.hinge_angles_at(t, y)[hinge] - angle)
-
-        return g
-
     def hinge_rates(self, y: np.ndarray) -> np.ndarray:
         """dD_k/dt as the model's dampers see it: A q' (reduced: chord rates, the bending
         rates being dropped)."""
@@ -520,29 +538,9 @@ class PaperSystem(OdeSystem):
             v[:n], v[n : 2 * n], v[2 * n : 3 * n], None if rate is None else rate[0]
         )
 
-    def hinge_moments(self, times: np.ndarray, Y: np.ndarray, D: np.ndarray) -> np.ndarray:
-        """Hinge moments (N m, (nt, n)), positive when resisting an increase of D: spring
-        kappa (D - rest) + damper nu dD/dt + acting stops + the constraint moment -lambda of
-        locked hinges (from the constrained acceleration solve)."""
-        ch = self.chain
-        rates = np.array([self.hinge_rates(y) for y in Y]).reshape(D.shape)
-        M: np.ndarray = ch.kappa * (D - ch.rest_angle) + ch.nu * rates
-        if self.locked:
-            for i, (t, y) in enumerate(zip(times, Y)):
-                lam = self.accel_locked(t, y)[1]
-                M[i, self._lock_h] -= lam
-        return M
-
     def event_functions(self) -> tuple[EventSpec, ...]:
-        """The current mode's events (``event_rows``) as g(t, y) = D_k - angle."""
-        return tuple(
-            EventSpec(
-                g=self._hinge_crossing(r.hinge, r.angle),
-                direction=r.direction,
-                label=f"{r.kind} hinge {r.hinge}",
-            )
-            for r in events.event_rows(self)
-        )
+        """The current mode's events (``events.event_specs``)."""
+        return events.event_specs(self)
 
     def apply_event(self, index: int, t: float, y: np.ndarray) -> tuple[np.ndarray, EventRecord]:
         """A stop switching (no jump: the integrator restarts at the kink) or a latch locking
