@@ -9,6 +9,7 @@ declares its keys (``KEYS``: the one list, which ``scene_keys.SCENE_KEYS`` reads
 from __future__ import annotations
 
 import dataclasses
+import math
 import numbers
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -16,6 +17,7 @@ from typing import Any, ClassVar, Self
 
 from rodval.core.checks import check_keys, check_number
 from rodval.core.keys import BOOLEAN, INTEGER, NUMBER, STRING, Key
+from rodval.core.keys import TABLE as TABLE_KIND
 
 
 def _keys(hinge: str, **more: Key) -> dict[str, Key]:
@@ -26,6 +28,11 @@ def _keys(hinge: str, **more: Key) -> dict[str, Key]:
         "angle": Key(NUMBER, "rad", "finite", required=True),
         **more,
     }
+
+
+def _torque_keys(**more: Key) -> dict[str, Key]:
+    """A torque item's keys: ``hinge`` (required), then the kind's own (``more``)."""
+    return {"hinge": Key(INTEGER, "", "0..n-1", required=True), **more}
 
 
 @dataclass(frozen=True)
@@ -262,5 +269,112 @@ class HingeTorque(HingeItem):
         return ()
 
 
+def _constant_row(hinge: int, component: str, value: float) -> Row:
+    """The row of a constant ``component`` ("moment", N m, or "rate", N m s/rad) across
+    ``hinge`` (numba is imported with the loads, not at import: `rodval --help`)."""
+    from rodval.core.load_table import COMP_MOMENT, COMP_RATE, LAW_CONSTANT
+
+    comp = COMP_MOMENT if component == "moment" else COMP_RATE
+    return (hinge, comp, LAW_CONSTANT, 0.0, math.inf, 1.0, value, 0.0, 0.0)
+
+
+#: The load laws a motor's ``torque`` table may name (its ``value`` is the law's X, in N m).
+MOTOR_LAWS = ("constant", "ramp", "harmonic", "tabulated")
+
+
+@dataclass(frozen=True)
+class Motor(HingeTorque):
+    """A motor across hinge ``hinge`` (0..n-1) applying the torque M (N m, positive driving
+    the hinge angle D up), either a law of time, ``torque`` = a load law's table with the
+    torque as ``value`` (``{type = "constant", value = 2.0, t_on = 0.5}``; types
+    ``MOTOR_LAWS``, their keys as for ``[[loads]]``), or the torque-speed line of a
+    deployment actuator, M = ``stall_torque`` (1 - dD/dt / ``no_load_speed``) (N m > 0,
+    rad/s > 0): full torque at rest, none at the no-load speed, braking beyond it (the line
+    is not clipped). The energy audit books its work int M dD/dt as external."""
+
+    TABLE = "motors"
+    NOUN = "motor"
+    KEYS = _torque_keys(
+        torque=Key(TABLE_KIND, "N m", "a load law's table with the torque as `value`"),
+        stall_torque=Key(NUMBER, "N m", "> 0 (with no_load_speed)"),
+        no_load_speed=Key(NUMBER, "rad/s", "> 0 (with stall_torque)"),
+    )
+
+    torque: dict[str, Any] | None = None
+    stall_torque: float | None = None
+    no_load_speed: float | None = None
+    #: the force its ``torque`` table's load law builds (``_motor_law``), None for a line
+    _law: Any = dataclasses.field(default=None, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        line = (self.stall_torque, self.no_load_speed)
+        if (self.torque is None) == (line == (None, None)):
+            raise ValueError(
+                "motor needs either torque (a law of time) or stall_torque with "
+                "no_load_speed (a torque-speed line), "
+                + ("got neither" if self.torque is None else "not both")
+            )
+        if self.torque is None:
+            if None in line:
+                raise ValueError("motor stall_torque and no_load_speed go together")
+            for name, v, unit in (
+                ("stall_torque", self.stall_torque, "N m"),
+                ("no_load_speed", self.no_load_speed, "rad/s"),
+            ):
+                check_number(f"motor {name}", v, low=0.0, low_open=True, finite=True, unit=unit)
+        else:
+            object.__setattr__(self, "_law", _motor_law(self.torque))
+
+    def moment(self, t: float, rate: float) -> float:
+        if self.torque is None:
+            assert self.stall_torque is not None and self.no_load_speed is not None
+            return self.stall_torque * (1.0 - rate / self.no_load_speed)
+        force = self._law
+        return float(force.fx(t)) if force.active(t) and force.fx is not None else 0.0
+
+    def rows(self) -> list[Row]:
+        if self.torque is None:
+            assert self.stall_torque is not None and self.no_load_speed is not None
+            return [
+                _constant_row(self.hinge, "moment", self.stall_torque),
+                _constant_row(self.hinge, "rate", self.stall_torque / self.no_load_speed),
+            ]
+        from rodval.core.load_table import COMP_MOMENT
+
+        return [(self.hinge, COMP_MOMENT, *row[2:]) for row in self._law.rows() or []]
+
+    def breakpoints(self) -> tuple[float, ...]:
+        return () if self.torque is None else self._law.breakpoints
+
+    def as_dict(self) -> dict[str, Any]:
+        d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.init}
+        return {k: v for k, v in d.items() if v is not None}
+
+
+def _motor_law(spec: Any) -> Any:
+    """A motor's ``torque`` table as the force its load law builds (on node 1, the torque as
+    X; ``rodval.core.loads.LOAD_FACTORIES``); ValueError naming the key."""
+    from rodval.core.loads import LOAD_FACTORIES
+
+    if not isinstance(spec, dict) or spec.get("type") not in MOTOR_LAWS:
+        raise ValueError(
+            f"motor torque must be a table with type one of {', '.join(MOTOR_LAWS)}, got {spec!r}"
+        )
+    args = {k: v for k, v in spec.items() if k != "type"}
+    if "value" not in args:
+        raise ValueError("motor torque needs value (the torque in N m)")
+    args["X"] = args.pop("value")
+    try:
+        return LOAD_FACTORIES[spec["type"]](1, **args)
+    except ValueError as exc:  # the law's own check, in a motor's words
+        words = str(exc).replace(" X ", " value ").replace("(N)", "(N m)")
+        raise ValueError(f"motor torque: {words.replace(' load ', ' law ')}") from None
+    except TypeError:
+        raise ValueError(
+            f"motor torque: a {spec['type']} law takes value and its times, got {sorted(spec)}"
+        ) from None
+
+
 #: The hinge items by scene table (and ``Scene`` field) name, in the scene files' order.
-HINGE_ITEMS: dict[str, type[HingeItem]] = {kind.TABLE: kind for kind in (Latch, Stop)}
+HINGE_ITEMS: dict[str, type[HingeItem]] = {kind.TABLE: kind for kind in (Latch, Stop, Motor)}

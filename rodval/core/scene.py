@@ -33,6 +33,7 @@ from rodval.core.checks import check_keys, check_number
 from rodval.core.damping import DampingRequest
 from rodval.core.hinges import HINGE_ITEMS, HingeTorque
 from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
+from rodval.core.hinges import Motor as Motor
 from rodval.core.hinges import Stop as Stop
 from rodval.core.loads import NodalForce
 from rodval.core.quantities import GROUPS, OUTPUTS, UNIT, check_output_bases, quantities_of
@@ -346,6 +347,8 @@ class Scene:
         Hinges that lock at an angle (at most one latch per hinge).
     stops : sequence of Stop
         One-sided limit stops in the hinges.
+    motors : sequence of Motor
+        Moments across hinges (``rodval.core.hinges.HingeTorque``).
     base : Base
         The body node 0 belongs to: pinned at the origin (default) or a free rigid body.
     name : str
@@ -367,6 +370,7 @@ class Scene:
     name: str = "scene"
     latches: tuple[Latch, ...] = ()
     stops: tuple[Stop, ...] = ()
+    motors: tuple[Motor, ...] = ()
     base: Base = PINNED
     damping: DampingRequest | None = None
 
