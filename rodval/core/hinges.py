@@ -376,5 +376,41 @@ def _motor_law(spec: Any) -> Any:
         ) from None
 
 
+@dataclass(frozen=True)
+class RateDamper(HingeTorque):
+    """A viscous rate damper across hinge ``hinge`` (0..n-1): the moment -``damping`` (dD/dt -
+    ``rate``) (N m; damping > 0 in N m s/rad, the set rate in rad/s, default 0: a plain
+    viscous deployment damper). Its power is booked with the external work (it may drive the
+    hinge towards its set rate)."""
+
+    TABLE = "rate_dampers"
+    NOUN = "rate damper"
+    KEYS = _torque_keys(
+        damping=Key(NUMBER, "N m s/rad", "> 0, <= 1e12", required=True),
+        rate=Key(NUMBER, "rad/s", "finite"),
+    )
+
+    damping: float = 1.0
+    rate: float = 0.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        from rodval.core.bounds import bounded_number
+
+        bounded_number("rate damper damping (N m s/rad)", self.damping, positive=True)
+        check_number("rate damper rate", self.rate, finite=True, unit="rad/s")
+
+    def moment(self, t: float, rate: float) -> float:
+        return -self.damping * (rate - self.rate)
+
+    def rows(self) -> list[Row]:
+        rows = [_constant_row(self.hinge, "rate", self.damping)]
+        if self.rate:
+            rows.append(_constant_row(self.hinge, "moment", self.damping * self.rate))
+        return rows
+
+
 #: The hinge items by scene table (and ``Scene`` field) name, in the scene files' order.
-HINGE_ITEMS: dict[str, type[HingeItem]] = {kind.TABLE: kind for kind in (Latch, Stop, Motor)}
+HINGE_ITEMS: dict[str, type[HingeItem]] = {
+    kind.TABLE: kind for kind in (Latch, Stop, Motor, RateDamper)
+}

@@ -34,6 +34,7 @@ from rodval.core.damping import DampingRequest
 from rodval.core.hinges import HINGE_ITEMS, HingeTorque
 from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
 from rodval.core.hinges import Motor as Motor
+from rodval.core.hinges import RateDamper as RateDamper
 from rodval.core.hinges import Stop as Stop
 from rodval.core.loads import NodalForce
 from rodval.core.quantities import GROUPS, OUTPUTS, UNIT, check_output_bases, quantities_of
@@ -347,7 +348,7 @@ class Scene:
         Hinges that lock at an angle (at most one latch per hinge).
     stops : sequence of Stop
         One-sided limit stops in the hinges.
-    motors : sequence of Motor
+    motors, rate_dampers : sequence of Motor, RateDamper
         Moments across hinges (``rodval.core.hinges.HingeTorque``).
     base : Base
         The body node 0 belongs to: pinned at the origin (default) or a free rigid body.
@@ -371,6 +372,7 @@ class Scene:
     latches: tuple[Latch, ...] = ()
     stops: tuple[Stop, ...] = ()
     motors: tuple[Motor, ...] = ()
+    rate_dampers: tuple[RateDamper, ...] = ()
     base: Base = PINNED
     damping: DampingRequest | None = None
 
