@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from rodval.core.loads import harmonic
-from rodval.core.scene import Chain, InitialState, Latch, Scene
+from rodval.core.scene import Chain, InitialState, Latch, Motor, Scene
 from rodval.core.scene_file import scene_from_dict
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
@@ -113,3 +113,20 @@ def three_panel_free_scene(mass: float = 1000.0, inertia: float = 2000.0) -> Sce
     doc["outputs"] = ["phi", "hinge_angle", "angular_momentum", "momentum", "base"]
     doc["base"] = {"kind": "free", "mass": mass, "inertia": inertia, "hinge_offset": [1.0, 0.0]}
     return scene_from_dict(doc)
+
+
+def motor_wing(t_end: float = 3.0, num: int = 61, EI: float = 1e4) -> Scene:
+    """A three-panel wing deployed by motors (issue 55): panels l = 1 m, m = 2 kg/m, EI
+    N m^2, no hinge springs, hinge 0 free (the root panel turns on its pin), hinges 1 and 2
+    stowed at -1.2 rad, each driven by a torque-speed motor (stall 4 N m, no-load speed 2
+    rad/s) to a latch at 0 rad; both lock inside 2.5 s."""
+    chain = Chain.uniform(3, l=1.0, m=2.0, EI=EI, mu=0.0, kappa=0.0, nu=0.0)
+    return Scene(
+        chain=chain,
+        t_end=t_end,
+        times=np.linspace(0.0, t_end, num),
+        outputs=("phi", "hinge_angle", "hinge_moment", "energy"),
+        initial=InitialState(phi=[0.0, -1.2, -2.4]),
+        latches=(Latch(1, 0.0), Latch(2, 0.0)),
+        motors=tuple(Motor(k, stall_torque=4.0, no_load_speed=2.0) for k in (1, 2)),
+    )
