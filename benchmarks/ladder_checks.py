@@ -49,16 +49,8 @@ def lagrangian() -> None:
             q, v = rng.uniform(-1.0, 1.0, N), rng.uniform(-2.0, 2.0, N)
             X, Y = rng.uniform(-5.0, 5.0, 3), rng.uniform(-5.0, 5.0, 3)
             acc = np.empty(N)
-            ladder_accel(
-                V,
-                np.concatenate([q, v]),
-                True,
-                np.cumsum(X[::-1])[::-1],
-                np.cumsum(Y[::-1])[::-1],
-                np.empty(0),
-                True,
-                acc,
-            )
+            loads = (True, np.cumsum(X[::-1])[::-1], np.cumsum(Y[::-1])[::-1], np.empty(0))
+            ladder_accel(V, np.concatenate([q, v]), loads, True, acc)
             M, f = equations(ref, q, v, X, Y)
             scale = np.max(np.abs(f)) + np.max(np.abs(M)) * np.max(np.abs(acc))
             worst_res = max(worst_res, np.max(np.abs(M @ acc - f)) / scale)

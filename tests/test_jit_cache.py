@@ -115,7 +115,7 @@ def test_rodval_installs_it_for_its_own_kernels():
         p.relative_to(jit_cache.PACKAGE_ROOT).as_posix() for p in jit_cache.import_closure(kernels)
     }
     # the full model's kernels reach the load kernels they call, not the CLI
-    assert {"models/assembly/kernels.py", "core/loads.py"} <= closure
+    assert {"models/assembly/kernels.py", "core/load_table.py"} <= closure
     assert not any(p.startswith(("cli/", "report/", "study/")) for p in closure)
 
 

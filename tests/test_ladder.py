@@ -79,7 +79,7 @@ def test_exact_kinematics_equals_an_independent_lagrangian(p):
         Tq = rng.uniform(-5.0, 5.0, n)
         acc = np.empty(N)
         y = np.concatenate([q, v])
-        ladder_accel(V, y, True, SX, SY, Tq, True, acc)
+        ladder_accel(V, y, (True, SX, SY, Tq), True, acc)
         M, f = equations(ref, q, v, X, Y)
         f += hinge_moment_forces(ref, q, Tq)
         scale = np.max(np.abs(f)) + np.max(np.abs(M)) * np.max(np.abs(acc))

@@ -43,7 +43,8 @@ METHODS = (rb.METHOD_SWEEP, rb.METHOD_BAND)
 
 def banded(ref: ReducedSystem, t: float, phi: np.ndarray, dphi: np.ndarray, method: int):
     Cst = rb.banded_constants(ref.cc, ref.scene.chain)
-    return rb.bending_at(Cst, phi, dphi, ref.loads.suffix_sums(t), NO_TQ, ref.damped, method)
+    loads = ref.kernel_loads(t, np.concatenate([phi, dphi]))
+    return rb.bending_at(Cst, phi, dphi, loads, ref.damped, method)
 
 
 def assert_close(a, b):
@@ -193,8 +194,8 @@ def test_accel_wrapper_and_band_structure():
     phi, dphi = rng.normal(size=n), rng.normal(size=n)
     SX, SY = ref.loads.suffix_sums(0.3)
     out = np.empty(n)
-    rb.reduced_accel(Cst, np.concatenate([phi, dphi]), True, SX, SY, NO_TQ, True, out)
-    ddphi, _ = rb.bending_at(Cst, phi, dphi, (SX, SY), NO_TQ, True, rb.METHOD_SWEEP)
+    rb.reduced_accel(Cst, np.concatenate([phi, dphi]), (True, SX, SY, NO_TQ), True, out)
+    ddphi, _ = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_SWEEP)
     np.testing.assert_array_equal(out, ddphi)
     assert_close(out, ref.numpy_rhs(0.3, np.concatenate([phi, dphi]))[n:])
     scales = Cst[lu.C_RSCALE :]
@@ -214,7 +215,7 @@ def test_work_array_variant(n, method):
     sc = make_scene(n, True, True)
     Cst = rb.banded_constants(None, sc.chain, "published")
     rng = np.random.default_rng(4)
-    SX, SY = rng.normal(size=n), rng.normal(size=n)
+    loads = (True, rng.normal(size=n), rng.normal(size=n), NO_TQ)
     work = np.full(
         (rb.work_size(n) if method == rb.METHOD_BAND else rb.sweep_work_size(n)) + 3, np.nan
     )
@@ -222,14 +223,12 @@ def test_work_array_variant(n, method):
         y = np.concatenate([rng.normal(size=n), rng.normal(size=n)])
         a = np.empty(n), np.empty(2 * n)
         b = np.empty(n), np.empty(2 * n)
-        assert rb.reduced_solve_work(
-            Cst, y, True, SX, SY, NO_TQ, True, a, np.empty(rb.work_size(n)), method
-        )
-        assert rb.reduced_solve_work(Cst, y, True, SX, SY, NO_TQ, True, b, work, method)
+        assert rb.reduced_solve_work(Cst, y, loads, True, a, np.empty(rb.work_size(n)), method)
+        assert rb.reduced_solve_work(Cst, y, loads, True, b, work, method)
         np.testing.assert_array_equal(a[0], b[0])
         np.testing.assert_array_equal(a[1], b[1])
         if method == rb.METHOD_AUTO:
-            assert rb.reduced_solve(Cst, y, True, SX, SY, NO_TQ, True, b)
+            assert rb.reduced_solve(Cst, y, loads, True, b)
             np.testing.assert_array_equal(a[0], b[0])
             np.testing.assert_array_equal(a[1], b[1])
 
@@ -251,8 +250,8 @@ def test_sweep_and_band_agree_on_a_long_chain(coefficients):
     Cst = rb.banded_constants(None, chain, coefficients)
     phi, dphi = rng.normal(size=n), rng.normal(size=n)
     SX, SY = np.cumsum(rng.normal(size=n)[::-1])[::-1], np.cumsum(rng.normal(size=n)[::-1])[::-1]
-    a = rb.bending_at(Cst, phi, dphi, (SX, SY), NO_TQ, True, rb.METHOD_SWEEP)
-    b = rb.bending_at(Cst, phi, dphi, (SX, SY), NO_TQ, True, rb.METHOD_BAND)
+    a = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_SWEEP)
+    b = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_BAND)
     for u, v in zip(a, b):
         np.testing.assert_allclose(u, v, rtol=0, atol=1e-9 * np.max(np.abs(v)))
 
@@ -265,7 +264,8 @@ def band_residual(Cst, phi, dphi, SX, SY, ddphi, gamma):
     N = lu.NB * n
     c, s = np.cos(phi), np.sin(phi)
     f = np.empty((3, n))
-    rb.reduced_forces(Cst, np.concatenate([phi, dphi]), (c, s), True, SX, SY, NO_TQ, True, f)
+    loads = (True, SX, SY, NO_TQ)
+    rb.reduced_forces(Cst, np.concatenate([phi, dphi]), (c, s), loads, True, f)
     unscaled = Cst.copy()
     unscaled[lu.C_RSCALE :] = 1.0
     A = np.empty((N, lu.W))
@@ -309,7 +309,7 @@ def test_backward_error_on_a_long_chain():
     phi, dphi = rng.normal(size=n), rng.normal(size=n)
     SX = np.cumsum(rng.normal(size=n)[::-1])[::-1] * 100.0
     SY = np.cumsum(rng.normal(size=n)[::-1])[::-1] * 100.0
-    sweep = rb.bending_at(Cst, phi, dphi, (SX, SY), NO_TQ, True, rb.METHOD_SWEEP)
-    band = rb.bending_at(Cst, phi, dphi, (SX, SY), NO_TQ, True, rb.METHOD_BAND)
+    sweep = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_SWEEP)
+    band = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_BAND)
     assert band_residual(Cst, phi, dphi, SX, SY, *sweep) < 1e-13
     assert band_residual(Cst, phi, dphi, SX, SY, *band) < 1e-8

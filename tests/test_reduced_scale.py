@@ -38,7 +38,7 @@ def test_the_sweep_skips_the_rods_at_rest_and_matches_the_dense_reduced_model():
     c, s = np.cos(phi), np.sin(phi)
     y = np.concatenate([phi, dphi])
     f = np.empty((3, n))
-    rb.reduced_forces(Cst, y, (c, s), True, SX, SY, NO_TQ, system.damped, f)
+    rb.reduced_forces(Cst, y, (c, s), (True, SX, SY, NO_TQ), system.damped, f)
     T = np.full((n, 3, 4), np.nan)
     ddphi, gamma = np.empty(n), np.empty(2 * n)
     assert rb.solve_sweep(Cst, c, s, f, T, (ddphi, gamma))
@@ -60,8 +60,8 @@ def test_the_quiet_part_and_the_banded_lu_agree_at_n_3000():
     n = 3000
     system, phi, dphi, SX, SY = quiet_state(n, 40)
     Cst = rb.banded_constants(system.cc, system.chain)
-    sweep = rb.bending_at(Cst, phi, dphi, (SX, SY), NO_TQ, True, rb.METHOD_SWEEP)
-    band = rb.bending_at(Cst, phi, dphi, (SX, SY), NO_TQ, True, rb.METHOD_BAND)
+    sweep = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_SWEEP)
+    band = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_BAND)
     for u, v in zip(sweep, band):
         np.testing.assert_allclose(u, v, rtol=0, atol=1e-9 * np.max(np.abs(v)))
 
@@ -93,12 +93,12 @@ def test_the_equilibration_is_written_on_the_banded_lus_first_use():
     Cst = rb.banded_constants(system.cc, system.chain)
     assert not np.any(Cst[lu.C_EQUIL]) and np.all(Cst[lu.C_RSCALE :] == 1.0)
     rows, cols = dense_ruiz_scales(lu.band_magnitudes(Cst), lu.RUIZ_SWEEPS)
-    band = rb.bending_at(Cst, phi, dphi, (SX, SY), NO_TQ, True, rb.METHOD_BAND)
+    band = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_BAND)
     assert np.all(Cst[lu.C_EQUIL] == 1.0)
     np.testing.assert_array_equal(Cst[lu.C_RSCALE : lu.C_RSCALE + lu.NB].T.ravel(), rows)
     np.testing.assert_array_equal(Cst[lu.C_CSCALE : lu.C_CSCALE + lu.NB].T.ravel(), cols)
     assert not np.all(rows == 1.0) and not np.all(cols == 1.0)
-    sweep = rb.bending_at(Cst, phi, dphi, (SX, SY), NO_TQ, True, rb.METHOD_SWEEP)
+    sweep = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_SWEEP)
     for u, v in zip(sweep, band):
         np.testing.assert_allclose(u, v, rtol=0, atol=1e-11 * np.max(np.abs(v)))
 

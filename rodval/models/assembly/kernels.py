@@ -17,16 +17,17 @@ exploited (``kernel="numba"``, the default):
   by Foreman-Mackey et al. 2017, "celerite", generalised to a non-symmetric matrix for the
   ``published`` coefficients).
 
-Argument conventions: ``full_accel(V, y, has_load, SX, SY, Tq, damped, out)`` for the
+Argument conventions: ``full_accel(V, y, loads, damped, out)`` for the
 Python-side right-hand side (whose loads may be any callable); ``full_rhs`` and ``*_mechanics``
 have the compiled integrators' type ``rodval.solvers.signature.RHS_TYPE`` (loads and hinge
 moments from the compiled load table, ``rodval.core.load_table.load_sums`` and ``hinge_torques``,
 O(log rows) per evaluation). ``V`` holds rows of length-n vectors (layout ``V_*`` below),
 ``S = [damped]``. Generalized forces are one array ``f`` of rows (n each): f[0] on phi, then
-one row per bending coordinate (alpha, beta). ``Tq`` (N m): the motors' and rate dampers'
-moments across the hinges (positive driving D_k up), length n, or length 0 for none (then
-nothing is added: ``hinge_moments_at``); their generalized force A^T Tq is external
-(``hinge_moments_into``) and their power sum_k Tq_k dD_k/dt is booked in P_ext.
+one row per bending coordinate (alpha, beta). ``loads`` = (has_load, SX, SY, Tq) (``Loads``):
+the load suffix sums and the motors' and rate dampers' moments ``Tq`` (N m) across the hinges
+(positive driving D_k up), length n, or length 0 for none (then nothing is added:
+``hinge_moments_at``); their generalized force A^T Tq is external (``hinge_moments_into``) and
+their power sum_k Tq_k dD_k/dt is booked in P_ext.
 """
 
 from __future__ import annotations
@@ -42,6 +43,10 @@ from rodval.core.load_table import applied_torques, hinge_torques, load_sums
 #: A float64 array (numba reads no annotation: they are mypy's); two of them, a kernel's outputs.
 Arr = NDArray[np.float64]
 Pair = tuple[Arr, Arr]
+#: The loads a kernel applies, one argument (has_load, SX, SY, Tq): whether a load acts, the
+#: load suffix sums SX, SY (N, n each; read only when has_load), the hinge moments Tq (N m, n,
+#: or empty for none).
+Loads = tuple[bool, Arr, Arr, Arr]
 
 # Rows of V (per-rod vectors). Shared by both models.
 V_L, V_OUTER, V_PPDIAG, V_W, V_KAPPA, V_NU, V_KB, V_REST, V_CB = range(9)
@@ -164,15 +169,16 @@ def hinge_rates(v: Arr, n: int, theta: int = -1) -> Arr:
 
 
 @njit(cache=True)
-def hinge_moments_at(L: Arr, t: float, v: Arr, n: int) -> Pair:
+def hinge_moments_at(L: Arr, t: float, v: Arr, n: int, theta: int = -1) -> Pair:
     """(Tq, rates): the hinge moments Tq (N m, positive driving D_k up) of the load table L's
     hinge rows at t (``hinge_torques``, ``applied_torques``) at the hinge rates (rad/s) from
-    the rates v (``hinge_rates``: the full model's a_k q', the reduced model's chord rates);
-    both empty when no hinge row acts at t (no rate computed). O(n)."""
+    the rates v (``hinge_rates``: the full model's a_k q', the reduced model's chord rates;
+    ``theta``: a moving base's attitude index in v, ``hinge_of``); both empty when no hinge row
+    acts at t (no rate computed). O(n)."""
     T, C = hinge_torques(L, t, n)
     if T.shape[0] == 0:
         return T, T
-    rates = hinge_rates(v, n)
+    rates = hinge_rates(v, n, theta)
     return applied_torques(T, C, rates), rates
 
 
@@ -309,21 +315,12 @@ def schur_generators(V: Arr, c: Arr, s: Arr) -> tuple[Arr, Arr, Arr, Arr]:
 
 
 @njit(cache=True)
-def full_forces(
-    V: Arr,
-    y: Arr,
-    c: Arr,
-    s: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    f: Arr,
-) -> None:
+def full_forces(V: Arr, y: Arr, c: Arr, s: Arr, loads: Loads, damped: bool, f: Arr) -> None:
     """f = [Q; 0; 0] + A^T Tq - h - C q' - K q + A^T kappa rest of the full model (N m) into
     the rows f (3, n) (zeroed here), O(n). C q' (hinge dampers and the rods' bending damping)
-    only when ``damped``; Tq the hinge moments (N m, empty: none; module docstring)."""
+    only when ``damped``; ``loads`` = (has_load, SX, SY, Tq) (``Loads``: Tq empty for none;
+    module docstring)."""
+    has_load, SX, SY, Tq = loads
     n = V.shape[1]
     q, v = y[: 3 * n], y[3 * n :]
     phi, alpha, beta = q[:n], q[n : 2 * n], q[2 * n :]
@@ -393,48 +390,45 @@ def full_solve(V: Arr, c: Arr, s: Arr, f: Arr, out: Arr) -> None:
 
 
 @njit(cache=True)
-def full_accel(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
-) -> None:
+def full_accel(V: Arr, y: Arr, loads: Loads, damped: bool, out: Arr) -> None:
     """Accelerations q'' (3n) of the full model at y = [q; q'] into ``out``: M(phi) q'' =
-    [Q; 0; 0] + A^T Tq - h - C q' - K q. SX, SY are the load suffix sums (N), used when
-    ``has_load``; Tq the hinge moments (N m, empty: none). O(n) time and memory."""
+    [Q; 0; 0] + A^T Tq - h - C q' - K q, ``loads`` = (has_load, SX, SY, Tq) (``Loads``: the
+    load suffix sums (N) and the hinge moments (N m, empty: none)). O(n) time and memory."""
     n = V.shape[1]
     c = np.cos(y[:n])
     s = np.sin(y[:n])
     f = np.empty((3, n))
-    full_forces(V, y, c, s, has_load, SX, SY, Tq, damped, f)
+    full_forces(V, y, c, s, loads, damped, f)
     full_solve(V, c, s, f, out)
 
 
 @njit(cache=True, inline="always")
-def rhs_head(t: float, y: Arr, L: Arr, SX: Arr, SY: Arr, out: Arr) -> bool:
+def rhs_head(t: float, y: Arr, L: Arr, sums: Pair, out: Arr, moving: bool = False) -> Loads:
     """The start of a compiled right-hand side y' = [v; a] of a state y = [q; v]: out's first
-    half = v, the load suffix sums at t (N) into SX, SY (``load_sums``); returns whether a
-    load acts. O(N)."""
+    half = v, the load suffix sums at t (N) into sums = (SX, SY) (``load_sums``, n each), the
+    hinge moments at the state's rates v (``hinge_moments_at``; ``moving``: hinge 0 measured
+    from a moving base's attitude, v's last entry). Returns the ``Loads``. O(N)."""
     half = y.shape[0] // 2
     for i in range(half):  # a loop: a slice assignment compiles numba's shape check
         out[i] = y[half + i]
-    return bool(load_sums(L, t, SX, SY))
+    SX, SY = sums
+    has_load = bool(load_sums(L, t, SX, SY))
+    Tq = hinge_moments_at(L, t, y[half:], SX.shape[0], half - 1 if moving else -1)[0]
+    return has_load, SX, SY, Tq
 
 
 @njit(cache=True, inline="always")
-def rhs_start(t: float, y: Arr, P: Arr, L: Arr, out: Arr) -> tuple[bool, Arr, Arr]:
-    """``rhs_head`` with the load sums allocated (n each, n = P's columns): (has_load, SX,
-    SY). O(N)."""
-    SX = np.empty(P.shape[1])
-    SY = np.empty(P.shape[1])
-    return rhs_head(t, y, L, SX, SY, out), SX, SY
+def rhs_start(t: float, y: Arr, P: Arr, L: Arr, out: Arr, moving: bool = False) -> Loads:
+    """``rhs_head`` with the load sums allocated (n each, n = P's columns). O(N)."""
+    sums = (np.empty(P.shape[1]), np.empty(P.shape[1]))
+    return rhs_head(t, y, L, sums, out, moving)
 
 
 @njit(cache=True)
 def full_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the full model (compiled integrators' right-hand side, loads and hinge moments
     from table L)."""
-    n = P.shape[1]
-    has_load, SX, SY = rhs_start(t, y, P, L, out)
-    Tq = hinge_moments_at(L, t, y[3 * n :], n)[0]
-    full_accel(P, y, has_load, SX, SY, Tq, S[0] != 0.0, out[3 * n :])
+    full_accel(P, y, rhs_start(t, y, P, L, out), S[0] != 0.0, out[3 * P.shape[1] :])
 
 
 @njit(cache=True)

@@ -48,6 +48,7 @@ from rodval.models.assembly.kernels import (
     V_NU,
     V_OUTER,
     Arr,
+    Loads,
     Pair,
     load_power,
     rhs_start,
@@ -168,23 +169,16 @@ def chain_parts(V: Arr, q: Arr, dq: Arr) -> Parts:
 
 @njit(cache=True)
 def chain_forces(
-    V: Arr,
-    yc: Arr,
-    parts: Parts,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    attitude: tuple[float, float],
+    V: Arr, yc: Arr, parts: Parts, loads: Loads, damped: bool, attitude: tuple[float, float]
 ) -> Arr:
     """The force rows f (p+2, n) of the pinned ladder at the chain state yc with hinge 0
-    measured from the ``attitude`` (theta (rad), theta' (rad/s)); Tq the hinge moments (N m,
-    ``free_base.rhs_torques``, or empty: A^T Tq on the chain). O(n p^2)."""
+    measured from the ``attitude`` (theta (rad), theta' (rad/s)); ``loads`` the
+    ``kernels.Loads``, Tq the hinge moments (N m, ``free_base.rhs_torques``, or empty: A^T Tq
+    on the chain). O(n p^2)."""
     n, P1, N = chain_size(V)
     th, dth = attitude
     f = np.empty((P1 + 1, n))
-    ladder_forces(V, yc, parts[0], has_load, SX, SY, Tq, damped, f)
+    ladder_forces(V, yc, parts[0], loads, damped, f)
     shift = V[V_KAPPA, 0] * th + (V[V_NU, 0] * dth if damped else 0.0)
     f[0, 0] += shift  # -kappa_0 (D_0 - theta - rest) on phi_1 and alpha_1
     f[1, 0] += shift
@@ -228,18 +222,18 @@ def body_solve(V: Arr, parts: Parts, th: float, G: Arr, K: Arr, f: Arr, rb: Arr,
 
 
 @njit(cache=True)
-def free_accel(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
-) -> None:
-    """Q'' (N + 3) of a ladder rung on a free body at y = [Q; Q'] into ``out``; SX, SY the
-    load suffix sums (N), Tq the hinge moments (N m, ``free_base.rhs_torques``: A^T Tq on the
-    chain, -Tq_0 on the body's attitude). O(n p^2): three ladder solves."""
+def free_accel(V: Arr, y: Arr, loads: Loads, damped: bool, out: Arr) -> None:
+    """Q'' (N + 3) of a ladder rung on a free body at y = [Q; Q'] into ``out``; ``loads`` =
+    (has_load, SX, SY, Tq) (``kernels.Loads``): the load suffix sums (N), the hinge moments
+    (N m, ``free_base.rhs_torques``: A^T Tq on the chain, -Tq_0 on the body's attitude).
+    O(n p^2): three ladder solves."""
+    has_load, SX, SY, Tq = loads
     n, P1, N = chain_size(V)
     NQ = N + 3
     yc = chain_state(y, N)
     parts = chain_parts(V, yc[:N], yc[N:])
     th, dth = y[N + 2], y[NQ + N + 2]
-    f = chain_forces(V, yc, parts, has_load, SX, SY, Tq, damped, (th, dth))
+    f = chain_forces(V, yc, parts, loads, damped, (th, dth))
     rx, ry = offset_vector(V, th)
     w2 = dth * dth
     field_forces(V, parts, w2 * rx, w2 * ry, f)  # a_0's -theta'^2 rho part
@@ -279,20 +273,12 @@ def free_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def free_accel_locked(
-    V: Arr,
-    y: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    locks: Ints,
-    out: Arr,
-    lam: Arr,
+    V: Arr, y: Arr, loads: Loads, damped: bool, locks: Ints, out: Arr, lam: Arr
 ) -> None:
-    """Q'' with the hinges ``locks`` held (multipliers into ``lam``, N m; Tq acts in the
-    free accelerations, so a held hinge's multiplier holds its motor too); O(n p^2 m)."""
-    free_accel(V, y, has_load, SX, SY, Tq, damped, out)
+    """Q'' with the hinges ``locks`` held (multipliers into ``lam``, N m; the hinge moments
+    of ``loads`` act in the free accelerations, so a held hinge's multiplier holds its motor
+    too); O(n p^2 m)."""
+    free_accel(V, y, loads, damped, out)
     if locks.shape[0] > 0:
         U = np.empty((locks.shape[0], out.shape[0]))
         free_unit_responses(V, y, locks, U)
@@ -302,18 +288,14 @@ def free_accel_locked(
 @njit(cache=True)
 def free_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of a ladder rung on a free body (compiled integrators' right-hand side)."""
-    has_load, SX, SY = rhs_start(t, y, P, L, out)
-    Tq = rhs_torques(t, y, P, L)[0]
-    free_accel(P, y, has_load, SX, SY, Tq, S[0] != 0.0, out[y.shape[0] // 2 :])
+    free_accel(P, y, rhs_start(t, y, P, L, out, True), S[0] != 0.0, out[y.shape[0] // 2 :])
 
 
 @njit(cache=True)
 def free_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' with the hinges of S held; O(n p^2 m)."""
-    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
-    Tq = rhs_torques(t, y, P, L)[0]
-    acc = out[y.shape[0] // 2 :]
-    free_accel_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, locks, acc, lam)
+    loads, locks, lam = locked_head(t, y, P, S, L, out, True)
+    free_accel_locked(P, y, loads, S[0] != 0.0, locks, out[y.shape[0] // 2 :], lam)
 
 
 @njit(cache=True)
@@ -390,20 +372,18 @@ def free_mechanics(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -
 
 # ---------------------------------------------------------------------- prescribed motion
 @njit(cache=True)
-def prescribed_accel(
-    V: Arr, y: Arr, mo: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
-) -> None:
+def prescribed_accel(V: Arr, y: Arr, mo: Arr, loads: Loads, damped: bool, out: Arr) -> None:
     """Q'' (N + 3) of a ladder rung on a prescribed base at y = [Q; Q'] into ``out``: the
     body's accelerations are the laws' (``mo``: ``loads.motion_at`` at t), the chain's solve
     M_c q'' = f_c - J_S^T a_0 with a_0 = a_c + theta'' rho_perp - theta'^2 rho (theta, theta'
-    from the state, which follows the laws; Tq the hinge moments, N m, on the chain). O(n p^2):
-    one ladder solve."""
+    from the state, which follows the laws; ``loads`` the ``kernels.Loads``, Tq the hinge
+    moments, N m, on the chain). O(n p^2): one ladder solve."""
     n, P1, N = chain_size(V)
     NQ = N + 3
     yc = chain_state(y, N)
     parts = chain_parts(V, yc[:N], yc[N:])
     th, dth, ddth = y[N + 2], y[NQ + N + 2], mo[2, 2]
-    f = chain_forces(V, yc, parts, has_load, SX, SY, Tq, damped, (th, dth))
+    f = chain_forces(V, yc, parts, loads, damped, (th, dth))
     rx, ry = offset_vector(V, th)
     ax = mo[0, 2] - ddth * ry - dth * dth * rx
     ay = mo[1, 2] + ddth * rx - dth * dth * ry
@@ -427,22 +407,13 @@ def prescribed_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def prescribed_accel_locked(
-    V: Arr,
-    y: Arr,
-    mo: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    locks: Ints,
-    out: Pair,
+    V: Arr, y: Arr, mo: Arr, loads: Loads, damped: bool, locks: Ints, out: Pair
 ) -> None:
     """Q'' with the hinges ``locks`` held and their multipliers (N m) into out = (Q'', lam);
     hinge 0's row has -1 at theta, whose acceleration is the law's, so it holds D_0 = phi_1 +
     alpha_1 - theta(t). O(n p^2 m)."""
     acc, lam = out
-    prescribed_accel(V, y, mo, has_load, SX, SY, Tq, damped, acc)
+    prescribed_accel(V, y, mo, loads, damped, acc)
     if locks.shape[0] > 0:
         U = np.empty((locks.shape[0], acc.shape[0]))
         prescribed_unit_responses(V, y, locks, U)
@@ -452,12 +423,10 @@ def prescribed_accel_locked(
 @njit(cache=True)
 def prescribed_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of a ladder rung on a prescribed base (its laws in M[0]); the held hinges of S."""
-    has_load, SX, SY = rhs_start(t, y, P, L, out)
-    Tq = rhs_torques(t, y, P, L)[0]
+    loads = rhs_start(t, y, P, L, out, True)
     locks = held_hinges(S)[0]
     acc = (out[y.shape[0] // 2 :], np.empty(locks.shape[0]))
-    mo = motion_at(M[0], t)
-    prescribed_accel_locked(P, y, mo, has_load, SX, SY, Tq, S[0] != 0.0, locks, acc)
+    prescribed_accel_locked(P, y, motion_at(M[0], t), loads, S[0] != 0.0, locks, acc)
 
 
 @njit(cache=True)
@@ -470,13 +439,13 @@ def drive(V: Arr, y: Arr, mo: Arr, S: Arr, L: Arr, t: float) -> tuple[float, flo
     NQ = N + 3
     SX = np.zeros(n)  # left zero when no load acts
     SY = np.zeros(n)
-    has_load = load_sums(L, t, SX, SY)
     Tq = rhs_torques(t, y, V, L)[0]
     damped = S[0] != 0.0
     locks = held_hinges(S)[0]
     lam = np.zeros(locks.shape[0])
     acc = np.empty(N + 3)
-    prescribed_accel_locked(V, y, mo, has_load, SX, SY, Tq, damped, locks, (acc, lam))
+    loads = (bool(load_sums(L, t, SX, SY)), SX, SY, Tq)
+    prescribed_accel_locked(V, y, mo, loads, damped, locks, (acc, lam))
     yc = chain_state(y, N)
     parts = chain_parts(V, yc[:N], yc[N:])
     jx, jy = first_moment_rate(V, parts, acc)

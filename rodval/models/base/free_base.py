@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.core.load_table import applied_torques, hinge_torques, load_sums
+from rodval.core.load_table import hinge_torques, load_sums
 from rodval.models.assembly.kernels import (
     V_KAPPA,
     V_L,
@@ -39,11 +39,12 @@ from rodval.models.assembly.kernels import (
     V_REST,
     V_W,
     Arr,
+    Loads,
     Pair,
     full_forces,
     full_mechanics,
     full_solve,
-    hinge_rates,
+    hinge_moments_at,
     rhs_start,
 )
 from rodval.models.hinge_items.deployment import (
@@ -226,19 +227,19 @@ def base_solve(V: Arr, geo: Chords, th: float, G: Arr, K: Arr, f: Arr, rb: Arr, 
 
 
 @njit(cache=True)
-def base_accel(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
-) -> None:
+def base_accel(V: Arr, y: Arr, loads: Loads, damped: bool, out: Arr) -> None:
     """Q'' (3n + 3) of the full model on a free base at y = [Q; Q'] into ``out`` (module
-    docstring); SX, SY the load suffix sums (N), Tq the hinge moments (N m, ``rhs_torques``:
-    A^T Tq on the chain, -Tq_0 on the body's attitude). O(n): three chain solves."""
+    docstring); ``loads`` = (has_load, SX, SY, Tq) (``kernels.Loads``): the load suffix sums
+    (N), the hinge moments (N m, ``rhs_torques``: A^T Tq on the chain, -Tq_0 on the body's
+    attitude). O(n): three chain solves."""
+    has_load, SX, SY, Tq = loads
     n = V.shape[1]
     N = 3 * n + 3
     geo = _chords(V, y)
     ddelta = y[N + n : N + 2 * n] - y[N + 2 * n : N + 3 * n]
     th, dth = y[3 * n + 2], y[N + 3 * n + 2]
     f = np.empty((3, n))
-    full_forces(V, chain_state(y, 3 * n), geo[0], geo[1], has_load, SX, SY, Tq, damped, f)
+    full_forces(V, chain_state(y, 3 * n), geo[0], geo[1], loads, damped, f)
     shift = V[V_KAPPA, 0] * th + (V[V_NU, 0] * dth if damped else 0.0)
     f[0, 0] += shift  # hinge 0 measured from the body: D_0 - theta
     f[1, 0] += shift
@@ -277,20 +278,11 @@ def base_unit_responses(V: Arr, y: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def base_accel_locked(
-    V: Arr,
-    y: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    locks: Ints,
-    out: Arr,
-    lam: Arr,
+    V: Arr, y: Arr, loads: Loads, damped: bool, locks: Ints, out: Arr, lam: Arr
 ) -> None:
     """Q'' with the hinges ``locks`` held (multipliers into ``lam``, N m); O(n m)."""
     n = V.shape[1]
-    base_accel(V, y, has_load, SX, SY, Tq, damped, out)
+    base_accel(V, y, loads, damped, out)
     m = locks.shape[0]
     if m == 0:
         return
@@ -306,30 +298,22 @@ def rhs_torques(t: float, y: Arr, P: Arr, L: Arr) -> Pair:
     driving D_k up; ``loads.applied_torques``) at the hinge rates a_k Q' (rad/s), hinge 0's
     from the body's theta'; both empty when no hinge row acts at t (``kernels.
     hinge_moments_at`` with hinge 0 from the body). O(n)."""
-    n = P.shape[1]
-    T, C = hinge_torques(L, t, n)
-    if T.shape[0] == 0:
-        return T, T
-    v = y[y.shape[0] // 2 :]
-    rates = hinge_rates(v, n, v.shape[0] - 1)
-    return applied_torques(T, C, rates), rates
+    half = y.shape[0] // 2
+    return hinge_moments_at(L, t, y[half:], P.shape[1], half - 1)
 
 
 @njit(cache=True)
 def base_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the full model on a free base (compiled integrators' right-hand side)."""
-    has_load, SX, SY = rhs_start(t, y, P, L, out)
-    Tq = rhs_torques(t, y, P, L)[0]
-    base_accel(P, y, has_load, SX, SY, Tq, S[0] != 0.0, out[3 * P.shape[1] + 3 :])
+    loads = rhs_start(t, y, P, L, out, True)
+    base_accel(P, y, loads, S[0] != 0.0, out[3 * P.shape[1] + 3 :])
 
 
 @njit(cache=True)
 def base_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' with the hinges of S held (``deployment.lock_scalars``); O(n m)."""
-    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
-    Tq = rhs_torques(t, y, P, L)[0]
-    acc = out[3 * P.shape[1] + 3 :]
-    base_accel_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, locks, acc, lam)
+    loads, locks, lam = locked_head(t, y, P, S, L, out, True)
+    base_accel_locked(P, y, loads, S[0] != 0.0, locks, out[3 * P.shape[1] + 3 :], lam)
 
 
 @njit(cache=True)

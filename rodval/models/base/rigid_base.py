@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.models.assembly.kernels import Arr, Pair
+from rodval.models.assembly.kernels import Arr, Loads, Pair
 from rodval.models.base import chain_base as cb
 from rodval.models.hinge_items.deployment import Ints
 from rodval.models.kinematics.rigid_kernels import (
@@ -77,36 +77,25 @@ def free_momentum(V: Arr, y: Arr) -> tuple[float, float]:
 
 
 @njit(cache=True)
-def free_accel(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
-) -> None:
-    """Q'' (n + 3) on a free body (``chain_base.free_accel``; Tq the hinge moments, N m, at
-    the chord rates)."""
+def free_accel(V: Arr, y: Arr, loads: Loads, damped: bool, out: Arr) -> None:
+    """Q'' (n + 3) on a free body (``chain_base.free_accel``; ``loads`` the
+    ``kernels.Loads``, Tq the hinge moments, N m, at the chord rates)."""
     n = V.shape[1]
     z = to_ladder(y, n)
     acc = np.empty(z.shape[0] // 2)
-    cb.free_accel(V, z, has_load, SX, SY, Tq, damped, acc)
+    cb.free_accel(V, z, loads, damped, acc)
     from_ladder(acc, n, out)
 
 
 @njit(cache=True)
 def free_accel_locked(
-    V: Arr,
-    y: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    locks: Ints,
-    out: Arr,
-    lam: Arr,
+    V: Arr, y: Arr, loads: Loads, damped: bool, locks: Ints, out: Arr, lam: Arr
 ) -> None:
     """Q'' (n + 3) on a free body with ``locks`` held (``chain_base.free_accel_locked``)."""
     n = V.shape[1]
     z = to_ladder(y, n)
     acc = np.empty(z.shape[0] // 2)
-    cb.free_accel_locked(V, z, has_load, SX, SY, Tq, damped, locks, acc, lam)
+    cb.free_accel_locked(V, z, loads, damped, locks, acc, lam)
     from_ladder(acc, n, out)
 
 
@@ -134,23 +123,14 @@ def prescribed_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def prescribed_accel_locked(
-    V: Arr,
-    y: Arr,
-    mo: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    locks: Ints,
-    out: Pair,
+    V: Arr, y: Arr, mo: Arr, loads: Loads, damped: bool, locks: Ints, out: Pair
 ) -> None:
     """Q'' (n + 3) on a prescribed base with ``locks`` held and their multipliers into out =
     (Q'', lam) (``chain_base``'s)."""
     n = V.shape[1]
     z = to_ladder(y, n)
     acc = np.empty(z.shape[0] // 2)
-    cb.prescribed_accel_locked(V, z, mo, has_load, SX, SY, Tq, damped, locks, (acc, out[1]))
+    cb.prescribed_accel_locked(V, z, mo, loads, damped, locks, (acc, out[1]))
     from_ladder(acc, n, out[0])
 
 

@@ -4,8 +4,9 @@ API: ``banded_constants`` (once per chain), ``reduced_solve`` (phi'' and gamma a
 y = [phi; phi'] into out = (phi'', gamma)), ``reduced_solve_work`` (the same with a reusable
 work array and a method choice), ``reduced_accel`` (phi'' only, the argument list of
 ``kernels.full_accel`` with Cst in place of V), ``bending_at`` (Python convenience). Each
-takes the hinge moments ``Tq`` (N m, empty for none; ``kernels`` module docstring) right
-after the load sums: their generalized force A^T Tq joins the right-hand sides r_p, r_g.
+takes the ``kernels.Loads`` (has_load, SX, SY, Tq): the load suffix sums and the hinge moments
+``Tq`` (N m, empty for none; ``kernels`` module docstring), whose generalized force A^T Tq
+joins the right-hand sides r_p, r_g.
 
 The dense route (``kernels.reduced_accel``, ``ReducedSystem.recover_bending``) eliminates the
 bending angles first, M_r = M_pp - K_pg B^-1 M_gp, which is a dense n x n matrix (O(n^2) to
@@ -76,9 +77,9 @@ from rodval.models.assembly.kernels import (
     V_REST,
     V_W,
     Arr,
+    Loads,
     Pair,
     constant_rows,
-    hinge_moments_at,
     hinge_moments_into,
     rhs_head,
 )
@@ -87,19 +88,19 @@ from rodval.models.bending import reduced_band_lu as lu
 
 
 @njit(cache=True)
-def reduced_forces(
-    Cst: Arr, y: Arr, geo: Pair, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, f: Arr
-) -> None:
+def reduced_forces(Cst: Arr, y: Arr, geo: Pair, loads: Loads, damped: bool, f: Arr) -> None:
     """Right-hand sides (N m) at y = [phi; phi'] into the rows f (3, n): f[0] = r_p = Q - G_pp
     phi'^2 - C_pp phi' - K_pp phi, f[1] = r_alpha, f[2] = r_beta, with r_g = -(G_gp phi'^2 +
-    C_gp phi' + K_gp phi) (C only when ``damped``), plus A^T Tq (the hinge moments, N m;
-    empty: none). geo = (cos phi, sin phi).
+    C_gp phi' + K_gp phi) (C only when ``damped``), plus A^T Tq; ``loads`` = (has_load, SX,
+    SY, Tq) (``kernels.Loads``: Tq the hinge moments, N m, empty: none). geo = (cos phi, sin
+    phi).
 
     One pass root to tip (the hinge springs and dampers, kernels.hinge_forces with alpha =
     beta = 0; the prefix sums of G_pp and G_pa^T, kernels.gpp_times and upper_t_times) and
     one back (the suffix sums of G_pp, the load), each sum in the order of those kernels.
     O(n)."""
     c, s = geo
+    has_load, SX, SY, Tq = loads
     n = Cst.shape[1]
     phi, dphi = y[:n], y[n:]
     fp, fa, fb = f[0], f[1], f[2]
@@ -340,17 +341,15 @@ METHOD_AUTO, METHOD_BAND, METHOD_SWEEP = 0, 1, 2
 
 
 @njit(cache=True)
-def reduced_solve(
-    Cst: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Pair
-) -> bool:
+def reduced_solve(Cst: Arr, y: Arr, loads: Loads, damped: bool, out: Pair) -> bool:
     """phi'' (rad/s^2, n) and gamma = [alpha; beta] (rad, 2n) into out = (phi'', gamma) of
     the reduced model at state y = [phi; phi'] (module docstring: the sweep, with the banded
-    LU as fallback). ``Cst`` from ``banded_constants``; SX, SY are the load suffix sums (N,
-    see load_table.load_sums), used when ``has_load``; Tq the hinge moments (N m, empty: none);
-    ``damped`` adds the hinge dampers. O(n) time and memory per evaluation. Returns False if
-    the system is singular (outputs then hold NaN)."""
+    LU as fallback). ``Cst`` from ``banded_constants``; ``loads`` = (has_load, SX, SY, Tq)
+    (``kernels.Loads``: the load suffix sums (N, load_table.load_sums), the hinge moments
+    (N m, empty: none)); ``damped`` adds the hinge dampers. O(n) time and memory per
+    evaluation. Returns False if the system is singular (outputs then hold NaN)."""
     work = np.empty(sweep_work_size(Cst.shape[1]))  # the fallback allocates its own
-    return reduced_solve_work(Cst, y, has_load, SX, SY, Tq, damped, out, work, METHOD_AUTO)
+    return reduced_solve_work(Cst, y, loads, damped, out, work, METHOD_AUTO)
 
 
 @njit(cache=True)
@@ -370,16 +369,7 @@ def sweep_work_size(n: int) -> int:
 
 @njit(cache=True)
 def reduced_solve_work(
-    Cst: Arr,
-    y: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    out: Pair,
-    work: Arr,
-    method: int,
+    Cst: Arr, y: Arr, loads: Loads, damped: bool, out: Pair, work: Arr, method: int
 ) -> bool:
     """``reduced_solve`` with a caller-provided float64 work array of length >= work_size(n),
     or >= sweep_work_size(n) (then the banded LU, if used, allocates its part), so that a
@@ -399,7 +389,7 @@ def reduced_solve_work(
             c[k] = np.cos(p)
             s[k] = np.sin(p)
     f = work[2 * n : 5 * n].reshape((3, n))
-    reduced_forces(Cst, y, (c, s), has_load, SX, SY, Tq, damped, f)
+    reduced_forces(Cst, y, (c, s), loads, damped, f)
     rest = work[7 * n :]
     if method != METHOD_BAND:
         if solve_sweep(Cst, c, s, f, rest[: 12 * n].reshape((n, 3, 4)), out):
@@ -443,37 +433,30 @@ def bending_at(
     Cst: np.ndarray,
     phi: np.ndarray,
     dphi: np.ndarray,
-    sums: tuple[np.ndarray, np.ndarray] | None,
-    Tq: np.ndarray,
+    loads: Loads,
     damped: bool,
     method: int = METHOD_AUTO,
 ) -> Pair:
-    """(phi'', gamma) at one state, ``sums`` = LoadSet.suffix_sums(t) (None: no load), Tq
-    the hinge moments (N m, length 0: none). The O(n) replacement of
-    ReducedSystem.recover_bending (which returns gamma)."""
+    """(phi'', gamma) at one state, ``loads`` = (has_load, SX, SY, Tq) (``kernels.Loads``:
+    the load suffix sums, N, and the hinge moments, N m, length 0: none). The O(n) replacement
+    of ReducedSystem.recover_bending (which returns gamma)."""
     n = phi.shape[0]
     phi = np.ascontiguousarray(phi, dtype=np.float64)
     dphi = np.ascontiguousarray(dphi, dtype=np.float64)
-    if sums is None:
-        SX = SY = np.zeros(n)
-    else:
-        SX, SY = (np.ascontiguousarray(v, dtype=np.float64) for v in sums)
+    SX, SY, Tq = (np.ascontiguousarray(v, dtype=np.float64) for v in loads[1:])
     ddphi, gamma = np.empty(n), np.empty(2 * n)
     work = np.empty(sweep_work_size(n))  # the banded LU, if needed, allocates its own
     y = np.concatenate((phi, dphi))
-    Tq = np.ascontiguousarray(Tq, dtype=np.float64)
-    sol = (ddphi, gamma)
-    reduced_solve_work(Cst, y, sums is not None, SX, SY, Tq, bool(damped), sol, work, method)
+    packed = (bool(loads[0]), SX, SY, Tq)
+    reduced_solve_work(Cst, y, packed, bool(damped), (ddphi, gamma), work, method)
     return ddphi, gamma
 
 
 @njit(cache=True)
-def reduced_accel(
-    Cst: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
-) -> None:
+def reduced_accel(Cst: Arr, y: Arr, loads: Loads, damped: bool, out: Arr) -> None:
     """phi'' at y = [phi; phi'] into ``out`` (the argument convention of
     ``kernels.full_accel``); O(n) time and memory."""
-    reduced_solve(Cst, y, has_load, SX, SY, Tq, damped, (out, np.empty(2 * Cst.shape[1])))
+    reduced_solve(Cst, y, loads, damped, (out, np.empty(2 * Cst.shape[1])))
 
 
 @njit(cache=True)
@@ -493,15 +476,14 @@ def track_bending(gamma: Arr, seen: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def rhs_work(t: float, y: Arr, M: Arr, L: Arr, out: Arr) -> tuple[bool, Arr, Arr, Arr, Arr]:
-    """The start of the reduced model's compiled right-hand sides (``rhs_head``) on the work
-    space M[0, 0] (``rhs_work_size``): (has_load, SX, SY, gamma, the solve's work). O(n)."""
+def rhs_work(t: float, y: Arr, M: Arr, L: Arr, out: Arr) -> tuple[Loads, Arr, Arr]:
+    """The start of the reduced model's compiled right-hand sides (``rhs_head``: the hinge
+    moments at the chord rates) on the work space M[0, 0] (``rhs_work_size``): (the
+    ``Loads``, gamma, the solve's work). O(n)."""
     half = y.shape[0] // 2
     work = M[0, 0]
-    SX = work[:half]
-    SY = work[half : 2 * half]
-    has_load = rhs_head(t, y, L, SX, SY, out)
-    return has_load, SX, SY, work[2 * half : 4 * half], work[4 * half : work.shape[0] - 1]
+    loads = rhs_head(t, y, L, (work[:half], work[half : 2 * half]), out)
+    return loads, work[2 * half : 4 * half], work[4 * half : work.shape[0] - 1]
 
 
 @njit(cache=True)
@@ -511,9 +493,7 @@ def reduced_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> N
     allocation without hinge moments: ``M[0, 0]`` is its work space (``rhs_work_size``;
     ``ReducedSystem.compiled_scratch``), whose last slot keeps the largest |alpha|, |beta| of
     the solves (the run's small-bending check, at no extra solve)."""
-    half = y.shape[0] // 2
-    has_load, SX, SY, gamma, work = rhs_work(t, y, M, L, out)
-    Tq = hinge_moments_at(L, t, y[half:], half)[0]
-    sol = (out[half:], gamma)
-    reduced_solve_work(P, y, has_load, SX, SY, Tq, S[0] != 0.0, sol, work, METHOD_AUTO)
+    loads, gamma, work = rhs_work(t, y, M, L, out)
+    sol = (out[y.shape[0] // 2 :], gamma)
+    reduced_solve_work(P, y, loads, S[0] != 0.0, sol, work, METHOD_AUTO)
     M[0, 0, -1] = track_bending(gamma, M[0, 0, -1])

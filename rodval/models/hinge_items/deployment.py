@@ -36,12 +36,12 @@ from rodval.models.assembly.kernels import (
     V_OUTER,
     V_PPDIAG,
     Arr,
+    Loads,
     Pair,
     add_moment,
     full_accel,
     full_solve,
     generator_solve,
-    hinge_moments_at,
     hinge_of,
     rhs_start,
 )
@@ -115,21 +115,13 @@ def full_unit_responses(V: Arr, phi: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def full_accel_locked(
-    V: Arr,
-    y: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    locks: Ints,
-    out: Arr,
-    lam: Arr,
+    V: Arr, y: Arr, loads: Loads, damped: bool, locks: Ints, out: Arr, lam: Arr
 ) -> None:
     """q'' (3n) of the full model with the hinges ``locks`` held (a_k^T q'' = 0) into
-    ``out``, their multipliers (N m, generalized force a_k lambda_k) into ``lam``; the hinge
-    moments Tq (N m, empty: none) in the free accelerations. O(n m)."""
-    full_accel(V, y, has_load, SX, SY, Tq, damped, out)  # the free accelerations, O(n)
+    ``out``, their multipliers (N m, generalized force a_k lambda_k) into ``lam``; the
+    ``loads`` (``kernels.Loads``: the hinge moments Tq, N m, in the free accelerations).
+    O(n m)."""
+    full_accel(V, y, loads, damped, out)  # the free accelerations, O(n)
     if locks.shape[0] > 0:
         U = np.empty((locks.shape[0], out.shape[0]))
         full_unit_responses(V, y[: V.shape[1]], locks, U)
@@ -166,22 +158,13 @@ def _reduced_linear(Cst: Arr, c: Arr, s: Arr, f: Arr, T: Arr, out: Pair) -> bool
 
 @njit(cache=True)
 def reduced_solve_locked(
-    Cst: Arr,
-    y: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    held: tuple[Ints, Arr],
-    out: Pair,
-    lam: Arr,
+    Cst: Arr, y: Arr, loads: Loads, damped: bool, held: tuple[Ints, Arr], out: Pair, lam: Arr
 ) -> bool:
     """phi'' (n) and gamma (2n) into out = (phi'', gamma), the multipliers lambda (m) into
     ``lam`` of the reduced model at y = [phi; phi'] with the hinges held = (locks, angles)
     held at their angles: D_k = a_p^T phi + a_g^T gamma = angle_k exactly (an algebraic
-    equation of the solve); the hinge moments Tq (N m, empty: none) in the first solve's
-    right-hand sides. O(n m). False if a solve is singular."""
+    equation of the solve); the ``loads`` (``kernels.Loads``: the hinge moments Tq, N m, in
+    the first solve's right-hand sides). O(n m). False if a solve is singular."""
     locks, angles = held
     ddphi, gamma = out
     n = Cst.shape[1]
@@ -190,7 +173,7 @@ def reduced_solve_locked(
     c = np.cos(phi)
     s = np.sin(phi)
     f = np.empty((3, n))
-    reduced_forces(Cst, y, (c, s), has_load, SX, SY, Tq, damped, f)
+    reduced_forces(Cst, y, (c, s), loads, damped, f)
     T = np.empty((n, 3, 4))
     if not _reduced_linear(Cst, c, s, f, T, out):
         return False
@@ -298,24 +281,22 @@ def held_hinges(S: Arr) -> tuple[Ints, Arr]:
 
 @njit(cache=True, inline="always")
 def locked_head(
-    t: float, y: Arr, P: Arr, S: Arr, L: Arr, out: Arr
-) -> tuple[Arr, Arr, bool, Ints, Arr]:
+    t: float, y: Arr, P: Arr, S: Arr, L: Arr, out: Arr, moving: bool = False
+) -> tuple[Loads, Ints, Arr]:
     """The start of a compiled right-hand side with the hinges of S held (``rhs_start``):
-    (SX, SY, has_load, locks, lam): the load suffix sums at t (N), whether a load acts, the
-    held hinges and room for their multipliers. O(n)."""
-    has_load, SX, SY = rhs_start(t, y, P, L, out)
+    (loads, locks, lam): the ``kernels.Loads`` at t (``moving``: hinge 0 from a moving base's
+    attitude), the held hinges and room for their multipliers. O(n)."""
+    loads = rhs_start(t, y, P, L, out, moving)
     locks, _ = held_hinges(S)
-    return SX, SY, has_load, locks, np.empty(locks.shape[0])
+    return loads, locks, np.empty(locks.shape[0])
 
 
 @njit(cache=True)
 def full_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the full model with the hinges of S held (``full_accel_locked``), the hinge
     moments at the rates a_k q' (``kernels.hinge_moments_at``); O(n m)."""
-    n = P.shape[1]
-    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
-    Tq = hinge_moments_at(L, t, y[3 * n :], n)[0]
-    full_accel_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, locks, out[3 * n :], lam)
+    loads, locks, lam = locked_head(t, y, P, S, L, out)
+    full_accel_locked(P, y, loads, S[0] != 0.0, locks, out[3 * P.shape[1] :], lam)
 
 
 @njit(cache=True)
@@ -325,13 +306,11 @@ def reduced_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Ar
     as ``reduced_banded.reduced_rhs`` does, the hinge moments at the chord rates; a singular
     solve gives NaN (the run ends as diverged). O(n m)."""
     half = y.shape[0] // 2
-    has_load, SX, SY, gamma, _ = rhs_work(t, y, M, L, out)
-    Tq = hinge_moments_at(L, t, y[half:], half)[0]
+    loads, gamma, _ = rhs_work(t, y, M, L, out)
     held = held_hinges(S)
     lam = np.empty(held[0].shape[0])
     ddphi = np.empty(half)
-    sol = (ddphi, gamma)
-    if not reduced_solve_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, held, sol, lam):
+    if not reduced_solve_locked(P, y, loads, S[0] != 0.0, held, (ddphi, gamma), lam):
         ddphi[:] = np.nan
     for i in range(half):  # a loop: a slice assignment compiles numba's shape check
         out[half + i] = ddphi[i]

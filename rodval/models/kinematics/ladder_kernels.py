@@ -33,11 +33,11 @@ from rodval.models.assembly.kernels import (
     V_L,
     V_NU,
     Arr,
+    Loads,
     compiled_damper_power,
     external_power,
     generator_solve,
     hinge_forces,
-    hinge_moments_at,
     hinge_moments_into,
     load_moments,
     rhs_start,
@@ -164,14 +164,13 @@ def _velocity_terms(
 
 
 @njit(cache=True)
-def ladder_forces(
-    V: Arr, y: Arr, geo: Geometry, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, f: Arr
-) -> None:
+def ladder_forces(V: Arr, y: Arr, geo: Geometry, loads: Loads, damped: bool, f: Arr) -> None:
     """f = [Q; 0] + A^T Tq - dPi/dq - C q' - c(q, q') (N m) into the rows f (p+2, n: phi,
-    then g), ``geo`` the ``ladder_geometry`` at q; Tq: the hinge moments (N m, n, or empty for
-    none) on the rows the hinge springs act on (phi, alpha, beta:
-    ``kernels.hinge_moments_into``). O(n p^2)."""
+    then g), ``geo`` the ``ladder_geometry`` at q; ``loads`` = (has_load, SX, SY, Tq)
+    (``kernels.Loads``), Tq the hinge moments (N m, n, or empty for none) on the rows the
+    hinge springs act on (phi, alpha, beta: ``kernels.hinge_moments_into``). O(n p^2)."""
     c, s, g, A, Pg = geo
+    has_load, SX, SY, Tq = loads
     n = c.shape[0]
     P1 = g.shape[0]
     N = n * (P1 + 1)
@@ -246,15 +245,13 @@ def shape_count(V: Arr) -> int:
 
 
 @njit(cache=True)
-def ladder_accel(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
-) -> None:
-    """Accelerations q'' (N) of the ladder at y = [q; q'] into ``out``; SX, SY: the load
-    suffix sums (N) when ``has_load``; Tq: the hinge moments (N m, empty for none). O(n p^2)
+def ladder_accel(V: Arr, y: Arr, loads: Loads, damped: bool, out: Arr) -> None:
+    """Accelerations q'' (N) of the ladder at y = [q; q'] into ``out``; ``loads`` the load
+    suffix sums (N) and the hinge moments (N m, empty for none) (``kernels.Loads``). O(n p^2)
     time, O(n p) memory."""
     geo = ladder_geometry(V, y)
     f = np.empty((shape_count(V) + 1, V.shape[1]))
-    ladder_forces(V, y, geo, has_load, SX, SY, Tq, damped, f)
+    ladder_forces(V, y, geo, loads, damped, f)
     ladder_solve(V, geo, f, out)
 
 
@@ -271,21 +268,12 @@ def ladder_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def ladder_accel_locked(
-    V: Arr,
-    y: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    locks: Ints,
-    out: Arr,
-    lam: Arr,
+    V: Arr, y: Arr, loads: Loads, damped: bool, locks: Ints, out: Arr, lam: Arr
 ) -> None:
     """q'' (N) with the hinges ``locks`` held into ``out``, their multipliers (N m) into
     ``lam`` (``deployment.superpose``: the hinge moments Tq act in the free accelerations, so
     a held hinge's multiplier holds its motor too); O(n p^2 m)."""
-    ladder_accel(V, y, has_load, SX, SY, Tq, damped, out)
+    ladder_accel(V, y, loads, damped, out)
     if locks.shape[0] > 0:
         U = np.empty((locks.shape[0], out.shape[0]))
         ladder_unit_responses(V, y[: out.shape[0]], locks, U)
@@ -296,19 +284,14 @@ def ladder_accel_locked(
 def ladder_rhs(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the ladder (compiled integrators' right-hand side, loads and hinge moments from
     table L: ``kernels.hinge_moments_at`` on the hinge rates a_k q' its dampers see)."""
-    half = y.shape[0] // 2
-    has_load, SX, SY = rhs_start(t, y, P, L, out)
-    Tq = hinge_moments_at(L, t, y[half:], P.shape[1])[0]
-    ladder_accel(P, y, has_load, SX, SY, Tq, S[0] != 0.0, out[half:])
+    ladder_accel(P, y, rhs_start(t, y, P, L, out), S[0] != 0.0, out[y.shape[0] // 2 :])
 
 
 @njit(cache=True)
 def ladder_rhs_locked(t: float, y: Arr, P: Arr, S: Arr, M: Arr, L: Arr, out: Arr) -> None:
     """y' of the ladder with the hinges of S held (``deployment.lock_scalars``)."""
-    half = y.shape[0] // 2
-    SX, SY, has_load, locks, lam = locked_head(t, y, P, S, L, out)
-    Tq = hinge_moments_at(L, t, y[half:], P.shape[1])[0]
-    ladder_accel_locked(P, y, has_load, SX, SY, Tq, S[0] != 0.0, locks, out[half:], lam)
+    loads, locks, lam = locked_head(t, y, P, S, L, out)
+    ladder_accel_locked(P, y, loads, S[0] != 0.0, locks, out[y.shape[0] // 2 :], lam)
 
 
 @njit(cache=True)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rodval.models.assembly.kernels import Arr
+from rodval.models.assembly.kernels import Arr, Loads
 from rodval.models.hinge_items.deployment import Ints, hinge_events
 from rodval.models.kinematics.ladder_kernels import (
     ladder_accel,
@@ -71,14 +71,13 @@ def state_from_ladder(z: Arr, n: int, out: Arr) -> None:
 
 
 @njit(cache=True)
-def rigid_accel(
-    V: Arr, y: Arr, has_load: bool, SX: Arr, SY: Arr, Tq: Arr, damped: bool, out: Arr
-) -> None:
+def rigid_accel(V: Arr, y: Arr, loads: Loads, damped: bool, out: Arr) -> None:
     """phi'' (n) of the pinned rigid chain at y = [phi; phi'] into ``out`` (``ladder_accel``
-    on ``rigid_constants``; Tq the hinge moments, N m, empty for none); O(n)."""
+    on ``rigid_constants``; ``loads``: ``kernels.Loads``, Tq the hinge moments, N m, at the
+    chord rates, empty for none); O(n)."""
     n = V.shape[1]
     acc = np.empty(3 * n)
-    ladder_accel(V, to_ladder(y, n), has_load, SX, SY, Tq, damped, acc)
+    ladder_accel(V, to_ladder(y, n), loads, damped, acc)
     out[:] = acc[:n]
 
 
@@ -95,22 +94,13 @@ def rigid_unit_responses(V: Arr, q: Arr, locks: Ints, U: Arr) -> None:
 
 @njit(cache=True)
 def rigid_accel_locked(
-    V: Arr,
-    y: Arr,
-    has_load: bool,
-    SX: Arr,
-    SY: Arr,
-    Tq: Arr,
-    damped: bool,
-    locks: Ints,
-    out: Arr,
-    lam: Arr,
+    V: Arr, y: Arr, loads: Loads, damped: bool, locks: Ints, out: Arr, lam: Arr
 ) -> None:
     """phi'' (n) with the hinges ``locks`` held (D_k'' = 0) into ``out``, their multipliers
-    (N m) into ``lam`` (``ladder_accel_locked``, Tq the hinge moments); O(n m)."""
+    (N m) into ``lam`` (``ladder_accel_locked``, ``loads`` with the hinge moments); O(n m)."""
     n = V.shape[1]
     acc = np.empty(3 * n)
-    ladder_accel_locked(V, to_ladder(y, n), has_load, SX, SY, Tq, damped, locks, acc, lam)
+    ladder_accel_locked(V, to_ladder(y, n), loads, damped, locks, acc, lam)
     out[:] = acc[:n]
 
 

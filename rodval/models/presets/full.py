@@ -143,14 +143,10 @@ class FullSystem(PaperSystem):
         O(n) solves with the compiled one (deployment.full_accel_locked)."""
         n, h = self.n, self._lock_h
         if self.kernel == "numba":
-            sums = self.loads.suffix_sums(t)
-            SX, SY = (self._no_load, self._no_load) if sums is None else sums
             out = np.empty(3 * n)
             lam = np.empty(h.size)
-            Tq = self.torques_at(t, y)
-            deployment.full_accel_locked(
-                self.V, y, sums is not None, SX, SY, Tq, self.damped, h, out, lam
-            )
+            loads = self.kernel_loads(t, y)
+            deployment.full_accel_locked(self.V, y, loads, self.damped, h, out, lam)
             return out, lam
         q, v = y[: 3 * n], y[3 * n :]
         ckj, skj = angle_differences(q[:n])

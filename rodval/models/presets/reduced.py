@@ -73,17 +73,12 @@ class ReducedSystem(PaperSystem):
         if self.kernel != "numba" or self.locked:
             return super().rhs(t, y)
         n = self.n
-        sums = self.loads.suffix_sums(t)
-        SX, SY = (self._no_load, self._no_load) if sums is None else sums
         out = np.empty_like(y)
         out[:n] = y[n:]
         reduced_banded.reduced_solve_work(
             self.V,
             y,
-            sums is not None,
-            np.ascontiguousarray(SX),
-            np.ascontiguousarray(SY),
-            self.torques_at(t, y),
+            self.kernel_loads(t, y),
             self.damped,
             (out[n:], self._gamma),
             self._work,
@@ -219,9 +214,8 @@ class ReducedSystem(PaperSystem):
         if self.locked:
             return self.solve_locked(t, y)[1]
         if self.kernel == "numba":
-            sums = self.loads.suffix_sums(t)
-            Tq = self.torques_at(t, y)
-            return reduced_banded.bending_at(self.V, phi, dphi, sums, Tq, self.damped)[1]
+            loads = self.kernel_loads(t, y)
+            return reduced_banded.bending_at(self.V, phi, dphi, loads, self.damped)[1]
         cc, d = self.cc, self._dense
         M_r, G_r, U, G_pa = self.reduced_matrices(phi)  # once: phi'' and gamma share them
         ddphi = np.linalg.solve(M_r, self.forces(t, phi, dphi, G_r))
@@ -248,22 +242,13 @@ class ReducedSystem(PaperSystem):
         angle - A_p phi]; numba: superposition of m + 1 O(n) sweeps."""
         n, h = self.n, self._lock_h
         phi, dphi = y[:n], y[n:]
-        sums = self.loads.suffix_sums(t)
         m = h.size
         if self.kernel == "numba":
-            SX, SY = (self._no_load, self._no_load) if sums is None else sums
             x, gamma, lam = np.empty(n), np.empty(2 * n), np.empty(m)
+            loads = self.kernel_loads(t, y)
+            held = (h, self._lock_a)
             ok = deployment.reduced_solve_locked(
-                self.V,
-                y,
-                sums is not None,
-                SX,
-                SY,
-                self.torques_at(t, y),
-                self.damped,
-                (h, self._lock_a),
-                (x, gamma),
-                lam,
+                self.V, y, loads, self.damped, held, (x, gamma), lam
             )
             if not ok:
                 raise FloatingPointError("singular constrained reduced solve")

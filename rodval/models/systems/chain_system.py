@@ -149,17 +149,14 @@ class ChainSystem(PaperSystem):
         return out
 
     def accel_locked(self, t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        sums = self.loads.suffix_sums(t)
-        SX, SY = (self._no_load, self._no_load) if sums is None else sums
         out = np.empty(self.N)
         lam = np.empty(self._lock_h.size)
-        Tq = self.torques_at(t, y)
-        args = (sums is not None, SX, SY, Tq, self.damped, self._lock_h, out, lam)
+        loads = self.kernel_loads(t, y)
         if self.kernels.drive is None:
-            self.kernels.locked(self.V, y, *args)
+            self.kernels.locked(self.V, y, loads, self.damped, self._lock_h, out, lam)
         else:
             mo = motion_at(self.compiled_scratch()[0], t)
-            self.kernels.locked(self.V, y, mo, *args[:6], (out, lam))  # out = (q'', lam)
+            self.kernels.locked(self.V, y, mo, loads, self.damped, self._lock_h, (out, lam))
         return out, lam
 
     def unit_responses(self, q: np.ndarray, hinges: Any) -> np.ndarray:

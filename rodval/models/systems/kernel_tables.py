@@ -17,12 +17,12 @@ from rodval.models.kinematics import rigid_kernels as rk
 
 
 class KernelTable(NamedTuple):
-    """A rung's kernels on one base kind. ``accel(V, y, has_load, SX, SY, Tq, damped, out)``:
-    q'' (None on a prescribed base, whose constrained solve always runs; ``Tq`` (N m): the
-    hinge moments of the motors and rate dampers, length n, or length 0 for none);
-    ``locked(V, y, has_load, SX, SY, Tq, damped, locks, out, lam)``: q'' and the multipliers
-    with ``locks`` held (a prescribed base's: ``locked(V, y, mo, has_load, SX, SY, Tq, damped,
-    locks, (out, lam))``, ``mo`` its motion at t); ``unit(V, q, locks, U)``: U[j] = M^-1
+    """A rung's kernels on one base kind. ``accel(V, y, loads, damped, out)``: q'' (None on a
+    prescribed base, whose constrained solve always runs; ``loads`` = (has_load, SX, SY, Tq),
+    ``kernels.Loads``: the load suffix sums and the hinge moments Tq (N m) of the motors and
+    rate dampers, length n, or length 0 for none); ``locked(V, y, loads, damped, locks, out,
+    lam)``: q'' and the multipliers with ``locks`` held (a prescribed base's: ``locked(V, y,
+    mo, loads, damped, locks, (out, lam))``, ``mo`` its motion at t); ``unit(V, q, locks, U)``: U[j] = M^-1
     a_{locks[j]}; ``rhs``, ``mechanics``, ``rhs_locked``: RHS_TYPE, ``events``: EVENTS_TYPE;
     ``momentum(V, y)``: a moving base's total P; ``kinetic``: the RHS_TYPE function whose
     out[0] is T (a prescribed base's: the massless body's, the drive's power left out);

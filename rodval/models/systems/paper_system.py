@@ -16,6 +16,7 @@ from rodval.core.checks import check_choice
 from rodval.core.load_table import LOAD_COLUMNS, load_table
 from rodval.core.loads import LoadSet
 from rodval.core.scene import Scene, hinge_angles
+from rodval.models.assembly.kernels import Loads
 from rodval.models.assembly.paper_matrices import (
     DEFAULT_VARIANT,
     ChainConstants,
@@ -60,7 +61,7 @@ class PaperSystem(OdeSystem):
     has_momentum = True
     #: True for the full model (state [q; q'], 6n), False for the reduced one ([phi; phi']).
     full: bool
-    #: accel(V, y, has_load, SX, SY, Tq, damped, out) and the RHS_TYPE functions (rhs, mechanics;
+    #: accel(V, y, loads, damped, out) (``kernel_loads``) and the RHS_TYPE functions (rhs, mechanics;
     #: rhs with locked hinges, ``deployment.lock_scalars``) and the EVENTS_TYPE one.
     accel_kernel: Any
     compiled_rhs: Any
@@ -274,7 +275,6 @@ class PaperSystem(OdeSystem):
         once, so that loading or compiling it is not part of the integration's wall time."""
         if self.kernel == "numba":
             self.V = self.kernel_constants()
-            self._no_load = np.zeros(self.n)
             self._flags = np.array([1.0 if self.damped else 0.0])
             self._mech = np.zeros(3)
         self.rhs(0.0, self.y0)
@@ -295,13 +295,10 @@ class PaperSystem(OdeSystem):
             return out
         if self.kernel == "numpy":
             return self.numpy_rhs(t, y)
-        sums = self.loads.suffix_sums(t)
-        SX, SY = (self._no_load, self._no_load) if sums is None else sums
         half = y.size // 2
         out = np.empty_like(y)
         out[:half] = y[half:]
-        Tq = self.torques_at(t, y)
-        self.accel_kernel(self.V, y, sums is not None, SX, SY, Tq, self.damped, out[half:])
+        self.accel_kernel(self.V, y, self.kernel_loads(t, y), self.damped, out[half:])
         return out
 
     def compiled(self) -> CompiledForm | None:
@@ -366,6 +363,15 @@ class PaperSystem(OdeSystem):
             return NO_TORQUES
         Tq = self.loads.hinge_moments(t, self.hinge_rates(y))
         return NO_TORQUES if Tq is None else Tq
+
+    def kernel_loads(self, t: float, y: np.ndarray) -> Loads:
+        """The compiled kernels' loads at one state (``kernels.Loads``): whether a load acts at
+        t, its suffix sums SX, SY (N, n each, contiguous; zeros when none acts) and the hinge
+        moments Tq (N m, ``torques_at``). O(n)."""
+        sums = self.loads.suffix_sums(t)
+        SX, SY = (np.zeros(self.n), np.zeros(self.n)) if sums is None else sums
+        Tq = self.torques_at(t, y)
+        return sums is not None, np.ascontiguousarray(SX), np.ascontiguousarray(SY), Tq
 
     def torque_forces(self, t: float, y: np.ndarray) -> np.ndarray | None:
         """A^T Tq (N m, 3n): the hinge moments' generalized forces on q = [phi; alpha; beta]
