@@ -18,6 +18,7 @@ the power on each step's dense output (exact to the dense output's order), 1e-8 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -216,3 +217,24 @@ def test_full_and_exudyn_lock_the_motor_wing_within_a_millisecond():
     assert set(times[0]) == set(times[1]) == {"latch hinge 1", "latch hinge 2"}
     for label, t in times[0].items():
         assert abs(times[1][label] - t) < 1e-3, (label, t, times[1][label])
+
+
+def test_modes_of_a_scene_with_torque_items_are_refused_not_built_without_them():
+    """A motor's moment would load the equilibrium and a rate coefficient damp the modes:
+    rather than leave them out silently, every model's modes refuse the scene in one line."""
+    from rodval.models.registry import get_model
+
+    scene = one_rod(**LINE)
+    for model in ("full", "reduced", "exudyn"):
+        with pytest.raises(ValueError, match=r"modes of a scene with motors are not built"):
+            get_model(model).modes(scene)
+
+
+def test_the_shipped_motor_wing_deploys(tmp_path):
+    """studies/scenes/wing_motors.toml: both latches lock, the run valid."""
+    from rodval.core.scene_file import load_scene
+
+    scene = load_scene(Path(__file__).resolve().parents[1] / "studies/scenes/wing_motors.toml")
+    traj = simulate(scene, "reduced")
+    assert traj.stats.status == 0, traj.stats.message
+    assert {e["label"] for e in traj.events} == {"latch hinge 1", "latch hinge 2"}

@@ -167,6 +167,13 @@ class Model(ABC):
         if cls.MODAL_ANALYSIS is None:
             raise ValueError(f"model {cls.name!r} has no modal analysis")
         check_resolved(scene, f"model {cls.name!r} modes")
+        if scene.torques:
+            kinds = sorted({type(item).TABLE for item in scene.torques})
+            raise ValueError(
+                f"model {cls.name!r}: modes of a scene with {' and '.join(kinds)} are not built "
+                "(a moment across a hinge would load the equilibrium and its rate coefficient "
+                "damp the modes); remove them for the structure's own modes"
+            )
         if scene.base.prescribed:
             raise ValueError(
                 f"model {cls.name!r}: modes of a chain on a prescribed base (a motion that is a "
