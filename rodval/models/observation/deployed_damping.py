@@ -65,8 +65,9 @@ _NOTES: dict[tuple[Any, ...], list[str]] = {}
 def deployed_scene(scene: Scene, c: Any = None) -> Scene:
     """The deployed structure of ``scene`` (module docstring): every latch held at its angle,
     the other hinges at their rest angles, straight rods at rest, no loads, stops, motors or
-    rate dampers (the structure's own modes), a prescribed base pinned; its rods' bending damping ``c`` (N m^2 s; None: the scene's, with
-    its damping request, so that a deployed request is converted for this structure)."""
+    rate dampers (the structure's own modes), a prescribed base pinned; its rods' bending
+    damping ``c`` (N m^2 s; None: the scene's, with its damping request, so that a deployed
+    request is converted for this structure)."""
     latches = tuple(dataclasses.replace(latch, held=True) for latch in scene.latches)
     D = np.array(scene.chain.rest_angle, float)  # rad: the springs' rest angles,
     for latch in latches:  # each latch's angle on its hinge (``equilibrium_angles``)
