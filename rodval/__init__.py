@@ -27,6 +27,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "Stop": ("rodval.core.scene", "Stop"),
     "Motor": ("rodval.core.scene", "Motor"),
     "RateDamper": ("rodval.core.scene", "RateDamper"),
+    "CompliantLatch": ("rodval.core.scene", "CompliantLatch"),
     "Base": ("rodval.core.base", "Base"),
     "Motion": ("rodval.core.motion", "Motion"),
     "NodalForce": ("rodval.core.loads", "NodalForce"),
@@ -63,6 +64,7 @@ __all__ = [
     "Stop",
     "Motor",
     "RateDamper",
+    "CompliantLatch",
     "Base",
     "Motion",
     "NodalForce",
@@ -102,6 +104,7 @@ if TYPE_CHECKING:  # the names as mypy and editors see them; at run time ``__get
     from rodval.core.scene import (
         TABLE1_TIMES,
         Chain,
+        CompliantLatch,
         InitialState,
         Latch,
         Motor,

@@ -105,7 +105,7 @@ def test_compiled_form_of_a_locked_mode_is_the_python_right_hand_side(cls):
     rng = np.random.default_rng(7)
     system = cls(STOPS)
     width = 6 if cls is FullSystem else 2
-    for mode in [((True, False), ()), ((False, True), (0,))]:
+    for mode in [((True, False), (), ()), ((False, True), (0,), ())]:
         system._activate(mode)
         form = system.compiled()
         specs = system.event_functions()

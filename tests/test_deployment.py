@@ -221,10 +221,10 @@ def test_numba_and_numpy_agree_with_rest_angles_stops_and_locks():
     for cls, width in ((FullSystem, 6), (ReducedSystem, 2)):
         fast, ref = cls(sc, kernel="numba"), cls(sc, kernel="numpy")
         for mode in [
-            ((False, False), ()),
-            ((True, True), ()),
-            ((True, False), (0,)),
-            ((False, True), (1, 0)),
+            ((False, False), (), ()),
+            ((True, True), (), ()),
+            ((True, False), (0,), ()),
+            ((False, True), (1, 0), ()),
         ]:
             fast._activate(mode)
             ref._activate(mode)
@@ -332,7 +332,7 @@ def test_locked_kernels_at_larger_n(system_cls, width):
         latches=(Latch(3, 0.5), Latch(17, 0.5), Latch(39, 0.5)),
     )
     fast, ref = system_cls(sc, kernel="numba"), system_cls(sc, kernel="numpy")
-    mode = ((), (2, 0, 1))
+    mode = ((), (2, 0, 1), ())
     fast._activate(mode)
     ref._activate(mode)
     y = np.random.default_rng(5).normal(scale=0.5, size=width * n)

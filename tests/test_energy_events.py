@@ -129,7 +129,7 @@ def test_a_held_hinge_adds_no_power_to_the_full_models_residual():
     latch = scene.latches.index(next(la for la in scene.latches if la.hinge == 4))
 
     def defect(state, locked):
-        system._activate(((False,), locked))
+        system._activate(((False,), locked, ()))
         f = system.rhs(0.0, state)
         h = 1e-7
         dE = (

@@ -47,6 +47,7 @@ def test_every_key_of_the_table_is_type_checked_naming_it(path, key):
     doc = {"based_on": "paper", "latches": [item], "stops": [dict(item)], "loads": [load]}
     doc["motors"] = [{"hinge": 1, "stall_torque": 1.0, "no_load_speed": 1.0}]
     doc["rate_dampers"] = [{"hinge": 1, "damping": 1.0}]
+    doc["compliant_latches"] = [{"hinge": 2, "angle": 0.3, "stiffness": 1e4}]
     bad = 5 if key.kind is STRING or path == "base" else "x"
     set_path(doc, path, bad)
     with pytest.raises(ValueError) as err:

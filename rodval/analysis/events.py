@@ -92,6 +92,12 @@ def _ratio(a: float, b: float) -> float:
     return a / b if b != 0 else math.nan
 
 
+def _compliant(record: Any) -> bool:
+    """Whether an event record is a compliant latch's engagement (no impact, no impulse)."""
+    flag = record.get("compliant")
+    return isinstance(flag, bool | np.bool_) and bool(flag)
+
+
 def is_lock(label: Any) -> bool:
     """Whether an event's label names a lock ("latch ..."): the one test the tables use."""
     return str(label).startswith("latch")
@@ -130,9 +136,11 @@ def comparability(
     (``window_steps``), a grazing lock (``GRAZING_LOSS``), an earlier lock of the case more
     than COMPARABLE_DT_S apart, a kinetic plus bending energy before the lock more than
     COMPARABLE_ENERGY apart (``state_energies``). A lock whose record has no finite impulse
-    (a damaged or edited run record: rodval records every lock's) says so first."""
+    (a damaged or edited run record: rodval records every ideal lock's; a compliant latch's
+    engagement, ``compliant``, has none: no impact) says so first."""
     for who, record in (("its", ev), ("the reference's", r)):
-        if is_lock(record.get("label")) and not math.isfinite(_number(record.get("impulse"))):
+        impulse = _number(record.get("impulse"))
+        if is_lock(record.get("label")) and not _compliant(record) and not math.isfinite(impulse):
             return f"{who} record has no finite lock impulse (a damaged run record)"
     for who, record, run in (("its", ev, own_run), ("the reference's", r, ref_run)):
         if run is None or not is_lock(record.get("label")):

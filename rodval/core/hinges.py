@@ -101,6 +101,29 @@ class AtAngle(HingeItem):
         check_number(f"{self.NOUN} angle", self.angle, finite=True, unit="rad")
 
 
+def _check_direction(noun: str, direction: Any) -> None:
+    """A latch's ``direction``: the integer +1 or -1, or None."""
+    if direction is not None and (
+        isinstance(direction, bool)
+        or not isinstance(direction, numbers.Integral)
+        or direction not in (1, -1)
+    ):
+        raise ValueError(
+            f"{noun} direction must be the integer +1 or -1, or omitted (None), got {direction!r}"
+        )
+
+
+def _check_ahead(latch: Any, d0: float) -> None:
+    """A latch's hinge starts (at D = ``d0`` rad) short of its angle, in its direction."""
+    side = int(latch.angle > d0) - int(latch.angle < d0)
+    if side == 0 or (latch.direction is not None and side != latch.direction):
+        raise ValueError(
+            f"{latch.NOUN} on hinge {latch.hinge}: the hinge starts at D = {d0:.6g} rad, at or "
+            f"beyond its latch angle {latch.angle:.6g} rad"
+            + (f" in direction {latch.direction:+d}" if latch.direction else "")
+        )
+
+
 #: A held latch's hinge must start at its angle (rad) and at rest (rad/s) to this distance: the
 #: initial state is on the constraint (round-off of the angles' sums, 1e-12 rad, with room).
 HELD_START = 1e-9
@@ -132,15 +155,7 @@ class Latch(AtAngle):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        if self.direction is not None and (
-            isinstance(self.direction, bool)
-            or not isinstance(self.direction, numbers.Integral)
-            or self.direction not in (1, -1)
-        ):
-            raise ValueError(
-                f"latch direction must be the integer +1 or -1, or omitted (None), "
-                f"got {self.direction!r}"
-            )
+        _check_direction(self.NOUN, self.direction)
         if self.window is not None:
             check_number("latch window", self.window, low=0.0, low_open=True, finite=True, unit="s")
         if not isinstance(self.held, bool):
@@ -174,13 +189,7 @@ class Latch(AtAngle):
                         f"{d0:.6g} rad, dD/dt = {rate0[latch.hinge]:.6g} rad/s"
                     )
                 continue
-            side = int(latch.angle > d0) - int(latch.angle < d0)
-            if side == 0 or (latch.direction is not None and side != latch.direction):
-                raise ValueError(
-                    f"latch on hinge {latch.hinge}: the hinge starts at D = {d0:.6g} rad, at or "
-                    f"beyond its latch angle {latch.angle:.6g} rad"
-                    + (f" in direction {latch.direction:+d}" if latch.direction else "")
-                )
+            _check_ahead(latch, d0)
         return latches
 
 
@@ -240,6 +249,61 @@ class Stop(AtAngle):
                     positive=False,
                 )
         return stops
+
+
+@dataclass(frozen=True)
+class CompliantLatch(AtAngle):
+    """A compliant latch on hinge ``hinge`` (0..n-1): when the hinge angle D reaches ``angle``
+    (rad) moving in ``direction`` (+1, -1; None: towards the angle from the initial state) it
+    engages, without an impact, and holds the hinge thereafter by a spring-damper about its
+    angle with free ``play`` (rad >= 0) on either side: beyond angle + play the moment
+    -``stiffness`` (D - angle - play) - ``damping`` dD/dt, below angle - play the same about
+    angle - play, none inside (stiffness > 0 in N m/rad, damping >= 0 in N m s/rad). Its two
+    sides are the stops ``engaged_stops`` gives, so every model that has stops applies it;
+    the ideal ``Latch`` is its limit of infinite stiffness."""
+
+    TABLE = "compliant_latches"
+    NOUN = "compliant latch"
+    KEYS = _keys(
+        "0..n-1, one latch per hinge",
+        direction=Key(INTEGER, "", "+1 or -1", none=True),
+        stiffness=Key(NUMBER, "N m/rad", "> 0, <= 1e12", required=True),
+        damping=Key(NUMBER, "N m s/rad", ">= 0, <= 1e12"),
+        play=Key(NUMBER, "rad", ">= 0, finite"),
+    )
+
+    direction: int | None = None
+    stiffness: float = 1e4
+    damping: float = 0.0
+    play: float = 0.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _check_direction(self.NOUN, self.direction)
+        check_number("compliant latch play", self.play, low=0.0, finite=True, unit="rad")
+        self.engaged_stops()  # the stops' own checks: stiffness > 0, damping >= 0, bounded
+
+    def engaged_stops(self) -> tuple[Stop, Stop]:
+        """The two stops (upper, lower) that hold the hinge once the latch has engaged."""
+        return (
+            Stop(self.hinge, self.angle + self.play, "upper", self.stiffness, self.damping),
+            Stop(self.hinge, self.angle - self.play, "lower", self.stiffness, self.damping),
+        )
+
+    @classmethod
+    def check_in(cls, items: Any, scene: Any) -> tuple[Self, ...]:
+        """At most one latch of either kind per hinge, each ahead of its hinge's initial
+        angle (rad) in its direction."""
+        latches = super().check_in(items, scene)
+        hinges = [la.hinge for la in latches] + [la.hinge for la in scene.latches]
+        if len(set(hinges)) != len(hinges):
+            raise ValueError(
+                f"at most one latch (ideal or compliant) per hinge, got hinges {hinges}"
+            )
+        D0 = scene.initial_hinge_angles()
+        for la in latches:
+            _check_ahead(la, float(D0[la.hinge]))
+        return latches
 
 
 Row = tuple[float, ...]
@@ -412,5 +476,5 @@ class RateDamper(HingeTorque):
 
 #: The hinge items by scene table (and ``Scene`` field) name, in the scene files' order.
 HINGE_ITEMS: dict[str, type[HingeItem]] = {
-    kind.TABLE: kind for kind in (Latch, Stop, Motor, RateDamper)
+    kind.TABLE: kind for kind in (Latch, Stop, Motor, RateDamper, CompliantLatch)
 }

@@ -32,6 +32,7 @@ from rodval.core.bounds import as_rod_array
 from rodval.core.checks import check_keys, check_number
 from rodval.core.damping import DampingRequest
 from rodval.core.hinges import HINGE_ITEMS, HingeTorque
+from rodval.core.hinges import CompliantLatch as CompliantLatch
 from rodval.core.hinges import Latch as Latch  # re-exported: a scene's items
 from rodval.core.hinges import Motor as Motor
 from rodval.core.hinges import RateDamper as RateDamper
@@ -350,6 +351,8 @@ class Scene:
         One-sided limit stops in the hinges.
     motors, rate_dampers : sequence of Motor, RateDamper
         Moments across hinges (``rodval.core.hinges.HingeTorque``).
+    compliant_latches : sequence of CompliantLatch
+        Latches that hold their hinge by a spring-damper once engaged.
     base : Base
         The body node 0 belongs to: pinned at the origin (default) or a free rigid body.
     name : str
@@ -373,6 +376,7 @@ class Scene:
     stops: tuple[Stop, ...] = ()
     motors: tuple[Motor, ...] = ()
     rate_dampers: tuple[RateDamper, ...] = ()
+    compliant_latches: tuple[CompliantLatch, ...] = ()
     base: Base = PINNED
     damping: DampingRequest | None = None
 

@@ -34,6 +34,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from rodval.core.hinges import HINGE_ITEMS
+
 #: Largest bending angle (rad) within the paper models' small-bending assumption.
 SMALL_BENDING_RAD = 0.2
 #: Largest relative energy-audit residual of a valid run (see the module docstring).
@@ -153,14 +155,14 @@ def energy_balance(
 def momentum_point(scene: Any) -> str | None:
     """The point about which the angular momentum of ``scene`` is conserved, or None: "centre
     of mass" on a free base, "root" (node 0) on a pinned chain whose hinge 0 has no spring,
-    damper, stop or latch; None with any load (their moments would have to be booked) and on
-    a prescribed base.
-    Latches and stops elsewhere are internal: the momentum is kept through their events."""
+    damper or hinge item (a latch, stop, motor, ... reacts on the ground); None with any load
+    (their moments would have to be booked) and on a prescribed base.
+    Hinge items elsewhere are internal: the momentum is kept through their events."""
     if scene.loads or scene.base.prescribed:  # a prescribed base drives the chain
         return None
     if scene.base.free:
         return MOMENTUM_POINTS[0]
-    items = [*scene.latches, *scene.stops]
+    items = [item for table in HINGE_ITEMS for item in getattr(scene, table)]
     if scene.chain.kappa[0] == 0 and scene.chain.nu[0] == 0 and all(i.hinge != 0 for i in items):
         return MOMENTUM_POINTS[1]
     return None

@@ -55,6 +55,7 @@ def _why_exact(scene: Scene) -> list[str]:
         for what, present in (
             ("latches", bool(scene.latches)),
             ("stops", bool(scene.stops)),
+            ("compliant latches", bool(scene.compliant_latches)),
             (f"a {scene.base.kind} base", scene.base.moving),
         )
         if present

@@ -47,8 +47,8 @@ KERNELS = ("numba", "numpy")
 NO_MATRICES = np.zeros((0, 0, 0))
 NO_LOADS = np.zeros((0, len(LOAD_COLUMNS)))
 NO_TORQUES = np.zeros(0)
-#: A mode: which stops act, which latches are locked (in lock order).
-Mode = tuple[tuple[bool, ...], tuple[int, ...]]
+#: A mode: which stops act, which latches are locked, which compliant latches engaged (in order).
+Mode = tuple[tuple[bool, ...], tuple[int, ...], tuple[int, ...]]
 
 
 class PaperSystem(OdeSystem):
@@ -89,18 +89,18 @@ class PaperSystem(OdeSystem):
         self.loads = LoadSet(scene.loads, chain.n, scene.torques)
         self.initial = scene.initial.resolve(chain.n)
         self.latches = tuple(scene.latches)
-        self.stops = tuple(scene.stops)
+        self.compliant = tuple(scene.compliant_latches)
         D0 = scene.initial_hinge_angles()
-        #: latch directions resolved (None: towards the angle from the initial state)
-        self.latch_dir = tuple(
-            int(np.sign(la.angle - D0[la.hinge])) if la.direction is None else la.direction
-            for la in self.latches
+        #: the scene's stops, then the compliant latches' (``events.system_stops``)
+        self.stops, self._initial_stops = events.system_stops(scene, D0)
+        self.latch_dir, self.compliant_dir = (  # resolved: +1 or -1
+            events.directions(group, D0) for group in (self.latches, self.compliant)
         )
-        self._initial_stops = tuple(bool(st.acts(D0[st.hinge])) for st in self.stops)
         self._initial_locked = tuple(j for j, la in enumerate(self.latches) if la.held)
-        #: mode: which stops act, which latches are locked (in lock order)
+        #: mode: which stops act, which latches are locked, which compliant latches engaged
         self.stop_active: tuple[bool, ...] = self._initial_stops
         self.locked: tuple[int, ...] = ()
+        self.engaged: tuple[int, ...] = ()
         self._history: list[tuple[float, Mode]] = []
         self._lock_h = np.zeros(0, dtype=np.int64)
         self._lock_a = np.zeros(0)
@@ -475,7 +475,7 @@ class PaperSystem(OdeSystem):
             self._flags[0] = 1.0 if self.damped else 0.0
 
     def _activate(self, mode: Mode) -> None:
-        stops, locked = mode
+        stops, locked, self.engaged = mode
         if stops != self.stop_active:
             self.stop_active = stops
             self._apply_stops()
@@ -487,11 +487,11 @@ class PaperSystem(OdeSystem):
 
     @property
     def mode(self) -> Mode:
-        return (self.stop_active, self.locked)
+        return (self.stop_active, self.locked, self.engaged)
 
     def _mode_for(self, t: float) -> Mode:
         """The mode in effect at time t: set by the last event strictly before t."""
-        mode = (self._initial_stops, self._initial_locked)
+        mode: Mode = (self._initial_stops, self._initial_locked, ())
         for ts, m in self._history:
             if ts < t:
                 mode = m
@@ -513,7 +513,7 @@ class PaperSystem(OdeSystem):
         """Back to the initial mode (the held latches locked, the stops the initial state is
         beyond), forgetting the event history: called by the driver before a run."""
         self._history = []
-        self._activate((self._initial_stops, self._initial_locked))
+        self._activate((self._initial_stops, self._initial_locked, ()))
 
     def set_mode(self, mode: Mode, t: float) -> None:
         """Enter ``mode`` at time t (an event), recorded for ``_mode_for``."""
