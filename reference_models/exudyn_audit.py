@@ -13,7 +13,8 @@ the node states exudyn recorded at every step.
   angles 3e-6 and 6e-5);
 * D(t) = int P_diss dt, P_diss (W) the power of the scene's dampers on the beam: the hinge
   dampers nu_k (dD_k/dt)^2 (hinge 0's rate from a free base's), the acting stops' dampers
-  d (dD_k/dt)^2 and the rods' Kelvin-Voigt bending damping int c (dK/dt)^2 ds (exudyn's
+  d (dD_k/dt)^2 (an engaged compliant latch's two stops', internal as theirs, after its
+  engagement: ``timed_stops``) and the rods' Kelvin-Voigt bending damping int c (dK/dt)^2 ds (exudyn's
   ``bendingDamping``: the virtual work int c K' delta K ds of its material curvature K; 5
   Gauss points per element; exudyn's C++ ``ComputeODE2LHS`` adds ``bendingDamping *
   curvature_t`` to the bending moment, with curvature_t = (f_t g - f g_t) / g^2, f = r' x r'',
@@ -58,6 +59,7 @@ from reference_models.exudyn_beam import (
     body_attitude,
     cross2d,
     system_energies,
+    timed_stops,
     torque_moments,
 )
 from reference_models.exudyn_observe import (
@@ -74,9 +76,12 @@ from rodval.mechanics.lock_window import window_energies
 from rodval.solvers.audit import balance
 
 
-def step_powers(scene: Scene, E: int, t_rec: Array, records: Nodes) -> tuple[Array, ...]:
+def step_powers(
+    scene: Scene, E: int, t_rec: Array, records: Nodes, engaged: dict[int, float] | None = None
+) -> tuple[Array, ...]:
     """(P_ext, P_diss) (W, (steps,)) at the recorded steps, P_ext the nodal loads' only, and
-    the torque items' work (J, (steps,), ``_torque_work``) there (see the module docstring)."""
+    the torque items' work (J, (steps,), ``_torque_work``) there (see the module docstring);
+    ``engaged``: hinge -> the time (s) its compliant latch acts after (``Latches.engaged``)."""
     chain = scene.chain
     qv = {key: (q, v) for key, (q, v, _) in records.items()}
     qL, vL, qR, vR = rod_ends(scene.n, E, qv)
@@ -90,9 +95,9 @@ def step_powers(scene: Scene, E: int, t_rec: Array, records: Nodes) -> tuple[Arr
                 p_ext[i] = float(forces[0] @ vR[i, :, 0] + forces[1] @ vR[i, :, 1])
     p_diss = np.sum(chain.nu * dD**2, -1)
     D0 = scene.initial_hinge_angles()
-    for stop in scene.stops:
+    for stop, t_on in timed_stops(scene, engaged):
         k = stop.hinge
-        inside = stop.acts(recorded_hinge_angle(records, E, k, D0[k], t_rec.size))
+        inside = stop.acts(recorded_hinge_angle(records, E, k, D0[k], t_rec.size)) & (t_rec > t_on)
         p_diss += np.where(inside, stop.damping * dD[:, k] ** 2, 0.0)
     for k, w, _, dS, ddS, Q, V in beam_elements(chain, E, qv):
         c = chain.bending_damping[k]
@@ -129,25 +134,40 @@ def _cumulative(t: Array, p: Array) -> Array:
 
 
 def energy_parts(
-    scene: Scene, E: int, EA: float, times: Any, t_rec: Array, records: Nodes
+    scene: Scene,
+    E: int,
+    EA: float,
+    times: Any,
+    t_rec: Array,
+    records: Nodes,
+    engaged: dict[int, float] | None = None,
 ) -> Array:
     """(kinetic, hinge, rod strain) energy (J), (3, len(times)), at any times (s) inside the
-    recorded steps (``system_energies`` on the node states interpolated there); the rod strain is
-    the bending and the (small) axial strain energy."""
+    recorded steps (``system_energies`` on the node states interpolated there; ``engaged``:
+    hinge -> the time (s) its compliant latch acts after (``Latches.engaged``)); the rod strain is the
+    bending and the (small) axial strain energy."""
     times = np.asarray(times, float)
     at = states_at(times, t_rec, records)
     phi, _, alpha, beta = chord_angles(scene, E, times, t_rec, records, at)
-    kin, strain, hinge = system_energies(scene, E, EA, at, phi, alpha, beta)
+    kin, strain, hinge = system_energies(scene, E, EA, at, (phi, alpha, beta), (times, engaged))
     return np.array([kin, hinge, strain])
 
 
 def ledger(
-    scene: Scene, E: int, EA: float, t_rec: Array, records: Nodes, events: list[dict[str, Any]]
+    scene: Scene,
+    E: int,
+    EA: float,
+    recorded: tuple[Array, Nodes],
+    events: list[dict[str, Any]],
+    engaged: dict[int, float] | None = None,
 ) -> tuple[Array, Array]:
-    """W_ext and D (J) at the recorded steps; the lock records in ``events`` get their
-    ``instant_energy_loss`` (0), hinge and bending energy before the lock and, for a window
-    the recorded steps reach to its end, its energy accounts (module docstring)."""
-    p_ext, p_diss, w_torque = step_powers(scene, E, t_rec, records)
+    """W_ext and D (J) at the recorded steps (``recorded`` = (their times, their node
+    states); ``engaged``: hinge -> the time (s) its compliant latch acts after (``Latches.engaged``)); the
+    lock records in ``events`` get their ``instant_energy_loss`` (0), hinge and bending
+    energy before the lock and, for a window the recorded steps reach to its end, its energy
+    accounts (module docstring)."""
+    t_rec, records = recorded
+    p_ext, p_diss, w_torque = step_powers(scene, E, t_rec, records, engaged)
     W, D = _cumulative(t_rec, p_ext) + w_torque, _cumulative(t_rec, p_diss)
 
     locks = [ev for ev in events if "t_activated" in ev]
@@ -155,7 +175,7 @@ def ledger(
     ta = np.array([ev["t_activated"] for ev in locks])
     te = np.array([ev["t"] + ev["impulse_window"] for ev in locks])
     closed = te <= t_rec[-1]
-    parts = energy_parts(scene, E, EA, np.concatenate([ta, te[closed]]), t_rec, records)
+    parts = energy_parts(scene, E, EA, np.concatenate([ta, te[closed]]), *recorded, engaged)
     before, end = parts[:, : ta.size].T.tolist(), iter(parts[:, ta.size :].T.tolist())
     work, lost = (
         np.interp(te, t_rec, W) - np.interp(ta, t_rec, W),
@@ -195,9 +215,12 @@ def account(
     records: Nodes,
     events: list[dict[str, Any]],
     observed: Observed,
+    engaged: dict[int, float] | None = None,
 ) -> tuple[float | None, dict[str, float]]:
-    """The audit of a run that reached ``times``: the lock records completed (``ledger``)
-    and, where the scene asks for "energy", the audit quantities added to ``observed``;
+    """The audit of a run that reached ``times`` (``engaged``: hinge -> the time (s) its
+    compliant latch acts after, ``Latches.engaged``):
+    the lock records completed (``ledger``) and, where the scene asks for "energy", the
+    audit quantities added to ``observed``;
     returns the scalar residual (None without the audit) and the settings entry
     {"numerical_dissipation": J} (empty without the audit).
 
@@ -209,10 +232,10 @@ def account(
     if n < 2 or not (scene.latches or "energy" in observed):  # nothing to account for
         return None, {}
     reached = {key: tuple(x[:n] for x in arrs) for key, arrs in records.items()}
-    W, D = ledger(scene, E, EA, t_rec[:n], reached, events)
+    W, D = ledger(scene, E, EA, (t_rec[:n], reached), events, engaged)
     if "energy" not in observed:
         return None, {}
-    steps = energy_parts(scene, E, EA, t_rec[:n], t_rec[:n], reached).sum(axis=0)
+    steps = energy_parts(scene, E, EA, t_rec[:n], t_rec[:n], reached, engaged).sum(axis=0)
     energy = observed["energy"][0][:, 0]
     quantities, lost = audit_quantities(times, energy, float(steps[0]), t_rec[:n], W, D)
     observed.update(quantities)

@@ -229,6 +229,27 @@ def stop_law(side: str) -> Callable[..., float]:
     return law
 
 
+def engaged_law(law: Callable[..., float], switch: list[bool]) -> Callable[..., float]:
+    """springTorqueUserFunction ``law`` once ``switch[0]`` is True (a compliant latch's stop
+    law from its engagement on, set by ``Latches``), zero before: O(1) a call."""
+
+    def gated(mbs: Any, t: float, item: int, *spring: float) -> float:
+        return law(mbs, t, item, *spring) if switch[0] else 0.0
+
+    return gated
+
+
+def timed_stops(scene: Scene, engaged: dict[int, float] | None) -> list[tuple[Stop, float]]:
+    """Every stop acting on the run with the time (s) it acts after: the scene's stops from
+    the start (-inf) and each engaged compliant latch's two stops (``engaged_stops``) after
+    its engagement (``engaged``: hinge -> that time, ``Latches.engaged``)."""
+    stops, on = [(stop, -math.inf) for stop in scene.stops], engaged or {}
+    for latch in scene.compliant_latches:
+        if latch.hinge in on:
+            stops += [(stop, on[latch.hinge]) for stop in latch.engaged_stops()]
+    return stops
+
+
 def torque_law(item: HingeTorque, errors: list[Exception]) -> Callable[..., float]:
     """springTorqueUserFunction of a torque item (motor, rate damper) on a zero-stiffness,
     zero-damping torsional connector across its hinge: exudyn's restoring torque is -M, M =
@@ -318,13 +339,22 @@ def beam_elements(chain: Chain, E: int, at: Nodes) -> Iterator[tuple[Any, ...]]:
 
 
 def system_energies(
-    scene: Scene, E: int, EA: float, at: Nodes, phi: Array, alpha: Array, beta: Array
+    scene: Scene,
+    E: int,
+    EA: float,
+    at: Nodes,
+    angles: tuple[Array, Array, Array],
+    engaged: tuple[Array, dict[int, float] | None] | None = None,
 ) -> tuple[Array, Array, Array]:
     """Kinetic, rod strain and hinge energy (J) per output time: beam and point-mass kinetic
     (and a free base's body, m |v_c|^2 / 2 + J theta'^2 / 2, from ``at[BODY]``); the rods'
     bending (EI kappa^2/2) and axial (EA eps^2/2, EA of the run) strain; the hinge springs
-    (kappa D^2/2 with the continuous tangent angles phi + alpha, phi + beta, hinge 0 from the
-    body's attitude) and the acting stops. The potential energy is strain + hinge."""
+    (kappa D^2/2 with the continuous tangent angles phi + alpha, phi + beta, ``angles`` =
+    (phi, alpha, beta), hinge 0 from the body's attitude) and the acting stops, an engaged
+    compliant latch's after its engagement (``engaged`` = (the output times, s; hinge -> the
+    time it acts after), ``timed_stops``). The potential energy is strain +
+    hinge."""
+    phi, alpha, beta = angles
     chain = scene.chain
     kin = np.zeros(phi.shape[0])
     pot = np.zeros(phi.shape[0])
@@ -347,9 +377,11 @@ def system_energies(
         kin += 0.5 * (mass * np.sum(v_c**2, -1) + inertia * rate**2)
     D = hinge_angles(phi, alpha, beta, attitude)
     hinge = 0.5 * np.sum(chain.kappa * (D - chain.rest_angle) ** 2, -1)
-    for stop in scene.stops:
+    times, on = engaged if engaged is not None else (np.zeros(phi.shape[0]), None)
+    for stop, t_on in timed_stops(scene, on):
         pen = D[:, stop.hinge] - stop.angle
-        hinge += np.where(stop.acts(D[:, stop.hinge]), 0.5 * stop.stiffness * pen**2, 0.0)
+        acting = stop.acts(D[:, stop.hinge]) & (times > t_on)
+        hinge += np.where(acting, 0.5 * stop.stiffness * pen**2, 0.0)
     return kin, pot, hinge
 
 
@@ -416,3 +448,39 @@ def momentum_audit_rows(scene: Scene, E: int, at: Nodes) -> tuple[Array, Array]:
         X = first.sum(-2) / mass.sum()
         h = h - cross2d(X[:, None, :], p)
     return h.sum(-1), np.abs(h).sum(-1)
+
+
+def mass_points(
+    chain: Chain, ltg: list[list[Array]], E: int, size: int
+) -> tuple[Array, Array, Array, Array]:
+    """The chain's mass points: the quadrature points of every rod (5 Gauss points per
+    element, ``GAUSS_X``, ``GAUSS_W``) and the node masses mu_k at the rods' ends. ``ltg``:
+    each rod's beam nodes' ODE2 indices (rod, node 0..E, [x, y, slope x, slope y]); ``size``
+    the number of ODE2 coordinates. Returns (Gx, Gy (points, size): rows giving each point's
+    x, y (m) from the coordinates; w (points,) its mass, kg; rod_of (points,) its rod)."""
+    rows_x: list[Array] = []
+    rows_y: list[Array] = []
+    wts: list[float] = []
+    rod_of: list[int] = []
+    for k in range(chain.n):
+        le = chain.l[k] / E
+        sg = 0.5 * le * (GAUSS_X + 1.0)
+        S = hermite_shapes(sg, le)[0]
+        for j in range(E):
+            a, b = ltg[k][j], ltg[k][j + 1]
+            dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
+            for g in range(sg.size):
+                for rows, c in ((rows_x, 0), (rows_y, 1)):
+                    r = np.zeros(size)
+                    r[dofs[:, c]] = S[g]
+                    rows.append(r)
+                wts.append(chain.m[k] * 0.5 * le * GAUSS_W[g])
+                rod_of.append(k)
+        if chain.mu[k] > 0:
+            for rows, c in ((rows_x, 0), (rows_y, 1)):
+                r = np.zeros(size)
+                r[ltg[k][E][c]] = 1.0
+                rows.append(r)
+            wts.append(chain.mu[k])
+            rod_of.append(k)
+    return np.array(rows_x), np.array(rows_y), np.array(wts), np.array(rod_of)

@@ -6,7 +6,7 @@ masses, loads and sensors
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -15,13 +15,13 @@ from reference_models.exudyn_beam import (
     BODY,
     Array,
     Nodes,
+    engaged_law,
     initial_node_states,
     load_function,
     revolutions,
     stop_law,
     torque_law,
 )
-from rodval.core.hinges import HingeTorque, Stop
 from rodval.core.scene import Scene
 from rodval.core.validity import momentum_point
 
@@ -41,6 +41,8 @@ class BuiltSystem:
     body: int | None = None  # a moving base's NodeRigidBody2D (None: pinned to the ground)
     #: a prescribed base's CoordinateConstraints (x, y, theta), () otherwise
     drives: tuple[int, ...] = ()
+    #: hinge -> the switch [engaged] of its compliant latch's laws (``engaged_law``)
+    latch_switches: dict[int, list[bool]] = field(default_factory=dict)
 
 
 def _items() -> Any:
@@ -56,6 +58,8 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     spring-damper on the end tangents (relaxed at the rest angle: exudyn's ``offset``); limit
     stops a second spring-damper with a one-sided user law; latches a rotation-locking
     ObjectJointGeneric, inactive until the pre-step function (``Latches``) switches it on;
+    a compliant latch its two stops' spring-dampers (``CompliantLatch.engaged_stops``), whose
+    laws are zero until ``Latches`` sets the latch's switch (``engaged_law``);
     a torque item (motor, rate damper) a zero spring-damper whose user law is its moment.
     A free base is a NodeRigidBody2D (reference coordinates [x_c, y_c, theta] at the initial
     position and attitude) with an ObjectRigidBody2D of the body's mass and inertia; hinge 0
@@ -74,7 +78,9 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     body_node, root_body = _add_body(mbs, scene, ground)
     drives = _add_drives(mbs, scene, body_node)
     load_errors: list[Exception] = []
-    latch_joints = _add_hinges(mbs, scene, E, root_body, (nodes, elems), load_errors)
+    switches = {latch.hinge: [False] for latch in scene.compliant_latches}
+    springs = _hinge_springs(scene, (load_errors, switches))
+    latch_joints = _add_hinges(mbs, scene, E, root_body, (nodes, elems), springs)
     it = _items()
     for k in range(chain.n):
         if chain.mu[k] > 0:
@@ -91,7 +97,16 @@ def build(scene: Scene, E: int, EA: float) -> BuiltSystem:
     node_sensors = _add_sensors(mbs, scene, E, nodes, body_node)
     mbs.Assemble()
     return BuiltSystem(
-        SC, mbs, node_sensors, load_errors, nodes, (ref, q0, v0), latch_joints, body_node, drives
+        SC,
+        mbs,
+        node_sensors,
+        load_errors,
+        nodes,
+        (ref, q0, v0),
+        latch_joints,
+        body_node,
+        drives,
+        switches,
     )
 
 
@@ -218,20 +233,51 @@ def _add_rods(
     return nodes, elems
 
 
+#: A torsional spring-damper: stiffness (N m/rad), damping (N m s/rad), offset (rad), its user
+#: law (springTorqueUserFunction) or 0
+Spring = tuple[float, float, float, Any]
+
+
+def _hinge_springs(
+    scene: Scene, hooks: tuple[list[Exception], dict[int, list[bool]]]
+) -> list[list[Spring]]:
+    """Per hinge, its torsional spring-dampers in build order: its spring (kappa, nu, rest
+    angle), its stops (one-sided laws, ``stop_law``), its compliant latch's two stops (zero
+    until engaged, ``engaged_law``), its torque items (``torque_law``). ``hooks`` = (the list
+    a torque law's exceptions go to, hinge -> its compliant latch's switch). O(n + items)."""
+    errors, switches = hooks
+    chain = scene.chain
+    springs: list[list[Spring]] = [
+        [(float(chain.kappa[k]), float(chain.nu[k]), float(chain.rest_angle[k]), 0)]
+        for k in range(chain.n)
+    ]
+    for stop in scene.stops:
+        springs[stop.hinge].append((stop.stiffness, stop.damping, stop.angle, stop_law(stop.side)))
+    for latch in scene.compliant_latches:
+        switch = switches[latch.hinge]
+        springs[latch.hinge] += [
+            (st.stiffness, st.damping, st.angle, engaged_law(stop_law(st.side), switch))
+            for st in latch.engaged_stops()
+        ]
+    for item in scene.torques:
+        springs[item.hinge].append((0.0, 0.0, 0.0, torque_law(item, errors)))
+    return springs
+
+
 def _add_hinges(
     mbs: Any,
     scene: Scene,
     E: int,
     root_body: int,
     mesh: tuple[list[list[int]], list[list[int]]],
-    errors: list[Exception],
+    springs: list[list[Spring]],
 ) -> dict[int, int]:
-    """Hinge k's joint, spring-damper, stops, torque items and latch joint; returns hinge ->
-    latch joint. ``mesh`` = (the rods' beam nodes, their elements); a torque law's exceptions
-    go to ``errors``. Hinge 0 joins ``root_body`` (the ground, or a free base's body at its
-    hinge offset, the angle measured from the body frame; a free or prescribed base) to rod 1:
-    a torque item's moment M acts on rod k+1's root, -M on rod k's tip (hinge 0: on the ground
-    or the body). A held latch's joint is active from the start."""
+    """Hinge k's joint, spring-dampers (``springs[k]``, ``_hinge_springs``) and latch joint;
+    returns hinge -> latch joint. ``mesh`` = (the rods' beam nodes, their elements). Hinge 0
+    joins ``root_body`` (the ground, or a free base's body at its hinge offset, the angle
+    measured from the body frame; a free or prescribed base) to rod 1: a torque item's moment
+    M acts on rod k+1's root, -M on rod k's tip (hinge 0: on the ground or the body). A held
+    latch's joint is active from the start."""
     it = _items()
     nodes, elems = mesh
     chain = scene.chain
@@ -239,12 +285,6 @@ def _add_hinges(
     tangent_left = ini["phi"] + ini["alpha"]
     tangent_right = ini["phi"] + ini["beta"]
     latch_of = {latch.hinge: latch for latch in scene.latches}
-    stops_of: dict[int, list[Stop]] = {}
-    for stop in scene.stops:
-        stops_of.setdefault(stop.hinge, []).append(stop)
-    torques_of: dict[int, list[HingeTorque]] = {}
-    for item in scene.torques:
-        torques_of.setdefault(item.hinge, []).append(item)
     latch_joints: dict[int, int] = {}
     for k in range(chain.n):
         if k == 0 and scene.base.moving:
@@ -267,15 +307,7 @@ def _add_hinges(
         pos1 = mbs.AddMarker(it.MarkerNodePosition(nodeNumber=nodes[k][0]))
         mbs.AddObject(it.ObjectJointRevolute2D(markerNumbers=[pos0, pos1]))
         rot1 = mbs.AddMarker(it.MarkerBodyRigid(bodyNumber=elems[k][0], localPosition=[0, 0, 0]))
-        springs: list[tuple[float, float, float, Any]] = [
-            (float(chain.kappa[k]), float(chain.nu[k]), float(chain.rest_angle[k]), 0)
-        ]
-        springs += [
-            (stop.stiffness, stop.damping, stop.angle, stop_law(stop.side))
-            for stop in stops_of.get(k, [])
-        ]
-        springs += [(0.0, 0.0, 0.0, torque_law(item, errors)) for item in torques_of.get(k, [])]
-        _add_springs(mbs, (rot0, rot1), angle0, springs)
+        _add_springs(mbs, (rot0, rot1), angle0, springs[k])
         if k in latch_of:
             latch = latch_of[k]
             latch_joints[k] = _add_latch_joint(mbs, (rot0, rot1), float(latch.angle), latch.held)
@@ -286,7 +318,7 @@ def _add_springs(
     mbs: Any,
     markers: tuple[int, int],
     angle0: float,
-    springs: list[tuple[float, float, float, Any]],
+    springs: list[Spring],
 ) -> None:
     """Torsional spring-dampers (stiffness N m/rad, damping N m s/rad, offset rad, user law
     or 0) between the two rotation markers, each with its revolution counter from angle0

@@ -12,11 +12,11 @@ attitude; the body's motion is then part of the outputs ("base", "momentum",
 "angular_momentum", the kinetic energy). A prescribed base is the same body (of a nominal
 mass) with its three coordinates imposed by CoordinateConstraints following the laws; the
 outputs treat it as massless, as the native models do, and its run has no energy audit (the
-drive's work is not measured). The torsional springs use
-a NodeGenericData to keep their angle continuous beyond +-pi (hinge 0 turns past pi in the
-paper's example). Point masses mu_k sit on the end node of rod k; the scene's nodal forces act
-there through exudyn load user functions, exactly zero outside each force's support; motors,
-rate dampers through torque user laws across their hinges (``exudyn_beam.torque_law``).
+drive's work is not measured). The torsional springs use a NodeGenericData to keep their
+angle continuous beyond +-pi (hinge 0 turns past pi in the paper's example). Point masses
+mu_k sit on the end node of rod k; the scene's nodal forces act there through exudyn load
+user functions, exactly zero outside each force's support; motors, rate dampers through
+torque user laws across their hinges (``exudyn_beam.torque_law``).
 
 Nothing of the paper's equations is used: the quantities are measured on the beam solution by
 their definitions (see ``rodval.core.scene``):
@@ -44,15 +44,15 @@ step (halved, down to step/64, only if Newton fails): the option ``step``'s, or 
 (EigenSparse), no files, graphics or console output. Newton's absolute tolerance is
 ``newton_atol_per_EA * EA`` (N): the default lies below the round-off of the stiff axial
 forces. With latches the Newton Jacobian is renewed every step (``JAC_PER_STEP``; why:
-docs/reference_model.md, "Speed").
-rodval's native integrator settings are refused unless at their defaults (``check_settings``;
-``blowup_factor`` and ``max_wall_s`` apply). Before every step ``Guard`` checks the state:
-non-finite (STATUS_DIVERGED), kinetic energy above blowup_factor x (E(0) + W+ + 1e-6 J)
-(STATUS_BLOWUP), rotation per step above ``max_rotation_per_step`` (STATUS_FAILED); a verdict
-stops the run. Then ``RunBudget`` (``exudyn_budget``) reads the clock (the run's wall-clock
-budget, set-up included: STATUS_WALL) and counts the recorded steps against the memory bound;
-a run without a wall-clock budget is refused before any work when it plans more than
-``MAX_STEPS_UNBOUNDED`` steps or more than its records fit in memory (``check_plan``).
+docs/reference_model.md, "Speed"). rodval's native integrator settings are refused unless at
+their defaults (``check_settings``; ``blowup_factor`` and ``max_wall_s`` apply). Before every
+step ``Guard`` checks the state: non-finite (STATUS_DIVERGED), kinetic energy above
+blowup_factor x (E(0) + W+ + 1e-6 J) (STATUS_BLOWUP), rotation per step above
+``max_rotation_per_step`` (STATUS_FAILED); a verdict stops the run. Then ``RunBudget``
+(``exudyn_budget``) reads the clock (the run's wall-clock budget, set-up included:
+STATUS_WALL) and counts the recorded steps against the memory bound; a run without a
+wall-clock budget is refused before any work when it plans more than ``MAX_STEPS_UNBOUNDED``
+steps or more than its records fit in memory (``check_plan``).
 """
 
 from __future__ import annotations
@@ -429,7 +429,7 @@ class ExudynModel(Model):
             step_used=float(sim.timeIntegration.initialStepSize),
             **newton_record(sim, bool(scene.latches)),
         )
-        latches = Latches(built, guard, scene, self.elements) if scene.latches else None
+        latches = Latches.of(built, guard, scene, self.elements)
         self._solve(scene, built, sim, (guard, latches, budget), stats)
         run_info.update(
             steps=stats.nsteps,
@@ -442,13 +442,13 @@ class ExudynModel(Model):
             update_status(stats, STATUS_ERROR, f"reading sensors failed: {exc}")
             return self._trajectory(scene, np.empty(0), {}, stats, run_info)
         times = ended(scene, stats, (guard, budget), t_rec, diverged)
-        events, lock_steps = lock_records(latches)
+        events, switched = lock_records(latches)
         reached = t_rec[t_rec <= times[-1]] if times.size else t_rec[:0]
-        stops = stop_events(scene, self.elements, reached, records, lock_steps)
+        stops = stop_events(scene, self.elements, reached, records, switched[0])
         events = sorted(events + stops, key=lambda ev: ev["t"])
         try:
             observed, audit = self._observe(
-                scene, (times, reached, t_rec, records), lock_steps, events, stats
+                scene, (times, reached, t_rec, records), switched, events, stats
             )
         except Exception as exc:  # noqa: BLE001
             message = f"observation failed: {type(exc).__name__}: {exc}"
@@ -461,20 +461,20 @@ class ExudynModel(Model):
         self,
         scene: Scene,
         recorded: tuple[Array, Array, Array, Nodes],
-        lock_steps: dict[int, float],
+        switched: tuple[dict[int, float], dict[int, float]],
         events: list[dict[str, Any]],
         stats: SolverStats,
     ) -> tuple[Observed, dict[str, float]]:
         """The outputs at the kept output times and the audit's settings entry of a run,
         ``recorded`` = (the kept output times, the recorded times reached, all recorded times,
-        the node records); its peaks and energy and momentum residuals into ``stats``, the
-        lock records in ``events`` completed (``account``)."""
+        the node records), ``switched`` (``lock_records``); its peaks and energy and momentum
+        residuals into ``stats``, the lock records in ``events`` completed (``account``)."""
         times, reached, t_rec, records = recorded
         E, EA = self.elements, self.EA
-        observed = observe(scene, E, EA, times, t_rec, records, lock_steps) if times.size else {}
-        stats.peaks = recorded_peaks(scene, E, EA, reached, t_rec, records, lock_steps)
+        observed = observe(scene, E, EA, times, t_rec, records, *switched) if times.size else {}
+        stats.peaks = recorded_peaks(scene, E, EA, reached, t_rec, records, *switched)
         stats.energy_residual, audit = account(
-            body_view(scene), E, EA, times, t_rec, records, events, observed
+            body_view(scene), E, EA, times, t_rec, records, events, observed, switched[1]
         )
         if scene.base.prescribed:
             stats.energy_residual, audit = unaudited_drive(observed, events)

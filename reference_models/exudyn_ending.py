@@ -81,16 +81,19 @@ def ended(
     return times[times < stats.t_reached - tol]  # the state at the detection time is bad
 
 
-def lock_records(latches: Latches | None) -> tuple[list[dict[str, Any]], dict[int, float]]:
-    """The lock events in time order and hinge -> lock time (s), pending locks closed."""
+def lock_records(
+    latches: Latches | None,
+) -> tuple[list[dict[str, Any]], tuple[dict[int, float], dict[int, float]]]:
+    """The lock events in time order and (hinge -> lock time, hinge -> the time its compliant
+    latch acts after) (s, ``Latches.engaged``), pending locks closed."""
     if latches is None:
-        return [], {}
+        return [], ({}, {})
     try:
         latches.close()
     except Exception:  # noqa: BLE001 - the pending locks stay unrecorded
         pass
     events = sorted(latches.events, key=lambda ev: ev["t"])
-    return events, dict(latches.lock_times.items())
+    return events, (dict(latches.lock_times.items()), dict(latches.engaged))
 
 
 def solver_message(solver: Any, default: str) -> str:

@@ -135,7 +135,7 @@ class Guard:
         if built.body is not None:
             at0[BODY] = self._add_body(scene, np.asarray(mbs.systemData.GetNodeLTGODE2(built.body)))
         parts = system_energies(
-            scene, E, EA, at0, ini["phi"][None], ini["alpha"][None], ini["beta"][None]
+            scene, E, EA, at0, (ini["phi"][None], ini["alpha"][None], ini["beta"][None])
         )
         self.spec = GuardSpec(blowup_factor=float(factor), energy0_J=float(np.sum(parts)))
         self.energy = Monitor(self.spec)

@@ -10,19 +10,18 @@ import numpy as np
 from numba import njit
 
 from reference_models.exudyn_beam import (
-    GAUSS_W,
-    GAUSS_X,
     Array,
     force_at,
     hermite_shapes,
+    mass_points,
     stop_moment,
     wrap_angle,
 )
 from reference_models.exudyn_build import BuiltSystem
 from reference_models.exudyn_guard import Guard
-from rodval.core.hinges import Stop
+from rodval.core.hinges import CompliantLatch, Latch, Stop
 from rodval.core.loads import NodalForce
-from rodval.core.scene import Chain, Scene
+from rodval.core.scene import Scene
 from rodval.mechanics.lock_window import lock_window
 from rodval.mechanics.rigid import rigid_lock
 from rodval.mechanics.root_momentum import root_momentum_fields
@@ -45,6 +44,10 @@ class Latches:
     it within the coming step. The lock time is where D crosses the angle: the root of that
     extrapolation within the coming step, or of the cubic Hermite interpolant between the last
     two states when D is already past (bracketed between steps either way).
+
+    A compliant latch (``CompliantLatch``) is detected alike but not locked: at its switch its
+    two stops' laws are switched on (``_engage``), and its record is the event "latch hinge
+    k" at the crossing time, without a lock window (no impact).
 
     A held latch (``Latch.held``) has its joint active from the start (``exudyn_build``): it is
     never armed and records no lock event; its hinge counts as held for the other latches'
@@ -78,7 +81,8 @@ class Latches:
         size = guard.ref.size
         D0 = scene.initial_hinge_angles()
         self.items: list[dict[str, Any]] = []
-        for latch in scene.latches:
+        latches: tuple[Latch | CompliantLatch, ...] = (*scene.latches, *scene.compliant_latches)
+        for latch in latches:
             k = latch.hinge
             direction = latch.direction or int(np.sign(latch.angle - D0[k]))
             self.items.append(
@@ -86,16 +90,18 @@ class Latches:
                     "latch": latch,
                     "k": k,
                     "dir": direction,
-                    "joint": built.latch_joints[latch.hinge],
+                    # an ideal latch's joint, or a compliant latch's switch (None: the other)
+                    "joint": built.latch_joints.get(k),
+                    "switch": built.latch_switches.get(k),
                     "left": body if k == 0 else ltg[k - 1][E][2:],
                     "right": ltg[k][0][2:],
                     "D": float(D0[k]),
                     # a held latch's joint is active from the start (exudyn_build): never
                     # armed, no lock event
-                    "state": "held" if latch.held else "armed",
+                    "state": "held" if getattr(latch, "held", False) else "armed",
                 }
             )
-        self.Gx, self.Gy, self.w, self.rod_of = _mass_points(chain, ltg, E, size)
+        self.Gx, self.Gy, self.w, self.rod_of = mass_points(chain, ltg, E, size)
 
         self.loads: list[tuple[NodalForce, Array, int]] = [
             (f, ltg[f.node - 1][E][:2], f.node) for f in scene.loads
@@ -120,9 +126,16 @@ class Latches:
         self.lock_times: dict[int, float] = {
             it["k"]: 0.0 for it in self.items if it["state"] == "held"
         }
+        #: hinge -> the time (s) its compliant latch acts after (``_engage``)
+        self.engaged: dict[int, float] = {}
         self.step_count = 0
         self._cfg = None  # exudyn's configuration of the last accepted state (StartOfStep)
         self._root_shapes: dict[int, tuple[Array, ...]] = {}  # rod -> its root's slopes
+
+    @classmethod
+    def of(cls, built: BuiltSystem, guard: Guard, scene: Scene, E: int) -> Latches | None:
+        """A run's latches, None when the scene has neither ideal nor compliant ones."""
+        return cls(built, guard, scene, E) if scene.latches or scene.compliant_latches else None
 
     # -- measures --------------------------------------------------------------------------
     def _state(self, known: tuple[Array, Array] | None = None) -> tuple[Array, ...]:
@@ -316,15 +329,18 @@ class Latches:
         """Switch latch ``i`` on before the step from t0 and open its lock record; ``times`` =
         (t0, t_lock, h) (s), ``qva`` = (q, v, a) at t0."""
         item, (t0, t_lock, h), (q, v, _) = self.items[i], times, qva
+        self._armed[i] = False
+        if item["switch"] is not None:
+            self._engage(item, t0, t_lock)
+            return
         self.mbs.SetObjectParameter(item["joint"], "activeConnector", True)
         item["state"] = "locking"
-        self._armed[i] = False
         self.lock_times[item["k"]] = t0
         before = self._measures(t0, item, *qva)
         # the chords just before the lock and the hinges held after it: the rigid-panel
         # lock's data (rodval.mechanics.rigid)
         before["chords"] = np.array([self._chord(j, q, v) for j in range(self.scene.n)])
-        before["held"] = [it["k"] for it in self.items if it["state"] != "armed"]
+        before["held"] = self._held()
         self.pending.append(
             {
                 "item": item,
@@ -340,6 +356,35 @@ class Latches:
                 "mean": 0.0,
                 "peak": abs(before["M_beam"]),
                 "step": h,
+            }
+        )
+
+    def _held(self) -> list[int]:
+        """The hinges an ideal latch holds (locking, locked or held from the start); an
+        engaged compliant latch's hinge is not held: its stops act on it."""
+        return [it["k"] for it in self.items if it["state"] not in ("armed", "engaged")]
+
+    def _engage(self, item: dict[str, Any], t0: float, t_lock: float) -> None:
+        """Engage a compliant latch before the step from t0 (s): its stops' laws switched on
+        (``engaged_law``), its moment in the hinge's from now on (``_hinge_moment``), and its
+        event "latch hinge k" at the crossing time t_lock (s), as an ideal latch's lock time;
+        no impact, so no lock window. The outputs count it after max(t0, t_lock)
+        (``engaged``): from the crossing, but never at a recorded state before its switch.
+        O(1)."""
+        latch, k = item["latch"], item["k"]
+        item["switch"][0] = True
+        item["state"] = "engaged"
+        self.engaged[k] = max(t0, t_lock)
+        self.stops.setdefault(k, []).extend(latch.engaged_stops())
+        self.events.append(
+            {
+                "t": float(t_lock),
+                "label": f"latch hinge {k}",
+                "hinge": int(k),
+                "hinges": [int(k)],
+                "angle": float(latch.angle),
+                "t_switched_on": float(t0),
+                "compliant": True,
             }
         )
 
@@ -395,7 +440,7 @@ class Latches:
         )
         # the root's angular momentum means nothing once hinge 0 is held (now, earlier, or
         # by the window's end): the ground's (the base's) holding moment is external
-        root_held = any(it["k"] == 0 and it["state"] != "armed" for it in self.items)
+        root_held = 0 in self._held()
         self.events.append(
             {
                 "t": float(ev["t_lock"]),
@@ -421,42 +466,6 @@ class Latches:
         )
         item["state"] = "locked"
         self.pending.remove(ev)
-
-
-def _mass_points(
-    chain: Chain, ltg: list[list[Array]], E: int, size: int
-) -> tuple[Array, Array, Array, Array]:
-    """The chain's mass points: the quadrature points of every rod (5 Gauss points per
-    element, ``GAUSS_X``, ``GAUSS_W``) and the node masses mu_k at the rods' ends. ``ltg``:
-    each rod's beam nodes' ODE2 indices (rod, node 0..E, [x, y, slope x, slope y]); ``size``
-    the number of ODE2 coordinates. Returns (Gx, Gy (points, size): rows giving each point's
-    x, y (m) from the coordinates; w (points,) its mass, kg; rod_of (points,) its rod)."""
-    rows_x: list[Array] = []
-    rows_y: list[Array] = []
-    wts: list[float] = []
-    rod_of: list[int] = []
-    for k in range(chain.n):
-        le = chain.l[k] / E
-        sg = 0.5 * le * (GAUSS_X + 1.0)
-        S = hermite_shapes(sg, le)[0]
-        for j in range(E):
-            a, b = ltg[k][j], ltg[k][j + 1]
-            dofs = np.array([a[:2], a[2:], b[:2], b[2:]])  # (4, 2)
-            for g in range(sg.size):
-                for rows, c in ((rows_x, 0), (rows_y, 1)):
-                    r = np.zeros(size)
-                    r[dofs[:, c]] = S[g]
-                    rows.append(r)
-                wts.append(chain.m[k] * 0.5 * le * GAUSS_W[g])
-                rod_of.append(k)
-        if chain.mu[k] > 0:
-            for rows, c in ((rows_x, 0), (rows_y, 1)):
-                r = np.zeros(size)
-                r[ltg[k][E][c]] = 1.0
-                rows.append(r)
-            wts.append(chain.mu[k])
-            rod_of.append(k)
-    return np.array(rows_x), np.array(rows_y), np.array(wts), np.array(rod_of)
 
 
 class _Sides:

@@ -19,6 +19,7 @@ from reference_models.exudyn_beam import (
     stop_moment,
     system_energies,
     system_momenta,
+    timed_stops,
     torque_moments,
     wrap_angle,
 )
@@ -86,13 +87,16 @@ def observe(
     t_rec: Array,
     records: Nodes,
     lock_steps: dict[int, float] | None = None,
+    engaged: dict[int, float] | None = None,
 ) -> Observed:
     """The scene's quantities at ``times`` from recorded node states (see module docstring).
 
     "hinge_angle": D_k (k = 0..n-1) from the continuous tangent angles; "hinge_moment" (N m):
     the moment of hinge k, in the sense of its spring's kappa (D - rest): the spring, damper
     and stop laws at the measured D and dD, less the torque items' moments (motors, rate
-    dampers: ``HingeTorque.moment``, positive driving D up), while the hinge is free, and
+    dampers: ``HingeTorque.moment``, positive driving D up; an engaged compliant latch's two
+    stops after its engagement, ``engaged``: hinge -> s, ``Latches.engaged``), while the hinge
+    is free, and
     from the state
     where its latch was switched on (``lock_steps``: hinge -> time, s) the beam's own bending
     moment EI kappa_b at the root of rod k+1 (the hinge has no inertia: it transmits that
@@ -126,10 +130,10 @@ def observe(
             out["tip_deflection"] = (tip[:, None], np.zeros(1, dtype=int))
     if scene.wants("hinge_angle", "hinge_moment"):
         _hinge_quantities(
-            scene, E, times, at, (phi, alpha, beta), (qL, vL, qR, vR), lock_steps, out
+            scene, E, (times, at), (phi, alpha, beta), (qL, vL, qR, vR), (lock_steps, engaged), out
         )
     if scene.wants("energy"):
-        kin, strain, hinge = system_energies(scene, E, EA, at, phi, alpha, beta)
+        kin, strain, hinge = system_energies(scene, E, EA, at, (phi, alpha, beta), (times, engaged))
         zero = np.zeros(1, dtype=int)
         out["kinetic"] = (kin[:, None], zero)
         out["potential"] = ((strain + hinge)[:, None], zero)
@@ -153,15 +157,18 @@ def recorded_peaks(
     t_rec: Array,
     records: Nodes,
     lock_steps: dict[int, float] | None = None,
+    engaged: dict[int, float] | None = None,
 ) -> dict[str, Any] | None:
     """The run's peaks (``SolverStats.peaks``) of the ``PEAK_QUANTITIES`` the scene outputs:
     ``peak_values`` of ``observe`` (the outputs' own quantity functions) at every recorded
-    step ``steps`` (s, those the run kept), whatever the output times; None when the scene
-    outputs none of them."""
+    step ``steps`` (s, those the run kept), whatever the output times (``lock_steps``,
+    ``engaged``: as ``observe``'s); None when the scene outputs none of them."""
     wanted = tuple(q for q in PEAK_QUANTITIES if scene.wants(q))
     if not wanted:
         return None
-    observed = observe(scene.with_(outputs=wanted), E, EA, steps, t_rec, records, lock_steps)
+    observed = observe(
+        scene.with_(outputs=wanted), E, EA, steps, t_rec, records, lock_steps, engaged
+    )
     return {"read_on": "every recorded step", "values": peak_values(steps, observed)}
 
 
@@ -214,16 +221,18 @@ def chord_angles(
 def _hinge_quantities(
     scene: Scene,
     E: int,
-    times: Array,
-    at: Nodes,
+    states: tuple[Array, Nodes],
     angles: tuple[Array, ...],
     ends: tuple[Array, ...],
-    lock_steps: dict[int, float] | None,
+    switched: tuple[dict[int, float] | None, dict[int, float] | None],
     out: Observed,
 ) -> None:
     """ "hinge_angle" D_k (rad) and "hinge_moment" (N m) into ``out`` (see ``observe``):
-    ``angles`` = (phi, alpha, beta) (nt, n); ``ends`` = the rods' left and right node states
-    and rates (qL, vL, qR, vR), (nt, n, 4)."""
+    ``states`` = (the times, s, the node states there); ``angles`` = (phi, alpha, beta) (nt,
+    n); ``ends`` = the rods' left and right node states and rates (qL, vL, qR, vR), (nt, n,
+    4); ``switched`` = (``lock_steps``, ``engaged``), each hinge -> s."""
+    times, at = states
+    lock_steps, engaged = switched
     phi, alpha, beta = angles
     qL, vL, qR, vR = ends
     hinges = np.arange(scene.n)
@@ -235,8 +244,9 @@ def _hinge_quantities(
     if scene.wants("hinge_moment"):
         chain = scene.chain
         M = chain.kappa * (D - chain.rest_angle) + chain.nu * dD
-        for stop in scene.stops:
-            M[:, stop.hinge] += stop_moment(stop, D[:, stop.hinge], dD[:, stop.hinge])
+        for stop, t_on in timed_stops(scene, engaged):
+            moment = stop_moment(stop, D[:, stop.hinge], dD[:, stop.hinge])
+            M[:, stop.hinge] += np.where(times > t_on, moment, 0.0)
         driving = torque_moments(scene, times, dD)
         if driving is not None:
             M -= driving
