@@ -15,14 +15,15 @@ from rodval.models.registry import simulate
 NO_TQ = np.zeros(0)
 
 
-def quiet_state(n: int, moving: int, seed: int = 3):
+def quiet_state(n: int, moving: int, seed: int = 3, kernel: str = "numpy"):
     """A paper-chain state with the last ``moving`` rods bent and turning and the others
-    exactly at rest (phi = phi' = 0), the pulse's load sums at t = 0.3 s."""
+    exactly at rest (phi = phi' = 0), the pulse's load sums at t = 0.3 s; the system on
+    ``kernel`` (numpy: with the dense reference, O(n^2) to build)."""
     rng = np.random.default_rng(seed)
     phi, dphi = np.zeros(n), np.zeros(n)
     phi[n - moving :] = rng.normal(scale=0.3, size=moving)
     dphi[n - moving :] = rng.normal(scale=0.5, size=moving)
-    system = ReducedSystem(paper_scene(n), kernel="numpy")
+    system = ReducedSystem(paper_scene(n), kernel=kernel)
     SX, SY = system.loads.suffix_sums(0.3)
     return system, phi, dphi, np.ascontiguousarray(SX), np.ascontiguousarray(SY)
 
@@ -58,7 +59,7 @@ def test_the_quiet_part_and_the_banded_lu_agree_at_n_3000():
     elimination, no skipping): the same phi'' and gamma to 1e-9 of the largest (the LU's
     pivot growth along the running sums, tests/test_reduced_banded.py)."""
     n = 3000
-    system, phi, dphi, SX, SY = quiet_state(n, 40)
+    system, phi, dphi, SX, SY = quiet_state(n, 40, kernel="numba")  # no dense reference here
     Cst = rb.banded_constants(system.cc, system.chain)
     sweep = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_SWEEP)
     band = rb.bending_at(Cst, phi, dphi, (True, SX, SY, NO_TQ), True, rb.METHOD_BAND)
